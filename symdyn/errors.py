@@ -1,0 +1,47 @@
+"""The one exception type symdyn raises for bad input, and its warning type."""
+
+from __future__ import annotations
+
+__all__ = ["SymdynError", "SymdynWarning", "location"]
+
+
+def location(
+    file: str | None = None,
+    link_index: int | None = None,
+    link_name: str | None = None,
+    field: str | None = None,
+) -> str:
+    """Format 'file: link 2 (forearm): field inertia.ixx' for messages."""
+    parts = []
+    if file:
+        parts.append(str(file))
+    if link_index is not None:
+        parts.append(f"link {link_index} ({link_name})" if link_name else f"link {link_index}")
+    if field:
+        parts.append(f"field '{field}'")
+    return ": ".join(parts)
+
+
+class SymdynError(ValueError):
+    """Bad input: a robot file, an expression, an option. The message names file, link and field."""
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        file: str | None = None,
+        link_index: int | None = None,
+        link_name: str | None = None,
+        field: str | None = None,
+    ) -> None:
+        self.file = file
+        self.link_index = link_index
+        self.link_name = link_name
+        self.field = field
+        self.reason = message
+        where = location(file, link_index, link_name, field)
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+class SymdynWarning(UserWarning):
+    """Implausible (but possible) input, e.g. principal moments breaking the triangle inequality."""

@@ -1,0 +1,171 @@
+"""The immutable robot model: a serial chain of links joined by general 1-DOF joints.
+
+Every loader (standard DH, modified DH, URDF) produces this model. Link i owns a
+*body frame* that moves with it. Its joint has a constant `placement`, the body
+frame of link i at q_i = 0 expressed in the body frame of link i-1 (the base
+frame for i = 1), and a unit `axis` in link i's own body frame:
+
+    parent_T_i(q_i) = placement @ Rot(axis, q_i)     (revolute)
+    parent_T_i(q_i) = placement @ Trans(axis * q_i)  (prismatic)
+
+Joint offsets (DH theta/d offsets) are folded into `placement`. Centre of mass,
+inertia tensor (about the centre of mass) are expressed in the body frame.
+`frame` is the convention's frame i (e.g. the standard-DH frame at the distal
+end) relative to the body frame: it is used only to report kinematics in the
+frames the user wrote, never by the dynamics.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+
+import sympy as sp
+
+from .transform import Transform
+
+__all__ = ["Friction", "Motor", "Link", "Robot", "JOINT_TYPES"]
+
+JOINT_TYPES = ("revolute", "prismatic")
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Joint friction F_i = viscous * qd_i + coulomb * sign(qd_i) (slide 16)."""
+
+    viscous: sp.Expr = sp.S.Zero
+    coulomb: sp.Expr = sp.S.Zero
+
+
+@dataclass(frozen=True)
+class Motor:
+    """A rotor reflected through a gearbox: adds gear_ratio**2 * inertia to M[i, i]."""
+
+    inertia: sp.Expr = sp.S.Zero
+    gear_ratio: sp.Expr = sp.S.One
+
+    @property
+    def reflected_inertia(self) -> sp.Expr:
+        return self.gear_ratio**2 * self.inertia
+
+
+@dataclass(frozen=True)
+class Link:
+    """One link with the joint that moves it relative to its parent."""
+
+    name: str
+    joint: str  # "revolute" | "prismatic"
+    placement: Transform
+    axis: sp.ImmutableMatrix  # 3x1 unit vector in the body frame
+    mass: sp.Expr
+    com: sp.ImmutableMatrix  # 3x1, body frame
+    inertia: sp.ImmutableMatrix  # 3x3 tensor about the centre of mass, body-frame axes
+    friction: Friction = field(default_factory=Friction)
+    motor: Motor = field(default_factory=Motor)
+    frame: Transform = field(default_factory=Transform.identity)
+
+    def joint_transform(self, q) -> Transform:
+        """parent_T_i(q): the body frame of this link in its parent's body frame."""
+        if self.joint == "revolute":
+            from .transform import rot_axis
+
+            return self.placement @ Transform.from_rotation(rot_axis(list(self.axis), q))
+        return self.placement @ Transform.from_translation(list(self.axis * q))
+
+    def subs(self, mapping: Mapping) -> Link:
+        x = dict(mapping)
+        return replace(
+            self,
+            placement=self.placement.subs(x),
+            axis=self.axis.xreplace(x),
+            mass=sp.sympify(self.mass).xreplace(x),
+            com=self.com.xreplace(x),
+            inertia=self.inertia.xreplace(x),
+            friction=Friction(
+                sp.sympify(self.friction.viscous).xreplace(x),
+                sp.sympify(self.friction.coulomb).xreplace(x),
+            ),
+            motor=Motor(
+                sp.sympify(self.motor.inertia).xreplace(x),
+                sp.sympify(self.motor.gear_ratio).xreplace(x),
+            ),
+            frame=self.frame.subs(x),
+        )
+
+
+@dataclass(frozen=True)
+class Robot:
+    """An immutable serial manipulator.
+
+    `values` holds the parameters the file gave values for (symbol -> SymPy
+    number or expression); `params` the free parameter symbols (no value), in
+    order of first appearance in the file. Gravity is the gravitational
+    acceleration in the base frame.
+    """
+
+    name: str
+    links: tuple[Link, ...]
+    gravity: sp.ImmutableMatrix
+    params: tuple[sp.Symbol, ...] = ()
+    values: tuple[tuple[sp.Symbol, sp.Expr], ...] = ()
+    source: str | None = None
+    source_sha256: str | None = None
+    convention: str = "standard"
+
+    @property
+    def n(self) -> int:
+        """Number of joints (degrees of freedom)."""
+        return len(self.links)
+
+    @property
+    def value_map(self) -> dict[sp.Symbol, sp.Expr]:
+        return dict(self.values)
+
+    def resolved(self) -> Robot:
+        """This robot with every valued parameter substituted: only `params` stay symbolic."""
+        if not self.values:
+            return self
+        mapping = self.value_map
+        return replace(
+            self,
+            links=tuple(link.subs(mapping) for link in self.links),
+            gravity=self.gravity.xreplace(mapping),
+            values=(),
+        )
+
+    def param_values(self, params=None) -> dict[sp.Symbol, float]:
+        """Numbers for the free parameters: a sequence in `params` order or a name/symbol map."""
+        if not self.params:
+            return {}
+        if params is None:
+            from .errors import SymdynError
+
+            names = ", ".join(str(p) for p in self.params)
+            raise SymdynError(f"robot '{self.name}' has free parameters ({names}); give their values")
+        if isinstance(params, Mapping):
+            by_name = {str(k): v for k, v in params.items()}
+            missing = [str(p) for p in self.params if str(p) not in by_name]
+            if missing:
+                from .errors import SymdynError
+
+                raise SymdynError(f"no value for parameter(s) {', '.join(missing)}")
+            return {p: float(by_name[str(p)]) for p in self.params}
+        seq = list(params)
+        if len(seq) != len(self.params):
+            from .errors import SymdynError
+
+            raise SymdynError(f"expected {len(self.params)} parameter values, got {len(seq)}")
+        return {p: float(v) for p, v in zip(self.params, seq, strict=True)}
+
+    def numeric(self, params=None) -> Robot:
+        """A fully numeric copy (every parameter substituted), for the numeric algorithms."""
+        r = self.resolved()
+        if not r.params:
+            return r
+        mapping = {p: sp.Float(v, 17) for p, v in r.param_values(params).items()}
+        return replace(
+            r,
+            links=tuple(link.subs(mapping) for link in r.links),
+            gravity=r.gravity.xreplace(mapping),
+            params=(),
+        )
