@@ -113,4 +113,4 @@ class Transform:
         return Transform(self.R.xreplace(mapping), self.p.xreplace(mapping))
 
     def is_identity(self) -> bool:
-        return self.R == sp.eye(3) and self.p == sp.zeros(3, 1)
+        return sp.eye(3) == self.R and self.p == sp.zeros(3, 1)

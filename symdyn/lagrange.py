@@ -1,0 +1,69 @@
+"""The Lagrange route: M from the link Jacobians, C from Christoffel symbols, G from the potential.
+
+In the base frame, with Jv_i the Jacobian of link i's centre of mass, Jw_i its
+angular-velocity Jacobian, R_i its orientation and I_i its inertia about the
+centre of mass (body axes):
+
+    M = sum_i m_i Jv_i^T Jv_i + Jw_i^T (R_i I_i R_i^T) Jw_i  (+ reflected motor inertia)
+    P = -sum_i m_i g^T p_ci                   (g: gravitational acceleration)
+    G_k = dP/dq_k
+    C_kj = sum_i 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) qd_i
+
+Derivatives are taken by forward-mode differentiation through the program's
+named intermediates (symdyn.program), never by expanding M.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .kinematics import forward_kinematics, point_jacobian
+from .program import Program
+from .robot import Robot
+
+__all__ = ["lagrange"]
+
+
+def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dict[str, sp.Matrix]:
+    """M, C and G of the robot (rigid bodies plus motor inertia) over the program's intermediates."""
+    n = robot.n
+    poses = forward_kinematics(robot, list(q), program)
+    M = sp.zeros(n, n)
+    P = sp.S.Zero
+    g = sp.Matrix(robot.gravity)
+    for i, link in enumerate(robot.links):
+        J = point_jacobian(robot, i, list(link.com), poses=poses)
+        Jv = J[:3, :].applyfunc(lambda x, i=i: program.let(x, f"Jv{i + 1}_"))
+        Jw = J[3:, :]
+        R = sp.Matrix(poses[i].R)
+        I_base = (R * sp.Matrix(link.inertia) * R.T).applyfunc(lambda x, i=i: program.let(x, f"Ib{i + 1}_"))
+        M += link.mass * (Jv.T * Jv) + Jw.T * I_base * Jw
+        pc = poses[i].apply(list(link.com))
+        P -= link.mass * (g.T * sp.Matrix(pc))[0]
+    for i, link in enumerate(robot.links):
+        M[i, i] += link.motor.reflected_inertia
+    M = M.applyfunc(lambda x: program.let(x, "M"))
+    for i in range(n):
+        for j in range(i):
+            M[i, j] = M[j, i]
+    G = sp.Matrix(program.diff([P], q[0], "dP")) if n == 1 else None
+    G = sp.Matrix([program.diff([P], q[k], "dP")[0] for k in range(n)])
+    upper = [(r, c) for r in range(n) for c in range(r, n)]
+    dM: list[dict[tuple[int, int], sp.Expr]] = []
+    for k in range(n):
+        derivs = program.diff([M[r, c] for r, c in upper], q[k], f"dM{k + 1}_")
+        table = {}
+        for (r, c), d in zip(upper, derivs, strict=True):
+            table[(r, c)] = table[(c, r)] = d
+        dM.append(table)
+    C = sp.zeros(n, n)
+    for k in range(n):
+        for j in range(n):
+            C[k, j] = sum(
+                (
+                    sp.Rational(1, 2) * (dM[i][(k, j)] + dM[j][(k, i)] - dM[k][(i, j)]) * qd[i]
+                    for i in range(n)
+                ),
+                sp.S.Zero,
+            )
+    return {"M": M, "C": C, "G": G}

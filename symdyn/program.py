@@ -1,0 +1,130 @@
+"""Straight-line programs: the named intermediates that keep derivations small.
+
+A `Program` is an ordered list of assignments ``t_k = expr_k`` where each
+expression uses the inputs (joint symbols, free parameters) and earlier
+intermediates only. The Newton-Euler recursion and the Lagrange kinematics
+write their vectors into a program component by component instead of
+nesting whole expressions, so the work stays linear in the number of links.
+
+Operations:
+- `let` names a non-trivial expression (atoms and numbers pass through);
+- `diff` differentiates outputs by forward-mode propagation through the
+  assignments (dt_k/dx = sum of partials times dt_j/dx);
+- `expand` substitutes the intermediates back, for closed forms;
+- `needed` lists the assignments that some outputs depend on, in order.
+
+Intermediate symbols are named ``_<hint><k>``; a leading underscore is never a
+parameter name, so they cannot clash with the robot file's symbols.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import sympy as sp
+
+__all__ = ["Program", "is_trivial"]
+
+
+def _negated(expr: sp.Expr) -> sp.Expr | None:
+    """-expr with the sign moved inside, when expr reads as a negative; else None."""
+    if expr.is_Mul:
+        c, rest = expr.as_coeff_Mul()
+        return (-c) * rest if c.is_negative else None
+    if expr.is_Add and expr.could_extract_minus_sign():
+        return sp.Add(*[-a for a in expr.args])
+    return None
+
+
+def is_trivial(expr: sp.Expr) -> bool:
+    """True for expressions not worth a name: numbers, symbols and number*symbol."""
+    if expr.is_Atom:
+        return True
+    if expr.is_Mul and len(expr.args) == 2:
+        a, b = expr.args
+        return bool(a.is_Number and b.is_Atom)
+    return False
+
+
+class Program:
+    """An ordered list of named intermediate assignments (symbol, expression)."""
+
+    def __init__(self) -> None:
+        self.assignments: list[tuple[sp.Symbol, sp.Expr]] = []
+        self._index: dict[sp.Symbol, int] = {}
+        self._by_expr: dict[sp.Expr, sp.Symbol] = {}
+        self._count = 0
+
+    def __len__(self) -> int:
+        return len(self.assignments)
+
+    def is_intermediate(self, s: sp.Basic) -> bool:
+        return s in self._index
+
+    def let(self, expr, hint: str = "t") -> sp.Expr:
+        """Name `expr` unless it is trivial; identical expressions share one name."""
+        expr = sp.sympify(expr)
+        if is_trivial(expr):
+            return expr
+        pos = _negated(expr)
+        if pos is not None and not is_trivial(pos):
+            # store the positive form once, so -e and e share one intermediate
+            return -self._name(pos, hint)
+        return self._name(expr, hint)
+
+    def _name(self, expr: sp.Expr, hint: str) -> sp.Symbol:
+        found = self._by_expr.get(expr)
+        if found is not None:
+            return found
+        self._count += 1
+        sym = sp.Symbol(f"_{hint}{self._count}")
+        self._index[sym] = len(self.assignments)
+        self.assignments.append((sym, expr))
+        self._by_expr[expr] = sym
+        return sym
+
+    def let_vector(self, v: Iterable, hint: str) -> sp.Matrix:
+        """Name each component of a vector (see `let`)."""
+        return sp.Matrix([self.let(x, hint) for x in v])
+
+    def _deps(self, expr: sp.Expr) -> set[sp.Symbol]:
+        return {s for s in expr.free_symbols if s in self._index}
+
+    def needed(self, outputs: Iterable[sp.Expr]) -> list[tuple[sp.Symbol, sp.Expr]]:
+        """The assignments the outputs depend on, in program order."""
+        todo = set()
+        for e in outputs:
+            todo |= self._deps(sp.sympify(e))
+        marked: set[int] = set()
+        stack = list(todo)
+        while stack:
+            s = stack.pop()
+            k = self._index[s]
+            if k in marked:
+                continue
+            marked.add(k)
+            stack.extend(self._deps(self.assignments[k][1]))
+        return [self.assignments[k] for k in sorted(marked)]
+
+    def diff(self, outputs: Sequence[sp.Expr], x: sp.Symbol, hint: str = "d") -> list[sp.Expr]:
+        """d(outputs)/dx by forward-mode propagation; derivatives become new intermediates."""
+        deriv: dict[sp.Symbol, sp.Expr] = {}
+        for sym, expr in self.needed(outputs):
+            deriv[sym] = self.let(self._total_derivative(expr, x, deriv), hint)
+        return [self._total_derivative(sp.sympify(e), x, deriv) for e in outputs]
+
+    def _total_derivative(self, expr: sp.Expr, x: sp.Symbol, deriv: dict) -> sp.Expr:
+        total = expr.diff(x) if x in expr.free_symbols else sp.S.Zero
+        for s in self._deps(expr):
+            ds = deriv.get(s, sp.S.Zero)
+            if ds != 0:
+                total += expr.diff(s) * ds
+        return total
+
+    def expand(self, exprs: Iterable[sp.Expr]) -> list[sp.Expr]:
+        """Substitute every intermediate back: closed forms over inputs only."""
+        exprs = [sp.sympify(e) for e in exprs]
+        full: dict[sp.Symbol, sp.Expr] = {}
+        for sym, expr in self.needed(exprs):
+            full[sym] = expr.xreplace(full)
+        return [e.xreplace(full) for e in exprs]
