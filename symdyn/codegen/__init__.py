@@ -1,0 +1,71 @@
+"""Code generation: the seven functions of design.md rendered for C, CasADi, NumPy and LaTeX.
+
+A target is a module `symdyn.codegen.<target>` with `render(ctx) -> {file name:
+text or bytes}`: a small printer plus its templates in templates/<target>/.
+`generate` renders every requested target in memory first and writes nothing
+unless all of them succeed (symdyn.codegen.output).
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..dynamics import derive
+from ..errors import SymdynError
+from ..robot import Robot
+from .functions import FUNCTION_NAMES, build_functions
+from .output import write_files
+from .render import PRECISIONS, RenderContext
+
+__all__ = ["generate", "render", "TARGETS", "FUNCTION_NAMES"]
+
+TARGETS = {"c": "c_target", "casadi": "casadi_target", "python": "numpy_target", "latex": "latex_target"}
+
+
+def _target_module(name: str):
+    if name not in TARGETS:
+        raise SymdynError(f"unknown target '{name}' (one of {', '.join(TARGETS)})")
+    return importlib.import_module(f"{__name__}.{TARGETS[name]}")
+
+
+def context(robot: Robot, precision: str = "double", method: str = "newton-euler") -> RenderContext:
+    """Derive the robot and build the target-independent function specs."""
+    if precision not in PRECISIONS:
+        raise SymdynError(f"unknown precision '{precision}' (double or float)")
+    dyn = derive(robot, method=method, simplify=False)
+    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), precision)
+
+
+def render(
+    robot: Robot,
+    targets: Sequence[str] = ("c", "casadi"),
+    precision: str = "double",
+    method: str = "newton-euler",
+) -> dict[str, str | bytes]:
+    """All files of the requested targets, in memory (name -> content)."""
+    modules = [_target_module(t) for t in dict.fromkeys(targets)]
+    ctx = context(robot, precision, method)
+    files: dict[str, str | bytes] = {}
+    for module in modules:
+        files.update(module.render(ctx))
+    return files
+
+
+def generate(
+    robot: Robot | str | os.PathLike,
+    targets: Sequence[str] = ("c", "casadi"),
+    out_dir: str | os.PathLike = ".",
+    precision: str = "double",
+    force: bool = False,
+    method: str = "newton-euler",
+) -> list[Path]:
+    """Render the targets for `robot` (a Robot or a robot file) and write them into out_dir."""
+    if not isinstance(robot, Robot):
+        from ..loaders import load_robot
+
+        robot = load_robot(robot)
+    files = render(robot, targets, precision, method)
+    return write_files(out_dir, files, force=force)

@@ -1,0 +1,160 @@
+"""The seven generated functions of design.md, as target-independent straight-line code.
+
+Each `FunctionSpec` names its inputs (q, qd, qdd or tau, p: vectors of SymPy
+symbols), one output (tau, M, C, V, G, F or qdd, row-major), and the
+eliminated temporaries (symdyn.simplify) that compute it. Printers for C,
+CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
+
+forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
+unrolled symbolically (no square roots):
+    D_j = M_jj - sum_{k<j} L_jk^2 D_k,  L_ij = (M_ij - sum_{k<j} L_ik L_jk D_k) / D_j,
+then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..dynamics import Dynamics
+from ..program import Program
+from ..simplify import Eliminated, OpCount, eliminate
+
+__all__ = ["FunctionSpec", "Input", "build_functions", "FUNCTION_NAMES"]
+
+FUNCTION_NAMES = (
+    "inverse_dynamics",
+    "mass_matrix",
+    "coriolis_matrix",
+    "coriolis",
+    "gravity",
+    "friction",
+    "forward_dynamics",
+)
+
+
+@dataclass(frozen=True)
+class Input:
+    """A vector argument: its name in the generated code and its symbols."""
+
+    name: str
+    symbols: tuple[sp.Symbol, ...]
+
+
+@dataclass(frozen=True)
+class FunctionSpec:
+    """One generated function: inputs, one output array, and the code computing it."""
+
+    name: str
+    doc: str
+    inputs: tuple[Input, ...]
+    output: str
+    shape: tuple[int, int]
+    code: Eliminated
+
+    @property
+    def ops(self) -> OpCount:
+        return self.code.ops
+
+    @property
+    def temporaries(self):
+        return self.code.temporaries
+
+    @property
+    def outputs(self):
+        return self.code.outputs
+
+    def used(self, inp: Input) -> bool:
+        """Whether any temporary or output reads the input vector."""
+        names = set(inp.symbols)
+        if not names:
+            return False
+        exprs = [e for _, e in self.code.temporaries] + list(self.code.outputs)
+        return any(names & e.free_symbols for e in exprs)
+
+
+def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
+    n = M.rows
+    L = sp.zeros(n, n)
+    D: list[sp.Expr] = [sp.S.Zero] * n
+    for j in range(n):
+        d = M[j, j] - sum((L[j, k] ** 2 * D[k] for k in range(j)), sp.S.Zero)
+        D[j] = prog.let(d, "fdD")
+        for i in range(j + 1, n):
+            s = M[i, j] - sum((L[i, k] * L[j, k] * D[k] for k in range(j)), sp.S.Zero)
+            L[i, j] = prog.let(s / D[j], "fdL") if s != 0 else sp.S.Zero
+    y: list[sp.Expr] = []
+    for i in range(n):
+        y.append(prog.let(b[i] - sum((L[i, k] * y[k] for k in range(i)), sp.S.Zero), "fdy"))
+    x: list[sp.Expr] = [sp.S.Zero] * n
+    for i in reversed(range(n)):
+        zi = y[i] / D[i]
+        x[i] = prog.let(zi - sum((L[k, i] * x[k] for k in range(i + 1, n)), sp.S.Zero), "fdx")
+    return x
+
+
+def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
+    """The seven functions of design.md for a derived robot, with CSE applied per function."""
+    n = dyn.n
+    q = Input("q", tuple(dyn.q))
+    qd = Input("qd", tuple(dyn.qd))
+    qdd = Input("qdd", tuple(dyn.qdd))
+    tau = Input("tau", tuple(sp.Symbol(f"tau{i + 1}") for i in range(n)))
+    p = Input("p", tuple(dyn.params))
+    c = dyn.compact
+
+    def spec(name, doc, inputs, out, shape, exprs, steps):
+        code = eliminate(steps, list(exprs))
+        return FunctionSpec(name, doc, inputs, out, shape, code)
+
+    prog = dyn.program
+    specs = [
+        spec(
+            "inverse_dynamics",
+            "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)",
+            (q, qd, qdd, p),
+            "tau",
+            (n, 1),
+            c["tau"],
+            dyn.assignments(("tau",)),
+        ),
+        spec("mass_matrix", "M(q), row-major n x n", (q, p), "M", (n, n), c["M"], dyn.assignments(("M",))),
+        spec(
+            "coriolis_matrix",
+            "C(q, qd) from Christoffel symbols, row-major; C qd = V",
+            (q, qd, p),
+            "C",
+            (n, n),
+            c["C"],
+            dyn.assignments(("C",)),
+        ),
+        spec("coriolis", "V(q, qd) = C(q, qd) qd", (q, qd, p), "V", (n, 1), c["V"], dyn.assignments(("V",))),
+        spec("gravity", "G(q)", (q, p), "G", (n, 1), c["G"], dyn.assignments(("G",))),
+        spec(
+            "friction",
+            "F(qd) = viscous qd + coulomb sign(qd)",
+            (qd, p),
+            "F",
+            (n, 1),
+            c["F"],
+            dyn.assignments(("F",)),
+        ),
+    ]
+    fd = Program()
+    bias = [c["V"][i] + c["G"][i] + c["F"][i] for i in range(n)]
+    b = [fd.let(tau.symbols[i] - bias[i], "fdb") for i in range(n)]
+    qdd_out = _ldlt_solve(sp.Matrix(c["M"]), b, fd)
+    steps = prog.needed(list(c["M"]) + bias) + fd.needed(qdd_out)
+    specs.append(
+        spec(
+            "forward_dynamics",
+            "qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T)",
+            (q, qd, tau, p),
+            "qdd",
+            (n, 1),
+            qdd_out,
+            steps,
+        )
+    )
+    return specs

@@ -1,0 +1,173 @@
+"""Common-subexpression elimination and operation counts for generated functions.
+
+`eliminate` turns a set of outputs, given over a program's named intermediates
+(symdyn.program), into one straight-line sequence of temporaries x0, x1, ...
+followed by the outputs:
+1. only the intermediates the outputs need are kept;
+2. SymPy's `cse` (with order="none", see design.md's speed notes) runs over
+   the intermediates and outputs together, so sin/cos of a joint and repeated
+   products are computed once across every output of the function;
+3. the result is ordered topologically (each temporary before its first use)
+   and renamed in evaluation order, which makes the output deterministic.
+
+`OpCount` counts what a C compiler would execute: a power with a small integer
+exponent is counted as repeated multiplications (the printers emit it so).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import sympy as sp
+
+__all__ = ["OpCount", "count_ops", "eliminate", "Eliminated"]
+
+MAX_UNROLLED_POWER = 8
+
+
+@dataclass(frozen=True)
+class OpCount:
+    """Operations of a straight-line function: multiplications, additions, divisions, calls."""
+
+    mul: int = 0
+    add: int = 0
+    div: int = 0
+    trig: int = 0
+    other: int = 0  # sqrt, sign, non-integer powers
+
+    @property
+    def total(self) -> int:
+        return self.mul + self.add + self.div + self.trig + self.other
+
+    def __add__(self, o: OpCount) -> OpCount:
+        return OpCount(
+            self.mul + o.mul, self.add + o.add, self.div + o.div, self.trig + o.trig, self.other + o.other
+        )
+
+    def summary(self) -> str:
+        return (
+            f"{self.total} operations: {self.mul} multiplications, {self.add} additions, "
+            f"{self.div} divisions, {self.trig} trigonometric calls, {self.other} other calls"
+        )
+
+
+_TRIG = (sp.sin, sp.cos, sp.tan)
+
+
+def _count(expr: sp.Expr) -> OpCount:
+    mul = add = div = trig = other = 0
+    stack = [expr]
+    while stack:
+        e = stack.pop()
+        if e.is_Atom:
+            continue
+        if e.is_Add:
+            add += len(e.args) - 1
+        elif e.is_Mul:
+            c, factors = e.as_coeff_mul()
+            den = [a for a in factors if a.is_Pow and a.exp.is_Integer and a.exp < 0]
+            num = [a for a in factors if a not in den]
+            n_num = len(num) + (0 if c in (1, -1) else 1)
+            mul += max(n_num - 1, 0) + max(len(den) - 1, 0)
+            if den:
+                div += 1
+            stack.extend(num)
+            stack.extend(sp.Pow(a.base, -a.exp) for a in den)
+            continue
+        elif e.is_Pow:
+            k = e.exp
+            if k.is_Integer and 0 < k <= MAX_UNROLLED_POWER:
+                mul += int(k) - 1
+            elif k.is_Integer and -MAX_UNROLLED_POWER <= k < 0:
+                div += 1
+                mul += int(-k) - 1
+            else:
+                other += 1
+            stack.append(e.base)
+            continue
+        elif isinstance(e, _TRIG):
+            trig += 1
+        elif e.is_Function:
+            other += 1
+        stack.extend(e.args)
+    return OpCount(mul, add, div, trig, other)
+
+
+def count_ops(temporaries: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[sp.Expr]) -> OpCount:
+    """Operations to evaluate the temporaries then the outputs, as the printers emit them."""
+    total = OpCount()
+    for _, e in temporaries:
+        total += _count(e)
+    for e in outputs:
+        total += _count(sp.sympify(e))
+    return total
+
+
+@dataclass(frozen=True)
+class Eliminated:
+    """Temporaries (x_k = expr over inputs and earlier temporaries) and outputs over them."""
+
+    temporaries: tuple[tuple[sp.Symbol, sp.Expr], ...]
+    outputs: tuple[sp.Expr, ...]
+
+    @property
+    def ops(self) -> OpCount:
+        return count_ops(self.temporaries, self.outputs)
+
+
+def _topological(nodes: dict[sp.Symbol, sp.Expr], roots: Sequence[sp.Expr]) -> list[sp.Symbol]:
+    """Every node reachable from the roots, each after the nodes it uses (stable DFS order)."""
+    order: list[sp.Symbol] = []
+    done: set[sp.Symbol] = set()
+
+    def deps(e: sp.Expr) -> list[sp.Symbol]:
+        return sorted((s for s in e.free_symbols if s in nodes), key=lambda s: _rank[s])
+
+    _rank = {s: k for k, s in enumerate(nodes)}
+    for root in roots:
+        stack: list[tuple[sp.Symbol, bool]] = [(s, False) for s in reversed(deps(root))]
+        while stack:
+            s, expanded = stack.pop()
+            if s in done:
+                continue
+            if expanded:
+                done.add(s)
+                order.append(s)
+                continue
+            stack.append((s, True))
+            stack.extend((d, False) for d in reversed(deps(nodes[s])) if d not in done)
+    return order
+
+
+def eliminate(
+    assignments: Sequence[tuple[sp.Symbol, sp.Expr]],
+    outputs: Sequence[sp.Expr],
+    prefix: str = "x",
+) -> Eliminated:
+    """CSE over a program's assignments and outputs; temporaries renamed prefix0, prefix1, ..."""
+    outputs = [sp.sympify(e) for e in outputs]
+    syms = [s for s, _ in assignments]
+    exprs = [e for _, e in assignments]
+    marker = sp.numbered_symbols("_cse")
+    repl, reduced = sp.cse(exprs + outputs, symbols=marker, order="none")
+    nodes: dict[sp.Symbol, sp.Expr] = {}
+    for s, e in repl:
+        nodes[s] = e
+    for s, e in zip(syms, reduced[: len(syms)], strict=True):
+        nodes[s] = e
+    outs = reduced[len(syms) :]
+    # inline temporaries that are a bare symbol or number (no work, only a name)
+    alias: dict[sp.Symbol, sp.Expr] = {}
+    for s in list(nodes):
+        e = nodes[s].xreplace(alias)
+        if e.is_Atom or (e.is_Mul and len(e.args) == 2 and e.args[0] == -1 and e.args[1].is_Atom):
+            alias[s] = e
+            del nodes[s]
+        else:
+            nodes[s] = e
+    outs = [e.xreplace(alias) for e in outs]
+    order = _topological(nodes, outs)
+    rename = {s: sp.Symbol(f"{prefix}{k}") for k, s in enumerate(order)}
+    temporaries = tuple((rename[s], nodes[s].xreplace(rename)) for s in order)
+    return Eliminated(temporaries, tuple(e.xreplace(rename) for e in outs))
