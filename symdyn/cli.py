@@ -1,0 +1,175 @@
+"""The `symdyn` command line: derive and generate (design.md, "Command line").
+
+Bad input prints one line, `symdyn: error: <file>: link <i> (<name>): field '<f>': <why>`,
+and exits with status 1; warnings print as `symdyn: warning: ...`. No
+traceback reaches the user and no partial output is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import warnings
+from collections.abc import Sequence
+
+import sympy as sp
+
+from . import __version__
+from .dynamics import METHODS, derive
+from .errors import SymdynError, SymdynWarning
+
+__all__ = ["main"]
+
+EXIT_BAD_INPUT = 1
+EXIT_INTERNAL = 3
+PRINTED = ("M", "C", "V", "G", "F")
+
+
+def _load(path: str):
+    from .loaders import load_robot
+
+    return load_robot(path)
+
+
+def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
+    """1-based entry names: M[1,2] for the matrices M and C, G[2] for the vectors."""
+    cols = shape[1]
+    return f"{name}[{k // cols + 1},{k % cols + 1}]" if name in ("M", "C") else f"{name}[{k + 1}]"
+
+
+def _derive_text(dyn) -> str:
+    lines = [
+        f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
+        f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
+        + (", ".join(map(str, dyn.params)) or "none"),
+        "# tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd",
+    ]
+    for name in PRINTED:
+        m = dyn.closed_form(name)
+        lines.append("")
+        for k, e in enumerate(m):
+            lines.append(f"{_entry_name(name, m.shape, k)} = {sp.sstr(e)}")
+    return "\n".join(lines) + "\n"
+
+
+def _derive_json(dyn) -> str:
+    doc: dict = {
+        "robot": dyn.robot.name,
+        "method": dyn.method,
+        "joints": dyn.n,
+        "q": [str(s) for s in dyn.q],
+        "qd": [str(s) for s in dyn.qd],
+        "qdd": [str(s) for s in dyn.qdd],
+        "params": [str(s) for s in dyn.params],
+    }
+    for name in PRINTED:
+        m = dyn.closed_form(name)
+        if name not in ("M", "C"):
+            doc[name] = [sp.sstr(e) for e in m]
+        else:
+            doc[name] = [[sp.sstr(m[i, j]) for j in range(m.cols)] for i in range(m.rows)]
+    return json.dumps(doc, indent=2) + "\n"
+
+
+def _derive_latex(dyn) -> str:
+    from .codegen.latex_target import dynamics_latex
+
+    return dynamics_latex(dyn)
+
+
+def cmd_derive(args: argparse.Namespace) -> int:
+    robot = _load(args.robot)
+    simplify = None if args.simplify == "auto" else args.simplify == "yes"
+    dyn = derive(robot, method=args.method, simplify=simplify)
+    text = {"text": _derive_text, "json": _derive_json, "latex": _derive_latex}[args.format](dyn)
+    sys.stdout.write(text)
+    return 0
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    from .codegen import generate
+
+    robot = _load(args.robot)
+    targets = args.target or ["c", "casadi"]
+    paths = generate(
+        robot,
+        targets=targets,
+        out_dir=args.out,
+        precision=args.precision,
+        force=args.force,
+        method=args.method,
+    )
+    for p in paths:
+        print(p)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="symdyn",
+        description="Symbolic equations of motion of robot manipulators, and code generated from them.",
+    )
+    parser.add_argument("--version", action="version", version=f"symdyn {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    d = sub.add_parser("derive", help="print M, C, V, G, F of a robot")
+    d.add_argument("robot", help="robot file (YAML or JSON)")
+    d.add_argument("--method", choices=METHODS, default="newton-euler")
+    d.add_argument("--format", choices=("text", "latex", "json"), default="text")
+    d.add_argument(
+        "--simplify",
+        choices=("auto", "yes", "no"),
+        default="auto",
+        help="trigonometric simplification of the closed forms (auto: up to 3 joints)",
+    )
+    d.set_defaults(func=cmd_derive)
+
+    g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
+    g.add_argument("robot", help="robot file (YAML or JSON)")
+    g.add_argument(
+        "--target",
+        action="append",
+        choices=("c", "casadi", "python", "latex"),
+        help="target language; repeat for several (default: c and casadi)",
+    )
+    g.add_argument("--out", required=True, help="output folder")
+    g.add_argument("--precision", choices=("double", "float"), default="double")
+    g.add_argument("--method", choices=METHODS, default="newton-euler")
+    g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
+    g.set_defaults(func=cmd_generate)
+    return parser
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    prefix = "symdyn: warning: " if issubclass(category, SymdynWarning) else "warning: "
+    print(f"{prefix}{message}", file=sys.stderr)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the `symdyn` command; returns the exit status."""
+    args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.showwarning = _show_warning
+        try:
+            return args.func(args)
+        except SymdynError as exc:
+            print(f"symdyn: error: {exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        except OSError as exc:
+            print(f"symdyn: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        except KeyboardInterrupt:
+            print("symdyn: interrupted", file=sys.stderr)
+            return 130
+        except Exception as exc:  # a bug in symdyn: say so in one line, not a traceback
+            print(
+                f"symdyn: internal error: {type(exc).__name__}: {exc} (please report it with the robot file)",
+                file=sys.stderr,
+            )
+            return EXIT_INTERNAL
+
+
+if __name__ == "__main__":
+    sys.exit(main())
