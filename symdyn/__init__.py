@@ -9,12 +9,14 @@ symdyn.generate(robot, targets=("c", "casadi"), out_dir="out")
 
 __version__ = "0.1.0"
 
-from . import inertia  # noqa: E402
+from . import (
+    inertia,  # noqa: E402
+    rnea,  # noqa: E402  (a callable module: symdyn.rnea(robot, q, qd, qdd))
+)
 from .codegen import generate  # noqa: E402
 from .dynamics import Dynamics, derive  # noqa: E402
 from .errors import SymdynError, SymdynWarning  # noqa: E402
 from .loaders import load_robot, robot_from_data  # noqa: E402
-from .rnea import rnea  # noqa: E402
 from .robot import Link, Robot  # noqa: E402
 
 __all__ = [

@@ -26,10 +26,23 @@ EXIT_INTERNAL = 3
 PRINTED = ("M", "C", "V", "G", "F")
 
 
-def _load(path: str):
+def _load(args: argparse.Namespace):
+    """A robot from a robot file, or from a URDF file (by its .urdf suffix) with --base/--tip."""
     from .loaders import load_robot
 
-    return load_robot(path)
+    if str(args.robot).lower().endswith(".urdf"):
+        from .loaders.urdf import load_urdf
+
+        return load_urdf(args.robot, base=args.base, tip=args.tip)
+    if args.base or args.tip:
+        raise SymdynError(f"{args.robot}: --base and --tip apply to URDF files only")
+    return load_robot(args.robot)
+
+
+def _add_robot_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("robot", help="robot file (YAML or JSON) or URDF file (.urdf)")
+    parser.add_argument("--base", help="URDF: the chain's base link (default: the root link)")
+    parser.add_argument("--tip", help="URDF: the chain's tip link (default: the single leaf)")
 
 
 def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
@@ -79,7 +92,7 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
-    robot = _load(args.robot)
+    robot = _load(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
     text = {"text": _derive_text, "json": _derive_json, "latex": _derive_latex}[args.format](dyn)
@@ -90,7 +103,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
 def cmd_generate(args: argparse.Namespace) -> int:
     from .codegen import generate
 
-    robot = _load(args.robot)
+    robot = _load(args)
     targets = args.target or ["c", "casadi"]
     paths = generate(
         robot,
@@ -114,7 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     d = sub.add_parser("derive", help="print M, C, V, G, F of a robot")
-    d.add_argument("robot", help="robot file (YAML or JSON)")
+    _add_robot_argument(d)
     d.add_argument("--method", choices=METHODS, default="newton-euler")
     d.add_argument("--format", choices=("text", "latex", "json"), default="text")
     d.add_argument(
@@ -126,7 +139,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.set_defaults(func=cmd_derive)
 
     g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
-    g.add_argument("robot", help="robot file (YAML or JSON)")
+    _add_robot_argument(g)
     g.add_argument(
         "--target",
         action="append",

@@ -23,9 +23,10 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
+from .crba import mass_matrix_crba
 from .errors import SymdynError
 from .lagrange import lagrange
-from .newton_euler import _joint_rotation_and_origin, newton_euler
+from .newton_euler import joint_frames, newton_euler
 from .program import Program
 from .robot import Robot
 from .symbols import joint_symbols
@@ -60,8 +61,9 @@ def simplify_entry(expr: sp.Expr) -> sp.Expr:
 class Dynamics:
     """The equations of motion of a robot, compact (over intermediates) and closed-form.
 
-    `compact[name]` holds each of M, C, V, G, F, tau as a SymPy Matrix over the
-    named intermediates of `program`; the attributes `M`, `C`, `V`, `G`, `F`,
+    `compact[name]` holds each of M, C, V, G, F, tau, and bias = V + G + F (one
+    Newton-Euler pass with qdd = 0, for forward dynamics), as a SymPy Matrix over
+    the named intermediates of `program`; the attributes `M`, `C`, `V`, `G`, `F`,
     `tau` are closed forms over q, qd, qdd and `params` only.
     """
 
@@ -146,28 +148,21 @@ class Dynamics:
 
 def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:
     n = robot.n
-    rot = [_joint_rotation_and_origin(link, qi) for link, qi in zip(robot.links, q, strict=True)]
+    rot = joint_frames(robot, q)
     zeros = [0] * n
     G = sp.Matrix(newton_euler(robot, q, zeros, zeros, program, gravity=True, tag="G", rotations=rot))
     V = sp.Matrix(newton_euler(robot, q, list(qd), zeros, program, gravity=False, tag="V", rotations=rot))
-    M = sp.zeros(n, n)
-    for j in range(n):
-        unit = [1 if k == j else 0 for k in range(n)]
-        col = newton_euler(robot, q, zeros, unit, program, gravity=False, tag=f"M{j + 1}", rotations=rot)
-        for i in range(j, n):
-            M[i, j] = M[j, i] = col[i]
-    for i, link in enumerate(robot.links):
-        M[i, i] += link.motor.reflected_inertia
-    M = M.applyfunc(lambda x: program.let(x, "M"))
+    M = mass_matrix_crba(robot, rot, program)
     Vn = [program.let(v, "V") for v in V]
     C = sp.Matrix(n, n, lambda i, j: 0)
     for j in range(n):
         col = program.diff(Vn, qd[j], f"dV{j + 1}_")
         for i in range(n):
             C[i, j] = sp.Rational(1, 2) * col[i]
+    bias = newton_euler(robot, q, list(qd), zeros, program, gravity=True, tag="B", rotations=rot)
     body = newton_euler(robot, q, list(qd), list(qdd), program, gravity=True, tag="T", rotations=rot)
     tau = sp.Matrix([body[i] + link.motor.reflected_inertia * qdd[i] for i, link in enumerate(robot.links)])
-    return {"M": M, "C": C, "V": sp.Matrix(Vn), "G": G, "tau": tau}
+    return {"M": M, "C": C, "V": sp.Matrix(Vn), "G": G, "tau": tau, "bias": sp.Matrix(bias)}
 
 
 def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = None) -> Dynamics:
@@ -192,8 +187,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         terms["F"] = F
         if method == "lagrange":
             terms["tau"] = terms["M"] * qdd + terms["V"] + terms["G"] + F
+            terms["bias"] = terms["V"] + terms["G"] + F
         else:
             terms["tau"] = terms["tau"] + F
+            terms["bias"] = terms["bias"] + F
     if simplify is None:
         simplify = r.n <= AUTO_SIMPLIFY_MAX_JOINTS
     return Dynamics(
@@ -204,6 +201,6 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         qdd=qdd,
         params=r.params,
         program=program,
-        compact={k: sp.Matrix(terms[k]) for k in QUANTITIES},
+        compact={k: sp.Matrix(terms[k]) for k in (*QUANTITIES, "bias")},
         simplified=bool(simplify),
     )

@@ -30,15 +30,45 @@ from collections.abc import Sequence
 
 import sympy as sp
 
+from . import vectors as v3
 from .program import Program
-from .robot import Robot
+from .robot import Link, Robot
 
-__all__ = ["newton_euler"]
+__all__ = ["newton_euler", "joint_frames"]
+
+JointFrame = tuple[v3.Mat, v3.Vec]
 
 
-def _joint_rotation_and_origin(link, qi) -> tuple[sp.Matrix, sp.Matrix]:
-    T = link.joint_transform(qi)
-    return sp.Matrix(T.R), sp.Matrix(T.p)
+def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
+    """(R_i, p_i) per link: rotation and origin of body i in its parent's body frame."""
+    out = []
+    for link, qi in zip(robot.links, q, strict=True):
+        T = link.joint_transform(qi)
+        out.append((v3.mat(T.R), v3.vec(T.p)))
+    return out
+
+
+def _name(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
+    return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
+
+
+def _outward(
+    link: Link, frame: JointFrame, w: v3.Vec, wd: v3.Vec, vd: v3.Vec, qd, qdd, program: Program, k: str
+) -> tuple[v3.Vec, v3.Vec, v3.Vec]:
+    """w_i, wd_i, vd_i of link i from those of its parent (slide 15, body frames)."""
+    R, p = frame
+    a = v3.vec(link.axis)
+    vd_new = v3.mul_t(R, v3.add(v3.cross(wd, p), v3.cross(w, v3.cross(w, p)), vd))
+    w_par = _name(program, v3.mul_t(R, w), f"wp{k}_")
+    wd_par = v3.mul_t(R, wd)
+    if link.joint == "revolute":
+        w_new = _name(program, v3.add(w_par, v3.scale(qd, a)), f"w{k}_")
+        wd_new = v3.add(wd_par, v3.cross(w_par, v3.scale(qd, a)), v3.scale(qdd, a))
+    else:
+        w_new = w_par
+        wd_new = wd_par
+        vd_new = v3.add(vd_new, v3.scale(2, v3.cross(w_new, v3.scale(qd, a))), v3.scale(qdd, a))
+    return w_new, _name(program, wd_new, f"wd{k}_"), _name(program, vd_new, f"vd{k}_")
 
 
 def newton_euler(
@@ -50,63 +80,47 @@ def newton_euler(
     *,
     gravity: bool = True,
     tag: str = "",
-    rotations: list[tuple[sp.Matrix, sp.Matrix]] | None = None,
+    rotations: list[JointFrame] | None = None,
 ) -> list[sp.Expr]:
     """Rigid-body joint efforts (no friction, no motor inertia) for the given state.
 
     `q`, `qd`, `qdd` may hold symbols or numbers (zeros fold away). The result
     is a list of expressions over the program's intermediates. `rotations`
-    (R_i, p_i per link) may be passed in to share them across passes.
+    (R_i, p_i per link, from `joint_frames`) may be passed in to share them.
     """
     n = robot.n
-    if rotations is None:
-        rotations = [_joint_rotation_and_origin(link, qi) for link, qi in zip(robot.links, q, strict=True)]
-    zero = sp.zeros(3, 1)
+    frames = rotations if rotations is not None else joint_frames(robot, q)
+    zero: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
     w, wd = zero, zero
-    vd = -sp.Matrix(robot.gravity) if gravity else zero
-    vd = program.let_vector(vd, f"{tag}g") if gravity else vd
-    forces: list[sp.Matrix] = []
-    moments: list[sp.Matrix] = []
+    vd = _name(program, v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
+    forces: list[v3.Vec] = []
+    moments: list[v3.Vec] = []
     for i, link in enumerate(robot.links):
-        R, p = rotations[i]
-        Rt = R.T
-        a = sp.Matrix(link.axis)
         k = f"{tag}{i + 1}"
-        vd_new = Rt * (wd.cross(p) + w.cross(w.cross(p)) + vd)
-        w_par = program.let_vector(Rt * w, f"wp{k}_")
-        if link.joint == "revolute":
-            w_new = program.let_vector(w_par + a * qd[i], f"w{k}_")
-            wd_new = program.let_vector(Rt * wd + w_par.cross(a * qd[i]) + a * qdd[i], f"wd{k}_")
-        else:
-            w_new = w_par
-            wd_new = program.let_vector(Rt * wd, f"wd{k}_")
-            vd_new = vd_new + 2 * w_new.cross(a * qd[i]) + a * qdd[i]
-        w, wd = w_new, wd_new
-        vd = program.let_vector(vd_new, f"vd{k}_")
-        c = sp.Matrix(link.com)
-        vc = program.let_vector(wd.cross(c) + w.cross(w.cross(c)) + vd, f"vc{k}_")
-        I = sp.Matrix(link.inertia)
-        Iw = program.let_vector(I * w, f"Iw{k}_")
-        forces.append(program.let_vector(link.mass * vc, f"F{k}_"))
-        moments.append(program.let_vector(I * wd + w.cross(Iw), f"N{k}_"))
+        w, wd, vd = _outward(link, frames[i], w, wd, vd, qd[i], qdd[i], program, k)
+        c = v3.vec(link.com)
+        I = v3.mat(link.inertia)
+        vc = _name(program, v3.add(v3.cross(wd, c), v3.cross(w, v3.cross(w, c)), vd), f"vc{k}_")
+        Iw = _name(program, v3.mul(I, w), f"Iw{k}_")
+        forces.append(_name(program, v3.scale(link.mass, vc), f"F{k}_"))
+        moments.append(_name(program, v3.add(v3.mul(I, wd), v3.cross(w, Iw)), f"N{k}_"))
     tau: list[sp.Expr] = [sp.S.Zero] * n
     f_next, n_next = zero, zero
     for i in reversed(range(n)):
         link = robot.links[i]
         k = f"{tag}{i + 1}"
-        c = sp.Matrix(link.com)
+        c = v3.vec(link.com)
         F = forces[i]
         if i + 1 < n:
-            R1, p1 = rotations[i + 1]
-            Rf = program.let_vector(R1 * f_next, f"Rf{k}_")
-            Rn = R1 * n_next
-            n_new = moments[i] + Rn + c.cross(F) + p1.cross(Rf)
-            f_new = Rf + F
+            R1, p1 = frames[i + 1]
+            Rf = _name(program, v3.mul(R1, f_next), f"Rf{k}_")
+            n_new = v3.add(moments[i], v3.mul(R1, n_next), v3.cross(c, F), v3.cross(p1, Rf))
+            f_new = v3.add(Rf, F)
         else:
-            n_new = moments[i] + c.cross(F)
+            n_new = v3.add(moments[i], v3.cross(c, F))
             f_new = F
-        f_next = program.let_vector(f_new, f"f{k}_")
-        n_next = program.let_vector(n_new, f"n{k}_")
-        a = sp.Matrix(link.axis)
-        tau[i] = (a.T * (n_next if link.joint == "revolute" else f_next))[0]
+        f_next = _name(program, f_new, f"f{k}_")
+        n_next = _name(program, n_new, f"n{k}_")
+        a = v3.vec(link.axis)
+        tau[i] = v3.dot(a, n_next if link.joint == "revolute" else f_next)
     return tau

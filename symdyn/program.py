@@ -31,9 +31,7 @@ def _negated(expr: sp.Expr) -> sp.Expr | None:
     if expr.is_Mul:
         c, rest = expr.as_coeff_Mul()
         return (-c) * rest if c.is_negative else None
-    if expr.is_Add and expr.could_extract_minus_sign():
-        return sp.Add(*[-a for a in expr.args])
-    return None
+    return None  # sums are left as they are: normalising their sign costs more than it saves
 
 
 def is_trivial(expr: sp.Expr) -> bool:
@@ -44,6 +42,44 @@ def is_trivial(expr: sp.Expr) -> bool:
         a, b = expr.args
         return bool(a.is_Number and b.is_Atom)
     return False
+
+
+def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
+    """Total derivative of e, given the derivatives `dmap` of the symbols it uses (others 0).
+
+    Handles the forms the recursions produce (sums, products, integer powers,
+    sin, cos, sign) directly, which is much faster than SymPy's general diff.
+    """
+    if e.is_Symbol:
+        return dmap.get(e, sp.S.Zero)
+    if e.is_Number or e.is_NumberSymbol:
+        return sp.S.Zero
+    hit = memo.get(e)
+    if hit is not None:
+        return hit
+    args = e.args
+    if e.is_Add:
+        out = sp.Add(*[d for d in (_derivative(a, dmap, memo) for a in args) if d != 0])
+    elif e.is_Mul:
+        terms = []
+        for i, a in enumerate(args):
+            da = _derivative(a, dmap, memo)
+            if da != 0:
+                terms.append(sp.Mul(*args[:i], *args[i + 1 :], da))
+        out = sp.Add(*terms)
+    elif e.is_Pow and args[1].is_Number:
+        db = _derivative(args[0], dmap, memo)
+        out = args[1] * args[0] ** (args[1] - 1) * db if db != 0 else sp.S.Zero
+    elif isinstance(e, (sp.sin, sp.cos)):
+        da = _derivative(args[0], dmap, memo)
+        slope = sp.cos(args[0]) if isinstance(e, sp.sin) else -sp.sin(args[0])
+        out = slope * da if da != 0 else sp.S.Zero
+    elif isinstance(e, sp.sign):
+        out = sp.S.Zero  # almost everywhere
+    else:
+        out = sp.Add(*[e.diff(s) * d for s, d in dmap.items() if s in e.free_symbols])
+    memo[e] = out
+    return out
 
 
 class Program:
@@ -108,18 +144,13 @@ class Program:
 
     def diff(self, outputs: Sequence[sp.Expr], x: sp.Symbol, hint: str = "d") -> list[sp.Expr]:
         """d(outputs)/dx by forward-mode propagation; derivatives become new intermediates."""
-        deriv: dict[sp.Symbol, sp.Expr] = {}
+        dmap: dict[sp.Basic, sp.Expr] = {x: sp.S.One}
         for sym, expr in self.needed(outputs):
-            deriv[sym] = self.let(self._total_derivative(expr, x, deriv), hint)
-        return [self._total_derivative(sp.sympify(e), x, deriv) for e in outputs]
-
-    def _total_derivative(self, expr: sp.Expr, x: sp.Symbol, deriv: dict) -> sp.Expr:
-        total = expr.diff(x) if x in expr.free_symbols else sp.S.Zero
-        for s in self._deps(expr):
-            ds = deriv.get(s, sp.S.Zero)
-            if ds != 0:
-                total += expr.diff(s) * ds
-        return total
+            d = _derivative(expr, dmap, {})
+            if d != 0:
+                dmap[sym] = self.let(d, hint)
+        memo: dict = {}
+        return [_derivative(sp.sympify(e), dmap, memo) for e in outputs]
 
     def expand(self, exprs: Iterable[sp.Expr]) -> list[sp.Expr]:
         """Substitute every intermediate back: closed forms over inputs only."""

@@ -22,6 +22,8 @@ Body i moves relative to body i-1 by parent_T_i(q_i) = placement @ Rot(axis, q_i
 
 from __future__ import annotations
 
+import sys
+import types
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
@@ -366,3 +368,13 @@ def potential_energy(robot, q, params=None) -> float | np.ndarray:
     p = link_com_positions(robot, _batch(q, mdl.n, "q"), params)
     U = -np.einsum("i,nij,j->n", mdl.mass, p, mdl.gravity)
     return float(U[0]) if single else U
+
+
+class _CallableModule(types.ModuleType):
+    """`symdyn.rnea` is both this module and the function of design.md: symdyn.rnea(robot, q, qd, qdd)."""
+
+    def __call__(self, robot, q, qd, qdd, params=None, **kwargs):
+        return rnea(robot, q, qd, qdd, params, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

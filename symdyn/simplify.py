@@ -16,12 +16,14 @@ exponent is counted as repeated multiplications (the printers emit it so).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import itertools
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import sympy as sp
 
-__all__ = ["OpCount", "count_ops", "eliminate", "Eliminated"]
+__all__ = ["OpCount", "count_ops", "eliminate", "eliminate_many", "Eliminated"]
 
 MAX_UNROLLED_POWER = 8
 
@@ -111,7 +113,7 @@ class Eliminated:
     temporaries: tuple[tuple[sp.Symbol, sp.Expr], ...]
     outputs: tuple[sp.Expr, ...]
 
-    @property
+    @cached_property
     def ops(self) -> OpCount:
         return count_ops(self.temporaries, self.outputs)
 
@@ -140,34 +142,92 @@ def _topological(nodes: dict[sp.Symbol, sp.Expr], roots: Sequence[sp.Expr]) -> l
     return order
 
 
+def _cse_nodes(
+    assignments: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[sp.Expr]
+) -> tuple[dict[sp.Symbol, sp.Expr], list[sp.Expr]]:
+    """One CSE pass over assignments and outputs: (symbol -> expression nodes, reduced outputs)."""
+    syms = [s for s, _ in assignments]
+    exprs = [e for _, e in assignments]
+    repl, reduced = sp.cse(exprs + list(outputs), symbols=sp.numbered_symbols("_cse"), order="none")
+    nodes: dict[sp.Symbol, sp.Expr] = dict(repl)
+    for s, e in zip(syms, reduced[: len(syms)], strict=True):
+        nodes[s] = e
+    outs = reduced[len(syms) :]
+
+    # inline temporaries that are a bare symbol or number (no work, only a name), to a fixpoint
+    # since an alias may name another alias
+    def is_alias(e: sp.Expr) -> bool:
+        return e.is_Atom or (e.is_Mul and len(e.args) == 2 and e.args[0] == -1 and e.args[1].is_Atom)
+
+    alias = {s: e for s, e in nodes.items() if is_alias(e)}
+    while True:
+        resolved = {s: e.xreplace(alias) for s, e in alias.items()}
+        if resolved == alias:
+            break
+        alias = resolved
+    kept = {s: e.xreplace(alias) for s, e in nodes.items() if s not in alias}
+    return kept, [e.xreplace(alias) for e in outs]
+
+
+def _renamed(expr: sp.Expr, rename: dict[sp.Symbol, sp.Symbol], memo: dict) -> sp.Expr:
+    """expr with symbols swapped, keeping its argument order (no re-canonicalisation, so fast)."""
+    if expr.is_Symbol:
+        return rename.get(expr, expr)
+    if expr.is_Atom:
+        return expr
+    hit = memo.get(expr)
+    if hit is not None:
+        return hit
+    args = tuple(_renamed(a, rename, memo) for a in expr.args)
+    out = expr.func._from_args(args) if (expr.is_Add or expr.is_Mul) else expr.func(*args)
+    memo[expr] = out
+    return out
+
+
+def _inputs(nodes: dict[sp.Symbol, sp.Expr], outputs: Sequence[sp.Expr]) -> set[sp.Symbol]:
+    """Every symbol that is not a temporary: joint symbols, parameters, tau."""
+    used = set().union(*(e.free_symbols for e in (*nodes.values(), *outputs)))
+    return used - set(nodes)
+
+
+def _extract(
+    nodes: dict[sp.Symbol, sp.Expr], outputs: Sequence[sp.Expr], prefix: str, taken: set[sp.Symbol]
+) -> Eliminated:
+    """The temporaries the outputs need, in order; fresh names that no input (a parameter
+    called x0) already has, for every function generated from the same robot."""
+    order = _topological(nodes, outputs)
+    fresh = (t for t in (sp.Symbol(f"{prefix}{k}") for k in itertools.count()) if t not in taken)
+    rename = {s: next(fresh) for s in order}
+    memo: dict = {}
+    temporaries = tuple((rename[s], _renamed(nodes[s], rename, memo)) for s in order)
+    return Eliminated(temporaries, tuple(_renamed(e, rename, memo) for e in outputs))
+
+
 def eliminate(
     assignments: Sequence[tuple[sp.Symbol, sp.Expr]],
     outputs: Sequence[sp.Expr],
     prefix: str = "x",
 ) -> Eliminated:
     """CSE over a program's assignments and outputs; temporaries renamed prefix0, prefix1, ..."""
-    outputs = [sp.sympify(e) for e in outputs]
-    syms = [s for s, _ in assignments]
-    exprs = [e for _, e in assignments]
-    marker = sp.numbered_symbols("_cse")
-    repl, reduced = sp.cse(exprs + outputs, symbols=marker, order="none")
-    nodes: dict[sp.Symbol, sp.Expr] = {}
-    for s, e in repl:
-        nodes[s] = e
-    for s, e in zip(syms, reduced[: len(syms)], strict=True):
-        nodes[s] = e
-    outs = reduced[len(syms) :]
-    # inline temporaries that are a bare symbol or number (no work, only a name)
-    alias: dict[sp.Symbol, sp.Expr] = {}
-    for s in list(nodes):
-        e = nodes[s].xreplace(alias)
-        if e.is_Atom or (e.is_Mul and len(e.args) == 2 and e.args[0] == -1 and e.args[1].is_Atom):
-            alias[s] = e
-            del nodes[s]
-        else:
-            nodes[s] = e
-    outs = [e.xreplace(alias) for e in outs]
-    order = _topological(nodes, outs)
-    rename = {s: sp.Symbol(f"{prefix}{k}") for k, s in enumerate(order)}
-    temporaries = tuple((rename[s], nodes[s].xreplace(rename)) for s in order)
-    return Eliminated(temporaries, tuple(e.xreplace(rename) for e in outs))
+    nodes, outs = _cse_nodes(assignments, [sp.sympify(e) for e in outputs])
+    return _extract(nodes, outs, prefix, _inputs(nodes, outs))
+
+
+def eliminate_many(
+    assignments: Sequence[tuple[sp.Symbol, sp.Expr]],
+    groups: dict[str, Sequence[sp.Expr]],
+    prefix: str = "x",
+    reserved: Iterable[sp.Symbol] = (),
+) -> dict[str, Eliminated]:
+    """`eliminate` for several functions sharing one program: one CSE pass, then each
+    group keeps only the temporaries its outputs need (renamed from prefix0 per group,
+    skipping the names of inputs and of the `reserved` symbols)."""
+    flat = [sp.sympify(e) for outs in groups.values() for e in outs]
+    nodes, reduced = _cse_nodes(assignments, flat)
+    taken = _inputs(nodes, reduced) | set(reserved)
+    result: dict[str, Eliminated] = {}
+    k = 0
+    for name, outs in groups.items():
+        result[name] = _extract(nodes, reduced[k : k + len(outs)], prefix, taken)
+        k += len(outs)
+    return result

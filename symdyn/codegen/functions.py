@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..dynamics import Dynamics
+from ..dynamics import QUANTITIES, Dynamics
 from ..program import Program
-from ..simplify import Eliminated, OpCount, eliminate
+from ..simplify import Eliminated, OpCount, eliminate_many
 
 __all__ = ["FunctionSpec", "Input", "build_functions", "FUNCTION_NAMES"]
 
@@ -104,57 +104,36 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
     p = Input("p", tuple(dyn.params))
     c = dyn.compact
 
-    def spec(name, doc, inputs, out, shape, exprs, steps):
-        code = eliminate(steps, list(exprs))
-        return FunctionSpec(name, doc, inputs, out, shape, code)
-
-    prog = dyn.program
-    specs = [
-        spec(
-            "inverse_dynamics",
-            "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)",
-            (q, qd, qdd, p),
-            "tau",
-            (n, 1),
-            c["tau"],
-            dyn.assignments(("tau",)),
-        ),
-        spec("mass_matrix", "M(q), row-major n x n", (q, p), "M", (n, n), c["M"], dyn.assignments(("M",))),
-        spec(
+    fd = Program()
+    b = [fd.let(tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
+    qdd_out = _ldlt_solve(sp.Matrix(c["M"]), b, fd)
+    table = [
+        ("inverse_dynamics", "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)", (q, qd, qdd, p), "tau", c["tau"]),
+        ("mass_matrix", "M(q), row-major n x n", (q, p), "M", c["M"]),
+        (
             "coriolis_matrix",
             "C(q, qd) from Christoffel symbols, row-major; C qd = V",
             (q, qd, p),
             "C",
-            (n, n),
             c["C"],
-            dyn.assignments(("C",)),
         ),
-        spec("coriolis", "V(q, qd) = C(q, qd) qd", (q, qd, p), "V", (n, 1), c["V"], dyn.assignments(("V",))),
-        spec("gravity", "G(q)", (q, p), "G", (n, 1), c["G"], dyn.assignments(("G",))),
-        spec(
-            "friction",
-            "F(qd) = viscous qd + coulomb sign(qd)",
-            (qd, p),
-            "F",
-            (n, 1),
-            c["F"],
-            dyn.assignments(("F",)),
-        ),
-    ]
-    fd = Program()
-    bias = [c["V"][i] + c["G"][i] + c["F"][i] for i in range(n)]
-    b = [fd.let(tau.symbols[i] - bias[i], "fdb") for i in range(n)]
-    qdd_out = _ldlt_solve(sp.Matrix(c["M"]), b, fd)
-    steps = prog.needed(list(c["M"]) + bias) + fd.needed(qdd_out)
-    specs.append(
-        spec(
+        ("coriolis", "V(q, qd) = C(q, qd) qd", (q, qd, p), "V", c["V"]),
+        ("gravity", "G(q)", (q, p), "G", c["G"]),
+        ("friction", "F(qd) = viscous qd + coulomb sign(qd)", (qd, p), "F", c["F"]),
+        (
             "forward_dynamics",
             "qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T)",
             (q, qd, tau, p),
             "qdd",
-            (n, 1),
-            qdd_out,
-            steps,
-        )
-    )
-    return specs
+            sp.Matrix(qdd_out),
+        ),
+    ]
+    outputs = {name: list(exprs) for name, _, _, _, exprs in table}
+    program_outputs = [e for name in QUANTITIES for e in c[name]] + list(c["bias"])
+    steps = dyn.program.needed(program_outputs) + fd.needed(qdd_out)
+    inputs = (*q.symbols, *qd.symbols, *qdd.symbols, *tau.symbols, *p.symbols)
+    code = eliminate_many(steps, outputs, reserved=inputs)
+    return [
+        FunctionSpec(name, doc, inputs, out, (exprs.rows, exprs.cols), code[name])
+        for name, doc, inputs, out, exprs in table
+    ]

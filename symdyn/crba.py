@@ -1,0 +1,114 @@
+"""The mass matrix by the composite-rigid-body algorithm, symbolically, in body frames.
+
+Each body i carries, about its body-frame origin, its mass m_i, first moment
+h_i = m_i c_i and rotational inertia I_i = I_ci + m_i (c_i^T c_i 1 - c_i c_i^T).
+The composite body of the subtree rooted at i adds its children, moved into
+frame i (R, p: child frame in parent frame, h' = R h):
+
+    m += m_j,   h += R h_j + m_j p,
+    I += R I_j R^T - [h' x][p x] - [p x][h' x] - m_j [p x]^2
+
+A unit acceleration of joint j makes the composite j exert the spatial force
+(moment n about the origin, force f) = (I^c a, a x h^c) for a revolute joint
+with axis a, or (h^c x a, m^c a) for a prismatic one. Carried inward,
+n <- R n + p x R f, f <- R f, and projected on each joint i <= j, it gives
+M_ij = a_i . n (revolute) or a_i . f (prismatic). O(n^2), against n
+Newton-Euler passes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import sympy as sp
+
+from . import vectors as v3
+from .newton_euler import JointFrame
+from .program import Program
+from .robot import Robot
+
+__all__ = ["mass_matrix_crba"]
+
+
+def _sym3(program: Program, I: Sequence[Sequence[sp.Expr]], hint: str) -> v3.Mat:
+    """Name the 6 distinct entries of a symmetric 3x3 matrix."""
+    e = {(r, c): program.let(I[r][c], hint) for r in range(3) for c in range(r, 3)}
+    return tuple(tuple(e[(min(r, c), max(r, c))] for c in range(3)) for r in range(3))  # type: ignore[return-value]
+
+
+def _skew_sq(p: v3.Vec) -> list[list[sp.Expr]]:
+    """[p x]^2 = p p^T - (p^T p) 1."""
+    pp = v3.dot(p, p)
+    return [[v3._prod(p[r], p[c]) - (pp if r == c else 0) for c in range(3)] for r in range(3)]
+
+
+def _sym_cross_term(u: v3.Vec, p: v3.Vec) -> list[list[sp.Expr]]:
+    """[u x][p x] + [p x][u x] = u p^T + p u^T - 2 (u . p) 1."""
+    up = v3.dot(u, p)
+    return [
+        [v3._sum((v3._prod(u[r], p[c]), v3._prod(p[r], u[c]), -2 * up if r == c else 0)) for c in range(3)]
+        for r in range(3)
+    ]
+
+
+def _rotate(R: v3.Mat, I: v3.Mat) -> list[list[sp.Expr]]:
+    """R I R^T."""
+    RI = [[v3.dot(R[r], (I[0][c], I[1][c], I[2][c])) for c in range(3)] for r in range(3)]
+    return [[v3.dot(RI[r], R[c]) for c in range(3)] for r in range(3)]
+
+
+def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -> sp.Matrix:
+    """M(q) of the rigid bodies plus reflected motor inertia, over the program's intermediates."""
+    n = robot.n
+    mass: list[sp.Expr] = []
+    h: list[v3.Vec] = []
+    I: list[v3.Mat] = []
+    for link in robot.links:
+        c = v3.vec(link.com)
+        m = sp.sympify(link.mass)
+        Ic = v3.mat(link.inertia)
+        cc = _skew_sq(c)
+        mass.append(m)
+        h.append(tuple(program.let(v3._prod(m, x), "h") for x in c))  # type: ignore[arg-type]
+        I.append(
+            _sym3(program, [[Ic[r][k] - v3._prod(m, cc[r][k]) for k in range(3)] for r in range(3)], "Io")
+        )
+    for j in reversed(range(1, n)):
+        R, p = frames[j]
+        Rh = tuple(program.let(x, "Rh") for x in v3.mul(R, h[j]))
+        mj = mass[j]
+        parent = j - 1
+        mass[parent] = program.let(mass[parent] + mj, "mc")
+        h[parent] = tuple(program.let(x, "hc") for x in v3.add(h[parent], Rh, v3.scale(mj, p)))  # type: ignore[assignment]
+        RIR = _rotate(R, I[j])
+        cross = _sym_cross_term(Rh, p)
+        pp = _skew_sq(p)
+        I[parent] = _sym3(
+            program,
+            [
+                [I[parent][r][k] + RIR[r][k] - cross[r][k] - v3._prod(mj, pp[r][k]) for k in range(3)]
+                for r in range(3)
+            ],
+            "Ic",
+        )
+    M = sp.zeros(n, n)
+    for j in range(n):
+        a = v3.vec(robot.links[j].axis)
+        if robot.links[j].joint == "revolute":
+            nf = tuple(program.let(x, "Fn") for x in v3.mul(I[j], a))
+            ff = tuple(program.let(x, "Ff") for x in v3.cross(a, h[j]))
+        else:
+            nf = tuple(program.let(x, "Fn") for x in v3.cross(h[j], a))
+            ff = tuple(program.let(x, "Ff") for x in v3.scale(mass[j], a))
+        for i in range(j, -1, -1):
+            if i < j:
+                R, p = frames[i + 1]
+                ff_new = tuple(program.let(x, "Ff") for x in v3.mul(R, ff))
+                nf = tuple(program.let(x, "Fn") for x in v3.add(v3.mul(R, nf), v3.cross(p, ff_new)))
+                ff = ff_new
+            ai = v3.vec(robot.links[i].axis)
+            entry = v3.dot(ai, nf if robot.links[i].joint == "revolute" else ff)
+            if i == j:
+                entry = entry + robot.links[j].motor.reflected_inertia
+            M[i, j] = M[j, i] = program.let(entry, "M")
+    return M

@@ -1,0 +1,92 @@
+"""Zero-aware 3-vector and 3x3-matrix arithmetic on tuples of SymPy expressions.
+
+The recursions multiply rotation matrices that are mostly 0 and +-1 (DH twists
+of 0 and +-pi/2) by vectors that are often sparse (planar motion, axes along
+z). SymPy's Matrix builds every product and sum before folding zeros; these
+helpers skip zero factors and unit coefficients up front, which keeps both the
+derivation time and the size of the resulting expressions down.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import sympy as sp
+
+__all__ = ["Vec", "Mat", "vec", "mat", "add", "sub", "scale", "cross", "dot", "mul", "mul_t", "neg"]
+
+Vec = tuple[sp.Expr, sp.Expr, sp.Expr]
+Mat = tuple[Vec, Vec, Vec]
+ZERO = sp.S.Zero
+
+
+def vec(v: Sequence) -> Vec:
+    return tuple(sp.sympify(x) for x in v)  # type: ignore[return-value]
+
+
+def mat(m) -> Mat:
+    """Rows of a 3x3 matrix (SymPy Matrix or nested sequence)."""
+    return tuple(
+        tuple(sp.sympify(m[i, j] if hasattr(m, "shape") else m[i][j]) for j in range(3)) for i in range(3)
+    )  # type: ignore[return-value]
+
+
+def _prod(a: sp.Expr, b: sp.Expr) -> sp.Expr:
+    if a == 0 or b == 0:
+        return ZERO
+    if a == 1:
+        return b
+    if b == 1:
+        return a
+    if a == -1:
+        return -b
+    if b == -1:
+        return -a
+    return a * b
+
+
+def _sum(terms) -> sp.Expr:
+    terms = [t for t in terms if t != 0]
+    if not terms:
+        return ZERO
+    if len(terms) == 1:
+        return terms[0]
+    return sp.Add(*terms)
+
+
+def add(*vs: Vec) -> Vec:
+    return tuple(_sum(v[i] for v in vs) for i in range(3))  # type: ignore[return-value]
+
+
+def sub(a: Vec, b: Vec) -> Vec:
+    return tuple(_sum((a[i], -b[i] if b[i] != 0 else ZERO)) for i in range(3))  # type: ignore[return-value]
+
+
+def neg(a: Vec) -> Vec:
+    return tuple(-x if x != 0 else ZERO for x in a)  # type: ignore[return-value]
+
+
+def scale(k: sp.Expr, a: Vec) -> Vec:
+    return tuple(_prod(k, x) for x in a)  # type: ignore[return-value]
+
+
+def dot(a: Sequence[sp.Expr], b: Sequence[sp.Expr]) -> sp.Expr:
+    return _sum(_prod(x, y) for x, y in zip(a, b, strict=True))
+
+
+def cross(a: Vec, b: Vec) -> Vec:
+    return (
+        _sum((_prod(a[1], b[2]), -_prod(a[2], b[1]))),
+        _sum((_prod(a[2], b[0]), -_prod(a[0], b[2]))),
+        _sum((_prod(a[0], b[1]), -_prod(a[1], b[0]))),
+    )
+
+
+def mul(R: Mat, v: Vec) -> Vec:
+    """R v."""
+    return tuple(dot(R[i], v) for i in range(3))  # type: ignore[return-value]
+
+
+def mul_t(R: Mat, v: Vec) -> Vec:
+    """R^T v."""
+    return tuple(dot((R[0][j], R[1][j], R[2][j]), v) for j in range(3))  # type: ignore[return-value]
