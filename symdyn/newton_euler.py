@@ -11,6 +11,9 @@ a base acceleration vd_0 = -g, is
     prismatic: w_i = R_i^T w_{i-1},  wd_i = R_i^T wd_{i-1},
                vd_i = R_i^T [...] + 2 w_i x a_i qd_i + a_i qdd_i
     vc_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
+
+with wd x r + w x (w x r) computed as W r, W = [wd x] + [w x]^2, once per link
+for both the centre of mass and the next joint's origin
     F_i = m_i vc_i,   N_i = I_i wd_i + w_i x I_i w_i
 
 and the inward one, i = n .. 1,
@@ -52,13 +55,37 @@ def _name(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
     return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
 
 
+def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
+    """W = [wd x] + [w x]^2, so that wd x r + w x (w x r) = W r for any point r of the link."""
+    sq = [program.let(v3._prod(w[j], w[j]), f"ww{k}_") for j in range(3)]
+    xy, xz, yz = (program.let(v3._prod(w[a], w[b]), f"ww{k}_") for a, b in ((0, 1), (0, 2), (1, 2)))
+    W = (
+        (-v3._sum((sq[1], sq[2])), v3._sum((xy, -wd[2])), v3._sum((xz, wd[1]))),
+        (v3._sum((xy, wd[2])), -v3._sum((sq[0], sq[2])), v3._sum((yz, -wd[0]))),
+        (v3._sum((xz, -wd[1])), v3._sum((yz, wd[0])), -v3._sum((sq[0], sq[1]))),
+    )
+    return tuple(_name(program, row, f"W{k}_") for row in W)  # type: ignore[return-value]
+
+
 def _outward(
-    link: Link, frame: JointFrame, w: v3.Vec, wd: v3.Vec, vd: v3.Vec, qd, qdd, program: Program, k: str
+    link: Link,
+    frame: JointFrame,
+    w: v3.Vec,
+    wd: v3.Vec,
+    vd: v3.Vec,
+    W: v3.Mat,
+    qd,
+    qdd,
+    program: Program,
+    k: str,
 ) -> tuple[v3.Vec, v3.Vec, v3.Vec]:
-    """w_i, wd_i, vd_i of link i from those of its parent (slide 15, body frames)."""
+    """w_i, wd_i, vd_i of link i from those of its parent (slide 15, body frames).
+
+    The parent's W = [wd x] + [w x]^2 gives wd x p + w x (w x p) = W p.
+    """
     R, p = frame
     a = v3.vec(link.axis)
-    vd_new = v3.mul_t(R, v3.add(v3.cross(wd, p), v3.cross(w, v3.cross(w, p)), vd))
+    vd_new = v3.mul_t(R, v3.add(v3.mul(W, p), vd))
     w_par = _name(program, v3.mul_t(R, w), f"wp{k}_")
     wd_par = v3.mul_t(R, wd)
     if link.joint == "revolute":
@@ -92,15 +119,17 @@ def newton_euler(
     frames = rotations if rotations is not None else joint_frames(robot, q)
     zero: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
     w, wd = zero, zero
+    W: v3.Mat = (zero, zero, zero)
     vd = _name(program, v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
     forces: list[v3.Vec] = []
     moments: list[v3.Vec] = []
     for i, link in enumerate(robot.links):
         k = f"{tag}{i + 1}"
-        w, wd, vd = _outward(link, frames[i], w, wd, vd, qd[i], qdd[i], program, k)
+        w, wd, vd = _outward(link, frames[i], w, wd, vd, W, qd[i], qdd[i], program, k)
+        W = _tilde(program, w, wd, k)
         c = v3.vec(link.com)
         I = v3.mat(link.inertia)
-        vc = _name(program, v3.add(v3.cross(wd, c), v3.cross(w, v3.cross(w, c)), vd), f"vc{k}_")
+        vc = _name(program, v3.add(v3.mul(W, c), vd), f"vc{k}_")
         Iw = _name(program, v3.mul(I, w), f"Iw{k}_")
         forces.append(_name(program, v3.scale(link.mass, vc), f"F{k}_"))
         moments.append(_name(program, v3.add(v3.mul(I, wd), v3.cross(w, Iw)), f"N{k}_"))

@@ -1,0 +1,395 @@
+"""Shared helpers for the derivation tests: example robots, hand-built robots, random robots.
+
+Nothing here calls the derivation code to produce an *expected* value: expected
+values come from the lecture's closed forms (slides 17-18), from the raw YAML
+read with `yaml.safe_load` (independent of the loader), from hand-written DH
+matrices, or from the numeric oracle `symdyn.rnea`.
+
+Derivations are cached (`derived`, `derived_robot`) so that each example robot
+is derived once per method per test session, whichever test file asks first.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, replace
+from fractions import Fraction
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+import yaml
+from hypothesis import strategies as st
+
+from symdyn.dynamics import derive
+from symdyn.errors import SymdynWarning
+from symdyn.loaders.robot_file import load_robot, robot_from_data
+from symdyn.robot import Friction, Link, Motor, Robot
+from symdyn.transform import Transform
+
+EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLE_NAMES = tuple(sorted(p.stem for p in EXAMPLES_DIR.glob("*.yaml")))
+QUANTITIES = ("M", "C", "V", "G", "tau")
+
+Z = sp.ImmutableMatrix([0, 0, 1])
+ZERO3 = sp.ImmutableMatrix(sp.zeros(3, 3))
+
+
+def vec(v) -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(3, 1, [sp.sympify(x) for x in v])
+
+
+def mat(a) -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(np.asarray(a, dtype=float).tolist())
+
+
+# --------------------------------------------------------------------------- examples
+
+
+@lru_cache(maxsize=None)
+def example(name: str) -> Robot:
+    """examples/<name>.yaml through the loader (its published-data warnings silenced)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SymdynWarning)
+        return load_robot(EXAMPLES_DIR / f"{name}.yaml")
+
+
+@lru_cache(maxsize=None)
+def raw_example(name: str) -> dict:
+    """The example file as plain data (yaml.safe_load), independent of the loader."""
+    return yaml.safe_load((EXAMPLES_DIR / f"{name}.yaml").read_text())
+
+
+def raw_value(value, parameters: dict | None = None) -> sp.Expr:
+    """A number or expression string of a trusted example file, evaluated with SymPy."""
+    expr = sp.sympify(value)
+    subs = {sp.Symbol(k): sp.sympify(v) for k, v in (parameters or {}).items() if v is not None}
+    for _ in range(5):  # parameter values may refer to other parameters
+        expr = expr.subs(subs)
+    return expr
+
+
+@lru_cache(maxsize=None)
+def derived(name: str, method: str, simplify: bool | None = False):
+    """derive(example(name), method) once per session (closed forms unsimplified by default)."""
+    return derive(example(name), method=method, simplify=simplify)
+
+
+@lru_cache(maxsize=None)
+def derived_robot(robot: Robot, method: str, simplify: bool | None = False):
+    """derive(robot, method) once per session for a hand-built (hashable) robot."""
+    return derive(robot, method=method, simplify=simplify)
+
+
+def random_params(robot: Robot, rng: np.random.Generator) -> np.ndarray:
+    """Random positive values for the robot's free parameters, in `robot.params` order."""
+    return rng.uniform(0.5, 2.0, len(robot.params))
+
+
+def random_state(robot: Robot, rng: np.random.Generator):
+    """(q, qd, qdd): revolute angles over a full turn, prismatic offsets within +-0.5 m."""
+    n = robot.n
+    revolute = np.array([lk.joint == "revolute" for lk in robot.links])
+    q = np.where(revolute, rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.5, 0.5, n))
+    qd = rng.uniform(-2, 2, n)
+    qd[np.abs(qd) < 1e-3] = 0.5  # keep sign(qd) away from its jump
+    qdd = rng.uniform(-2, 2, n)
+    return q, qd, qdd
+
+
+def ev(dyn, name: str, q=None, qd=None, qdd=None, params=None) -> np.ndarray:
+    """dyn.evaluate with M and C always shaped (n, n).
+
+    Dynamics.evaluate squeezes every (k, 1) result to (k,), which turns the 1 x 1 M and C
+    of a one-joint robot into vectors; test_dynamics.py::test_evaluate_shapes_one_joint
+    records that, the other tests compare values.
+    """
+    out = dyn.evaluate(name, q, qd, qdd, params)
+    return out.reshape(dyn.n, dyn.n) if name in ("M", "C") else out
+
+
+def assert_close(got, want, rtol: float = 1e-9, what: str = "") -> None:
+    """Equal up to `rtol` relative to the largest entry of `want` (entries near zero included)."""
+    got, want = np.asarray(got, dtype=float), np.asarray(want, dtype=float)
+    scale = max(float(np.max(np.abs(want), initial=0.0)), 1e-3)
+    np.testing.assert_allclose(got, want, rtol=rtol, atol=rtol * scale, err_msg=what)
+
+
+# --------------------------------------------------------------------------- the lecture's robots
+
+m, l, g = sp.symbols("m l g")
+m1, m2, l1, l2 = sp.symbols("m1 m2 l1 l2")
+q1, q2, qd1, qd2 = sp.symbols("q1 q2 qd1 qd2")
+
+
+def roger_eye_lecture() -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """Slide 17: a point mass m at distance l, M = m l^2, V = 0, G = m g l sin q."""
+    return sp.Matrix([[m * l**2]]), sp.Matrix([0]), sp.Matrix([m * g * l * sp.sin(q1)])
+
+
+def roger_arm_lecture() -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """Slide 18 (restated in the seed README): M, V, G of the two-link arm."""
+    c2, s2 = sp.cos(q2), sp.sin(q2)
+    s1, s12 = sp.sin(q1), sp.sin(q1 + q2)
+    M = sp.Matrix(
+        [
+            [m2 * l2**2 + 2 * m2 * l1 * l2 * c2 + (m1 + m2) * l1**2, m2 * l2**2 + m2 * l1 * l2 * c2],
+            [m2 * l2**2 + m2 * l1 * l2 * c2, m2 * l2**2],
+        ]
+    )
+    V = sp.Matrix([-m2 * l1 * l2 * s2 * (qd2**2 + 2 * qd1 * qd2), m2 * l1 * l2 * s2 * qd1**2])
+    G = sp.Matrix([(m1 + m2) * g * l1 * s1 + m2 * g * l2 * s12, m2 * g * l2 * s12])
+    return M, V, G
+
+
+def roger_eye_robot() -> Robot:
+    """Slide 17 built directly: one revolute z joint, the mass l along the body x axis."""
+    eye = Link("eye", "revolute", Transform.identity(), Z, m, vec([l, 0, 0]), ZERO3)
+    return Robot("roger_eye", (eye,), vec([g, 0, 0]), params=(m, l, g))
+
+
+def roger_arm_robot(motors: tuple[Motor, Motor] | None = None) -> Robot:
+    """Slide 18 built directly: point masses at the distal ends, hanging along +x."""
+    mo = motors or (Motor(), Motor())
+    upper = Link("upper", "revolute", Transform.identity(), Z, m1, vec([l1, 0, 0]), ZERO3, motor=mo[0])
+    fore = Link("fore", "revolute", Transform.tx(l1), Z, m2, vec([l2, 0, 0]), ZERO3, motor=mo[1])
+    params = [m1, m2, l1, l2, g]
+    for mot in mo:
+        params += [s for s in (mot.inertia, mot.gear_ratio) if isinstance(s, sp.Symbol)]
+    return Robot("roger_arm", (upper, fore), vec([g, 0, 0]), params=tuple(params))
+
+
+# --------------------------------------------------------------------------- symbolic small arms
+
+
+def sym3_data(convention: str = "standard") -> dict:
+    """A 3-joint RPR arm with pi/2 twists, every length, mass and inertia a free symbol."""
+    return {
+        "name": f"sym3_{convention}",
+        "convention": convention,
+        "gravity": [0, 0, "-g"],
+        "links": [
+            {
+                "name": "base",
+                "joint": "revolute",
+                "a": 0,
+                "alpha": "pi/2",
+                "d": "d1",
+                "theta": 0,
+                "mass": "m1",
+                "com": [0, "-c1", 0],
+                "inertia": {"ixx": "I1x", "iyy": "I1y", "izz": "I1z"},
+            },
+            {
+                "name": "slide",
+                "joint": "prismatic",
+                "a": 0,
+                "alpha": "-pi/2",
+                "d": "d2",
+                "theta": "pi/2",
+                "mass": "m2",
+                "com": [0, 0, "-c2"],
+                "inertia": {"ixx": "I2x", "iyy": "I2y", "izz": "I2z"},
+                "friction": {"viscous": "b2", "coulomb": "k2"},
+            },
+            {
+                "name": "wrist",
+                "joint": "revolute",
+                "a": "a3",
+                "alpha": "pi/2",
+                "d": 0,
+                "theta": 0,
+                "mass": "m3",
+                "com": ["-c3", 0, 0],
+                "inertia": {"ixx": "I3x", "iyy": "I3y", "izz": "I3z", "ixy": "I3xy"},
+                "motor": {"inertia": "J3", "gear_ratio": "n3"},
+            },
+        ],
+    }
+
+
+def _rational(x):
+    """Floats of a data tree as exact fraction strings ("0.05024" -> "157/3125")."""
+    if isinstance(x, float):
+        return str(Fraction(str(x)))
+    if isinstance(x, list):
+        return [_rational(y) for y in x]
+    if isinstance(x, dict):
+        return {k: _rational(v) for k, v in x.items()}
+    return x
+
+
+def rational_example(name: str) -> Robot:
+    """An example file with every decimal number read as the exact rational it denotes."""
+    return robot_from_data(_rational(raw_example(name)), source=f"{name} (rational)")
+
+
+def trig_zero(expr: sp.Expr, n: int) -> bool:
+    """Exact test that a polynomial in sin(q_i), cos(q_i) (and other symbols) vanishes.
+
+    Multiple angles are expanded (expand_trig), sin q_i, cos q_i become S_i, C_i, and the
+    polynomial is reduced modulo S_i**2 + C_i**2 - 1 (a Groebner basis: leading terms are
+    coprime), so a zero remainder means the expression is identically zero.
+    """
+    q = sp.symbols(f"q1:{n + 1}")
+    S = sp.symbols(f"S1:{n + 1}")
+    C = sp.symbols(f"C1:{n + 1}")
+    e = sp.expand(sp.expand_trig(sp.sympify(expr)))
+    rep = {}
+    for qi, si, ci in zip(q, S, C, strict=True):
+        rep[sp.sin(qi)] = si
+        rep[sp.cos(qi)] = ci
+    e = sp.expand(e.xreplace(rep))
+    if e.has(sp.sin, sp.cos):
+        raise AssertionError(f"unexpected trigonometric terms left in {e}")
+    if e == 0:
+        return True
+    gens = [*S, *C, *sorted(e.free_symbols - set(S) - set(C), key=str)]
+    _, rem = sp.reduced(e, [si**2 + ci**2 - 1 for si, ci in zip(S, C, strict=True)], *gens)
+    return rem == 0
+
+
+def assert_matrix_zero(A: sp.Matrix, n: int, what: str = "") -> None:
+    bad = [(i, x) for i, x in enumerate(A) if not trig_zero(x, n)]
+    assert not bad, f"{what}: non-zero entries {bad[:2]}"
+
+
+# --------------------------------------------------------------------------- random robots
+
+
+def rotation(rng: np.random.Generator) -> np.ndarray:
+    """A uniformly random rotation matrix (from a random unit quaternion)."""
+    w, x, y, z = (qu := rng.normal(size=4)) / np.linalg.norm(qu)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def random_inertia(rng: np.random.Generator, mass: float) -> np.ndarray:
+    """I = R diag(a, b, c) R^T of a random body: a = m(y2+z2), b = m(x2+z2), c = m(x2+y2).
+
+    Principal moments of that form always satisfy the triangle inequality.
+    """
+    x2, y2, z2 = rng.uniform(0.001, 0.05, 3)
+    R = rotation(rng)
+    inertia = R @ np.diag(mass * np.array([y2 + z2, x2 + z2, x2 + y2])) @ R.T
+    return (inertia + inertia.T) / 2
+
+
+TWISTS = ("0", "pi/2", "-pi/2", "pi", "random")
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """What hypothesis draws: the structure explicitly, the real numbers from a seed."""
+
+    kind: str  # "standard" | "modified" (DH, through robot_from_data) | "general" (Link)
+    joints: tuple[str, ...]
+    twists: tuple[str, ...]
+    seed: int
+
+    @property
+    def n(self) -> int:
+        return len(self.joints)
+
+
+@st.composite
+def robot_specs(draw, min_joints: int = 1, max_joints: int = 7) -> RobotSpec:
+    n = draw(st.integers(min_joints, max_joints))
+    kind = draw(st.sampled_from(("standard", "modified", "general")))
+    joints = draw(st.lists(st.sampled_from(("revolute", "prismatic")), min_size=n, max_size=n))
+    twists = draw(st.lists(st.sampled_from(TWISTS), min_size=n, max_size=n))
+    seed = draw(st.integers(0, 2**32 - 1))
+    return RobotSpec(kind, tuple(joints), tuple(twists), seed)
+
+
+def _maybe_zero(rng, lo, hi) -> float:
+    return 0.0 if rng.random() < 0.3 else float(rng.uniform(lo, hi))
+
+
+def random_dh_data(spec: RobotSpec) -> dict:
+    """A DH robot description (as loaded YAML) with random, physically valid links."""
+    rng = np.random.default_rng(spec.seed)
+    links = []
+    for i, (joint, twist) in enumerate(zip(spec.joints, spec.twists, strict=True)):
+        mass = float(rng.uniform(0.2, 3.0))
+        inertia = random_inertia(rng, mass)
+        alpha = float(rng.uniform(-math.pi, math.pi)) if twist == "random" else twist
+        link = {
+            "name": f"link{i + 1}",
+            "joint": joint,
+            "a": _maybe_zero(rng, -0.5, 0.5),
+            "alpha": alpha,
+            "d": _maybe_zero(rng, -0.5, 0.5),
+            "theta": _maybe_zero(rng, -math.pi, math.pi),
+            "mass": mass,
+            "com": [float(x) for x in rng.uniform(-0.3, 0.3, 3)],
+            "inertia": {
+                "ixx": float(inertia[0, 0]),
+                "iyy": float(inertia[1, 1]),
+                "izz": float(inertia[2, 2]),
+                "ixy": float(inertia[0, 1]),
+                "ixz": float(inertia[0, 2]),
+                "iyz": float(inertia[1, 2]),
+            },
+        }
+        if rng.random() < 0.5:
+            link["friction"] = {"viscous": float(rng.uniform(0, 2)), "coulomb": float(rng.uniform(0, 2))}
+        if rng.random() < 0.5:
+            link["motor"] = {"inertia": float(rng.uniform(0, 1e-3)), "gear_ratio": float(rng.uniform(1, 50))}
+        links.append(link)
+    gravity = rng.normal(size=3) * 5
+    return {
+        "name": f"random_{spec.kind}",
+        "convention": spec.kind,
+        "gravity": [float(x) for x in gravity],
+        "links": links,
+    }
+
+
+def random_general_robot(spec: RobotSpec) -> Robot:
+    """A chain of Link objects with random rotated placements and random unit joint axes."""
+    rng = np.random.default_rng(spec.seed)
+    links = []
+    for i, joint in enumerate(spec.joints):
+        if rng.random() < 0.3:
+            axis = np.zeros(3)
+            axis[rng.integers(3)] = rng.choice([-1.0, 1.0])
+        else:
+            axis = rng.normal(size=3)
+            axis /= np.linalg.norm(axis)
+        mass = float(rng.uniform(0.2, 3.0))
+        links.append(
+            Link(
+                name=f"link{i + 1}",
+                joint=joint,
+                placement=Transform(mat(rotation(rng)), mat(rng.uniform(-0.5, 0.5, (3, 1)))),
+                axis=mat(axis.reshape(3, 1)),
+                mass=sp.Float(mass),
+                com=mat(rng.uniform(-0.3, 0.3, (3, 1))),
+                inertia=mat(random_inertia(rng, mass)),
+                friction=Friction(*(sp.Float(v) for v in rng.uniform(0, 2, 2))),
+                motor=Motor(sp.Float(rng.uniform(0, 1e-3)), sp.Float(rng.uniform(1, 50))),
+            )
+        )
+    return Robot(f"random_general{spec.seed}", tuple(links), mat((rng.normal(size=3) * 5).reshape(3, 1)))
+
+
+def build_robot(spec: RobotSpec) -> Robot:
+    if spec.kind == "general":
+        return random_general_robot(spec)
+    return robot_from_data(random_dh_data(spec), source="hypothesis")
+
+
+def without_motors(robot: Robot) -> Robot:
+    return replace(robot, links=tuple(replace(lk, motor=Motor()) for lk in robot.links))
+
+
+def without_friction(robot: Robot) -> Robot:
+    return replace(robot, links=tuple(replace(lk, friction=Friction()) for lk in robot.links))
