@@ -20,6 +20,17 @@ from .loaders import load_robot
 __all__ = ["EXAMPLES", "render_all", "main"]
 
 EXAMPLES = ("roger_arm", "puma560", "panda")
+TOOLCHAIN_FILE = "TOOLCHAIN"
+
+
+def toolchain() -> str:
+    """The versions that byte-identical output depends on (SymPy's printing, CasADi's format)."""
+    import casadi
+    import sympy
+
+    from . import __version__
+
+    return f"symdyn {__version__}\nsympy {sympy.__version__}\ncasadi {casadi.__version__}\n"
 
 
 def render_all(root: Path) -> dict[str, dict[str, str | bytes]]:
@@ -40,6 +51,11 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     root = Path(args.root)
     stale = []
+    stamp = root / "generated" / TOOLCHAIN_FILE
+    if not stamp.is_file() or stamp.read_text() != toolchain():
+        stale.append(str(stamp))
+        if not args.check:
+            write_files(stamp.parent, {TOOLCHAIN_FILE: toolchain()}, force=True)
     for name, files in render_all(root).items():
         folder = root / "generated" / name
         for fname, content in files.items():

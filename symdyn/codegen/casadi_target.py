@@ -26,6 +26,7 @@ from __future__ import annotations
 import os
 import re
 import tempfile
+from dataclasses import replace
 
 import sympy as sp
 
@@ -288,7 +289,9 @@ def serialise(text: str, ctx: RenderContext) -> dict[str, bytes]:
 
 
 def render(ctx: RenderContext) -> dict[str, str | bytes]:
-    text = render_module(ctx)
+    """NAME_casadi.py and one NAME_<function>.casadi per function. CasADi's SX is double only,
+    so --precision float does not apply here (the header says double)."""
+    text = render_module(replace(ctx, precision="double"))
     files: dict[str, str | bytes] = {f"{module_name(ctx)}.py": text}
     files.update(serialise(text, ctx))
     return files

@@ -1,0 +1,57 @@
+"""The wheel is self-contained: templates ship inside it, and an installed copy generates code."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def wheel(tmp_path_factory) -> Path:
+    pytest.importorskip("hatchling", reason="the test extra installs hatchling to build the wheel")
+    out = tmp_path_factory.mktemp("wheel")
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(out), str(ROOT)],
+        check=True,
+        capture_output=True,
+        timeout=600,
+    )
+    (found,) = out.glob("symdyn-*.whl")
+    return found
+
+
+def test_wheel_contains_every_target_template(wheel):
+    names = zipfile.ZipFile(wheel).namelist()
+    for target in ("c", "casadi", "python", "latex"):
+        assert any(n.startswith(f"symdyn/templates/{target}/") and n.endswith(".j2") for n in names), target
+    assert "symdyn/cli.py" in names
+    assert not any(n.startswith("tests/") or n.startswith("generated/") for n in names)
+
+
+def test_installed_wheel_generates_code_outside_the_source_tree(wheel, tmp_path):
+    site = tmp_path / "site"
+    zipfile.ZipFile(wheel).extractall(site)
+    work = tmp_path / "elsewhere"
+    work.mkdir()
+    robot = ROOT / "examples" / "roger_arm.yaml"
+    script = (
+        "import symdyn, pathlib;"
+        "assert pathlib.Path(symdyn.__file__).parent.parent == pathlib.Path(r'%s');"
+        "paths = symdyn.generate(r'%s', targets=('c', 'python', 'latex'), out_dir='out');"
+        "print(len(paths))"
+    ) % (site, robot)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(site)
+    out = subprocess.run(
+        [sys.executable, "-c", script], cwd=work, env=env, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "4"
+    assert (work / "out" / "roger_arm_dynamics.c").read_text().startswith("/*")
