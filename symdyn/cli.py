@@ -16,6 +16,7 @@ from collections.abc import Sequence
 import sympy as sp
 
 from . import __version__
+from .app_cli import register
 from .dynamics import METHODS, derive
 from .errors import SymdynError, SymdynWarning
 
@@ -151,6 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--method", choices=METHODS, default="newton-euler")
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
     g.set_defaults(func=cmd_generate)
+    register(sub)  # simulate, analyze, check (the lecture's applications)
     return parser
 
 

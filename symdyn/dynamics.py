@@ -29,6 +29,7 @@ from .lagrange import lagrange
 from .newton_euler import joint_frames, newton_euler
 from .program import Program
 from .robot import Robot
+from .simplify import chop_float_noise
 from .symbols import joint_symbols
 
 __all__ = ["Dynamics", "derive", "METHODS", "QUANTITIES", "friction_vector"]
@@ -49,12 +50,12 @@ def friction_vector(robot: Robot, qd) -> sp.Matrix:
 
 
 def simplify_entry(expr: sp.Expr) -> sp.Expr:
-    """A readable closed form: expanded, trigonometric identities applied, collected."""
+    """A readable closed form: expanded, trigonometric identities applied, float rounding
+    residues dropped, common factors pulled out."""
     if expr == 0 or expr.is_Atom:
         return expr
     e = sp.trigsimp(sp.expand(expr))
-    e = sp.expand_trig(e) if e.has(sp.sin, sp.cos) and len(sp.Add.make_args(e)) > 40 else e
-    return sp.factor_terms(e)
+    return sp.factor_terms(chop_float_noise(e))
 
 
 @dataclass

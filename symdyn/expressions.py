@@ -61,6 +61,8 @@ RESERVED_NAMES = frozenset(_FUNCTIONS) | frozenset(_CONSTANTS)
 
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 _JOINT_SYMBOL = re.compile(r"(q|qd|qdd|tau)[0-9]+\Z")
+#: The joint symbols that allow_joint_symbols=True lets through (answer files of `symdyn check`).
+_ANSWER_JOINT_SYMBOL = re.compile(r"(q|qd|qdd)[1-9][0-9]*\Z")
 
 #: C keywords (C89 to C23): they cannot name a robot or a parameter of generated C.
 C_KEYWORDS = frozenset(
@@ -126,7 +128,7 @@ def _name_problem(name: str) -> str | None:
     if name in C_KEYWORDS:
         return f"'{name}' is a C keyword and cannot name a parameter"
     if name.startswith("_"):
-        return f"'{name}' starts with an underscore, which symdyn reserves for its intermediates"
+        return f"'{name}' starts with an underscore: such names are reserved for symdyn's intermediates"
     return None
 
 
@@ -156,9 +158,12 @@ def check_parameter_name(
 class _Builder:
     """Walks a whitelisted Python expression tree and builds SymPy objects."""
 
-    def __init__(self, text: str, fail: Callable[[str], SymdynError]) -> None:
+    def __init__(
+        self, text: str, fail: Callable[[str], SymdynError], allow_joint_symbols: bool = False
+    ) -> None:
         self.text = text
         self.fail = fail
+        self.allow_joint_symbols = allow_joint_symbols
         self.names: list[str] = []
 
     def _segment(self, node: ast.AST) -> str:
@@ -208,6 +213,9 @@ class _Builder:
             return _CONSTANTS[name]
         if name in _FUNCTIONS:
             raise self.fail(f"function '{name}' used without an argument")
+        if self.allow_joint_symbols and _ANSWER_JOINT_SYMBOL.match(name):
+            self.names.append(name)
+            return sp.Symbol(name)
         problem = _name_problem(name)
         if problem:
             raise self.fail(problem)
@@ -304,11 +312,14 @@ def parse_expression_names(
     link_index: int | None = None,
     link_name: str | None = None,
     field: str | None = None,
+    allow_joint_symbols: bool = False,
 ) -> tuple[sp.Expr, tuple[str, ...]]:
     """Parse like `parse_expression`; also return the parameter names in textual order.
 
     The names are those written in the text (left to right, first appearance,
     without repeats), even if they cancel in the result ("x - x").
+    With allow_joint_symbols=True the joint symbols q<k>, qd<k>, qdd<k> (k >= 1) are
+    accepted as names too (answer files of `symdyn check`); robot files never pass it.
     """
     fail = _fail_factory(file, link_index, link_name, field)
     if isinstance(value, bool):
@@ -330,7 +341,7 @@ def parse_expression_names(
         raise fail(f"cannot parse expression '{_short(text)}': {detail}") from None
     except (RecursionError, MemoryError, ValueError):
         raise fail(f"cannot parse expression '{_short(text)}'") from None
-    builder = _Builder(text, fail)
+    builder = _Builder(text, fail, allow_joint_symbols)
     expr = builder.build(tree.body)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise fail(f"expression '{_short(text)}' is not finite ({expr})")
@@ -346,6 +357,7 @@ def parse_expression(
     link_index: int | None = None,
     link_name: str | None = None,
     field: str | None = None,
+    allow_joint_symbols: bool = False,
 ) -> sp.Expr:
     """Parse a number (int/float from YAML) or an expression string into a SymPy expression.
 
@@ -354,7 +366,12 @@ def parse_expression(
     whitelist raises SymdynError naming the location and the offending construct.
     """
     expr, _ = parse_expression_names(
-        value, file=file, link_index=link_index, link_name=link_name, field=field
+        value,
+        file=file,
+        link_index=link_index,
+        link_name=link_name,
+        field=field,
+        allow_joint_symbols=allow_joint_symbols,
     )
     return expr
 

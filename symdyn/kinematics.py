@@ -109,7 +109,9 @@ def _pose_jacobian_function(robot: Robot, link: int, point: tuple):
 
 def _pose_and_jacobian(robot, q, link, point, params):
     values = robot.param_values(params) if robot.params else {}
-    f = _pose_jacobian_function(robot, link, tuple(sp.sympify(x) for x in point))
+    # a point may name parameters the file gives values for (the frame origin [l2, 0, 0])
+    known = robot.value_map
+    f = _pose_jacobian_function(robot, link, tuple(sp.sympify(x).xreplace(known) for x in point))
     T, J = f(np.asarray(q, dtype=float), [values[p] for p in robot.params])
     return np.asarray(T, dtype=float), np.asarray(J, dtype=float)
 

@@ -23,7 +23,7 @@ from functools import cached_property
 
 import sympy as sp
 
-__all__ = ["OpCount", "count_ops", "eliminate", "eliminate_many", "Eliminated"]
+__all__ = ["OpCount", "count_ops", "eliminate", "eliminate_many", "Eliminated", "chop_float_noise"]
 
 MAX_UNROLLED_POWER = 8
 
@@ -55,6 +55,26 @@ class OpCount:
 
 
 _TRIG = (sp.sin, sp.cos, sp.tan)
+#: Terms of a sum whose float coefficient is below CHOP times the largest are rounding residues.
+CHOP = 1e-12
+
+
+def _chop_sum(expr: sp.Expr) -> sp.Expr:
+    """A sum without the terms whose float coefficient is a rounding residue of the others."""
+    coeffs = [abs(t.as_coeff_Mul()[0]) for t in expr.args]
+    if not any(isinstance(c, sp.Float) for c in coeffs):
+        return expr
+    big = max(coeffs)
+    kept = [t for t, c in zip(expr.args, coeffs, strict=True) if c >= CHOP * big]
+    return sp.Add(*kept) if len(kept) < len(expr.args) else expr
+
+
+def chop_float_noise(expr: sp.Expr) -> sp.Expr:
+    """Drop float rounding residues from closed forms (e.g. 6.9e-18*sin(q3) beside
+    0.048*sin(q3)): terms below CHOP times the largest coefficient of their sum."""
+    if not expr.has(sp.Float):
+        return expr
+    return expr.replace(lambda e: e.is_Add, _chop_sum)
 
 
 def _count(expr: sp.Expr) -> OpCount:

@@ -35,7 +35,7 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from ..dynamics import AUTO_SIMPLIFY_MAX_JOINTS, Dynamics
-from ..simplify import eliminate
+from ..simplify import chop_float_noise, eliminate
 from .render import RenderContext, environment, header_lines
 
 __all__ = [
@@ -52,8 +52,6 @@ AMSMATH_NOTE = "% A fragment for a document body (\\input it); it needs only \\u
 #: Estimated visible width (characters) of one displayed line and of a bmatrix row.
 LINE_WIDTH = 56
 MATRIX_WIDTH = 60
-#: Terms of a sum whose float coefficient is below CHOP times the largest are rounding residues.
-CHOP = 1e-12
 
 # LaTeX spellings reserved for the notation; a parameter printing like one is spelled out.
 _RESERVED_LATEX = re.compile(r"(q|s|c|x|\\tau)(_\{.*\})?\Z|\\dot|\\ddot")
@@ -94,23 +92,6 @@ class DynamicsLatexPrinter(LatexPrinter):
             else:
                 out.append(("" if k == 0 else " + ") + self._print(term))
         return out
-
-
-def _chop_sum(expr: sp.Expr) -> sp.Expr:
-    """A sum without the terms whose float coefficient is a rounding residue of the others."""
-    coeffs = [abs(t.as_coeff_Mul()[0]) for t in expr.args]
-    if not any(isinstance(c, sp.Float) for c in coeffs):
-        return expr
-    big = max(coeffs)
-    kept = [t for t, c in zip(expr.args, coeffs, strict=True) if c >= CHOP * big]
-    return sp.Add(*kept) if len(kept) < len(expr.args) else expr
-
-
-def _chop(expr: sp.Expr) -> sp.Expr:
-    """Drop float rounding residues (terms below CHOP times the largest coefficient of their sum)."""
-    if not expr.has(sp.Float):
-        return expr
-    return expr.replace(lambda e: e.is_Add, _chop_sum)
 
 
 def _width(tex: str) -> int:
@@ -176,7 +157,7 @@ class _Notation:
 
     def prepare(self, expr: sp.Expr) -> sp.Expr:
         """expr with sin/cos of joint sums abbreviated and joints on their placeholders."""
-        expr = _chop(sp.sympify(expr))
+        expr = chop_float_noise(sp.sympify(expr))
         if expr.has(sp.sin, sp.cos):
             expr = expr.replace(
                 lambda e: isinstance(e, (sp.sin, sp.cos)) and self._joint_sum(e.args[0]) is not None,

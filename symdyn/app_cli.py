@@ -1,0 +1,379 @@
+"""The `symdyn` subcommands simulate, analyze and check (added to the parser by `register`).
+
+    symdyn simulate ROBOT [--q0 Q ...] [--qd0 QD ...] [--tau TAU ...]
+           [--track QREF ... [--kp KP ...] [--kd KD ...] [--model-params NAME=VALUE ...]]
+           --duration T --dt H [--integrator rk4|euler|lecture|semi-implicit]
+           [--params NAME=VALUE ...] --out traj.csv [--plot traj.png] [--progress]
+    symdyn analyze ROBOT --q Q ... [--qd QD ...] --torque-limits L ... [--axes x,y]
+           [--params NAME=VALUE ...] [--format text|json] [--plot fig.png]
+    symdyn check ROBOT ANSWERS.yaml [--method newton-euler|lagrange] [--samples N] [--verbose]
+
+Vectors are given as separate words or comma-separated ("--q0 0.1 0.2" or
+"--q0 0.1,0.2"; write "--q0=-pi/4,0" when the first value starts with a minus
+sign and is not a plain number). Every value may be an expression (pi/4); torques
+and references may use the time t ("0.5*sin(2*t)"). Expressions go through the
+safe parser, never eval. Bad input raises SymdynError, which `symdyn.cli.main`
+prints as one line with exit status 1; `check` exits 1 when an answer differs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import SymdynError
+from .expressions import parse_expression
+
+__all__ = ["register", "cmd_simulate", "cmd_analyze", "cmd_check"]
+
+
+# --------------------------------------------------------------------------- argument helpers
+
+
+def _words(items, what: str) -> list[str]:
+    """The comma- or space-separated values of a vector option, as strings."""
+    out: list[str] = []
+    for item in items or []:
+        out += [w.strip() for w in str(item).split(",")]
+    if any(not w for w in out):
+        raise SymdynError(f"{what}: empty value in '{','.join(map(str, items))}'")
+    return out
+
+
+def _numbers(items, what: str) -> list[float]:
+    """Numbers or constant expressions ("pi/4") of a vector option."""
+    values = []
+    words = _words(items, what)
+    for k, w in enumerate(words, 1):
+        e = parse_expression(w, field=f"{what}[{k}]" if len(words) > 1 else what)
+        if e.free_symbols:
+            names = ", ".join(sorted(str(s) for s in e.free_symbols))
+            raise SymdynError(f"{what}: '{w}' is not a number (unknown name {names})")
+        v = float(e)
+        if not np.isfinite(v):
+            raise SymdynError(f"{what}: '{w}' is not finite")
+        values.append(v)
+    return values
+
+
+def _vector(items, n: int, what: str, default=None) -> np.ndarray:
+    if items is None:
+        if default is None:
+            raise SymdynError(f"{what} is required ({n} values, one per joint)")
+        return np.asarray(default, dtype=float)
+    values = _numbers(items, what)
+    if len(values) != n:
+        raise SymdynError(f"{what}: expected {n} values (one per joint), got {len(values)}")
+    return np.array(values)
+
+
+def _assignments(items, what: str) -> dict[str, float]:
+    """NAME=VALUE pairs (space- or comma-separated) of --params / --model-params."""
+    out: dict[str, float] = {}
+    for w in _words(items, what):
+        name, sep, value = w.partition("=")
+        name = name.strip()
+        if not sep or not name or not value.strip():
+            raise SymdynError(f"{what}: expected NAME=VALUE, got '{w}'")
+        if name in out:
+            raise SymdynError(f"{what}: {name} given twice")
+        out[name] = _numbers([value], f"{what} {name}")[0]
+    return out
+
+
+def _gains(items, n: int, what: str, default: float) -> np.ndarray:
+    if items is None:
+        return np.full(n, default)
+    values = _numbers(items, what)
+    if len(values) == 1:
+        values = values * n
+    if len(values) != n:
+        raise SymdynError(f"{what}: expected 1 or {n} values, got {len(values)}")
+    return np.array(values)
+
+
+def _load(args: argparse.Namespace):
+    """The robot of args.robot (URDF too, when symdyn.cli knows how)."""
+    from . import cli
+
+    loader = getattr(cli, "_load", None)
+    if loader is not None:
+        return loader(args)
+    from .loaders import load_robot
+
+    return load_robot(args.robot)
+
+
+def _add_robot_argument(parser: argparse.ArgumentParser) -> None:
+    from . import cli
+
+    adder = getattr(cli, "_add_robot_argument", None)
+    if adder is not None:
+        adder(parser)
+    else:
+        parser.add_argument("robot", help="robot file (YAML or JSON)")
+
+
+def _with_params(robot, params: dict[str, float], option: str = "--params"):
+    """The robot with parameter values applied; every free parameter must then have one."""
+    from .simulate import with_parameters
+
+    robot = with_parameters(robot, params)
+    if robot.params:
+        names = ", ".join(str(p) for p in robot.params)
+        raise SymdynError(
+            f"robot '{robot.name}' has free parameters ({names}); give their values with "
+            f"{option} NAME=VALUE (e.g. {option} {str(robot.params[0])}=1)"
+        )
+    return robot
+
+
+def _check_out_path(path: str | None, option: str) -> None:
+    """Refuse an output path whose folder is missing (before any work is done)."""
+    if path is None:
+        return
+    target = Path(path)
+    if target.is_dir():
+        raise SymdynError(f"{option} {path}: is a folder")
+    if not (target.parent if str(target.parent) else Path(".")).is_dir():
+        raise SymdynError(f"{option} {path}: folder {target.parent} does not exist")
+
+
+def _check_plot_path(path: str | None) -> None:
+    if path is None:
+        return
+    from .simulate import _format_of
+
+    _check_out_path(path, "--plot")
+    _format_of(path)
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise SymdynError("--plot needs matplotlib (pip install 'symdyn[plot]')") from None
+
+
+# --------------------------------------------------------------------------- simulate
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from .control import ComputedTorque, Reference, track
+    from .simulate import plot_trajectory, simulate, time_expressions, write_atomic
+
+    _check_out_path(args.out, "--out")
+    _check_plot_path(args.plot)
+    robot = _with_params(_load(args), _assignments(args.params, "--params"))
+    n = robot.n
+    if args.track is not None and args.tau is not None:
+        raise SymdynError("--tau and --track exclude each other (--track computes the torque)")
+    if args.track is None:
+        for opt in ("kp", "kd", "model_params"):
+            if getattr(args, opt) is not None:
+                raise SymdynError(f"--{opt.replace('_', '-')} applies with --track only")
+    if args.track is not None:
+        reference = Reference(_words(args.track, "--track"), n)
+        r0, rd0, _ = reference(0.0)
+        q0 = _vector(args.q0, n, "--q0", default=r0)
+        qd0 = _vector(args.qd0, n, "--qd0", default=rd0)
+        model = robot
+        if args.model_params is not None:
+            model = _with_params(robot, _assignments(args.model_params, "--model-params"), "--model-params")
+        kp = _gains(args.kp, n, "--kp", 100.0)
+        kd = _gains(args.kd, n, "--kd", 20.0)
+        controller = ComputedTorque(model, kp, kd)
+        traj = track(
+            robot,
+            reference,
+            controller,
+            q0,
+            qd0,
+            duration=args.duration,
+            dt=args.dt,
+            integrator=args.integrator,
+            progress=True if args.progress else None,
+        )
+    else:
+        q0 = _vector(args.q0, n, "--q0", default=np.zeros(n))
+        qd0 = _vector(args.qd0, n, "--qd0", default=np.zeros(n))
+        tau = None if args.tau is None else time_expressions(_words(args.tau, "--tau"), n, "--tau")
+        traj = simulate(
+            robot,
+            q0,
+            qd0,
+            duration=args.duration,
+            dt=args.dt,
+            tau=tau,
+            integrator=args.integrator,
+            progress=True if args.progress else None,
+        )
+    image = plot_trajectory(traj) if args.plot else None  # rendered before anything is written
+    write_atomic(args.out, traj.csv_text())
+    if image is not None:
+        write_atomic(args.plot, image)
+    print(
+        f"{args.out}: {len(traj.t)} samples, t = 0 .. {traj.t[-1]:g} s, dt = {args.dt:g} s, "
+        f"integrator {traj.integrator}"
+    )
+    if traj.q_ref is not None:
+        err = np.abs(traj.q_ref - traj.q)
+        print(
+            "tracking error |q_ref - q|: final "
+            + ", ".join(f"{x:.3g}" for x in err[-1])
+            + "; maximum over the last half "
+            + ", ".join(f"{x:.3g}" for x in err[len(err) // 2 :].max(axis=0))
+        )
+    if args.plot:
+        print(args.plot)
+    return 0
+
+
+# --------------------------------------------------------------------------- analyze
+
+
+def cmd_analyze(args: argparse.Namespace) -> int:
+    from .analysis import analyze, parse_axes, plot_analysis
+
+    _check_plot_path(args.plot)
+    axes = parse_axes(args.axes)
+    if args.plot and axes is not None and len(axes) != 2:
+        raise SymdynError(f"--plot draws a 2-D task space: give two --axes (got {args.axes})")
+    robot = _with_params(_load(args), _assignments(args.params, "--params"))
+    n = robot.n
+    q = _vector(args.q, n, "--q")
+    qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
+    limits = _numbers(args.torque_limits, "--torque-limits")
+    result = analyze(robot, q, qd, torque_limits=limits, axes=axes)
+    image = None
+    if args.plot:
+        if len(result.axes) != 2:
+            raise SymdynError(
+                "--plot draws a 2-D task space: give two --axes "
+                f"(the default here is {','.join(result.axes)})"
+            )
+        image = plot_analysis(result, robot=robot)
+    sys.stdout.write(result.to_json() if args.format == "json" else result.to_text())
+    if image is not None:
+        from .simulate import write_atomic
+
+        write_atomic(args.plot, image)
+    return 0
+
+
+# --------------------------------------------------------------------------- check
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from .check import check_answers
+
+    if args.samples < 1:
+        raise SymdynError("--samples must be at least 1")
+    robot = _load(args)
+    report = check_answers(robot, args.answers, method=args.method, samples=args.samples)
+    sys.stdout.write(report.text(verbose=args.verbose))
+    return 0 if report.ok else 1
+
+
+# --------------------------------------------------------------------------- the parser
+
+
+def _positive(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got '{text}'") from None
+    if not np.isfinite(v) or v <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got '{text}'")
+    return v
+
+
+def register(subparsers) -> None:
+    """Add the subcommands simulate, analyze and check to `symdyn`'s subparsers."""
+    from .dynamics import METHODS
+    from .simulate import INTEGRATORS
+
+    vec = {"nargs": "+", "metavar": "V"}
+
+    s = subparsers.add_parser(
+        "simulate",
+        help="simulate the robot (optionally under computed-torque control); write a CSV",
+        description="Integrate qdd = M^-1 (tau - V - G - F) from q0, qd0 and write t, q1..qn, qd1..qdn "
+        "as CSV. Vectors: values separated by spaces or commas; expressions allowed (pi/4), "
+        "torques and references may use t.",
+    )
+    _add_robot_argument(s)
+    s.add_argument("--q0", **vec, help="initial joint positions (default 0, or q_ref(0) with --track)")
+    s.add_argument("--qd0", **vec, help="initial joint velocities (default 0, or qd_ref(0) with --track)")
+    s.add_argument(
+        "--tau",
+        **vec,
+        help="joint torques: numbers or expressions of t, one per joint (one value: every joint; default 0)",
+    )
+    s.add_argument(
+        "--track",
+        **vec,
+        help="computed-torque control tracking q_ref(t): one expression of t per joint "
+        "(qd_ref, qdd_ref by symbolic differentiation)",
+    )
+    s.add_argument("--kp", **vec, help="position gain(s) Kp, one or one per joint (default 100)")
+    s.add_argument("--kd", **vec, help="velocity gain(s) Kd, one or one per joint (default 20)")
+    s.add_argument(
+        "--model-params",
+        nargs="+",
+        metavar="NAME=VALUE",
+        help="the controller model's parameter values where they differ from the plant's",
+    )
+    s.add_argument("--duration", type=_positive, required=True, help="simulated time T (s)")
+    s.add_argument("--dt", type=_positive, required=True, help="time step H (s)")
+    s.add_argument(
+        "--integrator",
+        choices=INTEGRATORS,
+        default="rk4",
+        help="rk4 (default); euler = lecture: the scheme of slide 19, q += qd dt + qdd dt^2/2, "
+        "qd += qdd dt; semi-implicit: qd += qdd dt, then q += qd dt",
+    )
+    s.add_argument("--params", nargs="+", metavar="NAME=VALUE", help="parameter values (free or overriding)")
+    s.add_argument("--out", required=True, help="CSV file to write (atomically)")
+    s.add_argument("--plot", help="also draw q, qd (and the reference and tracking error) to this PNG")
+    s.add_argument(
+        "--progress", action="store_true", help="show a progress bar even when stderr is not a terminal"
+    )
+    s.set_defaults(func=cmd_simulate)
+
+    a = subparsers.add_parser(
+        "analyze",
+        help="inertia ellipsoid, dynamic manipulability and acceleration polytope at a state",
+        description="Lecture slides 21-23 at (q, qd): the generalized inertia ellipsoid (eigenvectors and "
+        "sqrt of eigenvalues of M M^T), the dynamic manipulability ellipsoid with its bias and "
+        "kappa_d = sqrt(det(J (M^T M)^-1 J^T)), and the acceleration polytope.",
+    )
+    _add_robot_argument(a)
+    a.add_argument("--q", **vec, required=True, help="joint positions")
+    a.add_argument("--qd", **vec, help="joint velocities (default 0)")
+    a.add_argument(
+        "--torque-limits", **vec, required=True, help="|tau_i| bounds: one for all, or one per joint"
+    )
+    a.add_argument(
+        "--axes",
+        help="task axes of the end-effector Jacobian (base frame), comma-separated among "
+        "x,y,z,rx,ry,rz (default: the linear axes that move, e.g. x,y for a planar arm)",
+    )
+    a.add_argument("--params", nargs="+", metavar="NAME=VALUE", help="parameter values (free or overriding)")
+    a.add_argument("--format", choices=("text", "json"), default="text")
+    a.add_argument("--plot", help="draw the ellipses and the polytope (two axes) to this PNG")
+    a.set_defaults(func=cmd_analyze)
+
+    c = subparsers.add_parser(
+        "check",
+        help="check answers (M, C, V, G, F, tau as expressions) against the derivation",
+        description="Compare an answers file (YAML: any of M, C, V, G, F, tau as expressions in the "
+        "robot's symbols and q1.., qd1.., qdd1..) with symdyn's derivation, symbolically and, when "
+        "inconclusive, numerically. Exit status 0 when every entry matches, 1 otherwise.",
+    )
+    _add_robot_argument(c)
+    c.add_argument("answers", help="answers file (YAML)")
+    c.add_argument("--method", choices=METHODS, default="newton-euler")
+    c.add_argument("--samples", type=int, default=16, help="random points for the numeric comparison")
+    c.add_argument("--verbose", action="store_true", help="also list the entries that match")
+    c.set_defaults(func=cmd_check)

@@ -1,0 +1,304 @@
+"""Checking textbook (or homework) answers against symdyn's derivation.
+
+An answers file (YAML) gives any of M, C, V, G, F, tau of a robot as
+expressions in the robot's parameter names and the joint symbols q1.., qd1..,
+qdd1..:
+
+    M: [["m2*l2**2 + 2*m2*l1*l2*cos(q2) + (m1 + m2)*l1**2", "m2*l2**2 + m2*l1*l2*cos(q2)"],
+        ["m2*l2**2 + m2*l1*l2*cos(q2)", "m2*l2**2"]]
+    G: ["(m1 + m2)*g*l1*sin(q1) + m2*g*l2*sin(q1 + q2)", "m2*g*l2*sin(q1 + q2)"]
+
+M and C are n x n lists of rows, the others lists of n entries (a 1-joint robot
+may give a single entry). Entries are numbers or strings parsed by symdyn's
+safe parser (never evaluated as code). Parameters that have a value in the
+robot file are replaced by that value.
+
+Each entry is compared with symdyn's closed form: first symbolically (the
+expanded difference, without floating-point rounding noise below 1e-12 of the
+largest number, then `sympy.simplify` of it, must be 0), and when that is
+inconclusive numerically at random points (joint values in [-pi, pi],
+velocities and accelerations in [-2, 2], free parameters in [0.5, 2]). An entry
+that differs at any point differs; one that agrees everywhere but resists
+simplification counts as matching numerically.
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import sympy as sp
+import yaml
+
+from .dynamics import METHODS, derive
+from .errors import SymdynError
+from .expressions import parse_expression
+from .robot import Robot
+from .symbols import joint_symbols
+
+__all__ = ["QUANTITIES", "EntryResult", "CheckReport", "load_answers", "parse_answers", "check_answers"]
+
+QUANTITIES = ("M", "C", "V", "G", "F", "tau")
+MATRICES = ("M", "C")
+SAMPLES = 16
+RTOL = 1e-9
+SIMPLIFY_MAX_OPS = 400  # larger differences are judged numerically only
+
+_JOINT = re.compile(r"(?<![\w.])(q|qd|qdd)([0-9]+)(?!\w)")
+_PLACEHOLDER = re.compile(r"(?<![\w.])(Q|QD|QDD)([0-9]+)(?!\w)")
+
+
+def _entry_label(name: str, index: tuple[int, ...]) -> str:
+    return f"{name}[{','.join(str(i) for i in index)}]"
+
+
+def _parse_entry(value: object, file: str | None, label: str) -> sp.Expr:
+    """Parse one answer entry, letting the joint symbols q<k>, qd<k>, qdd<k> through.
+
+    Uses parse_expression(..., allow_joint_symbols=True) when the parser offers it.
+    Otherwise the joint symbols are renamed to placeholders of the same length (q2 -> Q2,
+    qd2 -> QD2, qdd2 -> QDD2; such names are then refused in answers) before parsing and
+    renamed back after: the text is still only ever parsed by the whitelist parser.
+    """
+    if "allow_joint_symbols" in inspect.signature(parse_expression).parameters:
+        return parse_expression(value, file=file, field=label, allow_joint_symbols=True)
+    if not isinstance(value, str):
+        return parse_expression(value, file=file, field=label)
+    clash = _PLACEHOLDER.search(value)
+    if clash:
+        raise SymdynError(
+            f"the name '{clash.group(0)}' is reserved in answers (joint symbols are lower case: "
+            f"{clash.group(0).lower()})",
+            file=file,
+            field=label,
+        )
+    renamed = _JOINT.sub(lambda m: m.group(1).upper() + m.group(2), value)
+    try:
+        expr = parse_expression(renamed, file=file, field=label)
+    except SymdynError as exc:
+        reason = _PLACEHOLDER.sub(lambda m: m.group(1).lower() + m.group(2), exc.reason)
+        raise SymdynError(reason, file=file, field=label) from None
+    back = {
+        s: sp.Symbol(s.name.lower()) for s in expr.free_symbols if _PLACEHOLDER.fullmatch(s.name) is not None
+    }
+    return expr.xreplace(back)
+
+
+def parse_answers(data: object, robot: Robot, file: str | None = None) -> dict[str, sp.Matrix]:
+    """The answers of a mapping (e.g. read from YAML) as SymPy matrices over the robot's symbols."""
+    if not isinstance(data, Mapping):
+        kind = "empty file" if data is None else type(data).__name__
+        raise SymdynError(f"expected a mapping of M, C, V, G, F, tau to answers, got {kind}", file=file)
+    unknown = [str(k) for k in data if k not in QUANTITIES]
+    if unknown:
+        raise SymdynError(
+            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)})", file=file
+        )
+    if not data:
+        raise SymdynError("no answers given (any of M, C, V, G, F, tau)", file=file)
+    n = robot.n
+    q, qd, qdd = joint_symbols(n)
+    allowed = set(robot.params) | set(q) | set(qd) | set(qdd)
+    values = robot.value_map
+    out: dict[str, sp.Matrix] = {}
+    for name in QUANTITIES:
+        if name not in data:
+            continue
+        raw = data[name]
+        if name in MATRICES:
+            if n == 1 and not isinstance(raw, list):
+                raw = [[raw]]
+            ok = (
+                isinstance(raw, list)
+                and len(raw) == n
+                and all(isinstance(r, list) and len(r) == n for r in raw)
+            )
+            if not ok:
+                raise SymdynError(f"{name} must be a list of {n} rows of {n} entries", file=file, field=name)
+            cells = [((i + 1, j + 1), raw[i][j]) for i in range(n) for j in range(n)]
+            shape = (n, n)
+        else:
+            if n == 1 and not isinstance(raw, list):
+                raw = [raw]
+            if not (isinstance(raw, list) and len(raw) == n):
+                raise SymdynError(f"{name} must be a list of {n} entries", file=file, field=name)
+            cells = [((i + 1,), raw[i]) for i in range(n)]
+            shape = (n, 1)
+        entries = []
+        for index, value in cells:
+            label = _entry_label(name, index)
+            if isinstance(value, list):
+                raise SymdynError("expected one expression, got a list", file=file, field=label)
+            expr = _parse_entry(value, file, label).xreplace(values)
+            extra = sorted(str(s) for s in expr.free_symbols - allowed)
+            if extra:
+                names = ", ".join(str(s) for s in robot.params) or "none"
+                raise SymdynError(
+                    f"unknown name(s) {', '.join(extra)}: use the robot's free parameters ({names}) and "
+                    f"q1..q{n}, qd1..qd{n}, qdd1..qdd{n} (write cos(q2), not c2)",
+                    file=file,
+                    field=label,
+                )
+            entries.append(expr)
+        out[name] = sp.Matrix(*shape, entries)
+    return out
+
+
+def load_answers(path: str | os.PathLike, robot: Robot) -> dict[str, sp.Matrix]:
+    """Read an answers file (YAML, safe loader) for `robot`."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise SymdynError(f"not a UTF-8 text file: {exc.reason}", file=str(p)) from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or "invalid YAML"
+        raise SymdynError(f"invalid YAML{where}: {problem}", file=str(p)) from None
+    return parse_answers(data, robot, str(p))
+
+
+@dataclass
+class EntryResult:
+    """One compared entry: 1-based `index`, symdyn's `expected` and the answer's `got`.
+
+    status: "symbolic" (the difference simplifies to 0), "numeric" (equal at every
+    random point, simplification inconclusive) or "differs".
+    """
+
+    quantity: str
+    index: tuple[int, ...]
+    expected: sp.Expr
+    got: sp.Expr
+    status: str
+
+    @property
+    def label(self) -> str:
+        return _entry_label(self.quantity, self.index)
+
+    @property
+    def ok(self) -> bool:
+        return self.status != "differs"
+
+    def line(self) -> str:
+        return f"{self.label}: expected {sp.sstr(self.expected)}, got {sp.sstr(self.got)}"
+
+
+@dataclass
+class CheckReport:
+    robot: str
+    method: str
+    samples: int
+    results: list[EntryResult] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return all(r.ok for r in self.results)
+
+    @property
+    def differing(self) -> list[EntryResult]:
+        return [r for r in self.results if not r.ok]
+
+    def summary(self) -> str:
+        total = len(self.results)
+        names = ", ".join(dict.fromkeys(r.quantity for r in self.results))
+        if self.ok:
+            numeric = sum(r.status == "numeric" for r in self.results)
+            how = (
+                "all symbolically"
+                if not numeric
+                else f"{total - numeric} symbolically, {numeric} numerically at {self.samples} random points"
+            )
+            return f"{self.robot}: all {total} entries of {names} match ({how})"
+        bad = self.differing
+        return (
+            f"{self.robot}: {len(bad)} of {total} entries of {names} differ "
+            f"({', '.join(r.label for r in bad)})"
+        )
+
+    def text(self, verbose: bool = False) -> str:
+        lines = []
+        for r in self.results:
+            if not r.ok:
+                lines.append(r.line())
+            elif verbose:
+                lines.append(f"{r.label}: matches ({r.status})")
+        lines.append(self.summary())
+        return "\n".join(lines) + "\n"
+
+
+def _numeric_zero(diff: sp.Expr, scale: sp.Expr, symbols: list[sp.Symbol], points: np.ndarray) -> bool:
+    """Whether diff is 0 (relative to 1 + |scale|) at every sample point."""
+    f = sp.lambdify([symbols], [diff, scale], modules="numpy")
+    with np.errstate(all="ignore"):
+        d, s = (np.broadcast_to(np.asarray(x, dtype=float), points.shape[:1]) for x in f(points.T))
+    if not np.all(np.isfinite(d)):
+        return False
+    return bool(np.all(np.abs(d) <= RTOL * (1.0 + np.abs(s))))
+
+
+def _chop(diff: sp.Expr, *exprs: sp.Expr) -> sp.Expr:
+    """diff without the floating-point rounding noise of numeric parameter values."""
+    floats = [abs(f) for x in exprs for f in x.atoms(sp.Float)]
+    if not floats:
+        return diff
+    tiny = 1e-12 * max(1.0, float(max(floats)))
+    return diff.xreplace({f: sp.S.Zero for f in diff.atoms(sp.Float) if abs(f) <= tiny})
+
+
+def _symbolic_zero(diff: sp.Expr) -> bool:
+    if diff == 0:
+        return True
+    if sp.count_ops(diff) > SIMPLIFY_MAX_OPS:
+        return False
+    try:
+        return sp.simplify(diff) == 0
+    except Exception:  # simplification failing is only an inconclusive result
+        return False
+
+
+def check_answers(
+    robot: Robot,
+    answers: str | os.PathLike | Mapping,
+    method: str = "newton-euler",
+    samples: int = SAMPLES,
+    seed: int = 0,
+) -> CheckReport:
+    """Compare answers (a file or a mapping as in the YAML) with symdyn's derivation of `robot`."""
+    if method not in METHODS:
+        raise SymdynError(f"unknown method '{method}' (use {' or '.join(METHODS)})")
+    parsed = parse_answers(answers, robot) if isinstance(answers, Mapping) else load_answers(answers, robot)
+    dyn = derive(robot, method=method)
+    symbols = [*dyn.q, *dyn.qd, *dyn.qdd, *dyn.params]
+    rng = np.random.default_rng(seed)
+    n = dyn.n
+    points = np.column_stack(
+        [
+            rng.uniform(-np.pi, np.pi, (samples, n)),
+            rng.uniform(-2, 2, (samples, 2 * n)),
+            rng.uniform(0.5, 2.0, (samples, len(dyn.params))),
+        ]
+    )
+    report = CheckReport(robot.name, method, samples)
+    for name, got in parsed.items():
+        expected = dyn.closed_form(name)
+        for k in range(len(got)):
+            index = (k // n + 1, k % n + 1) if name in MATRICES else (k + 1,)
+            e, g = expected[k], got[k]
+            diff = _chop(sp.expand(g - e), e, g)
+            if diff == 0:
+                status = "symbolic"
+            elif not _numeric_zero(diff, sp.Abs(e) + sp.Abs(g), symbols, points):
+                status = "differs"
+            else:
+                status = "symbolic" if _symbolic_zero(diff) else "numeric"
+            report.results.append(EntryResult(name, index, e, g, status))
+    return report
