@@ -16,7 +16,7 @@ from . import (
 from .codegen import generate  # noqa: E402
 from .dynamics import Dynamics, derive  # noqa: E402
 from .errors import SymdynError, SymdynWarning  # noqa: E402
-from .loaders import load_robot, robot_from_data  # noqa: E402
+from .loaders import load_robot, load_urdf, robot_from_data  # noqa: E402
 from .robot import Link, Robot  # noqa: E402
 
 __all__ = [
@@ -30,6 +30,7 @@ __all__ = [
     "generate",
     "inertia",
     "load_robot",
+    "load_urdf",
     "rnea",
     "robot_from_data",
 ]

@@ -29,15 +29,9 @@ PRINTED = ("M", "C", "V", "G", "F")
 
 def _load(args: argparse.Namespace):
     """A robot from a robot file, or from a URDF file (by its .urdf suffix) with --base/--tip."""
-    from .loaders import load_robot
+    from .loaders import load
 
-    if str(args.robot).lower().endswith(".urdf"):
-        from .loaders.urdf import load_urdf
-
-        return load_urdf(args.robot, base=args.base, tip=args.tip)
-    if args.base or args.tip:
-        raise SymdynError(f"{args.robot}: --base and --tip apply to URDF files only")
-    return load_robot(args.robot)
+    return load(args.robot, base=args.base, tip=args.tip)
 
 
 def _add_robot_argument(parser: argparse.ArgumentParser) -> None:

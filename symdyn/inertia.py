@@ -42,6 +42,10 @@ Tensor = sp.ImmutableMatrix | np.ndarray
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
+#: Below this (kg m^2) a tensor entry is numerically zero: published URDFs write 1e-35 for none.
+ABSOLUTE_TOLERANCE = 1e-15
+
+
 def _is_symbolic(*args: Any) -> bool:
     """True if any argument is, or (as a sequence/array) contains, a SymPy object."""
     for a in args:
@@ -248,7 +252,7 @@ def check_inertia(
     if np.max(np.abs(A - A.T)) > 1e-9 * scale:
         raise SymdynError("inertia tensor is not symmetric", field="inertia", **where)
     moments = np.linalg.eigvalsh(0.5 * (A + A.T))
-    if moments[0] < -1e-12 * scale:
+    if moments[0] < -(1e-12 * scale + ABSOLUTE_TOLERANCE):
         raise SymdynError(
             f"inertia tensor is not positive semi-definite (principal moments {moments.tolist()})",
             field="inertia",
@@ -257,7 +261,7 @@ def check_inertia(
     loc = location(file, link_index, link_name, "inertia")
     prefix = f"{loc}: " if loc else ""
     i1, i2, i3 = moments
-    if i1 + i2 < i3 - 1e-9 * scale:
+    if i1 + i2 < i3 - (1e-9 * scale + ABSOLUTE_TOLERANCE):
         warnings.warn(
             f"{prefix}principal moments {moments.tolist()} break the triangle inequality "
             "I1 + I2 >= I3 (no real body has them)",

@@ -62,10 +62,10 @@ def generate(
     force: bool = False,
     method: str = "newton-euler",
 ) -> list[Path]:
-    """Render the targets for `robot` (a Robot or a robot file) and write them into out_dir."""
+    """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir."""
     if not isinstance(robot, Robot):
-        from ..loaders import load_robot
+        from ..loaders import load
 
-        robot = load_robot(robot)
+        robot = load(robot)
     files = render(robot, targets, precision, method)
     return write_files(out_dir, files, force=force)

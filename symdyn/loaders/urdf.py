@@ -16,7 +16,10 @@ a symdyn body frame unchanged (`Link.frame` is the identity):
   theorem (symdyn.inertia.rotate, parallel_axis). The inertial <origin> (xyz and
   rpy) is honoured;
 * the base link and everything rigidly fixed to it is the ground: its mass does
-  not enter the dynamics; links that are not below the base are ignored;
+  not enter the dynamics; links that are not below the base are ignored. The whole
+  file must be well formed (XML, numbers, one tree), but inertial data is checked
+  (symdyn.inertia.check_inertia: errors and warnings) only for the links that move,
+  so a bad tensor on, say, a mobile base's antenna does not refuse its arm;
 * <dynamics damping="" friction=""> become friction.viscous and friction.coulomb;
   limits, transmissions, visual and collision elements (and their meshes) are
   ignored: nothing is ever fetched, from disk or the network.
@@ -31,10 +34,10 @@ Integer, others as Float of the written text; an rpy angle within 1e-9 rad of a
 multiple of pi/2 is taken as that exact multiple, so that its sine and cosine are
 exactly 0 or +-1 (the 1.5707963267948966 of xacro output).
 
-The XML is read with the standard library's expat parser, hardened: document
-type declarations may not declare entities (so neither external entities nor
-entity expansion can happen), parameter entities and external DTDs are never
-loaded, and the file may be at most 64 MiB.
+The XML is read with the standard library's expat parser, hardened: a document
+type declaration (<!DOCTYPE ...>, which a URDF never needs) is refused, so no
+entity can be declared, expanded or fetched; parameter entities and external
+DTDs are never loaded either, and the file may be at most 64 MiB.
 """
 
 from __future__ import annotations
@@ -44,7 +47,6 @@ import hashlib
 import math
 import os
 import re
-import warnings
 from dataclasses import dataclass, field
 from xml.parsers import expat
 
@@ -100,6 +102,12 @@ def _parse_xml(raw: bytes, file: str) -> _Element:
     def end(tag: str) -> None:
         stack.pop()
 
+    def doctype(name, system_id, public_id, has_internal_subset) -> None:
+        raise _RefusedError(
+            f"line {parser.CurrentLineNumber}: document type declarations (<!DOCTYPE>) are refused: "
+            "a URDF needs none, and refusing them rules out external entities and entity expansion"
+        )
+
     def entity_declaration(name, *args) -> None:
         raise _RefusedError(
             f"line {parser.CurrentLineNumber}: the document declares the entity '{name}'; "
@@ -111,7 +119,8 @@ def _parse_xml(raw: bytes, file: str) -> _Element:
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
-    parser.EntityDeclHandler = entity_declaration
+    parser.StartDoctypeDeclHandler = doctype
+    parser.EntityDeclHandler = entity_declaration  # (unreachable without a DTD: defence in depth)
     parser.UnparsedEntityDeclHandler = entity_declaration
     parser.ExternalEntityRefHandler = external_entity
     try:
@@ -246,7 +255,8 @@ class _Reader:
             return Transform.identity()
         xyz = self.vector(el.attrib.get("xyz", "0 0 0"), _at(where, prefix + "origin.xyz"), el.line)
         rpy = self.vector(el.attrib.get("rpy", "0 0 0"), _at(where, prefix + "origin.rpy"), el.line)
-        return Transform(rpy_matrix(*(_snap_angle(a) for a in rpy)), sp.ImmutableMatrix(3, 1, xyz))
+        R = rpy_matrix(*(_snap_angle(a) for a in rpy)).applyfunc(_numeric)  # cos(1) -> 0.5403...
+        return Transform(R, sp.ImmutableMatrix(3, 1, xyz))
 
     # -- the document
     def read(self, root: _Element) -> None:
@@ -491,8 +501,8 @@ class _Tree:
             kids = self.children[name]
             if not kids and name != base:
                 out.append(name)
-            stack.extend(j.child for j in reversed(kids))
-        return out
+            stack.extend(j.child for j in kids)
+        return sorted(out, key=lambda name: self.links[name].index)  # file order
 
 
 def _link_name(reader: _Reader, name: str | None, what: str) -> str:
@@ -642,19 +652,18 @@ def _numeric(x: sp.Expr) -> sp.Expr:
     return sp.Float(x.evalf(17), 17)
 
 
-def _check_inertials(reader: _Reader, used: set[str]) -> None:
-    """Impossible inertial data is an error anywhere; implausible data warns for the links used."""
-    for link in reader.links.values():
-        if link.inertial is None:
-            continue
-        args = (link.inertial.mass, link.inertial.tensor)
-        kw = {"file": reader.file, "link_index": link.index, "link_name": link.name}
-        if link.name in used:
-            check_inertia(*args, **kw)
-        else:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                check_inertia(*args, **kw)
+def _check_inertials(reader: _Reader, names: list[str]) -> None:
+    """Impossible inertial data (error) and implausible data (warning) of the links that move."""
+    for name in names:
+        link = reader.links[name]
+        if link.inertial is not None:
+            check_inertia(
+                link.inertial.mass,
+                link.inertial.tensor,
+                file=reader.file,
+                link_index=link.index,
+                link_name=link.name,
+            )
 
 
 def _build(reader: _Reader, digest: str, base: str | None, tip: str | None) -> Robot:
@@ -683,7 +692,6 @@ def _build(reader: _Reader, digest: str, base: str | None, tip: str | None) -> R
     chain = {j.name for j in movable}
 
     links: list[Link] = []
-    used: set[str] = set()
     fixed = Transform.identity()  # previous body frame -> the current link on the path
     for j in path:
         if not j.movable:
@@ -699,7 +707,7 @@ def _build(reader: _Reader, digest: str, base: str | None, tip: str | None) -> R
                 line=child.line,
             )
         parts = _body_parts(tree, j.child, path_names, chain)
-        used.update(name for name, _ in parts)
+        _check_inertials(reader, [name for name, _ in parts])
         mass, com, inertia = _merge(
             [(reader.links[n].inertial, T) for n, T in parts if reader.links[n].inertial is not None]
         )
@@ -716,7 +724,6 @@ def _build(reader: _Reader, digest: str, base: str | None, tip: str | None) -> R
             )
         )
         fixed = Transform.identity()
-    _check_inertials(reader, used)
     return Robot(
         name=reader.robot_name,
         links=tuple(links),
