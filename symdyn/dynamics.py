@@ -144,7 +144,7 @@ class Dynamics:
         p = [values[s] for s in self.params]
         shape = self.compact[name].shape
         out = np.asarray(self._numeric[name](*vec, p), dtype=float).reshape(shape)
-        return out[:, 0] if shape[1] == 1 else out
+        return out[:, 0] if name not in ("M", "C") else out
 
 
 def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:

@@ -15,7 +15,7 @@ import math
 import warnings
 from dataclasses import dataclass, replace
 from fractions import Fraction
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +48,7 @@ def mat(a) -> sp.ImmutableMatrix:
 # --------------------------------------------------------------------------- examples
 
 
-@lru_cache(maxsize=None)
+@cache
 def example(name: str) -> Robot:
     """examples/<name>.yaml through the loader (its published-data warnings silenced)."""
     with warnings.catch_warnings():
@@ -56,7 +56,7 @@ def example(name: str) -> Robot:
         return load_robot(EXAMPLES_DIR / f"{name}.yaml")
 
 
-@lru_cache(maxsize=None)
+@cache
 def raw_example(name: str) -> dict:
     """The example file as plain data (yaml.safe_load), independent of the loader."""
     return yaml.safe_load((EXAMPLES_DIR / f"{name}.yaml").read_text())
@@ -71,13 +71,13 @@ def raw_value(value, parameters: dict | None = None) -> sp.Expr:
     return expr
 
 
-@lru_cache(maxsize=None)
+@cache
 def derived(name: str, method: str, simplify: bool | None = False):
     """derive(example(name), method) once per session (closed forms unsimplified by default)."""
     return derive(example(name), method=method, simplify=simplify)
 
 
-@lru_cache(maxsize=None)
+@cache
 def derived_robot(robot: Robot, method: str, simplify: bool | None = False):
     """derive(robot, method) once per session for a hand-built (hashable) robot."""
     return derive(robot, method=method, simplify=simplify)

@@ -18,7 +18,18 @@ def wheel(tmp_path_factory) -> Path:
     pytest.importorskip("hatchling", reason="the test extra installs hatchling to build the wheel")
     out = tmp_path_factory.mktemp("wheel")
     subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(out), str(ROOT)],
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "--no-deps",
+            "--no-build-isolation",
+            "-q",
+            "-w",
+            str(out),
+            str(ROOT),
+        ],
         check=True,
         capture_output=True,
         timeout=600,
@@ -43,10 +54,10 @@ def test_installed_wheel_generates_code_outside_the_source_tree(wheel, tmp_path)
     robot = ROOT / "examples" / "roger_arm.yaml"
     script = (
         "import symdyn, pathlib;"
-        "assert pathlib.Path(symdyn.__file__).parent.parent == pathlib.Path(r'%s');"
-        "paths = symdyn.generate(r'%s', targets=('c', 'python', 'latex'), out_dir='out');"
+        f"assert pathlib.Path(symdyn.__file__).parent.parent == pathlib.Path(r'{site}');"
+        f"paths = symdyn.generate(r'{robot}', targets=('c', 'python', 'latex'), out_dir='out');"
         "print(len(paths))"
-    ) % (site, robot)
+    )
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     env["PYTHONPATH"] = str(site)
     out = subprocess.run(
