@@ -6,7 +6,6 @@ examples/answers/roger_arm_answers.yaml; wrong answers are made from them by han
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import pytest
@@ -15,7 +14,6 @@ import yaml
 
 import symdyn.check as check_module
 import symdyn.cli as cli
-from symdyn.app_cli import register
 from symdyn.check import check_answers, load_answers
 from symdyn.errors import SymdynError
 from symdyn.loaders import load_robot
@@ -35,17 +33,8 @@ def answers() -> dict:
     return yaml.safe_load(ANSWERS.read_text())
 
 
-def run_cli(argv, monkeypatch) -> int:
-    original = cli.build_parser
-
-    def build():
-        parser = original()
-        sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-        if "simulate" not in sub.choices:
-            register(sub)
-        return parser
-
-    monkeypatch.setattr(cli, "build_parser", build)
+def run_cli(argv, monkeypatch=None) -> int:
+    """The symdyn command in-process (symdyn.cli.main, which registers simulate/analyze/check)."""
     return cli.main([str(a) for a in argv])
 
 

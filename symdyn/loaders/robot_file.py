@@ -16,13 +16,11 @@ resolved and stored in `Robot.values`, in file order.
 from __future__ import annotations
 
 import difflib
-import hashlib
 import json
 import os
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import sympy as sp
 import yaml
@@ -36,6 +34,7 @@ from ..expressions import (
 from ..robot import JOINT_TYPES, Friction, Link, Motor, Robot
 from ..transform import Transform
 from .dh import CONVENTIONS, dh_link, to_body
+from .source import read_source
 
 __all__ = ["load_robot", "robot_from_data"]
 
@@ -73,20 +72,7 @@ def load_robot(path: str | os.PathLike) -> Robot:
     Raises SymdynError (naming file, link and field) for any bad input; warns
     with SymdynWarning for implausible inertial data.
     """
-    try:
-        file = os.fspath(path)
-    except TypeError:
-        raise SymdynError(f"robot file path must be a string or path, not {path!r}") from None
-    file = str(file)
-    try:
-        raw = Path(file).read_bytes()
-    except FileNotFoundError:
-        raise SymdynError("no such file", file=file) from None
-    except IsADirectoryError:
-        raise SymdynError("is a directory, not a robot file", file=file) from None
-    except OSError as exc:
-        raise SymdynError(f"cannot read file: {exc.strerror or exc}", file=file) from None
-    digest = hashlib.sha256(raw).hexdigest()
+    file, raw, digest = read_source(path, "robot file")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -43,7 +43,6 @@ DTDs are never loaded either, and the file may be at most 64 MiB.
 from __future__ import annotations
 
 import difflib
-import hashlib
 import math
 import os
 import re
@@ -57,10 +56,10 @@ from ..expressions import C_KEYWORDS
 from ..inertia import check_inertia, parallel_axis, rotate
 from ..robot import Friction, Link, Robot
 from ..transform import Transform, rot_axis, rpy_matrix
+from .source import MAX_BYTES, read_source
 
 __all__ = ["load_urdf", "urdf_robot_name", "MAX_BYTES"]
 
-MAX_BYTES = 64 * 2**20
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\Z")
@@ -742,24 +741,10 @@ def load_urdf(path: str | os.PathLike, base: str | None = None, tip: str | None 
     link and field for bad input; warns with SymdynWarning for implausible inertial
     data of the links used. The robot's name is the URDF name made a C identifier.
     """
-    try:
-        file = str(os.fspath(path))
-    except TypeError:
-        raise SymdynError(f"URDF path must be a string or path, not {path!r}") from None
-    try:
-        with open(file, "rb") as fh:
-            raw = fh.read(MAX_BYTES + 1)
-    except FileNotFoundError:
-        raise SymdynError("no such file", file=file) from None
-    except IsADirectoryError:
-        raise SymdynError("is a directory, not a URDF file", file=file) from None
-    except OSError as exc:
-        raise SymdynError(f"cannot read file: {exc.strerror or exc}", file=file) from None
-    if len(raw) > MAX_BYTES:
-        raise SymdynError(f"file larger than {MAX_BYTES // 2**20} MiB", file=file)
+    file, raw, digest = read_source(path, "URDF file")
     for what, value in (("base", base), ("tip", tip)):
         if value is not None and not isinstance(value, str):
             raise SymdynError(f"{what} must be a link name, not {value!r}", file=file)
     reader = _Reader(file)
     reader.read(_parse_xml(raw, file))
-    return _build(reader, hashlib.sha256(raw).hexdigest(), base, tip)
+    return _build(reader, digest, base, tip)

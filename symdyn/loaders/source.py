@@ -1,0 +1,36 @@
+"""Reading a description file's bytes, with the errors every loader gives for it."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+
+from ..errors import SymdynError
+
+__all__ = ["read_source", "MAX_BYTES"]
+
+#: Larger files are refused before parsing (a robot description is kilobytes).
+MAX_BYTES = 64 * 2**20
+
+
+def read_source(path: str | os.PathLike, kind: str) -> tuple[str, bytes, str]:
+    """(file name, its bytes, their sha256 hex digest); SymdynError naming the file otherwise.
+
+    `kind` names what the file should be ("robot file", "URDF file") in messages.
+    """
+    try:
+        file = str(os.fspath(path))
+    except TypeError:
+        raise SymdynError(f"{kind} path must be a string or path, not {path!r}") from None
+    try:
+        with open(file, "rb") as fh:
+            raw = fh.read(MAX_BYTES + 1)
+    except FileNotFoundError:
+        raise SymdynError("no such file", file=file) from None
+    except IsADirectoryError:
+        raise SymdynError(f"is a directory, not a {kind}", file=file) from None
+    except OSError as exc:
+        raise SymdynError(f"cannot read file: {exc.strerror or exc}", file=file) from None
+    if len(raw) > MAX_BYTES:
+        raise SymdynError(f"file larger than {MAX_BYTES // 2**20} MiB", file=file)
+    return file, raw, hashlib.sha256(raw).hexdigest()
