@@ -27,7 +27,7 @@ from .newton_euler import JointFrame
 from .program import Program
 from .robot import Robot
 
-__all__ = ["mass_matrix_crba"]
+__all__ = ["composite_inertias", "mass_matrix_crba", "gravity_composite"]
 
 
 def _sym3(program: Program, I: Sequence[Sequence[sp.Expr]], hint: str) -> v3.Mat:
@@ -57,8 +57,11 @@ def _rotate(R: v3.Mat, I: v3.Mat) -> list[list[sp.Expr]]:
     return [[v3.dot(RI[r], R[c]) for c in range(3)] for r in range(3)]
 
 
-def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -> sp.Matrix:
-    """M(q) of the rigid bodies plus reflected motor inertia, over the program's intermediates."""
+def composite_inertias(
+    robot: Robot, frames: list[JointFrame], program: Program
+) -> tuple[list[sp.Expr], list[v3.Vec], list[v3.Mat]]:
+    """Mass, first moment and rotational inertia (about the body origin, body axes) of the
+    subtree rooted at each link (the link and everything outboard of it)."""
     n = robot.n
     mass: list[sp.Expr] = []
     h: list[v3.Vec] = []
@@ -91,6 +94,13 @@ def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -
             ],
             "Ic",
         )
+    return mass, h, I
+
+
+def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -> sp.Matrix:
+    """M(q) of the rigid bodies plus reflected motor inertia, over the program's intermediates."""
+    n = robot.n
+    mass, h, I = composite_inertias(robot, frames, program)
     M = sp.zeros(n, n)
     for j in range(n):
         a = v3.vec(robot.links[j].axis)
@@ -112,3 +122,26 @@ def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -
                 entry = entry + robot.links[j].motor.reflected_inertia
             M[i, j] = M[j, i] = program.let(entry, "M")
     return M
+
+
+def gravity_composite(robot: Robot, frames: list[JointFrame], program: Program) -> list[sp.Expr]:
+    """G(q) from the composite bodies: with g_k the gravitational acceleration in frame k
+    (g_k = R_k^T g_{k-1}) and m^c_k, h^c_k the subtree's mass and first moment about origin k,
+
+        G_k = a_k . (g_k x h^c_k)   (revolute: minus gravity's torque about joint k)
+        G_k = -m^c_k (a_k . g_k)    (prismatic: minus gravity's force along joint k)
+
+    which is dP/dq_k for P = -sum_i m_i g^T p_ci. One rotation per link and no inward
+    force recursion, against a Newton-Euler pass with qd = qdd = 0."""
+    mass, h, _ = composite_inertias(robot, frames, program)
+    g = v3.vec(robot.gravity)
+    G: list[sp.Expr] = []
+    for k, link in enumerate(robot.links):
+        R, _p = frames[k]
+        g = tuple(program.let(x, f"gk{k + 1}_") for x in v3.mul_t(R, g))  # type: ignore[assignment]
+        a = v3.vec(link.axis)
+        if link.joint == "revolute":
+            G.append(v3.dot(a, v3.cross(g, h[k])))
+        else:
+            G.append(-v3._prod(mass[k], v3.dot(a, g)))
+    return G

@@ -1,9 +1,10 @@
 """`derive`: the equations of motion tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (slide 16).
 
 Two independent routes fill the same `Dynamics`:
-- "newton-euler" (symdyn.newton_euler): G = NE(q, 0, 0); V = NE(q, qd, 0) with
-  gravity off; column j of M = NE(q, 0, e_j) with gravity off; tau from one full
-  pass; C = 1/2 dV/dqd, which equals the Christoffel-symbol matrix because
+- "newton-euler" (symdyn.newton_euler, symdyn.crba): V = NE(q, qd, 0) with
+  gravity off; M by the composite-rigid-body algorithm and G from the same
+  composite bodies (both equal to NE with unit accelerations, resp. NE(q, 0, 0));
+  tau from one full pass; C = 1/2 dV/dqd, which equals the Christoffel-symbol matrix because
   V_k = sum_ij Gamma^k_ij qd_i qd_j with Gamma^k_ij symmetric in i, j.
 - "lagrange" (symdyn.lagrange): M from the link Jacobians, C from the
   Christoffel symbols of M, G from the potential energy, V = C qd.
@@ -23,7 +24,7 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
-from .crba import mass_matrix_crba
+from .crba import gravity_composite, mass_matrix_crba
 from .errors import SymdynError
 from .lagrange import lagrange
 from .newton_euler import joint_frames, newton_euler
@@ -151,7 +152,7 @@ def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str,
     n = robot.n
     rot = joint_frames(robot, q)
     zeros = [0] * n
-    G = sp.Matrix(newton_euler(robot, q, zeros, zeros, program, gravity=True, tag="G", rotations=rot))
+    G = sp.Matrix(gravity_composite(robot, rot, program))
     V = sp.Matrix(newton_euler(robot, q, list(qd), zeros, program, gravity=False, tag="V", rotations=rot))
     M = mass_matrix_crba(robot, rot, program)
     Vn = [program.let(v, "V") for v in V]

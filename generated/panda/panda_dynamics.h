@@ -4,9 +4,9 @@
  * Operation counts per call:
  *   inverse_dynamics    826 ops: 435 mul, 379 add, 0 div, 12 trig, 0 other
  *   mass_matrix         432 ops: 232 mul, 188 add, 0 div, 12 trig, 0 other
- *   coriolis_matrix    3593 ops: 1993 mul, 1588 add, 0 div, 12 trig, 0 other
+ *   coriolis_matrix    3709 ops: 2085 mul, 1600 add, 0 div, 24 trig, 0 other
  *   coriolis            777 ops: 415 mul, 350 add, 0 div, 12 trig, 0 other
- *   gravity             209 ops: 118 mul, 79 add, 0 div, 12 trig, 0 other
+ *   gravity              98 ops: 50 mul, 36 add, 0 div, 12 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics   1476 ops: 810 mul, 647 add, 7 div, 12 trig, 0 other
  */
@@ -59,7 +59,7 @@ void panda_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, panda_NDOF*panda_NDOF values, row-major: C[i*panda_NDOF + j] is row i, column j
  *
- * Cost per call: 3593 operations: 1993 multiplications, 1588 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
+ * Cost per call: 3709 operations: 2085 multiplications, 1600 additions, 0 divisions, 24 trigonometric calls, 0 other calls.
  */
 void panda_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 
@@ -82,7 +82,7 @@ void panda_coriolis(const double q[], const double qd[], const double p[], doubl
  * @param[in]  p  free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] G  gravity efforts G(q), panda_NDOF values
  *
- * Cost per call: 209 operations: 118 multiplications, 79 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
+ * Cost per call: 98 operations: 50 multiplications, 36 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
  */
 void panda_gravity(const double q[], const double p[], double G[]);
 

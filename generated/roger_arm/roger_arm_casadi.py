@@ -3,9 +3,9 @@
 # Operation counts per call:
 #   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
 #   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
-#   coriolis_matrix      24 ops: 18 mul, 4 add, 0 div, 2 trig, 0 other
+#   coriolis_matrix      28 ops: 22 mul, 4 add, 0 div, 2 trig, 0 other
 #   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
-#   gravity              23 ops: 14 mul, 5 add, 0 div, 4 trig, 0 other
+#   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
 #   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
 """CasADi functions of the robot roger_arm: tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
@@ -76,7 +76,7 @@ def build_inverse_dynamics() -> ca.Function:
     x16 = x15*x15
     x17 = x16*p[3]
     x18 = x4*x9
-    x19 = x18 + x5*x1
+    x19 = x18 + x1*x5
     x20 = x19 - x17
     x21 = x20*p[4]
     x22 = x21*x5 + x13*x4
@@ -128,31 +128,30 @@ def build_coriolis_matrix() -> ca.Function:
     """casadi.Function coriolis_matrix(q[2], qd[2], p[5]) -> C[2x2].
 
     C(q, qd) from Christoffel symbols; C qd = V.
-    16 temporaries; 24 operations (18 mul, 4 add, 0 div, 2 trig, 0 other).
+    15 temporaries; 28 operations (22 mul, 4 add, 0 div, 2 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
     p = ca.SX.sym("p", 5)
     x0 = ca.sin(q[1])
-    x1 = 2*p[1]*qd[0]
-    x2 = x0*x1
-    x3 = x2*p[4]
-    x4 = x3*p[3]
-    x5 = ca.cos(q[1])
-    x6 = qd[0] + qd[1]
-    x7 = 2*x6*p[3]
-    x8 = x5*x1
-    x9 = -x7 - x8
-    x10 = x9*p[4]
-    x11 = x5*x3 + x0*x10
-    x12 = x4 + x11*p[1]
-    x13 = x7*p[4]
-    x14 = x0*x13
-    x15 = x14*p[1]
+    x1 = 2*x0*p[1]*qd[0]
+    x2 = x1*p[4]
+    x3 = x2*p[3]
+    x4 = ca.cos(q[1])
+    x5 = qd[0] + qd[1]
+    x6 = 2*x4*p[1]*qd[0]
+    x7 = -x6 - 2*x5*p[3]
+    x8 = x7*p[4]
+    x9 = x4*x2 + x0*x8
+    x10 = x3 + x9*p[1]
+    x11 = 2*x5*p[3]
+    x12 = x11*p[4]
+    x13 = x0*x12
+    x14 = x13*p[1]
     C = ca.SX.zeros(2, 2)
-    C[0, 0] = 0.5*x12
-    C[0, 1] = -0.5*x15
-    C[1, 0] = 0.5*x4
+    C[0, 0] = 0.5*x10
+    C[0, 1] = -0.5*x14
+    C[1, 0] = 0.5*x3
     return ca.Function(
         "coriolis_matrix",
         [q, qd, p],
@@ -202,27 +201,24 @@ def build_gravity() -> ca.Function:
     """casadi.Function gravity(q[2], p[5]) -> G[2].
 
     G(q).
-    14 temporaries; 23 operations (14 mul, 5 add, 0 div, 4 trig, 0 other).
+    11 temporaries; 20 operations (12 mul, 4 add, 0 div, 4 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     p = ca.SX.sym("p", 5)
-    x0 = p[0]*ca.sin(q[0])
-    x1 = x0*p[2]
-    x2 = x1*p[1]
-    x3 = ca.sin(q[1])
+    x0 = ca.sin(q[1])
+    x1 = p[3]*p[4]
+    x2 = x0*x1
+    x3 = p[1]*p[2]
     x4 = ca.cos(q[1])
-    x5 = x4*x0
-    x6 = p[0]*ca.cos(q[0])
-    x7 = x5 + x3*x6
-    x8 = x7*p[4]
-    x9 = x8*p[3]
-    x10 = x3*x0 - x4*x6
-    x11 = x10*p[4]
-    x12 = x11*x3 + x8*x4
-    x13 = x2 + x9 + x12*p[1]
+    x5 = x4*x1
+    x6 = x5 + x3 + p[1]*p[4]
+    x7 = p[0]*ca.cos(q[0])
+    x8 = p[0]*ca.sin(q[0])
+    x9 = x4*x8
+    x10 = -x9 - x0*x7
     G = ca.SX.zeros(2, 1)
-    G[0] = x13
-    G[1] = x9
+    G[0] = x2*x7 + x8*x6
+    G[1] = -x10*x1
     return ca.Function(
         "gravity",
         [q, p],
@@ -253,7 +249,7 @@ def build_forward_dynamics() -> ca.Function:
     """casadi.Function forward_dynamics(q[2], qd[2], tau[2], p[5]) -> qdd[2].
 
     qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T).
-    39 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
+    38 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
@@ -270,37 +266,36 @@ def build_forward_dynamics() -> ca.Function:
     x8 = 1/x7
     x9 = p[0]*ca.sin(q[0])
     x10 = x9*p[2]
-    x11 = x10*p[1]
-    x12 = x1*x9
-    x13 = ca.sin(q[1])
-    x14 = qd[0]*qd[0]
-    x15 = x14*p[1]
-    x16 = p[0]*ca.cos(q[0])
-    x17 = -x15 - x16
-    x18 = x13*x17
-    x19 = x12 - x18
-    x20 = x19*p[4]
-    x21 = x20*p[3]
-    x22 = qd[0] + qd[1]
-    x23 = x22*x22
-    x24 = x23*p[3]
-    x25 = x1*x17
-    x26 = x25 + x13*x9
-    x27 = x26 - x24
-    x28 = x27*p[4]
-    x29 = x28*x13 + x20*x1
-    x30 = x11 + x21 + x29*p[1]
-    x31 = tau[0] - x30
-    x32 = x6 + x4
-    x33 = x32*x8
-    x34 = x6 - x7*x33*x33
-    x35 = tau[1] - x21
-    x36 = x35 - x33*x31
-    x37 = x36/x34
-    x38 = x8*x31 - x33*x37
+    x11 = x1*x9
+    x12 = ca.sin(q[1])
+    x13 = qd[0]*qd[0]
+    x14 = x13*p[1]
+    x15 = p[0]*ca.cos(q[0])
+    x16 = -x14 - x15
+    x17 = x12*x16
+    x18 = x11 - x17
+    x19 = x18*p[4]
+    x20 = x19*p[3]
+    x21 = qd[0] + qd[1]
+    x22 = x21*x21
+    x23 = x22*p[3]
+    x24 = x1*x16
+    x25 = x24 + x12*x9
+    x26 = x25 - x23
+    x27 = x26*p[4]
+    x28 = x27*x12 + x19*x1
+    x29 = x20 + x10*p[1] + x28*p[1]
+    x30 = tau[0] - x29
+    x31 = x6 + x4
+    x32 = x31*x8
+    x33 = x6 - x7*x32*x32
+    x34 = tau[1] - x20
+    x35 = x34 - x32*x30
+    x36 = x35/x33
+    x37 = x8*x30 - x32*x36
     qdd = ca.SX.zeros(2, 1)
-    qdd[0] = x38
-    qdd[1] = x37
+    qdd[0] = x37
+    qdd[1] = x36
     return ca.Function(
         "forward_dynamics",
         [q, qd, tau, p],

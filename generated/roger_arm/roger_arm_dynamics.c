@@ -4,9 +4,9 @@
  * Operation counts per call:
  *   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
  *   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
- *   coriolis_matrix      24 ops: 18 mul, 4 add, 0 div, 2 trig, 0 other
+ *   coriolis_matrix      28 ops: 22 mul, 4 add, 0 div, 2 trig, 0 other
  *   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
- *   gravity              23 ops: 14 mul, 5 add, 0 div, 4 trig, 0 other
+ *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
  */
@@ -47,7 +47,7 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double x16 = x15*x15;
     const double x17 = x16*l2;
     const double x18 = x4*x9;
-    const double x19 = x18 + x5*x1;
+    const double x19 = x18 + x1*x5;
     const double x20 = x19 - x17;
     const double x21 = x20*m2;
     const double x22 = x21*x5 + x13*x4;
@@ -79,7 +79,7 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     M[3] = x6;
 }
 
-/* C(q, qd) from Christoffel symbols, row-major; C qd = V (24 operations: 18 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
+/* C(q, qd) from Christoffel symbols, row-major; C qd = V (28 operations: 22 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
 void roger_arm_coriolis_matrix(const double q[], const double qd[], const double p[], double C[])
 {
     const double q2 = q[1];
@@ -89,24 +89,23 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
     const double x0 = sin(q2);
-    const double x1 = 2.0*l1*qd1;
-    const double x2 = x0*x1;
-    const double x3 = x2*m2;
-    const double x4 = x3*l2;
-    const double x5 = cos(q2);
-    const double x6 = qd1 + qd2;
-    const double x7 = 2.0*x6*l2;
-    const double x8 = x5*x1;
-    const double x9 = -x7 - x8;
-    const double x10 = x9*m2;
-    const double x11 = x5*x3 + x0*x10;
-    const double x12 = x4 + x11*l1;
-    const double x13 = x7*m2;
-    const double x14 = x0*x13;
-    const double x15 = x14*l1;
-    C[0] = 0.5*x12;
-    C[1] = -0.5*x15;
-    C[2] = 0.5*x4;
+    const double x1 = 2.0*x0*l1*qd1;
+    const double x2 = x1*m2;
+    const double x3 = x2*l2;
+    const double x4 = cos(q2);
+    const double x5 = qd1 + qd2;
+    const double x6 = 2.0*x4*l1*qd1;
+    const double x7 = -x6 - 2.0*x5*l2;
+    const double x8 = x7*m2;
+    const double x9 = x4*x2 + x0*x8;
+    const double x10 = x3 + x9*l1;
+    const double x11 = 2.0*x5*l2;
+    const double x12 = x11*m2;
+    const double x13 = x0*x12;
+    const double x14 = x13*l1;
+    C[0] = 0.5*x10;
+    C[1] = -0.5*x14;
+    C[2] = 0.5*x3;
     C[3] = 0.0;
 }
 
@@ -138,7 +137,7 @@ void roger_arm_coriolis(const double q[], const double qd[], const double p[], d
     V[1] = x5;
 }
 
-/* G(q) (23 operations: 14 multiplications, 5 additions, 0 divisions, 4 trigonometric calls, 0 other calls) */
+/* G(q) (20 operations: 12 multiplications, 4 additions, 0 divisions, 4 trigonometric calls, 0 other calls) */
 void roger_arm_gravity(const double q[], const double p[], double G[])
 {
     const double q1 = q[0];
@@ -148,22 +147,19 @@ void roger_arm_gravity(const double q[], const double p[], double G[])
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = g*sin(q1);
-    const double x1 = x0*m1;
-    const double x2 = x1*l1;
-    const double x3 = sin(q2);
+    const double x0 = sin(q2);
+    const double x1 = l2*m2;
+    const double x2 = x0*x1;
+    const double x3 = l1*m1;
     const double x4 = cos(q2);
-    const double x5 = x4*x0;
-    const double x6 = g*cos(q1);
-    const double x7 = x5 + x3*x6;
-    const double x8 = x7*m2;
-    const double x9 = x8*l2;
-    const double x10 = x3*x0 - x4*x6;
-    const double x11 = x10*m2;
-    const double x12 = x11*x3 + x8*x4;
-    const double x13 = x2 + x9 + x12*l1;
-    G[0] = x13;
-    G[1] = x9;
+    const double x5 = x4*x1;
+    const double x6 = x5 + x3 + l1*m2;
+    const double x7 = g*cos(q1);
+    const double x8 = g*sin(q1);
+    const double x9 = x4*x8;
+    const double x10 = -x9 - x0*x7;
+    G[0] = x2*x7 + x8*x6;
+    G[1] = -x10*x1;
 }
 
 /* F(qd) = viscous qd + coulomb sign(qd) (0 operations: 0 multiplications, 0 additions, 0 divisions, 0 trigonometric calls, 0 other calls) */
@@ -200,34 +196,33 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x8 = 1.0/x7;
     const double x9 = g*sin(q1);
     const double x10 = x9*m1;
-    const double x11 = x10*l1;
-    const double x12 = x1*x9;
-    const double x13 = sin(q2);
-    const double x14 = qd1*qd1;
-    const double x15 = x14*l1;
-    const double x16 = g*cos(q1);
-    const double x17 = -x15 - x16;
-    const double x18 = x13*x17;
-    const double x19 = x12 - x18;
-    const double x20 = x19*m2;
-    const double x21 = x20*l2;
-    const double x22 = qd1 + qd2;
-    const double x23 = x22*x22;
-    const double x24 = x23*l2;
-    const double x25 = x1*x17;
-    const double x26 = x25 + x13*x9;
-    const double x27 = x26 - x24;
-    const double x28 = x27*m2;
-    const double x29 = x28*x13 + x20*x1;
-    const double x30 = x11 + x21 + x29*l1;
-    const double x31 = tau1 - x30;
-    const double x32 = x6 + x4;
-    const double x33 = x32*x8;
-    const double x34 = x6 - x7*x33*x33;
-    const double x35 = tau2 - x21;
-    const double x36 = x35 - x33*x31;
-    const double x37 = x36/x34;
-    const double x38 = x8*x31 - x33*x37;
-    qdd[0] = x38;
-    qdd[1] = x37;
+    const double x11 = x1*x9;
+    const double x12 = sin(q2);
+    const double x13 = qd1*qd1;
+    const double x14 = x13*l1;
+    const double x15 = g*cos(q1);
+    const double x16 = -x14 - x15;
+    const double x17 = x12*x16;
+    const double x18 = x11 - x17;
+    const double x19 = x18*m2;
+    const double x20 = x19*l2;
+    const double x21 = qd1 + qd2;
+    const double x22 = x21*x21;
+    const double x23 = x22*l2;
+    const double x24 = x1*x16;
+    const double x25 = x24 + x12*x9;
+    const double x26 = x25 - x23;
+    const double x27 = x26*m2;
+    const double x28 = x27*x12 + x19*x1;
+    const double x29 = x20 + x10*l1 + x28*l1;
+    const double x30 = tau1 - x29;
+    const double x31 = x6 + x4;
+    const double x32 = x31*x8;
+    const double x33 = x6 - x7*x32*x32;
+    const double x34 = tau2 - x20;
+    const double x35 = x34 - x32*x30;
+    const double x36 = x35/x33;
+    const double x37 = x8*x30 - x32*x36;
+    qdd[0] = x37;
+    qdd[1] = x36;
 }

@@ -4,9 +4,9 @@
  * Operation counts per call:
  *   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
  *   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
- *   coriolis_matrix      24 ops: 18 mul, 4 add, 0 div, 2 trig, 0 other
+ *   coriolis_matrix      28 ops: 22 mul, 4 add, 0 div, 2 trig, 0 other
  *   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
- *   gravity              23 ops: 14 mul, 5 add, 0 div, 4 trig, 0 other
+ *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
  */
@@ -71,7 +71,7 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, roger_arm_NDOF*roger_arm_NDOF values, row-major: C[i*roger_arm_NDOF + j] is row i, column j
  *
- * Cost per call: 24 operations: 18 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls.
+ * Cost per call: 28 operations: 22 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls.
  */
 void roger_arm_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 
@@ -94,7 +94,7 @@ void roger_arm_coriolis(const double q[], const double qd[], const double p[], d
  * @param[in]  p  free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
  * @param[out] G  gravity efforts G(q), roger_arm_NDOF values
  *
- * Cost per call: 23 operations: 14 multiplications, 5 additions, 0 divisions, 4 trigonometric calls, 0 other calls.
+ * Cost per call: 20 operations: 12 multiplications, 4 additions, 0 divisions, 4 trigonometric calls, 0 other calls.
  */
 void roger_arm_gravity(const double q[], const double p[], double G[]);
 

@@ -3,9 +3,9 @@
 # Operation counts per call:
 #   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
 #   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
-#   coriolis_matrix      24 ops: 18 mul, 4 add, 0 div, 2 trig, 0 other
+#   coriolis_matrix      28 ops: 22 mul, 4 add, 0 div, 2 trig, 0 other
 #   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
-#   gravity              23 ops: 14 mul, 5 add, 0 div, 4 trig, 0 other
+#   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
 #   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
 """Dynamics of the robot roger_arm: tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
@@ -151,28 +151,27 @@ def coriolis_matrix(q, qd, p=None):
     l2 = p[..., 3]
     m2 = p[..., 4]
     x0 = np.sin(q2)
-    x1 = 2*l1*qd1
-    x2 = x0*x1
-    x3 = m2*x2
-    x4 = l2*x3
-    x5 = np.cos(q2)
-    x6 = qd1 + qd2
-    x7 = 2*l2*x6
-    x8 = x1*x5
-    x9 = -x7 - x8
-    x10 = m2*x9
-    x11 = x0*x10 + x3*x5
-    x12 = l1*x11 + x4
-    x13 = m2*x7
-    x14 = x0*x13
-    x15 = l1*x14
+    x1 = 2*l1*qd1*x0
+    x2 = m2*x1
+    x3 = l2*x2
+    x4 = np.cos(q2)
+    x5 = qd1 + qd2
+    x6 = 2*l1*qd1*x4
+    x7 = -2*l2*x5 - x6
+    x8 = m2*x7
+    x9 = x0*x8 + x2*x4
+    x10 = l1*x9 + x3
+    x11 = 2*l2*x5
+    x12 = m2*x11
+    x13 = x0*x12
+    x14 = l1*x13
     return _assemble(
         _lead,
         (2, 2),
         [
-            0.5*x12,
-            -0.5*x15,
-            0.5*x4,
+            0.5*x10,
+            -0.5*x14,
+            0.5*x3,
             0,
         ],
     )
@@ -233,26 +232,23 @@ def gravity(q, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = g*np.sin(q1)
-    x1 = m1*x0
-    x2 = l1*x1
-    x3 = np.sin(q2)
+    x0 = np.sin(q2)
+    x1 = l2*m2
+    x2 = x0*x1
+    x3 = l1*m1
     x4 = np.cos(q2)
-    x5 = x0*x4
-    x6 = g*np.cos(q1)
-    x7 = x3*x6 + x5
-    x8 = m2*x7
-    x9 = l2*x8
-    x10 = x0*x3 - x4*x6
-    x11 = m2*x10
-    x12 = x11*x3 + x4*x8
-    x13 = l1*x12 + x2 + x9
+    x5 = x1*x4
+    x6 = l1*m2 + x3 + x5
+    x7 = g*np.cos(q1)
+    x8 = g*np.sin(q1)
+    x9 = x4*x8
+    x10 = -x0*x7 - x9
     return _assemble(
         _lead,
         (2,),
         [
-            x13,
-            x9,
+            x2*x7 + x6*x8,
+            -x1*x10,
         ],
     )
 
@@ -307,39 +303,38 @@ def forward_dynamics(q, qd, tau, p=None):
     x8 = 1/x7
     x9 = g*np.sin(q1)
     x10 = m1*x9
-    x11 = l1*x10
-    x12 = x1*x9
-    x13 = np.sin(q2)
-    x14 = qd1*qd1
-    x15 = l1*x14
-    x16 = g*np.cos(q1)
-    x17 = -x15 - x16
-    x18 = x13*x17
-    x19 = x12 - x18
-    x20 = m2*x19
-    x21 = l2*x20
-    x22 = qd1 + qd2
-    x23 = x22*x22
-    x24 = l2*x23
-    x25 = x1*x17
-    x26 = x13*x9 + x25
-    x27 = -x24 + x26
-    x28 = m2*x27
-    x29 = x1*x20 + x13*x28
-    x30 = l1*x29 + x11 + x21
-    x31 = tau1 - x30
-    x32 = x4 + x6
-    x33 = x32*x8
-    x34 = -(x33*x33)*x7 + x6
-    x35 = tau2 - x21
-    x36 = -x31*x33 + x35
-    x37 = x36/x34
-    x38 = x31*x8 - x33*x37
+    x11 = x1*x9
+    x12 = np.sin(q2)
+    x13 = qd1*qd1
+    x14 = l1*x13
+    x15 = g*np.cos(q1)
+    x16 = -x14 - x15
+    x17 = x12*x16
+    x18 = x11 - x17
+    x19 = m2*x18
+    x20 = l2*x19
+    x21 = qd1 + qd2
+    x22 = x21*x21
+    x23 = l2*x22
+    x24 = x1*x16
+    x25 = x12*x9 + x24
+    x26 = -x23 + x25
+    x27 = m2*x26
+    x28 = x1*x19 + x12*x27
+    x29 = l1*x10 + l1*x28 + x20
+    x30 = tau1 - x29
+    x31 = x4 + x6
+    x32 = x31*x8
+    x33 = -(x32*x32)*x7 + x6
+    x34 = tau2 - x20
+    x35 = -x30*x32 + x34
+    x36 = x35/x33
+    x37 = x30*x8 - x32*x36
     return _assemble(
         _lead,
         (2,),
         [
-            x38,
             x37,
+            x36,
         ],
     )
