@@ -11,20 +11,23 @@ a base acceleration vd_0 = -g, is
     prismatic: w_i = R_i^T w_{i-1},  wd_i = R_i^T wd_{i-1},
                vd_i = R_i^T [...] + 2 w_i x a_i qd_i + a_i qdd_i
     vc_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
-
-with wd x r + w x (w x r) computed as W r, W = [wd x] + [w x]^2, once per link
-for both the centre of mass and the next joint's origin
-    F_i = m_i vc_i,   N_i = I_i wd_i + w_i x I_i w_i
+    F_i = m_i vc_i,   N_i = I_i wd_i + w_i x I_i w_i   (about the centre of mass)
 
 and the inward one, i = n .. 1,
 
     f_i = R_{i+1} f_{i+1} + F_i
-    n_i = N_i + R_{i+1} n_{i+1} + c_i x F_i + p_{i+1} x R_{i+1} f_{i+1}
+    n_i = N_i + c_i x F_i + R_{i+1} n_{i+1} + p_{i+1} x R_{i+1} f_{i+1}
     tau_i = a_i . n_i (revolute) or a_i . f_i (prismatic)
 
 where a_i is the joint axis (z for DH robots) and c_i the centre of mass.
 Components are named as they are computed, and zero inputs (qd = 0 for M
 and G, gravity off for M and V) fold away, so each pass costs O(n).
+
+wd x r + w x (w x r) is computed as W r, W = [wd x] + [w x]^2, once per link for
+both the centre of mass and the next joint's origin. For links whose inertia
+tensor has products of inertia, N_i + c_i x F_i is formed about the body origin
+instead (h = m c, I_o = I_c + m (c^T c 1 - c c^T)): F = m vd + W h and
+N_o = I_o wd + w x I_o w + h x vd, which need neither vc nor c x F.
 """
 
 from __future__ import annotations
@@ -53,6 +56,50 @@ def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
 
 def _name(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
     return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
+
+
+def _origin_inertia(link: Link) -> v3.Mat:
+    """I_o = I_c + m (c^T c 1 - c c^T): the inertia about the body origin (parallel axis)."""
+    m = sp.sympify(link.mass)
+    c = v3.vec(link.com)
+    Ic = v3.mat(link.inertia)
+    cc = v3.dot(c, c)
+    return tuple(
+        tuple(Ic[r][s] + v3._prod(m, (cc if r == s else 0) - v3._prod(c[r], c[s])) for s in range(3))
+        for r in range(3)
+    )  # type: ignore[return-value]
+
+
+def _about_origin(link: Link) -> bool:
+    """Whether the wrench is cheaper about the body origin: when the tensor about the centre
+    of mass already has products of inertia, I_o is no denser and c x F disappears; for a
+    diagonal tensor (published DH models) the centre-of-mass form is cheaper."""
+    Ic = link.inertia
+    return any(Ic[r, s] != 0 for r in range(3) for s in range(3) if r != s)
+
+
+def _body_wrench(
+    link: Link, W: v3.Mat, w: v3.Vec, wd: v3.Vec, vd: v3.Vec, program: Program, k: str
+) -> tuple[v3.Vec, v3.Vec]:
+    """Net force F and moment N about the body origin that accelerate the link (slide 15).
+
+    Either about the centre of mass, F = m (W c + vd), N = I_c wd + w x I_c w + c x F,
+    or about the origin with h = m c: F = m vd + W h, N = I_o wd + w x I_o w + h x vd."""
+    m = sp.sympify(link.mass)
+    c = v3.vec(link.com)
+    if _about_origin(link):
+        h = tuple(v3._prod(m, x) for x in c)
+        I = _origin_inertia(link)
+        F = _name(program, v3.add(v3.scale(m, vd), v3.mul(W, h)), f"F{k}_")
+        extra = v3.cross(h, vd)
+    else:
+        I = v3.mat(link.inertia)
+        vc = _name(program, v3.add(v3.mul(W, c), vd), f"vc{k}_")
+        F = _name(program, v3.scale(m, vc), f"F{k}_")
+        extra = v3.cross(c, F)
+    Iw = _name(program, v3.mul(I, w), f"Iw{k}_")
+    N = _name(program, v3.add(v3.mul(I, wd), v3.cross(w, Iw), extra), f"N{k}_")
+    return F, N
 
 
 def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
@@ -127,27 +174,22 @@ def newton_euler(
         k = f"{tag}{i + 1}"
         w, wd, vd = _outward(link, frames[i], w, wd, vd, W, qd[i], qdd[i], program, k)
         W = _tilde(program, w, wd, k)
-        c = v3.vec(link.com)
-        I = v3.mat(link.inertia)
-        vc = _name(program, v3.add(v3.mul(W, c), vd), f"vc{k}_")
-        Iw = _name(program, v3.mul(I, w), f"Iw{k}_")
-        forces.append(_name(program, v3.scale(link.mass, vc), f"F{k}_"))
-        moments.append(_name(program, v3.add(v3.mul(I, wd), v3.cross(w, Iw)), f"N{k}_"))
+        F, N = _body_wrench(link, W, w, wd, vd, program, k)
+        forces.append(F)
+        moments.append(N)
     tau: list[sp.Expr] = [sp.S.Zero] * n
     f_next, n_next = zero, zero
     for i in reversed(range(n)):
         link = robot.links[i]
         k = f"{tag}{i + 1}"
-        c = v3.vec(link.com)
-        F = forces[i]
         if i + 1 < n:
             R1, p1 = frames[i + 1]
             Rf = _name(program, v3.mul(R1, f_next), f"Rf{k}_")
-            n_new = v3.add(moments[i], v3.mul(R1, n_next), v3.cross(c, F), v3.cross(p1, Rf))
-            f_new = v3.add(Rf, F)
+            n_new = v3.add(moments[i], v3.mul(R1, n_next), v3.cross(p1, Rf))
+            f_new = v3.add(Rf, forces[i])
         else:
-            n_new = v3.add(moments[i], v3.cross(c, F))
-            f_new = F
+            n_new = moments[i]
+            f_new = forces[i]
         f_next = _name(program, f_new, f"f{k}_")
         n_next = _name(program, n_new, f"n{k}_")
         a = v3.vec(link.axis)

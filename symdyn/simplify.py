@@ -199,6 +199,7 @@ def _cse_nodes(
         for k, e in zip(second, reduced[: len(second)], strict=True):
             nodes[syms[k]] = e
         outs += list(reduced[len(second) :])
+
     # inline temporaries that are a bare symbol or number (no work, only a name), to a fixpoint
     # since an alias may name another alias
     def is_alias(e: sp.Expr) -> bool:

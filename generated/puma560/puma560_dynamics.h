@@ -4,7 +4,7 @@
  * Operation counts per call:
  *   inverse_dynamics    434 ops: 230 mul, 188 add, 0 div, 10 trig, 6 other
  *   mass_matrix         227 ops: 121 mul, 96 add, 0 div, 10 trig, 0 other
- *   coriolis_matrix    1189 ops: 732 mul, 437 add, 0 div, 20 trig, 0 other
+ *   coriolis_matrix    1191 ops: 732 mul, 439 add, 0 div, 20 trig, 0 other
  *   coriolis            353 ops: 200 mul, 143 add, 0 div, 10 trig, 0 other
  *   gravity              43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
  *   friction             24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
@@ -59,7 +59,7 @@ void puma560_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, puma560_NDOF*puma560_NDOF values, row-major: C[i*puma560_NDOF + j] is row i, column j
  *
- * Cost per call: 1189 operations: 732 multiplications, 437 additions, 0 divisions, 20 trigonometric calls, 0 other calls.
+ * Cost per call: 1191 operations: 732 multiplications, 439 additions, 0 divisions, 20 trigonometric calls, 0 other calls.
  */
 void puma560_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 

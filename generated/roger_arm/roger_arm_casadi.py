@@ -51,7 +51,7 @@ def build_inverse_dynamics() -> ca.Function:
     """casadi.Function inverse_dynamics(q[2], qd[2], qdd[2], p[5]) -> tau[2].
 
     tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
-    24 temporaries; 35 operations (20 mul, 11 add, 0 div, 4 trig, 0 other).
+    25 temporaries; 35 operations (20 mul, 11 add, 0 div, 4 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
@@ -60,30 +60,31 @@ def build_inverse_dynamics() -> ca.Function:
     x0 = p[0]*ca.sin(q[0])
     x1 = x0 + p[1]*qdd[0]
     x2 = x1*p[2]
-    x3 = qdd[0] + qdd[1]
-    x4 = ca.cos(q[1])
-    x5 = ca.sin(q[1])
-    x6 = qd[0]*qd[0]
-    x7 = x6*p[1]
-    x8 = p[0]*ca.cos(q[0])
-    x9 = -x7 - x8
-    x10 = x5*x9
-    x11 = -x10 + x4*x1
-    x12 = x11 + x3*p[3]
-    x13 = x12*p[4]
-    x14 = x13*p[3]
-    x15 = qd[0] + qd[1]
-    x16 = x15*x15
-    x17 = x16*p[3]
-    x18 = x4*x9
-    x19 = x18 + x1*x5
-    x20 = x19 - x17
-    x21 = x20*p[4]
-    x22 = x21*x5 + x13*x4
-    x23 = x14 + x2*p[1] + x22*p[1]
+    x3 = x2*p[1]
+    x4 = qdd[0] + qdd[1]
+    x5 = ca.cos(q[1])
+    x6 = ca.sin(q[1])
+    x7 = qd[0]*qd[0]
+    x8 = x7*p[1]
+    x9 = p[0]*ca.cos(q[0])
+    x10 = -x8 - x9
+    x11 = x6*x10
+    x12 = -x11 + x5*x1
+    x13 = x12 + x4*p[3]
+    x14 = x13*p[4]
+    x15 = x14*p[3]
+    x16 = qd[0] + qd[1]
+    x17 = x16*x16
+    x18 = x17*p[3]
+    x19 = x5*x10
+    x20 = x19 + x1*x6
+    x21 = x20 - x18
+    x22 = x21*p[4]
+    x23 = x22*x6 + x14*x5
+    x24 = x3 + x15 + x23*p[1]
     tau = ca.SX.zeros(2, 1)
-    tau[0] = x23
-    tau[1] = x14
+    tau[0] = x24
+    tau[1] = x15
     return ca.Function(
         "inverse_dynamics",
         [q, qd, qdd, p],
@@ -249,7 +250,7 @@ def build_forward_dynamics() -> ca.Function:
     """casadi.Function forward_dynamics(q[2], qd[2], tau[2], p[5]) -> qdd[2].
 
     qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T).
-    38 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
+    39 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
@@ -266,36 +267,37 @@ def build_forward_dynamics() -> ca.Function:
     x8 = 1/x7
     x9 = p[0]*ca.sin(q[0])
     x10 = x9*p[2]
-    x11 = x1*x9
-    x12 = ca.sin(q[1])
-    x13 = qd[0]*qd[0]
-    x14 = x13*p[1]
-    x15 = p[0]*ca.cos(q[0])
-    x16 = -x14 - x15
-    x17 = x12*x16
-    x18 = x11 - x17
-    x19 = x18*p[4]
-    x20 = x19*p[3]
-    x21 = qd[0] + qd[1]
-    x22 = x21*x21
-    x23 = x22*p[3]
-    x24 = x1*x16
-    x25 = x24 + x12*x9
-    x26 = x25 - x23
-    x27 = x26*p[4]
-    x28 = x27*x12 + x19*x1
-    x29 = x20 + x10*p[1] + x28*p[1]
-    x30 = tau[0] - x29
-    x31 = x6 + x4
-    x32 = x31*x8
-    x33 = x6 - x7*x32*x32
-    x34 = tau[1] - x20
-    x35 = x34 - x32*x30
-    x36 = x35/x33
-    x37 = x8*x30 - x32*x36
+    x11 = x10*p[1]
+    x12 = x1*x9
+    x13 = ca.sin(q[1])
+    x14 = qd[0]*qd[0]
+    x15 = x14*p[1]
+    x16 = p[0]*ca.cos(q[0])
+    x17 = -x15 - x16
+    x18 = x13*x17
+    x19 = x12 - x18
+    x20 = x19*p[4]
+    x21 = x20*p[3]
+    x22 = qd[0] + qd[1]
+    x23 = x22*x22
+    x24 = x23*p[3]
+    x25 = x1*x17
+    x26 = x25 + x13*x9
+    x27 = x26 - x24
+    x28 = x27*p[4]
+    x29 = x28*x13 + x20*x1
+    x30 = x11 + x21 + x29*p[1]
+    x31 = tau[0] - x30
+    x32 = x6 + x4
+    x33 = x32*x8
+    x34 = x6 - x7*x33*x33
+    x35 = tau[1] - x21
+    x36 = x35 - x33*x31
+    x37 = x36/x34
+    x38 = x8*x31 - x33*x37
     qdd = ca.SX.zeros(2, 1)
-    qdd[0] = x37
-    qdd[1] = x36
+    qdd[0] = x38
+    qdd[1] = x37
     return ca.Function(
         "forward_dynamics",
         [q, qd, tau, p],

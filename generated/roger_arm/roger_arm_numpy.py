@@ -70,33 +70,34 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x0 = g*np.sin(q1)
     x1 = l1*qdd1 + x0
     x2 = m1*x1
-    x3 = qdd1 + qdd2
-    x4 = np.cos(q2)
-    x5 = np.sin(q2)
-    x6 = qd1*qd1
-    x7 = l1*x6
-    x8 = g*np.cos(q1)
-    x9 = -x7 - x8
-    x10 = x5*x9
-    x11 = x1*x4 - x10
-    x12 = l2*x3 + x11
-    x13 = m2*x12
-    x14 = l2*x13
-    x15 = qd1 + qd2
-    x16 = x15*x15
-    x17 = l2*x16
-    x18 = x4*x9
-    x19 = x1*x5 + x18
-    x20 = -x17 + x19
-    x21 = m2*x20
-    x22 = x13*x4 + x21*x5
-    x23 = l1*x2 + l1*x22 + x14
+    x3 = l1*x2
+    x4 = qdd1 + qdd2
+    x5 = np.cos(q2)
+    x6 = np.sin(q2)
+    x7 = qd1*qd1
+    x8 = l1*x7
+    x9 = g*np.cos(q1)
+    x10 = -x8 - x9
+    x11 = x10*x6
+    x12 = x1*x5 - x11
+    x13 = l2*x4 + x12
+    x14 = m2*x13
+    x15 = l2*x14
+    x16 = qd1 + qd2
+    x17 = x16*x16
+    x18 = l2*x17
+    x19 = x10*x5
+    x20 = x1*x6 + x19
+    x21 = -x18 + x20
+    x22 = m2*x21
+    x23 = x14*x5 + x22*x6
+    x24 = l1*x23 + x15 + x3
     return _assemble(
         _lead,
         (2,),
         [
-            x23,
-            x14,
+            x24,
+            x15,
         ],
     )
 
@@ -303,38 +304,39 @@ def forward_dynamics(q, qd, tau, p=None):
     x8 = 1/x7
     x9 = g*np.sin(q1)
     x10 = m1*x9
-    x11 = x1*x9
-    x12 = np.sin(q2)
-    x13 = qd1*qd1
-    x14 = l1*x13
-    x15 = g*np.cos(q1)
-    x16 = -x14 - x15
-    x17 = x12*x16
-    x18 = x11 - x17
-    x19 = m2*x18
-    x20 = l2*x19
-    x21 = qd1 + qd2
-    x22 = x21*x21
-    x23 = l2*x22
-    x24 = x1*x16
-    x25 = x12*x9 + x24
-    x26 = -x23 + x25
-    x27 = m2*x26
-    x28 = x1*x19 + x12*x27
-    x29 = l1*x10 + l1*x28 + x20
-    x30 = tau1 - x29
-    x31 = x4 + x6
-    x32 = x31*x8
-    x33 = -(x32*x32)*x7 + x6
-    x34 = tau2 - x20
-    x35 = -x30*x32 + x34
-    x36 = x35/x33
-    x37 = x30*x8 - x32*x36
+    x11 = l1*x10
+    x12 = x1*x9
+    x13 = np.sin(q2)
+    x14 = qd1*qd1
+    x15 = l1*x14
+    x16 = g*np.cos(q1)
+    x17 = -x15 - x16
+    x18 = x13*x17
+    x19 = x12 - x18
+    x20 = m2*x19
+    x21 = l2*x20
+    x22 = qd1 + qd2
+    x23 = x22*x22
+    x24 = l2*x23
+    x25 = x1*x17
+    x26 = x13*x9 + x25
+    x27 = -x24 + x26
+    x28 = m2*x27
+    x29 = x1*x20 + x13*x28
+    x30 = l1*x29 + x11 + x21
+    x31 = tau1 - x30
+    x32 = x4 + x6
+    x33 = x32*x8
+    x34 = -(x33*x33)*x7 + x6
+    x35 = tau2 - x21
+    x36 = -x31*x33 + x35
+    x37 = x36/x34
+    x38 = x31*x8 - x33*x37
     return _assemble(
         _lead,
         (2,),
         [
+            x38,
             x37,
-            x36,
         ],
     )
