@@ -44,6 +44,9 @@ def is_trivial(expr: sp.Expr) -> bool:
     return False
 
 
+_ZERO = sp.S.Zero  # a singleton: `is` tests avoid SymPy's slow comparisons
+
+
 def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
     """Total derivative of e, given the derivatives `dmap` of the symbols it uses (others 0).
 
@@ -59,21 +62,21 @@ def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
         return hit
     args = e.args
     if e.is_Add:
-        out = sp.Add(*[d for d in (_derivative(a, dmap, memo) for a in args) if d != 0])
+        out = sp.Add(*[d for d in (_derivative(a, dmap, memo) for a in args) if d is not _ZERO])
     elif e.is_Mul:
         terms = []
         for i, a in enumerate(args):
             da = _derivative(a, dmap, memo)
-            if da != 0:
+            if da is not _ZERO:
                 terms.append(sp.Mul(*args[:i], *args[i + 1 :], da))
         out = sp.Add(*terms)
     elif e.is_Pow and args[1].is_Number:
         db = _derivative(args[0], dmap, memo)
-        out = args[1] * args[0] ** (args[1] - 1) * db if db != 0 else sp.S.Zero
+        out = args[1] * args[0] ** (args[1] - 1) * db if db is not _ZERO else _ZERO
     elif isinstance(e, (sp.sin, sp.cos)):
         da = _derivative(args[0], dmap, memo)
         slope = sp.cos(args[0]) if isinstance(e, sp.sin) else -sp.sin(args[0])
-        out = slope * da if da != 0 else sp.S.Zero
+        out = slope * da if da is not _ZERO else _ZERO
     elif isinstance(e, sp.sign):
         out = sp.S.Zero  # almost everywhere
     else:
@@ -147,7 +150,7 @@ class Program:
         dmap: dict[sp.Basic, sp.Expr] = {x: sp.S.One}
         for sym, expr in self.needed(outputs):
             d = _derivative(expr, dmap, {})
-            if d != 0:
+            if d is not _ZERO:
                 dmap[sym] = self.let(d, hint)
         memo: dict = {}
         return [_derivative(sp.sympify(e), dmap, memo) for e in outputs]

@@ -162,11 +162,56 @@ def _topological(nodes: dict[sp.Symbol, sp.Expr], roots: Sequence[sp.Expr]) -> l
     return order
 
 
-def _tree_cse(exprs: list[sp.Expr], prefix: str):
-    """SymPy's tree CSE alone (repeated subtrees), without opt_cse's common-argument search."""
-    from sympy.simplify.cse_main import tree_cse
+def _tree_cse(exprs: list[sp.Expr], prefix: str) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """Tree CSE alone: every compound subexpression met twice becomes a temporary.
 
-    return tree_cse(exprs, sp.numbered_symbols(prefix), opt_subs={}, order="none")
+    SymPy's tree_cse does the same but rebuilds every node through the full
+    constructor; here nodes are rebuilt without re-canonicalisation (their
+    arguments keep SymPy's order), which makes it several times faster."""
+    seen: set[sp.Expr] = set()
+    repeated: set[sp.Expr] = set()
+
+    def visit(e: sp.Expr) -> None:
+        stack = [e]
+        while stack:
+            x = stack.pop()
+            if x.is_Atom or (
+                x.is_Mul and len(x.args) == 2 and x.args[0] is sp.S.NegativeOne and x.args[1].is_Atom
+            ):
+                continue
+            if x in seen:
+                repeated.add(x)
+                continue
+            seen.add(x)
+            stack.extend(x.args)
+
+    for e in exprs:
+        visit(e)
+    names = sp.numbered_symbols(prefix)
+    replacements: list[tuple[sp.Symbol, sp.Expr]] = []
+    memo: dict[sp.Expr, sp.Expr] = {}
+
+    def rebuild(x: sp.Expr) -> sp.Expr:
+        if x.is_Atom:
+            return x
+        hit = memo.get(x)
+        if hit is not None:
+            return hit
+        args = tuple(rebuild(a) for a in x.args)
+        if args == x.args:
+            new = x
+        elif x.is_Add or x.is_Mul:
+            new = x.func._from_args(args)
+        else:
+            new = x.func(*args)
+        if x in repeated:
+            sym = next(names)
+            replacements.append((sym, new))
+            new = sym
+        memo[x] = new
+        return new
+
+    return replacements, [rebuild(e) for e in exprs]
 
 
 def _cse_nodes(

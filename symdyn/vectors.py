@@ -31,22 +31,31 @@ def mat(m) -> Mat:
     )  # type: ignore[return-value]
 
 
+_ONE, _MINUS_ONE = sp.S.One, sp.S.NegativeOne
+
+
+def _s(x) -> sp.Expr:
+    return x if isinstance(x, sp.Basic) else sp.sympify(x)
+
+
 def _prod(a: sp.Expr, b: sp.Expr) -> sp.Expr:
-    if a == 0 or b == 0:
+    # SymPy's 0, 1 and -1 are singletons: identity tests avoid SymPy's (slow) comparisons
+    a, b = _s(a), _s(b)
+    if a is ZERO or b is ZERO:
         return ZERO
-    if a == 1:
+    if a is _ONE:
         return b
-    if b == 1:
+    if b is _ONE:
         return a
-    if a == -1:
+    if a is _MINUS_ONE:
         return -b
-    if b == -1:
+    if b is _MINUS_ONE:
         return -a
     return a * b
 
 
 def _sum(terms) -> sp.Expr:
-    terms = [t for t in terms if t != 0]
+    terms = [t for t in map(_s, terms) if t is not ZERO]
     if not terms:
         return ZERO
     if len(terms) == 1:
@@ -59,11 +68,11 @@ def add(*vs: Vec) -> Vec:
 
 
 def sub(a: Vec, b: Vec) -> Vec:
-    return tuple(_sum((a[i], -b[i] if b[i] != 0 else ZERO)) for i in range(3))  # type: ignore[return-value]
+    return tuple(_sum((a[i], _prod(_MINUS_ONE, b[i]))) for i in range(3))  # type: ignore[return-value]
 
 
 def neg(a: Vec) -> Vec:
-    return tuple(-x if x != 0 else ZERO for x in a)  # type: ignore[return-value]
+    return tuple(_prod(_MINUS_ONE, x) for x in a)  # type: ignore[return-value]
 
 
 def scale(k: sp.Expr, a: Vec) -> Vec:
