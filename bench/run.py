@@ -101,6 +101,25 @@ ROBOTS = {  # name -> robot file (chains are written by bench/chains.py)
     "chain_9": chains.chain_file(9),
     "chain_12": chains.chain_file(12),
 }
+URDF_TIPS: dict[Path, str] = {}  # URDF file -> the tip link of its chain
+
+
+def _panda_urdf() -> Path | None:
+    """The Franka Panda URDF that example-robot-data (the test extra) ships, if installed."""
+    try:
+        from importlib.metadata import PackageNotFoundError, distribution
+
+        share = "cmeel.prefix/share/example-robot-data/robots"
+        robots = distribution("example-robot-data").locate_file(share)
+    except (ImportError, PackageNotFoundError):
+        return None
+    path = Path(str(robots)) / "panda_description" / "urdf" / "panda.urdf"
+    return path if path.is_file() else None
+
+
+if (_urdf := _panda_urdf()) is not None:  # the same arm as panda.yaml, through the URDF loader
+    ROBOTS["panda_urdf"] = _urdf
+    URDF_TIPS[_urdf] = "panda_hand"
 QUICK_ROBOTS = ("roger_arm_values", "puma560", "panda")
 ARMS = ("puma560", "stanford", "panda")  # the issue's "6-7 joint arms with numeric parameters"
 NSTATES = 256  # pre-generated random states, cycled through (a power of two)
@@ -206,11 +225,11 @@ def symdyn_command() -> list[str]:
 
 
 def load(path: Path):
-    from symdyn.loaders import load_robot
+    from symdyn.loaders import load as load_any
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # implausible-but-published inertia (PUMA link 1)
-        return load_robot(path)
+        return load_any(path, tip=URDF_TIPS.get(path))
 
 
 # --------------------------------------------------------------------------- generation
@@ -247,7 +266,8 @@ def generate(path: Path, out_dir: Path) -> tuple[float, float]:
     """`symdyn generate PATH --target c --out OUT_DIR` in a fresh process: (wall s, CPU s)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    run([*symdyn_command(), "generate", path, "--target", "c", "--out", out_dir, "--force"])
+    tip = ["--tip", URDF_TIPS[path]] if path in URDF_TIPS else []
+    run([*symdyn_command(), "generate", path, "--target", "c", "--out", out_dir, "--force", *tip])
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -308,7 +328,7 @@ HARNESS = r"""/* Timing harness for {name}: written by bench/run.py, do not edit
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include "{name}_dynamics.h"
+#include "{prefix}_dynamics.h"
 #include "cr_{name}.h"
 
 #define N {n}
@@ -376,16 +396,16 @@ static double run_bench(int b, long it)
 {{
     double s = now_ns();
     switch (b) {{
-    case 0: LOOP(N, {name}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT));
-    case 1: LOOP(N, CR(cr_{name}_inverse_dynamics, Q[k], QD[k], QDD[k]));
-    case 2: LOOP(N * N, {name}_mass_matrix(Q[k], P, OUT));
-    case 3: LOOP(N * N, CR(cr_{name}_mass_matrix, Q[k]));
-    case 4: LOOP(N, {name}_gravity(Q[k], P, OUT));
-    case 5: LOOP(N, CR(cr_{name}_gravity, Q[k]));
-    case 6: LOOP(N * N, {name}_coriolis_matrix(Q[k], QD[k], P, OUT));
-    case 7: LOOP(N, {name}_coriolis(Q[k], QD[k], P, OUT));
-    case 8: LOOP(N, {name}_friction(QD[k], P, OUT));
-    case 9: LOOP(N, {name}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT));
+    case 0: LOOP(N, {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT));
+    case 1: LOOP(N, CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]));
+    case 2: LOOP(N * N, {prefix}_mass_matrix(Q[k], P, OUT));
+    case 3: LOOP(N * N, CR(cr_{prefix}_mass_matrix, Q[k]));
+    case 4: LOOP(N, {prefix}_gravity(Q[k], P, OUT));
+    case 5: LOOP(N, CR(cr_{prefix}_gravity, Q[k]));
+    case 6: LOOP(N * N, {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT));
+    case 7: LOOP(N, {prefix}_coriolis(Q[k], QD[k], P, OUT));
+    case 8: LOOP(N, {prefix}_friction(QD[k], P, OUT));
+    case 9: LOOP(N, {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT));
     default: return -1.0;
     }}
     return (now_ns() - s) / (double)it;
@@ -424,25 +444,25 @@ int main(int argc, char **argv)
         }}
     }}
     fclose(f);
-    cr_work(cr_{name}_inverse_dynamics_work, &sz_iw, &sz_w);
-    cr_work(cr_{name}_mass_matrix_work, &sz_iw, &sz_w);
-    cr_work(cr_{name}_gravity_work, &sz_iw, &sz_w);
+    cr_work(cr_{prefix}_inverse_dynamics_work, &sz_iw, &sz_w);
+    cr_work(cr_{prefix}_mass_matrix_work, &sz_iw, &sz_w);
+    cr_work(cr_{prefix}_gravity_work, &sz_iw, &sz_w);
     cr_iw = malloc(sizeof(casadi_int) * (size_t)sz_iw);
     cr_w = malloc(sizeof(casadi_real) * (size_t)sz_w);
 
     if (strcmp(argv[2], "check") == 0) {{
         int ncheck = argc > 3 ? atoi(argv[3]) : 4;
         for (k = 0; k < ncheck && k < K; ++k) {{
-            {name}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT); print_out("inverse_dynamics", k, N);
-            {name}_mass_matrix(Q[k], P, OUT); print_out("mass_matrix", k, N * N);
-            {name}_coriolis_matrix(Q[k], QD[k], P, OUT); print_out("coriolis_matrix", k, N * N);
-            {name}_coriolis(Q[k], QD[k], P, OUT); print_out("coriolis", k, N);
-            {name}_gravity(Q[k], P, OUT); print_out("gravity", k, N);
-            {name}_friction(QD[k], P, OUT); print_out("friction", k, N);
-            {name}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT); print_out("forward_dynamics", k, N);
-            CR(cr_{name}_inverse_dynamics, Q[k], QD[k], QDD[k]); print_out("cr_inverse_dynamics", k, N);
-            CR(cr_{name}_mass_matrix, Q[k]); print_out("cr_mass_matrix", k, N * N);
-            CR(cr_{name}_gravity, Q[k]); print_out("cr_gravity", k, N);
+            {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT); print_out("inverse_dynamics", k, N);
+            {prefix}_mass_matrix(Q[k], P, OUT); print_out("mass_matrix", k, N * N);
+            {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT); print_out("coriolis_matrix", k, N * N);
+            {prefix}_coriolis(Q[k], QD[k], P, OUT); print_out("coriolis", k, N);
+            {prefix}_gravity(Q[k], P, OUT); print_out("gravity", k, N);
+            {prefix}_friction(QD[k], P, OUT); print_out("friction", k, N);
+            {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT); print_out("forward_dynamics", k, N);
+            CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]); print_out("cr_inverse_dynamics", k, N);
+            CR(cr_{prefix}_mass_matrix, Q[k]); print_out("cr_mass_matrix", k, N * N);
+            CR(cr_{prefix}_gravity, Q[k]); print_out("cr_gravity", k, N);
         }}
         return 0;
     }}
@@ -493,9 +513,9 @@ def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
     """Write the CasADi route's C and the harness; compile all three with FLAGS."""
     casadi_route.write_c(fns, f"cr_{row.name}", work)
     harness = work / f"bench_{row.name}.c"
-    harness.write_text(HARNESS.format(name=row.name, n=robot.n, nstates=NSTATES))
+    harness.write_text(HARNESS.format(name=row.name, prefix=robot.name, n=robot.n, nstates=NSTATES))
     exe = work / f"bench_{row.name}"
-    sources = [harness, gen_dir / f"{row.name}_dynamics.c", work / f"cr_{row.name}.c"]
+    sources = [harness, gen_dir / f"{robot.name}_dynamics.c", work / f"cr_{row.name}.c"]
     t0 = time.perf_counter()
     run([C_COMPILER, *FLAGS, "-I", gen_dir, "-I", work, "-o", exe, *sources, "-lm"])
     row.notes.append(f"C build {time.perf_counter() - t0:.1f} s")
