@@ -46,7 +46,6 @@ def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dic
     for i in range(n):
         for j in range(i):
             M[i, j] = M[j, i]
-    G = sp.Matrix(program.diff([P], q[0], "dP")) if n == 1 else None
     G = sp.Matrix([program.diff([P], q[k], "dP")[0] for k in range(n)])
     upper = [(r, c) for r in range(n) for c in range(r, n)]
     dM: list[dict[tuple[int, int], sp.Expr]] = []
