@@ -23,7 +23,7 @@ from collections.abc import Sequence
 import sympy as sp
 
 from . import vectors as v3
-from .newton_euler import JointFrame
+from .newton_euler import JointFrame, origin_inertia
 from .program import Program
 from .robot import Robot
 
@@ -67,15 +67,10 @@ def composite_inertias(
     h: list[v3.Vec] = []
     I: list[v3.Mat] = []
     for link in robot.links:
-        c = v3.vec(link.com)
         m = sp.sympify(link.mass)
-        Ic = v3.mat(link.inertia)
-        cc = _skew_sq(c)
         mass.append(m)
-        h.append(tuple(program.let(v3._prod(m, x), "h") for x in c))  # type: ignore[arg-type]
-        I.append(
-            _sym3(program, [[Ic[r][k] - v3._prod(m, cc[r][k]) for k in range(3)] for r in range(3)], "Io")
-        )
+        h.append(tuple(program.let(v3._prod(m, x), "h") for x in v3.vec(link.com)))  # type: ignore[arg-type]
+        I.append(_sym3(program, origin_inertia(link), "Io"))
     for j in reversed(range(1, n)):
         R, p = frames[j]
         Rh = tuple(program.let(x, "Rh") for x in v3.mul(R, h[j]))

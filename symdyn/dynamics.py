@@ -18,7 +18,6 @@ free parameters, simplified with trigonometric identities when requested
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 import sympy as sp
@@ -79,6 +78,7 @@ class Dynamics:
     compact: dict[str, sp.Matrix]
     simplified: bool
     _closed: dict[str, sp.Matrix] = field(default_factory=dict, repr=False)
+    _compiled: dict[str, object] = field(default_factory=dict, repr=False)
 
     @property
     def n(self) -> int:
@@ -125,17 +125,16 @@ class Dynamics:
         outs = [e for name in names for e in self.compact[name]]
         return self.program.needed(outs)
 
-    @cached_property
-    def _numeric(self):
-        args = [list(self.q), list(self.qd), list(self.qdd), list(self.params)]
-        funcs = {}
-        for name in QUANTITIES:
+    def _numeric(self, name: str):
+        """NumPy function of quantity `name` over the eliminated form, compiled on first use."""
+        f = self._compiled.get(name)
+        if f is None:
             m = self.compact[name]
             steps = self.program.needed(list(m))
-            funcs[name] = sp.lambdify(
-                args, sp.Matrix(m), modules="numpy", cse=lambda exprs, steps=steps: (steps, exprs)
-            )
-        return funcs
+            args = [list(self.q), list(self.qd), list(self.qdd), list(self.params)]
+            f = sp.lambdify(args, sp.Matrix(m), modules="numpy", cse=lambda exprs: (steps, exprs))
+            self._compiled[name] = f
+        return f
 
     def evaluate(self, name: str, q=None, qd=None, qdd=None, params=None) -> np.ndarray:
         """Numeric value of quantity `name` at a state (missing vectors are zero)."""
@@ -144,7 +143,7 @@ class Dynamics:
         values = self.robot.param_values(params) if self.params else {}
         p = [values[s] for s in self.params]
         shape = self.compact[name].shape
-        out = np.asarray(self._numeric[name](*vec, p), dtype=float).reshape(shape)
+        out = np.asarray(self._numeric(name)(*vec, p), dtype=float).reshape(shape)
         return out[:, 0] if name not in ("M", "C") else out
 
 

@@ -40,7 +40,7 @@ from . import vectors as v3
 from .program import Program
 from .robot import Link, Robot
 
-__all__ = ["newton_euler", "joint_frames"]
+__all__ = ["newton_euler", "joint_frames", "origin_inertia"]
 
 JointFrame = tuple[v3.Mat, v3.Vec]
 
@@ -58,7 +58,7 @@ def _name(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
     return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
 
 
-def _origin_inertia(link: Link) -> v3.Mat:
+def origin_inertia(link: Link) -> v3.Mat:
     """I_o = I_c + m (c^T c 1 - c c^T): the inertia about the body origin (parallel axis)."""
     m = sp.sympify(link.mass)
     c = v3.vec(link.com)
@@ -89,7 +89,7 @@ def _body_wrench(
     c = v3.vec(link.com)
     if _about_origin(link):
         h = tuple(v3._prod(m, x) for x in c)
-        I = _origin_inertia(link)
+        I = origin_inertia(link)
         F = _name(program, v3.add(v3.scale(m, vd), v3.mul(W, h)), f"F{k}_")
         extra = v3.cross(h, vd)
     else:

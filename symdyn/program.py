@@ -23,7 +23,7 @@ from collections.abc import Iterable, Sequence
 
 import sympy as sp
 
-__all__ = ["Program", "is_trivial"]
+__all__ = ["Program", "dependencies", "is_trivial"]
 
 
 def _negated(expr: sp.Expr) -> sp.Expr | None:
@@ -85,6 +85,21 @@ def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
     return out
 
 
+def dependencies(
+    assignments: Sequence[tuple[sp.Symbol, sp.Expr]], index: dict[sp.Symbol, int], outputs: Iterable[sp.Expr]
+) -> set[int]:
+    """Indices of the assignments that the outputs use, directly or through one another."""
+    marked: set[int] = set()
+    stack = [s for e in outputs for s in e.free_symbols if s in index]
+    while stack:
+        k = index[stack.pop()]
+        if k in marked:
+            continue
+        marked.add(k)
+        stack.extend(s for s in assignments[k][1].free_symbols if s in index)
+    return marked
+
+
 class Program:
     """An ordered list of named intermediate assignments (symbol, expression)."""
 
@@ -131,18 +146,7 @@ class Program:
 
     def needed(self, outputs: Iterable[sp.Expr]) -> list[tuple[sp.Symbol, sp.Expr]]:
         """The assignments the outputs depend on, in program order."""
-        todo = set()
-        for e in outputs:
-            todo |= self._deps(sp.sympify(e))
-        marked: set[int] = set()
-        stack = list(todo)
-        while stack:
-            s = stack.pop()
-            k = self._index[s]
-            if k in marked:
-                continue
-            marked.add(k)
-            stack.extend(self._deps(self.assignments[k][1]))
+        marked = dependencies(self.assignments, self._index, [sp.sympify(e) for e in outputs])
         return [self.assignments[k] for k in sorted(marked)]
 
     def diff(self, outputs: Sequence[sp.Expr], x: sp.Symbol, hint: str = "d") -> list[sp.Expr]:

@@ -23,6 +23,8 @@ from functools import cached_property
 
 import sympy as sp
 
+from .program import dependencies
+
 __all__ = ["OpCount", "count_ops", "eliminate", "eliminate_many", "Eliminated", "chop_float_noise"]
 
 MAX_UNROLLED_POWER = 8
@@ -228,7 +230,7 @@ def _cse_nodes(
     its CSE time for a few percent more operations."""
     syms = [s for s, _ in assignments]
     index = {s: k for k, s in enumerate(syms)}
-    heavy_deps = _closure(assignments, index, outputs)
+    heavy_deps = dependencies(assignments, index, [sp.sympify(e) for e in outputs])
     first = [k for k in range(len(syms)) if k in heavy_deps]
     second = [k for k in range(len(syms)) if k not in heavy_deps]
     exprs = [assignments[k][1] for k in first]
@@ -258,21 +260,6 @@ def _cse_nodes(
         alias = resolved
     kept = {s: e.xreplace(alias) for s, e in nodes.items() if s not in alias}
     return kept, [e.xreplace(alias) for e in outs]
-
-
-def _closure(
-    assignments: Sequence[tuple[sp.Symbol, sp.Expr]], index: dict[sp.Symbol, int], outputs: Sequence[sp.Expr]
-) -> set[int]:
-    """Indices of the assignments the outputs depend on (directly or through others)."""
-    marked: set[int] = set()
-    stack = [s for e in outputs for s in sp.sympify(e).free_symbols if s in index]
-    while stack:
-        k = index[stack.pop()]
-        if k in marked:
-            continue
-        marked.add(k)
-        stack.extend(s for s in assignments[k][1].free_symbols if s in index)
-    return marked
 
 
 def _renamed(expr: sp.Expr, rename: dict[sp.Symbol, sp.Symbol], memo: dict) -> sp.Expr:
