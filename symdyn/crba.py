@@ -23,14 +23,25 @@ from collections.abc import Sequence
 import sympy as sp
 
 from . import vectors as v3
-from .newton_euler import JointFrame, origin_inertia
+from .frames import JointFrame
+from .newton_euler import origin_inertia
 from .program import Program
 from .robot import Robot
 
-__all__ = ["composite_inertias", "mass_matrix_crba", "gravity_composite"]
+__all__ = [
+    "Composite",
+    "composite_inertias",
+    "shift_inertia",
+    "sym3",
+    "mass_matrix_crba",
+    "gravity_composite",
+]
 
 
-def _sym3(program: Program, I: Sequence[Sequence[sp.Expr]], hint: str) -> v3.Mat:
+Composite = tuple[sp.Expr, v3.Vec, v3.Mat]  # mass, first moment, rotational inertia about the origin
+
+
+def sym3(program: Program, I: Sequence[Sequence[sp.Expr]], hint: str) -> v3.Mat:
     """Name the 6 distinct entries of a symmetric 3x3 matrix."""
     e = {(r, c): program.let(I[r][c], hint) for r in range(3) for c in range(r, 3)}
     return tuple(tuple(e[(min(r, c), max(r, c))] for c in range(3)) for r in range(3))  # type: ignore[return-value]
@@ -51,10 +62,33 @@ def _sym_cross_term(u: v3.Vec, p: v3.Vec) -> list[list[sp.Expr]]:
     ]
 
 
-def _rotate(R: v3.Mat, I: v3.Mat) -> list[list[sp.Expr]]:
-    """R I R^T."""
-    RI = [[v3.dot(R[r], (I[0][c], I[1][c], I[2][c])) for c in range(3)] for r in range(3)]
-    return [[v3.dot(RI[r], R[c]) for c in range(3)] for r in range(3)]
+def shift_inertia(
+    frame: JointFrame, child: Composite, own: Composite, program: Program, hint: str
+) -> Composite:
+    """own + child, the child's spatial inertia (about its origin, its axes) moved into the parent
+    frame (R, p: child frame in parent frame, h' = R h):
+
+        m = m_o + m_j,   h = h_o + R h_j + m_j p,
+        I = I_o + R I_j R^T - [h' x][p x] - [p x][h' x] - m_j [p x]^2
+    """
+    R, p = frame.R, frame.p
+    mj, hj, Ij = child
+    mo, ho, Io = own
+    Rh = tuple(program.let(x, f"{hint}Rh") for x in v3.mul(R, hj))
+    m = program.let(v3._sum((mo, mj)), f"{hint}m")
+    h = tuple(program.let(x, f"{hint}h") for x in v3.add(ho, Rh, v3.scale(mj, p)))
+    RIR = frame.rotate_symmetric(Ij, program, f"{hint}r")
+    cross = _sym_cross_term(Rh, p)  # type: ignore[arg-type]
+    pp = _skew_sq(p)
+    I = sym3(
+        program,
+        [
+            [v3._sum((Io[r][k], RIR[r][k], -cross[r][k], -v3._prod(mj, pp[r][k]))) for k in range(3)]
+            for r in range(3)
+        ],
+        f"{hint}I",
+    )
+    return m, h, I  # type: ignore[return-value]
 
 
 def composite_inertias(
@@ -63,33 +97,17 @@ def composite_inertias(
     """Mass, first moment and rotational inertia (about the body origin, body axes) of the
     subtree rooted at each link (the link and everything outboard of it)."""
     n = robot.n
-    mass: list[sp.Expr] = []
-    h: list[v3.Vec] = []
-    I: list[v3.Mat] = []
-    for link in robot.links:
+    comp: list[Composite] = [(sp.S.Zero, (), ())] * n  # type: ignore[list-item]
+    for j in reversed(range(n)):
+        link = robot.links[j]
         m = sp.sympify(link.mass)
-        mass.append(m)
-        h.append(tuple(program.let(v3._prod(m, x), "h") for x in v3.vec(link.com)))  # type: ignore[arg-type]
-        I.append(_sym3(program, origin_inertia(link), "Io"))
-    for j in reversed(range(1, n)):
-        R, p = frames[j]
-        Rh = tuple(program.let(x, "Rh") for x in v3.mul(R, h[j]))
-        mj = mass[j]
-        parent = j - 1
-        mass[parent] = program.let(mass[parent] + mj, "mc")
-        h[parent] = tuple(program.let(x, "hc") for x in v3.add(h[parent], Rh, v3.scale(mj, p)))  # type: ignore[assignment]
-        RIR = _rotate(R, I[j])
-        cross = _sym_cross_term(Rh, p)
-        pp = _skew_sq(p)
-        I[parent] = _sym3(
-            program,
-            [
-                [I[parent][r][k] + RIR[r][k] - cross[r][k] - v3._prod(mj, pp[r][k]) for k in range(3)]
-                for r in range(3)
-            ],
-            "Ic",
+        own: Composite = (
+            m,
+            tuple(program.let(v3._prod(m, x), "h") for x in v3.vec(link.com)),  # type: ignore[arg-type]
+            sym3(program, origin_inertia(link), "Io"),
         )
-    return mass, h, I
+        comp[j] = own if j + 1 == n else shift_inertia(frames[j + 1], comp[j + 1], own, program, "c")
+    return [c[0] for c in comp], [c[1] for c in comp], [c[2] for c in comp]
 
 
 def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -> sp.Matrix:
@@ -107,7 +125,7 @@ def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -
             ff = tuple(program.let(x, "Ff") for x in v3.scale(mass[j], a))
         for i in range(j, -1, -1):
             if i < j:
-                R, p = frames[i + 1]
+                R, p = frames[i + 1].R, frames[i + 1].p
                 ff_new = tuple(program.let(x, "Ff") for x in v3.mul(R, ff))
                 nf = tuple(program.let(x, "Fn") for x in v3.add(v3.mul(R, nf), v3.cross(p, ff_new)))
                 ff = ff_new
@@ -132,7 +150,7 @@ def gravity_composite(robot: Robot, frames: list[JointFrame], program: Program) 
     g = v3.vec(robot.gravity)
     G: list[sp.Expr] = []
     for k, link in enumerate(robot.links):
-        R, _p = frames[k]
+        R = frames[k].R
         g = tuple(program.let(x, f"gk{k + 1}_") for x in v3.mul_t(R, g))  # type: ignore[assignment]
         a = v3.vec(link.axis)
         if link.joint == "revolute":

@@ -23,10 +23,12 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
+from .coriolis import coriolis_matrix_composite
 from .crba import gravity_composite, mass_matrix_crba
 from .errors import SymdynError
+from .frames import joint_frames
 from .lagrange import lagrange
-from .newton_euler import joint_frames, newton_euler
+from .newton_euler import newton_euler
 from .program import Program
 from .robot import Robot
 from .simplify import chop_float_noise
@@ -153,13 +155,11 @@ def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str,
     zeros = [0] * n
     G = sp.Matrix(gravity_composite(robot, rot, program))
     V = sp.Matrix(newton_euler(robot, q, list(qd), zeros, program, gravity=False, tag="V", rotations=rot))
-    M = mass_matrix_crba(robot, rot, program)
+    with distribute(True):  # numbers times sums fold into the coefficients of the composites
+        M = mass_matrix_crba(robot, rot, program)
     Vn = [program.let(v, "V") for v in V]
-    C = sp.Matrix(n, n, lambda i, j: 0)
-    for j in range(n):
-        col = program.diff(Vn, qd[j], f"dV{j + 1}_")
-        for i in range(n):
-            C[i, j] = sp.Rational(1, 2) * col[i]
+    with distribute(True):
+        C = coriolis_matrix_composite(robot, rot, list(qd), program)
     bias = newton_euler(robot, q, list(qd), zeros, program, gravity=True, tag="B", rotations=rot)
     body = newton_euler(robot, q, list(qd), list(qdd), program, gravity=True, tag="T", rotations=rot)
     tau = sp.Matrix([body[i] + link.motor.reflected_inertia * qdd[i] for i, link in enumerate(robot.links)])

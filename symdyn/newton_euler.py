@@ -37,21 +37,11 @@ from collections.abc import Sequence
 import sympy as sp
 
 from . import vectors as v3
+from .frames import JointFrame, joint_frames
 from .program import Program
 from .robot import Link, Robot
 
-__all__ = ["newton_euler", "joint_frames", "origin_inertia"]
-
-JointFrame = tuple[v3.Mat, v3.Vec]
-
-
-def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
-    """(R_i, p_i) per link: rotation and origin of body i in its parent's body frame."""
-    out = []
-    for link, qi in zip(robot.links, q, strict=True):
-        T = link.joint_transform(qi)
-        out.append((v3.mat(T.R), v3.vec(T.p)))
-    return out
+__all__ = ["newton_euler", "origin_inertia"]
 
 
 def _name(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
@@ -130,7 +120,7 @@ def _outward(
 
     The parent's W = [wd x] + [w x]^2 gives wd x p + w x (w x p) = W p.
     """
-    R, p = frame
+    R, p = frame.R, frame.p
     a = v3.vec(link.axis)
     vd_new = v3.mul_t(R, v3.add(v3.mul(W, p), vd))
     w_par = _name(program, v3.mul_t(R, w), f"wp{k}_")
@@ -160,7 +150,7 @@ def newton_euler(
 
     `q`, `qd`, `qdd` may hold symbols or numbers (zeros fold away). The result
     is a list of expressions over the program's intermediates. `rotations`
-    (R_i, p_i per link, from `joint_frames`) may be passed in to share them.
+    (per link, from `symdyn.frames.joint_frames`) may be passed in to share them.
     """
     n = robot.n
     frames = rotations if rotations is not None else joint_frames(robot, q)
@@ -183,7 +173,7 @@ def newton_euler(
         link = robot.links[i]
         k = f"{tag}{i + 1}"
         if i + 1 < n:
-            R1, p1 = frames[i + 1]
+            R1, p1 = frames[i + 1].R, frames[i + 1].p
             Rf = _name(program, v3.mul(R1, f_next), f"Rf{k}_")
             n_new = v3.add(moments[i], v3.mul(R1, n_next), v3.cross(p1, Rf))
             f_new = v3.add(Rf, forces[i])

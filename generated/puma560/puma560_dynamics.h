@@ -3,12 +3,12 @@
  * Robot puma560: 6 joints, 0 free parameters, double precision.
  * Operation counts per call:
  *   inverse_dynamics    434 ops: 230 mul, 188 add, 0 div, 10 trig, 6 other
- *   mass_matrix         227 ops: 121 mul, 96 add, 0 div, 10 trig, 0 other
- *   coriolis_matrix    1191 ops: 732 mul, 439 add, 0 div, 20 trig, 0 other
+ *   mass_matrix         184 ops: 96 mul, 80 add, 0 div, 8 trig, 0 other
+ *   coriolis_matrix    1039 ops: 565 mul, 464 add, 0 div, 10 trig, 0 other
  *   coriolis            353 ops: 200 mul, 143 add, 0 div, 10 trig, 0 other
  *   gravity              43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
  *   friction             24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
- *   forward_dynamics    790 ops: 444 mul, 324 add, 6 div, 10 trig, 6 other
+ *   forward_dynamics    749 ops: 419 mul, 308 add, 6 div, 10 trig, 6 other
  */
 #ifndef PUMA560_DYNAMICS_H
 #define PUMA560_DYNAMICS_H
@@ -47,7 +47,7 @@ void puma560_inverse_dynamics(const double q[], const double qd[], const double 
  * @param[in]  p  free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] M  joint-space mass (inertia) matrix M(q), puma560_NDOF*puma560_NDOF values, row-major: M[i*puma560_NDOF + j] is row i, column j
  *
- * Cost per call: 227 operations: 121 multiplications, 96 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
+ * Cost per call: 184 operations: 96 multiplications, 80 additions, 0 divisions, 8 trigonometric calls, 0 other calls.
  */
 void puma560_mass_matrix(const double q[], const double p[], double M[]);
 
@@ -59,7 +59,7 @@ void puma560_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, puma560_NDOF*puma560_NDOF values, row-major: C[i*puma560_NDOF + j] is row i, column j
  *
- * Cost per call: 1191 operations: 732 multiplications, 439 additions, 0 divisions, 20 trigonometric calls, 0 other calls.
+ * Cost per call: 1039 operations: 565 multiplications, 464 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
  */
 void puma560_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 
@@ -106,7 +106,7 @@ void puma560_friction(const double qd[], const double p[], double F[]);
  * @param[in]  p    free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] qdd  joint accelerations, puma560_NDOF values
  *
- * Cost per call: 790 operations: 444 multiplications, 324 additions, 6 divisions, 10 trigonometric calls, 6 other calls.
+ * Cost per call: 749 operations: 419 multiplications, 308 additions, 6 divisions, 10 trigonometric calls, 6 other calls.
  */
 void puma560_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
 

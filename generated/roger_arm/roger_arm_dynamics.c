@@ -4,7 +4,7 @@
  * Operation counts per call:
  *   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
  *   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
- *   coriolis_matrix      28 ops: 22 mul, 4 add, 0 div, 2 trig, 0 other
+ *   coriolis_matrix      33 ops: 22 mul, 9 add, 0 div, 2 trig, 0 other
  *   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
  *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
@@ -39,15 +39,15 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double x8 = x7*l1;
     const double x9 = g*cos(q1);
     const double x10 = -x8 - x9;
-    const double x11 = x6*x10;
-    const double x12 = -x11 + x5*x1;
+    const double x11 = x10*x6;
+    const double x12 = -x11 + x1*x5;
     const double x13 = x12 + x4*l2;
     const double x14 = x13*m2;
     const double x15 = x14*l2;
     const double x16 = qd1 + qd2;
     const double x17 = x16*x16;
     const double x18 = x17*l2;
-    const double x19 = x5*x10;
+    const double x19 = x10*x5;
     const double x20 = x19 + x1*x6;
     const double x21 = x20 - x18;
     const double x22 = x21*m2;
@@ -66,21 +66,21 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
     const double x0 = l1*l1;
-    const double x1 = cos(q2);
-    const double x2 = l2*m2;
+    const double x1 = l2*m2;
+    const double x2 = cos(q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
-    const double x5 = x0*m1;
-    const double x6 = m2*l2*l2;
+    const double x5 = m2*l2*l2;
+    const double x6 = x0*m1;
     const double x7 = x5 + x6 + 2.0*x4 + x0*m2;
-    const double x8 = x6 + x4;
+    const double x8 = x5 + x4;
     M[0] = x7;
     M[1] = x8;
     M[2] = x8;
-    M[3] = x6;
+    M[3] = x5;
 }
 
-/* C(q, qd) from Christoffel symbols, row-major; C qd = V (28 operations: 22 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
+/* C(q, qd) from Christoffel symbols, row-major; C qd = V (33 operations: 22 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
 void roger_arm_coriolis_matrix(const double q[], const double qd[], const double p[], double C[])
 {
     const double q2 = q[1];
@@ -89,25 +89,27 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double l1 = p[roger_arm_P_l1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = sin(q2);
-    const double x1 = 2.0*l1*qd1*x0;
-    const double x2 = x1*m2;
-    const double x3 = x2*l2;
-    const double x4 = cos(q2);
-    const double x5 = qd1 + qd2;
-    const double x6 = 2.0*l1*qd1*x4;
-    const double x7 = -x6 - 2.0*x5*l2;
-    const double x8 = x7*m2;
-    const double x9 = x8*x0 + x2*x4;
-    const double x10 = x3 + x9*l1;
-    const double x11 = 2.0*x5*l2;
-    const double x12 = x11*m2;
-    const double x13 = x12*x0;
-    const double x14 = x13*l1;
-    C[0] = 0.5*x10;
-    C[1] = -0.5*x14;
-    C[2] = 0.5*x3;
-    C[3] = 0.0;
+    const double x0 = l2*m2;
+    const double x1 = sin(q2);
+    const double x2 = l1*qd1;
+    const double x3 = x1*x2;
+    const double x4 = x0*x3;
+    const double x5 = cos(q2);
+    const double x6 = x3*m2;
+    const double x7 = 0.5*x6;
+    const double x8 = qd1 + qd2;
+    const double x9 = x5*x2;
+    const double x10 = 0.5*x0*x8 + 0.5*x9*m2;
+    const double x11 = x7*x5 - x10*x1;
+    const double x12 = x4 + 2.0*x11*l1;
+    const double x13 = x4 - x0*x3;
+    const double x14 = -2.0*x10 + x9*m2;
+    const double x15 = -x6 + 2.0*x7;
+    const double x16 = x13 + l1*(x14*x1 + x15*x5);
+    C[0] = x12;
+    C[1] = x16;
+    C[2] = x4;
+    C[3] = x13;
 }
 
 /* V(q, qd) = C(q, qd) qd (18 operations: 12 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
@@ -148,19 +150,19 @@ void roger_arm_gravity(const double q[], const double p[], double G[])
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = sin(q2);
-    const double x1 = l2*m2;
+    const double x0 = l2*m2;
+    const double x1 = sin(q2);
     const double x2 = x0*x1;
     const double x3 = l1*m1;
     const double x4 = cos(q2);
-    const double x5 = x4*x1;
+    const double x5 = x0*x4;
     const double x6 = x5 + x3 + l1*m2;
     const double x7 = g*cos(q1);
     const double x8 = g*sin(q1);
     const double x9 = x4*x8;
-    const double x10 = -x9 - x0*x7;
-    G[0] = x2*x7 + x8*x6;
-    G[1] = -x10*x1;
+    const double x10 = -x9 - x1*x7;
+    G[0] = x2*x7 + x6*x8;
+    G[1] = -x0*x10;
 }
 
 /* F(qd) = viscous qd + coulomb sign(qd) (0 operations: 0 multiplications, 0 additions, 0 divisions, 0 trigonometric calls, 0 other calls) */
@@ -187,40 +189,40 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
     const double x0 = l1*l1;
-    const double x1 = cos(q2);
-    const double x2 = l2*m2;
+    const double x1 = l2*m2;
+    const double x2 = cos(q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
-    const double x5 = x0*m1;
-    const double x6 = m2*l2*l2;
+    const double x5 = m2*l2*l2;
+    const double x6 = x0*m1;
     const double x7 = x5 + x6 + 2.0*x4 + x0*m2;
     const double x8 = 1.0/x7;
     const double x9 = g*sin(q1);
     const double x10 = x9*m1;
     const double x11 = x10*l1;
-    const double x12 = x1*x9;
+    const double x12 = x2*x9;
     const double x13 = sin(q2);
     const double x14 = qd1*qd1;
     const double x15 = x14*l1;
     const double x16 = g*cos(q1);
     const double x17 = -x15 - x16;
-    const double x18 = x13*x17;
+    const double x18 = x17*x13;
     const double x19 = x12 - x18;
     const double x20 = x19*m2;
     const double x21 = x20*l2;
     const double x22 = qd1 + qd2;
     const double x23 = x22*x22;
     const double x24 = x23*l2;
-    const double x25 = x1*x17;
+    const double x25 = x17*x2;
     const double x26 = x25 + x13*x9;
     const double x27 = x26 - x24;
     const double x28 = x27*m2;
-    const double x29 = x28*x13 + x20*x1;
+    const double x29 = x28*x13 + x20*x2;
     const double x30 = x11 + x21 + x29*l1;
     const double x31 = tau1 - x30;
-    const double x32 = x6 + x4;
+    const double x32 = x5 + x4;
     const double x33 = x32*x8;
-    const double x34 = x6 - x7*x33*x33;
+    const double x34 = x5 - x7*x33*x33;
     const double x35 = tau2 - x21;
     const double x36 = x35 - x33*x31;
     const double x37 = x36/x34;

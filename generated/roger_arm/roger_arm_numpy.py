@@ -3,7 +3,7 @@
 # Operation counts per call:
 #   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
 #   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
-#   coriolis_matrix      28 ops: 22 mul, 4 add, 0 div, 2 trig, 0 other
+#   coriolis_matrix      33 ops: 22 mul, 9 add, 0 div, 2 trig, 0 other
 #   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
 #   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
@@ -116,14 +116,14 @@ def mass_matrix(q, p=None):
     l2 = p[..., 3]
     m2 = p[..., 4]
     x0 = l1*l1
-    x1 = np.cos(q2)
-    x2 = l2*m2
+    x1 = l2*m2
+    x2 = np.cos(q2)
     x3 = x1*x2
     x4 = l1*x3
-    x5 = m1*x0
-    x6 = (l2*l2)*m2
+    x5 = (l2*l2)*m2
+    x6 = m1*x0
     x7 = m2*x0 + 2*x4 + x5 + x6
-    x8 = x4 + x6
+    x8 = x4 + x5
     return _assemble(
         _lead,
         (2, 2),
@@ -131,7 +131,7 @@ def mass_matrix(q, p=None):
             x7,
             x8,
             x8,
-            x6,
+            x5,
         ],
     )
 
@@ -151,29 +151,31 @@ def coriolis_matrix(q, qd, p=None):
     l1 = p[..., 1]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = np.sin(q2)
-    x1 = 2*l1*qd1*x0
-    x2 = m2*x1
-    x3 = l2*x2
-    x4 = np.cos(q2)
-    x5 = qd1 + qd2
-    x6 = 2*l1*qd1*x4
-    x7 = -2*l2*x5 - x6
-    x8 = m2*x7
-    x9 = x0*x8 + x2*x4
-    x10 = l1*x9 + x3
-    x11 = 2*l2*x5
-    x12 = m2*x11
-    x13 = x0*x12
-    x14 = l1*x13
+    x0 = l2*m2
+    x1 = np.sin(q2)
+    x2 = l1*qd1
+    x3 = x1*x2
+    x4 = x0*x3
+    x5 = np.cos(q2)
+    x6 = m2*x3
+    x7 = 0.5*x6
+    x8 = qd1 + qd2
+    x9 = x2*x5
+    x10 = 0.5*m2*x9 + 0.5*x0*x8
+    x11 = -x1*x10 + x5*x7
+    x12 = 2*l1*x11 + x4
+    x13 = -x0*x3 + x4
+    x14 = m2*x9 - 2*x10
+    x15 = -x6 + 2*x7
+    x16 = l1*(x1*x14 + x15*x5) + x13
     return _assemble(
         _lead,
         (2, 2),
         [
-            0.5*x10,
-            -0.5*x14,
-            0.5*x3,
-            0,
+            x12,
+            x16,
+            x4,
+            x13,
         ],
     )
 
@@ -233,23 +235,23 @@ def gravity(q, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = np.sin(q2)
-    x1 = l2*m2
+    x0 = l2*m2
+    x1 = np.sin(q2)
     x2 = x0*x1
     x3 = l1*m1
     x4 = np.cos(q2)
-    x5 = x1*x4
+    x5 = x0*x4
     x6 = l1*m2 + x3 + x5
     x7 = g*np.cos(q1)
     x8 = g*np.sin(q1)
     x9 = x4*x8
-    x10 = -x0*x7 - x9
+    x10 = -x1*x7 - x9
     return _assemble(
         _lead,
         (2,),
         [
             x2*x7 + x6*x8,
-            -x1*x10,
+            -x0*x10,
         ],
     )
 
@@ -294,18 +296,18 @@ def forward_dynamics(q, qd, tau, p=None):
     l2 = p[..., 3]
     m2 = p[..., 4]
     x0 = l1*l1
-    x1 = np.cos(q2)
-    x2 = l2*m2
+    x1 = l2*m2
+    x2 = np.cos(q2)
     x3 = x1*x2
     x4 = l1*x3
-    x5 = m1*x0
-    x6 = (l2*l2)*m2
+    x5 = (l2*l2)*m2
+    x6 = m1*x0
     x7 = m2*x0 + 2*x4 + x5 + x6
     x8 = 1/x7
     x9 = g*np.sin(q1)
     x10 = m1*x9
     x11 = l1*x10
-    x12 = x1*x9
+    x12 = x2*x9
     x13 = np.sin(q2)
     x14 = qd1*qd1
     x15 = l1*x14
@@ -318,16 +320,16 @@ def forward_dynamics(q, qd, tau, p=None):
     x22 = qd1 + qd2
     x23 = x22*x22
     x24 = l2*x23
-    x25 = x1*x17
+    x25 = x17*x2
     x26 = x13*x9 + x25
     x27 = -x24 + x26
     x28 = m2*x27
-    x29 = x1*x20 + x13*x28
+    x29 = x13*x28 + x2*x20
     x30 = l1*x29 + x11 + x21
     x31 = tau1 - x30
-    x32 = x4 + x6
+    x32 = x4 + x5
     x33 = x32*x8
-    x34 = -(x33*x33)*x7 + x6
+    x34 = -(x33*x33)*x7 + x5
     x35 = tau2 - x21
     x36 = -x31*x33 + x35
     x37 = x36/x34

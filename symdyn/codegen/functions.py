@@ -132,7 +132,7 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
     program_outputs = [e for name in QUANTITIES for e in c[name]] + list(c["bias"])
     steps = dyn.program.needed(program_outputs) + fd.needed(qdd_out)
     inputs = (*q.symbols, *qd.symbols, *qdd.symbols, *tau.symbols, *p.symbols)
-    code = eliminate_many(steps, outputs, reserved=inputs, light=("coriolis_matrix",))
+    code = eliminate_many(steps, outputs, reserved=inputs)
     return [
         FunctionSpec(name, doc, inputs, out, (exprs.rows, exprs.cols), code[name])
         for name, doc, inputs, out, exprs in table

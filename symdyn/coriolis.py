@@ -1,0 +1,172 @@
+"""The Christoffel-symbol Coriolis matrix from composite bodies, in body frames, O(n^2).
+
+Spatial vectors are pairs (angular, linear): a motion v = (w, u) with u the
+velocity of the body-frame origin, a force f = (n, f) with n the moment about
+the origin. s_k is joint k's motion subspace ((a_k, 0) revolute, (0, a_k)
+prismatic), v_k the body velocity and psi_k = v_k x s_k the rate of change of
+s_k as seen from the world. For the subtree rooted at m (the link and
+everything outboard), I^c_m is its spatial inertia, h^c_m = sum I_i v_i its
+momentum and Idot^c_m = sum (v_i x* I_i - I_i v_i x) the world rate of change
+of I^c_m. Differentiating V_j = s_j^T dh^c_j/dt by qd_k (with
+d a_i/d qd_k = 2 psi_k + s_k x v_i for the velocity-product accelerations)
+gives, with m = max(j, k) and every vector carried into one frame,
+
+    2 C_jk = s_j^T (s_k x* h^c_m + 2 I^c_m psi_k + Idot^c_m s_k)
+
+which is the Christoffel form C = 1/2 dV/dqd (Echeandia and Wensing 2021 reach
+the same result through their matrices B_i). With the half-quantities
+H = h^c / 2 and P = Idot^c / 2 this reads, for j >= k,
+
+    C_kj = s_k^T Y_j,               Y_j = P_j s_j + s_j x* H_j + I^c_j psi_j
+    C_jk = s_k^T A_j + psi_k^T F_j,  A_j = P_j s_j - s_j x* H_j,  F_j = I^c_j s_j
+
+(the lower triangle uses the symmetry of I^c and Idot^c and
+<a, b x* f> = -<b, a x* f>). Only the three forces Y_j, A_j and F_j travel
+inward, n <- R n + p x R f, f <- R f; nothing with an inertia is formed per
+pair of joints, against one Newton-Euler tangent pass per column when C is
+computed as 1/2 dV/dqd.
+
+A zero-mass spatial inertia (h, I) carries P: for a body with first moment h
+and rotational inertia I about its origin moving with (w, u),
+Idot = (dh, dI) with dh = w x h + m u and dI = [w x] I - I [w x] - ([u x][h x] + [h x][u x]).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from . import vectors as v3
+from .crba import Composite, composite_inertias, shift_inertia, sym3
+from .frames import JointFrame
+from .newton_euler import origin_inertia
+from .program import Program
+from .robot import Link, Robot
+
+__all__ = ["coriolis_matrix_composite"]
+
+Spatial = tuple[v3.Vec, v3.Vec]
+_HALF = sp.Rational(1, 2)
+_ZERO3: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
+
+
+def _named(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
+    return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
+
+
+def _motion_subspace(link: Link) -> Spatial:
+    a = v3.vec(link.axis)
+    return (a, _ZERO3) if link.joint == "revolute" else (_ZERO3, a)
+
+
+def _cross_motion(v: Spatial, s: Spatial) -> Spatial:
+    """v x s for motion vectors: (w x ws, w x us + u x ws)."""
+    (w, u), (ws, us) = v, s
+    return v3.cross(w, ws), v3.add(v3.cross(w, us), v3.cross(u, ws))
+
+
+def _cross_force(s: Spatial, f: Spatial) -> Spatial:
+    """s x* f for a motion s and a force f: (ws x n + us x f, ws x f)."""
+    (ws, us), (n, fl) = s, f
+    return v3.add(v3.cross(ws, n), v3.cross(us, fl)), v3.cross(ws, fl)
+
+
+def _apply_inertia(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial) -> Spatial:
+    """The spatial inertia (m, h, I) times a motion (w, u): (I w + h x u, m u - h x w)."""
+    w, u = v
+    return v3.add(v3.mul(I, w), v3.cross(h, u)), v3.sub(v3.scale(m, u), v3.cross(h, w))
+
+
+def _to_parent(frame: JointFrame, f: Spatial) -> Spatial:
+    """A force carried from a body frame into its parent's: (R n + p x R f, R f)."""
+    R, p = frame.R, frame.p
+    Rf = v3.mul(R, f[1])
+    return v3.add(v3.mul(R, f[0]), v3.cross(p, Rf)), Rf
+
+
+def _inertia_rate(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial, program: Program, k: str) -> Composite:
+    """The world rate of change v x* I - I v x of a body's spatial inertia (m, h, I) moving
+    with v = (w, u), as a zero-mass inertia (dh, dI)."""
+    w, u = v
+    dh = _named(program, v3.add(v3.cross(w, h), v3.scale(m, u)), f"Pd{k}_")
+    K = [[v3.dot(row, (I[0][c], I[1][c], I[2][c])) for c in range(3)] for row in _skew(w)]
+    uh2 = v3._prod(2, v3.dot(u, h))
+    dI = [
+        [
+            v3._sum((K[r][c], K[c][r], -v3._prod(u[r], h[c]), -v3._prod(h[r], u[c]), uh2 if r == c else 0))
+            for c in range(3)
+        ]
+        for r in range(3)
+    ]
+    return sp.S.Zero, dh, sym3(program, dI, f"PI{k}_")
+
+
+def _skew(w: v3.Vec) -> v3.Mat:
+    z = sp.S.Zero
+    return ((z, -w[2], w[1]), (w[2], z, -w[0]), (-w[1], w[0], z))  # type: ignore[return-value]
+
+
+def coriolis_matrix_composite(robot: Robot, frames: list[JointFrame], qd, program: Program) -> sp.Matrix:
+    """C(q, qd) with V = C qd and dM/dt - 2C skew-symmetric (Christoffel symbols), over the
+    program's intermediates; see the module docstring for the recursion."""
+    n = robot.n
+    mass, hc, Ic = composite_inertias(robot, frames, program)
+    s = [_motion_subspace(link) for link in robot.links]
+    # outward: body velocities and psi_k = v_k x s_k
+    vel: list[Spatial] = []
+    w, u = _ZERO3, _ZERO3
+    for i in range(n):
+        R, p = frames[i].R, frames[i].p
+        u = v3.mul_t(R, v3.add(u, v3.cross(w, p)))
+        w = v3.mul_t(R, w)
+        w = _named(program, v3.add(w, v3.scale(qd[i], s[i][0])), f"w{i + 1}_")
+        u = _named(program, v3.add(u, v3.scale(qd[i], s[i][1])), f"u{i + 1}_")
+        vel.append((w, u))
+    psi = [tuple(_named(program, x, f"psi{k + 1}_") for x in _cross_motion(vel[k], s[k])) for k in range(n)]
+    # inward: half momentum H and half inertia rate P of every subtree
+    H: list[Spatial] = [((), ())] * n  # type: ignore[list-item]
+    P: list[Composite] = [(sp.S.Zero, _ZERO3, ((sp.S.Zero,) * 3,) * 3)] * n  # type: ignore[list-item]
+    for i in reversed(range(n)):
+        link = robot.links[i]
+        k = str(i + 1)
+        m = sp.sympify(link.mass)
+        h = v3.vec(v3.scale(m, v3.vec(link.com)))
+        m2, h2, I2 = _HALF * m, v3.scale(_HALF, h), _halved(origin_inertia(link))
+        half = _apply_inertia(m2, h2, I2, vel[i])
+        own = _inertia_rate(m2, h2, I2, vel[i], program, k)
+        if i + 1 < n:
+            child = _to_parent(frames[i + 1], H[i + 1])
+            half = (v3.add(half[0], child[0]), v3.add(half[1], child[1]))
+            own = shift_inertia(frames[i + 1], P[i + 1], own, program, f"P{k}_")
+        H[i] = (_named(program, half[0], f"Hn{k}_"), _named(program, half[1], f"Hf{k}_"))
+        P[i] = own
+    C = sp.zeros(n, n)
+    for j in reversed(range(n)):
+        k = str(j + 1)
+        Ps = tuple(_named(program, x, f"Ps{k}_") for x in _apply_inertia(sp.S.Zero, P[j][1], P[j][2], s[j]))
+        sH = tuple(_named(program, x, f"sH{k}_") for x in _cross_force(s[j], H[j]))
+        Ipsi = _apply_inertia(mass[j], hc[j], Ic[j], psi[j])
+        Y = tuple(_named(program, v3.add(Ps[r], sH[r], Ipsi[r]), f"Y{k}_") for r in range(2))
+        A = tuple(_named(program, v3.sub(Ps[r], sH[r]), f"A{k}_") for r in range(2))
+        F = tuple(_named(program, x, f"F{k}_") for x in _apply_inertia(mass[j], hc[j], Ic[j], s[j]))
+        C[j, j] = program.let(_project(s[j], Y), "C")
+        for i in reversed(range(j)):
+            Y, A, F = (
+                tuple(_named(program, x, f"{tag}{k}_") for x in _to_parent(frames[i + 1], vec))
+                for tag, vec in (("Y", Y), ("A", A), ("F", F))
+            )
+            C[i, j] = program.let(_project(s[i], Y), "C")
+            C[j, i] = program.let(v3._sum((_project(s[i], A), _project(psi[i], F))), "C")
+    return C
+
+
+def _project(m: Spatial, f: Spatial) -> sp.Expr:
+    """m^T f for a motion m and a force f."""
+    return v3._sum((v3.dot(m[0], f[0]), v3.dot(m[1], f[1])))
+
+
+def _add3(a: v3.Mat, b: v3.Mat) -> v3.Mat:
+    return tuple(v3.add(a[r], b[r]) for r in range(3))  # type: ignore[return-value]
+
+
+def _halved(I: v3.Mat) -> v3.Mat:
+    return tuple(tuple(v3._prod(_HALF, x) for x in row) for row in I)  # type: ignore[return-value]

@@ -1,0 +1,97 @@
+"""Joint frames for the symbolic recursions, and rotations of inertia tensors between them.
+
+Link i's body frame sits in its parent's at p_i with orientation
+R_i = B_i Rot(a_i, q_i) (revolute) or R_i = B_i (prismatic), B_i the constant
+rotation of the joint's placement (symdyn.robot). The composite-body
+recursions move symmetric 3x3 tensors (rotational inertias and their rates of
+change) into the parent frame, R J R^T. For a joint about a coordinate axis k,
+with (i, j) the other two axes in right-handed order, c = cos q and s = sin q,
+the rotation about k gives
+
+    t = e s^2 + 2 J_ij c s,   J'_ii = J_ii - t,   J'_jj = J_jj + t,   J'_ij = e c s + J_ij (1 - 2 s^2),
+    J'_ik = c J_ik - s J_jk,  J'_jk = s J_ik + c J_jk,  J'_kk = J_kk,
+
+e = J_ii - J_jj: the identity c^2 + s^2 = 1 is used
+up front, so a tensor symmetric about the joint axis (J_ii = J_jj, J_ij = 0)
+passes through with no trigonometric term at all, and the constant B_i is
+applied after with zero-aware products.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import sympy as sp
+
+from . import vectors as v3
+from .program import Program
+from .robot import Robot
+
+__all__ = ["JointFrame", "joint_frames"]
+
+#: the two axes spanning the plane of a rotation about x, y or z, in right-handed order
+_PLANES = {0: (1, 2), 1: (2, 0), 2: (0, 1)}
+
+
+@dataclass(frozen=True)
+class JointFrame:
+    """Body frame i in its parent's: rotation R = B Rot(axis, q), origin p (parent axes)."""
+
+    R: v3.Mat
+    p: v3.Vec
+    B: v3.Mat
+    #: (i, j, k, cos q, sin q) when the joint turns about coordinate axis k, else None
+    turn: tuple[int, int, int, sp.Expr, sp.Expr] | None = None
+
+    def rotate_symmetric(self, J: v3.Mat, program: Program, hint: str) -> list[list[sp.Expr]]:
+        """R J R^T for a symmetric J (entries of the result, not yet named)."""
+        if self.turn is None:
+            return _congruence(self.R, J)
+        i, j, k, c, s = self.turn
+        e = v3._sum((J[i][i], -J[j][j]))
+        out = [[sp.S.Zero] * 3 for _ in range(3)]
+        out[i][i], out[j][j] = J[i][i], J[j][j]
+        if e is not sp.S.Zero or J[i][j] is not sp.S.Zero:
+            ss = program.let(s * s, f"{hint}ss_")
+            cs = program.let(c * s, f"{hint}cs_")
+            c2 = program.let(1 - 2 * ss, f"{hint}c2_")
+            t = program.let(v3._sum((v3._prod(e, ss), v3._prod(J[i][j], 2 * cs))), hint)
+            out[i][i] = v3._sum((J[i][i], -t))
+            out[j][j] = v3._sum((J[j][j], t))
+            out[i][j] = v3._sum((v3._prod(e, cs), v3._prod(J[i][j], c2)))
+        out[i][k] = v3._sum((v3._prod(c, J[i][k]), -v3._prod(s, J[j][k])))
+        out[j][k] = v3._sum((v3._prod(s, J[i][k]), v3._prod(c, J[j][k])))
+        out[k][k] = J[k][k]
+        for r, q in ((j, i), (k, i), (k, j)):
+            out[r][q] = out[q][r]
+        return _congruence(self.B, out)
+
+
+def _congruence(R: v3.Mat, J: Sequence[Sequence[sp.Expr]]) -> list[list[sp.Expr]]:
+    """R J R^T, skipping zero and unit factors."""
+    RJ = [[v3.dot(R[r], (J[0][c], J[1][c], J[2][c])) for c in range(3)] for r in range(3)]
+    return [[v3.dot(RJ[r], R[c]) for c in range(3)] for r in range(3)]
+
+
+def _coordinate_axis(axis: Sequence[sp.Expr]) -> tuple[int, int] | None:
+    """(k, sign) when the axis is +-e_k, else None."""
+    for k in range(3):
+        if axis[k] in (1, -1) and all(axis[o] == 0 for o in range(3) if o != k):
+            return k, int(axis[k])
+    return None
+
+
+def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
+    """R_i, p_i (and the factors of R_i) per link: body i in its parent's body frame."""
+    out = []
+    for link, qi in zip(robot.links, q, strict=True):
+        T = link.joint_transform(qi)
+        turn = None
+        coord = _coordinate_axis(list(link.axis)) if link.joint == "revolute" else None
+        if coord is not None:
+            k, sign = coord
+            angle = qi if sign == 1 else -qi
+            turn = (*_PLANES[k], k, sp.cos(angle), sp.sin(angle))
+        out.append(JointFrame(v3.mat(T.R), v3.vec(T.p), v3.mat(link.placement.R), turn))
+    return out
