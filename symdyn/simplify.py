@@ -4,8 +4,9 @@
 (symdyn.program), into one straight-line sequence of temporaries x0, x1, ...
 followed by the outputs:
 1. only the intermediates the outputs need are kept;
-2. SymPy's `cse` (with order="none", see design.md's speed notes) runs over
-   the intermediates and outputs together, so sin/cos of a joint and repeated
+2. common-subexpression elimination (symdyn.cse: SymPy's algorithm with
+   order="none", see design.md's speed notes, rebuilt for speed) runs over the
+   intermediates and outputs together, so sin/cos of a joint and repeated
    products are computed once across every output of the function;
 3. the result is ordered topologically (each temporary before its first use)
    and renamed in evaluation order, which makes the output deterministic.
@@ -23,7 +24,7 @@ from functools import cached_property
 
 import sympy as sp
 
-from .program import dependencies
+from .cse import fast_cse
 
 __all__ = ["OpCount", "count_ops", "eliminate", "eliminate_many", "Eliminated", "chop_float_noise"]
 
@@ -164,88 +165,16 @@ def _topological(nodes: dict[sp.Symbol, sp.Expr], roots: Sequence[sp.Expr]) -> l
     return order
 
 
-def _tree_cse(exprs: list[sp.Expr], prefix: str) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
-    """Tree CSE alone: every compound subexpression met twice becomes a temporary.
-
-    SymPy's tree_cse does the same but rebuilds every node through the full
-    constructor; here nodes are rebuilt without re-canonicalisation (their
-    arguments keep SymPy's order), which makes it several times faster."""
-    seen: set[sp.Expr] = set()
-    repeated: set[sp.Expr] = set()
-
-    def visit(e: sp.Expr) -> None:
-        stack = [e]
-        while stack:
-            x = stack.pop()
-            if x.is_Atom or (
-                x.is_Mul and len(x.args) == 2 and x.args[0] is sp.S.NegativeOne and x.args[1].is_Atom
-            ):
-                continue
-            if x in seen:
-                repeated.add(x)
-                continue
-            seen.add(x)
-            stack.extend(x.args)
-
-    for e in exprs:
-        visit(e)
-    names = sp.numbered_symbols(prefix)
-    replacements: list[tuple[sp.Symbol, sp.Expr]] = []
-    memo: dict[sp.Expr, sp.Expr] = {}
-
-    def rebuild(x: sp.Expr) -> sp.Expr:
-        if x.is_Atom:
-            return x
-        hit = memo.get(x)
-        if hit is not None:
-            return hit
-        args = tuple(rebuild(a) for a in x.args)
-        if args == x.args:
-            new = x
-        elif x.is_Add or x.is_Mul:
-            new = x.func._from_args(args)
-        else:
-            new = x.func(*args)
-        if x in repeated:
-            sym = next(names)
-            replacements.append((sym, new))
-            new = sym
-        memo[x] = new
-        return new
-
-    return replacements, [rebuild(e) for e in exprs]
-
-
 def _cse_nodes(
-    assignments: Sequence[tuple[sp.Symbol, sp.Expr]],
-    outputs: Sequence[sp.Expr],
-    light_outputs: Sequence[sp.Expr] = (),
+    assignments: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[sp.Expr]
 ) -> tuple[dict[sp.Symbol, sp.Expr], list[sp.Expr]]:
-    """CSE over assignments and outputs: (symbol -> expression nodes, reduced outputs).
-
-    `outputs` get SymPy's full cse (common subtrees and common arguments of sums and
-    products). `light_outputs` (appended to the returned list) and the assignments
-    only they need get the tree CSE alone, in a second pass over the first pass's
-    result: the Coriolis matrix is half of a 7-joint arm's program, and this halves
-    its CSE time for a few percent more operations."""
+    """CSE over assignments and outputs together (symdyn.cse): (symbol -> expression nodes,
+    reduced outputs)."""
     syms = [s for s, _ in assignments]
-    index = {s: k for k, s in enumerate(syms)}
-    heavy_deps = dependencies(assignments, index, [sp.sympify(e) for e in outputs])
-    first = [k for k in range(len(syms)) if k in heavy_deps]
-    second = [k for k in range(len(syms)) if k not in heavy_deps]
-    exprs = [assignments[k][1] for k in first]
-    repl, reduced = sp.cse(exprs + list(outputs), symbols=sp.numbered_symbols("_cse"), order="none")
+    repl, reduced = fast_cse([e for _, e in assignments] + list(outputs), "_cse")
     nodes: dict[sp.Symbol, sp.Expr] = dict(repl)
-    for k, e in zip(first, reduced[: len(first)], strict=True):
-        nodes[syms[k]] = e
-    outs = list(reduced[len(first) :])
-    if light_outputs:
-        exprs = [assignments[k][1] for k in second]
-        repl, reduced = _tree_cse(exprs + list(light_outputs), "_csl")
-        nodes.update(repl)
-        for k, e in zip(second, reduced[: len(second)], strict=True):
-            nodes[syms[k]] = e
-        outs += list(reduced[len(second) :])
+    nodes.update(zip(syms, reduced[: len(syms)], strict=True))
+    outs = list(reduced[len(syms) :])
 
     # inline temporaries that are a bare symbol or number (no work, only a name), to a fixpoint
     # since an alias may name another alias
@@ -311,23 +240,16 @@ def eliminate_many(
     groups: dict[str, Sequence[sp.Expr]],
     prefix: str = "x",
     reserved: Iterable[sp.Symbol] = (),
-    light: Iterable[str] = (),
 ) -> dict[str, Eliminated]:
     """`eliminate` for several functions sharing one program: one CSE pass, then each
     group keeps only the temporaries its outputs need (renamed from prefix0 per group,
-    skipping the names of inputs and of the `reserved` symbols). Groups named in
-    `light` get the cheaper tree CSE for what only they need (see `_cse_nodes`)."""
-    light = set(light)
-    heavy_names = [name for name in groups if name not in light]
-    light_names = [name for name in groups if name in light]
-    heavy = [sp.sympify(e) for name in heavy_names for e in groups[name]]
-    lighter = [sp.sympify(e) for name in light_names for e in groups[name]]
-    nodes, reduced = _cse_nodes(assignments, heavy, lighter)
+    skipping the names of inputs and of the `reserved` symbols)."""
+    outputs = [sp.sympify(e) for name in groups for e in groups[name]]
+    nodes, reduced = _cse_nodes(assignments, outputs)
     taken = _inputs(nodes, reduced) | set(reserved)
     result: dict[str, Eliminated] = {}
     k = 0
-    for name in heavy_names + light_names:
-        outs = groups[name]
+    for name, outs in groups.items():
         result[name] = _extract(nodes, reduced[k : k + len(outs)], prefix, taken)
         k += len(outs)
-    return {name: result[name] for name in groups}
+    return result

@@ -3,12 +3,12 @@
  * Robot panda: 7 joints, 0 free parameters, double precision.
  * Operation counts per call:
  *   inverse_dynamics    780 ops: 414 mul, 354 add, 0 div, 12 trig, 0 other
- *   mass_matrix         396 ops: 206 mul, 178 add, 0 div, 12 trig, 0 other
- *   coriolis_matrix    1872 ops: 964 mul, 896 add, 0 div, 12 trig, 0 other
+ *   mass_matrix         399 ops: 206 mul, 181 add, 0 div, 12 trig, 0 other
+ *   coriolis_matrix    1868 ops: 956 mul, 900 add, 0 div, 12 trig, 0 other
  *   coriolis            743 ops: 398 mul, 333 add, 0 div, 12 trig, 0 other
  *   gravity              98 ops: 50 mul, 36 add, 0 div, 12 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
- *   forward_dynamics   1412 ops: 771 mul, 622 add, 7 div, 12 trig, 0 other
+ *   forward_dynamics   1415 ops: 771 mul, 625 add, 7 div, 12 trig, 0 other
  */
 #ifndef PANDA_DYNAMICS_H
 #define PANDA_DYNAMICS_H
@@ -47,7 +47,7 @@ void panda_inverse_dynamics(const double q[], const double qd[], const double qd
  * @param[in]  p  free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] M  joint-space mass (inertia) matrix M(q), panda_NDOF*panda_NDOF values, row-major: M[i*panda_NDOF + j] is row i, column j
  *
- * Cost per call: 396 operations: 206 multiplications, 178 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
+ * Cost per call: 399 operations: 206 multiplications, 181 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
  */
 void panda_mass_matrix(const double q[], const double p[], double M[]);
 
@@ -59,7 +59,7 @@ void panda_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, panda_NDOF*panda_NDOF values, row-major: C[i*panda_NDOF + j] is row i, column j
  *
- * Cost per call: 1872 operations: 964 multiplications, 896 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
+ * Cost per call: 1868 operations: 956 multiplications, 900 additions, 0 divisions, 12 trigonometric calls, 0 other calls.
  */
 void panda_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 
@@ -106,7 +106,7 @@ void panda_friction(const double qd[], const double p[], double F[]);
  * @param[in]  p    free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] qdd  joint accelerations, panda_NDOF values
  *
- * Cost per call: 1412 operations: 771 multiplications, 622 additions, 7 divisions, 12 trigonometric calls, 0 other calls.
+ * Cost per call: 1415 operations: 771 multiplications, 625 additions, 7 divisions, 12 trigonometric calls, 0 other calls.
  */
 void panda_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
 

@@ -4,8 +4,8 @@
  * Operation counts per call:
  *   inverse_dynamics    434 ops: 230 mul, 188 add, 0 div, 10 trig, 6 other
  *   mass_matrix         184 ops: 96 mul, 80 add, 0 div, 8 trig, 0 other
- *   coriolis_matrix    1039 ops: 565 mul, 464 add, 0 div, 10 trig, 0 other
- *   coriolis            353 ops: 200 mul, 143 add, 0 div, 10 trig, 0 other
+ *   coriolis_matrix    1037 ops: 562 mul, 465 add, 0 div, 10 trig, 0 other
+ *   coriolis            352 ops: 199 mul, 143 add, 0 div, 10 trig, 0 other
  *   gravity              43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
  *   friction             24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
  *   forward_dynamics    749 ops: 419 mul, 308 add, 6 div, 10 trig, 6 other
@@ -59,7 +59,7 @@ void puma560_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, puma560_NDOF*puma560_NDOF values, row-major: C[i*puma560_NDOF + j] is row i, column j
  *
- * Cost per call: 1039 operations: 565 multiplications, 464 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
+ * Cost per call: 1037 operations: 562 multiplications, 465 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
  */
 void puma560_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 
@@ -71,7 +71,7 @@ void puma560_coriolis_matrix(const double q[], const double qd[], const double p
  * @param[in]  p   free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] V   Coriolis and centrifugal efforts V(q, qd), puma560_NDOF values
  *
- * Cost per call: 353 operations: 200 multiplications, 143 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
+ * Cost per call: 352 operations: 199 multiplications, 143 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
  */
 void puma560_coriolis(const double q[], const double qd[], const double p[], double V[]);
 

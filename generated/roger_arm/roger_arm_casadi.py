@@ -3,7 +3,7 @@
 # Operation counts per call:
 #   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
 #   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
-#   coriolis_matrix      33 ops: 22 mul, 9 add, 0 div, 2 trig, 0 other
+#   coriolis_matrix      32 ops: 21 mul, 9 add, 0 div, 2 trig, 0 other
 #   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
 #   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
@@ -68,8 +68,8 @@ def build_inverse_dynamics() -> ca.Function:
     x8 = x7*p[1]
     x9 = p[0]*ca.cos(q[0])
     x10 = -x8 - x9
-    x11 = x10*x6
-    x12 = -x11 + x1*x5
+    x11 = -x10*x6
+    x12 = x1*x5 + x11
     x13 = x12 + x4*p[3]
     x14 = x13*p[4]
     x15 = x14*p[3]
@@ -77,7 +77,7 @@ def build_inverse_dynamics() -> ca.Function:
     x17 = x16*x16
     x18 = x17*p[3]
     x19 = x10*x5
-    x20 = x19 + x1*x6
+    x20 = x1*x6 + x19
     x21 = x20 - x18
     x22 = x21*p[4]
     x23 = x22*x6 + x14*x5
@@ -108,8 +108,8 @@ def build_mass_matrix() -> ca.Function:
     x3 = x1*x2
     x4 = x3*p[1]
     x5 = p[4]*p[3]*p[3]
-    x6 = x0*p[2]
-    x7 = x5 + x6 + 2*x4 + x0*p[4]
+    x6 = p[2]*x0
+    x7 = x5 + x6 + p[4]*x0 + 2*x4
     x8 = x5 + x4
     M = ca.SX.zeros(2, 2)
     M[0, 0] = x7
@@ -129,7 +129,7 @@ def build_coriolis_matrix() -> ca.Function:
     """casadi.Function coriolis_matrix(q[2], qd[2], p[5]) -> C[2x2].
 
     C(q, qd) from Christoffel symbols; C qd = V.
-    17 temporaries; 33 operations (22 mul, 9 add, 0 div, 2 trig, 0 other).
+    18 temporaries; 32 operations (21 mul, 9 add, 0 div, 2 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
@@ -142,20 +142,21 @@ def build_coriolis_matrix() -> ca.Function:
     x5 = ca.cos(q[1])
     x6 = x3*p[4]
     x7 = 0.5*x6
-    x8 = qd[0] + qd[1]
-    x9 = x5*x2
-    x10 = 0.5*x0*x8 + 0.5*x9*p[4]
-    x11 = x7*x5 - x10*x1
-    x12 = x4 + 2*x11*p[1]
-    x13 = x4 - x0*x3
-    x14 = -2*x10 + x9*p[4]
-    x15 = -x6 + 2*x7
-    x16 = x13 + p[1]*(x14*x1 + x15*x5)
+    x8 = x5*x2
+    x9 = x8*p[4]
+    x10 = qd[0] + qd[1]
+    x11 = 0.5*x9 + 0.5*x0*x10
+    x12 = x7*x5 - x11*x1
+    x13 = x4 + 2*x12*p[1]
+    x14 = x4 - x0*x3
+    x15 = -2*x11 + x9
+    x16 = 2*x7 - x6
+    x17 = x14 + p[1]*(x15*x1 + x16*x5)
     C = ca.SX.zeros(2, 2)
-    C[0, 0] = x12
-    C[0, 1] = x16
+    C[0, 0] = x13
+    C[0, 1] = x17
     C[1, 0] = x4
-    C[1, 1] = x13
+    C[1, 1] = x14
     return ca.Function(
         "coriolis_matrix",
         [q, qd, p],
@@ -218,8 +219,8 @@ def build_gravity() -> ca.Function:
     x6 = x5 + x3 + p[1]*p[4]
     x7 = p[0]*ca.cos(q[0])
     x8 = p[0]*ca.sin(q[0])
-    x9 = x4*x8
-    x10 = -x9 - x1*x7
+    x9 = x8*x4
+    x10 = -x9 - x7*x1
     G = ca.SX.zeros(2, 1)
     G[0] = x2*x7 + x6*x8
     G[1] = -x0*x10
@@ -265,27 +266,27 @@ def build_forward_dynamics() -> ca.Function:
     x3 = x1*x2
     x4 = x3*p[1]
     x5 = p[4]*p[3]*p[3]
-    x6 = x0*p[2]
-    x7 = x5 + x6 + 2*x4 + x0*p[4]
+    x6 = p[2]*x0
+    x7 = x5 + x6 + p[4]*x0 + 2*x4
     x8 = 1/x7
     x9 = p[0]*ca.sin(q[0])
     x10 = x9*p[2]
     x11 = x10*p[1]
-    x12 = x2*x9
+    x12 = x9*x2
     x13 = ca.sin(q[1])
     x14 = qd[0]*qd[0]
     x15 = x14*p[1]
     x16 = p[0]*ca.cos(q[0])
     x17 = -x15 - x16
-    x18 = x17*x13
-    x19 = x12 - x18
+    x18 = -x17*x13
+    x19 = x12 + x18
     x20 = x19*p[4]
     x21 = x20*p[3]
     x22 = qd[0] + qd[1]
     x23 = x22*x22
     x24 = x23*p[3]
     x25 = x17*x2
-    x26 = x25 + x13*x9
+    x26 = x9*x13 + x25
     x27 = x26 - x24
     x28 = x27*p[4]
     x29 = x28*x13 + x20*x2
@@ -297,7 +298,7 @@ def build_forward_dynamics() -> ca.Function:
     x35 = tau[1] - x21
     x36 = x35 - x33*x31
     x37 = x36/x34
-    x38 = x8*x31 - x33*x37
+    x38 = x31*x8 - x33*x37
     qdd = ca.SX.zeros(2, 1)
     qdd[0] = x38
     qdd[1] = x37

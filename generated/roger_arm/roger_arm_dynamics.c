@@ -4,7 +4,7 @@
  * Operation counts per call:
  *   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
  *   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
- *   coriolis_matrix      33 ops: 22 mul, 9 add, 0 div, 2 trig, 0 other
+ *   coriolis_matrix      32 ops: 21 mul, 9 add, 0 div, 2 trig, 0 other
  *   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
  *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
@@ -39,8 +39,8 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double x8 = x7*l1;
     const double x9 = g*cos(q1);
     const double x10 = -x8 - x9;
-    const double x11 = x10*x6;
-    const double x12 = -x11 + x1*x5;
+    const double x11 = -x10*x6;
+    const double x12 = x1*x5 + x11;
     const double x13 = x12 + x4*l2;
     const double x14 = x13*m2;
     const double x15 = x14*l2;
@@ -48,7 +48,7 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double x17 = x16*x16;
     const double x18 = x17*l2;
     const double x19 = x10*x5;
-    const double x20 = x19 + x1*x6;
+    const double x20 = x1*x6 + x19;
     const double x21 = x20 - x18;
     const double x22 = x21*m2;
     const double x23 = x22*x6 + x14*x5;
@@ -71,8 +71,8 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     const double x3 = x1*x2;
     const double x4 = x3*l1;
     const double x5 = m2*l2*l2;
-    const double x6 = x0*m1;
-    const double x7 = x5 + x6 + 2.0*x4 + x0*m2;
+    const double x6 = m1*x0;
+    const double x7 = x5 + x6 + m2*x0 + 2.0*x4;
     const double x8 = x5 + x4;
     M[0] = x7;
     M[1] = x8;
@@ -80,7 +80,7 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     M[3] = x5;
 }
 
-/* C(q, qd) from Christoffel symbols, row-major; C qd = V (33 operations: 22 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
+/* C(q, qd) from Christoffel symbols, row-major; C qd = V (32 operations: 21 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
 void roger_arm_coriolis_matrix(const double q[], const double qd[], const double p[], double C[])
 {
     const double q2 = q[1];
@@ -97,19 +97,20 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double x5 = cos(q2);
     const double x6 = x3*m2;
     const double x7 = 0.5*x6;
-    const double x8 = qd1 + qd2;
-    const double x9 = x5*x2;
-    const double x10 = 0.5*x0*x8 + 0.5*x9*m2;
-    const double x11 = x7*x5 - x10*x1;
-    const double x12 = x4 + 2.0*x11*l1;
-    const double x13 = x4 - x0*x3;
-    const double x14 = -2.0*x10 + x9*m2;
-    const double x15 = -x6 + 2.0*x7;
-    const double x16 = x13 + l1*(x14*x1 + x15*x5);
-    C[0] = x12;
-    C[1] = x16;
+    const double x8 = x5*x2;
+    const double x9 = x8*m2;
+    const double x10 = qd1 + qd2;
+    const double x11 = 0.5*x9 + 0.5*x0*x10;
+    const double x12 = x7*x5 - x11*x1;
+    const double x13 = x4 + 2.0*x12*l1;
+    const double x14 = x4 - x0*x3;
+    const double x15 = -2.0*x11 + x9;
+    const double x16 = 2.0*x7 - x6;
+    const double x17 = x14 + l1*(x15*x1 + x16*x5);
+    C[0] = x13;
+    C[1] = x17;
     C[2] = x4;
-    C[3] = x13;
+    C[3] = x14;
 }
 
 /* V(q, qd) = C(q, qd) qd (18 operations: 12 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
@@ -159,8 +160,8 @@ void roger_arm_gravity(const double q[], const double p[], double G[])
     const double x6 = x5 + x3 + l1*m2;
     const double x7 = g*cos(q1);
     const double x8 = g*sin(q1);
-    const double x9 = x4*x8;
-    const double x10 = -x9 - x1*x7;
+    const double x9 = x8*x4;
+    const double x10 = -x9 - x7*x1;
     G[0] = x2*x7 + x6*x8;
     G[1] = -x0*x10;
 }
@@ -194,27 +195,27 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x3 = x1*x2;
     const double x4 = x3*l1;
     const double x5 = m2*l2*l2;
-    const double x6 = x0*m1;
-    const double x7 = x5 + x6 + 2.0*x4 + x0*m2;
+    const double x6 = m1*x0;
+    const double x7 = x5 + x6 + m2*x0 + 2.0*x4;
     const double x8 = 1.0/x7;
     const double x9 = g*sin(q1);
     const double x10 = x9*m1;
     const double x11 = x10*l1;
-    const double x12 = x2*x9;
+    const double x12 = x9*x2;
     const double x13 = sin(q2);
     const double x14 = qd1*qd1;
     const double x15 = x14*l1;
     const double x16 = g*cos(q1);
     const double x17 = -x15 - x16;
-    const double x18 = x17*x13;
-    const double x19 = x12 - x18;
+    const double x18 = -x17*x13;
+    const double x19 = x12 + x18;
     const double x20 = x19*m2;
     const double x21 = x20*l2;
     const double x22 = qd1 + qd2;
     const double x23 = x22*x22;
     const double x24 = x23*l2;
     const double x25 = x17*x2;
-    const double x26 = x25 + x13*x9;
+    const double x26 = x9*x13 + x25;
     const double x27 = x26 - x24;
     const double x28 = x27*m2;
     const double x29 = x28*x13 + x20*x2;
@@ -226,7 +227,7 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x35 = tau2 - x21;
     const double x36 = x35 - x33*x31;
     const double x37 = x36/x34;
-    const double x38 = x8*x31 - x33*x37;
+    const double x38 = x31*x8 - x33*x37;
     qdd[0] = x38;
     qdd[1] = x37;
 }

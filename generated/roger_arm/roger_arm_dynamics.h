@@ -4,7 +4,7 @@
  * Operation counts per call:
  *   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
  *   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
- *   coriolis_matrix      33 ops: 22 mul, 9 add, 0 div, 2 trig, 0 other
+ *   coriolis_matrix      32 ops: 21 mul, 9 add, 0 div, 2 trig, 0 other
  *   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
  *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
@@ -71,7 +71,7 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, roger_arm_NDOF*roger_arm_NDOF values, row-major: C[i*roger_arm_NDOF + j] is row i, column j
  *
- * Cost per call: 33 operations: 22 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls.
+ * Cost per call: 32 operations: 21 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls.
  */
 void roger_arm_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 

@@ -3,7 +3,7 @@
 # Operation counts per call:
 #   inverse_dynamics     35 ops: 20 mul, 11 add, 0 div, 4 trig, 0 other
 #   mass_matrix          14 ops: 9 mul, 4 add, 0 div, 1 trig, 0 other
-#   coriolis_matrix      33 ops: 22 mul, 9 add, 0 div, 2 trig, 0 other
+#   coriolis_matrix      32 ops: 21 mul, 9 add, 0 div, 2 trig, 0 other
 #   coriolis             18 ops: 12 mul, 4 add, 0 div, 2 trig, 0 other
 #   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
@@ -78,8 +78,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x8 = l1*x7
     x9 = g*np.cos(q1)
     x10 = -x8 - x9
-    x11 = x10*x6
-    x12 = x1*x5 - x11
+    x11 = -x10*x6
+    x12 = x1*x5 + x11
     x13 = l2*x4 + x12
     x14 = m2*x13
     x15 = l2*x14
@@ -159,23 +159,24 @@ def coriolis_matrix(q, qd, p=None):
     x5 = np.cos(q2)
     x6 = m2*x3
     x7 = 0.5*x6
-    x8 = qd1 + qd2
-    x9 = x2*x5
-    x10 = 0.5*m2*x9 + 0.5*x0*x8
-    x11 = -x1*x10 + x5*x7
-    x12 = 2*l1*x11 + x4
-    x13 = -x0*x3 + x4
-    x14 = m2*x9 - 2*x10
-    x15 = -x6 + 2*x7
-    x16 = l1*(x1*x14 + x15*x5) + x13
+    x8 = x2*x5
+    x9 = m2*x8
+    x10 = qd1 + qd2
+    x11 = 0.5*x0*x10 + 0.5*x9
+    x12 = -x1*x11 + x5*x7
+    x13 = 2*l1*x12 + x4
+    x14 = -x0*x3 + x4
+    x15 = -2*x11 + x9
+    x16 = -x6 + 2*x7
+    x17 = l1*(x1*x15 + x16*x5) + x14
     return _assemble(
         _lead,
         (2, 2),
         [
-            x12,
-            x16,
-            x4,
             x13,
+            x17,
+            x4,
+            x14,
         ],
     )
 
@@ -313,8 +314,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x15 = l1*x14
     x16 = g*np.cos(q1)
     x17 = -x15 - x16
-    x18 = x13*x17
-    x19 = x12 - x18
+    x18 = -x13*x17
+    x19 = x12 + x18
     x20 = m2*x19
     x21 = l2*x20
     x22 = qd1 + qd2
