@@ -1,10 +1,11 @@
 """`derive`: the equations of motion tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (slide 16).
 
 Two independent routes fill the same `Dynamics`:
-- "newton-euler" (symdyn.newton_euler, symdyn.crba): V = NE(q, qd, 0) with
-  gravity off; M by the composite-rigid-body algorithm and G from the same
+- "newton-euler" (symdyn.newton_euler, symdyn.crba, symdyn.coriolis): V = NE(q, qd, 0)
+  with gravity off; M by the composite-rigid-body algorithm and G from the same
   composite bodies (both equal to NE with unit accelerations, resp. NE(q, 0, 0));
-  tau from one full pass; C = 1/2 dV/dqd, which equals the Christoffel-symbol matrix because
+  tau from one full pass; C = 1/2 dV/dqd from composite inertias, momenta and
+  inertia rates, which equals the Christoffel-symbol matrix because
   V_k = sum_ij Gamma^k_ij qd_i qd_j with Gamma^k_ij symmetric in i, j.
 - "lagrange" (symdyn.lagrange): M from the link Jacobians, C from the
   Christoffel symbols of M, G from the potential energy, V = C qd.
