@@ -164,9 +164,5 @@ def _project(m: Spatial, f: Spatial) -> sp.Expr:
     return v3._sum((v3.dot(m[0], f[0]), v3.dot(m[1], f[1])))
 
 
-def _add3(a: v3.Mat, b: v3.Mat) -> v3.Mat:
-    return tuple(v3.add(a[r], b[r]) for r in range(3))  # type: ignore[return-value]
-
-
 def _halved(I: v3.Mat) -> v3.Mat:
     return tuple(tuple(v3._prod(_HALF, x) for x in row) for row in I)  # type: ignore[return-value]
