@@ -36,26 +36,21 @@ from __future__ import annotations
 import sympy as sp
 
 from . import vectors as v3
-from .crba import Composite, composite_inertias, shift_inertia, sym3
+from .crba import Composite, Spatial, apply_inertia, composite_inertias, motion_subspace, shift_inertia, sym3
 from .frames import JointFrame
 from .newton_euler import origin_inertia
 from .program import Program
-from .robot import Link, Robot
+from .robot import Robot
 
 __all__ = ["coriolis_matrix_composite"]
 
-Spatial = tuple[v3.Vec, v3.Vec]
 _HALF = sp.Rational(1, 2)
 _ZERO3: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
 
 
-def _named(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
-    return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
-
-
-def _motion_subspace(link: Link) -> Spatial:
-    a = v3.vec(link.axis)
-    return (a, _ZERO3) if link.joint == "revolute" else (_ZERO3, a)
+def _let_spatial(program: Program, v: Spatial, hint: str) -> Spatial:
+    """Name the six components of a spatial vector."""
+    return program.let_vector(v[0], hint), program.let_vector(v[1], hint)
 
 
 def _cross_motion(v: Spatial, s: Spatial) -> Spatial:
@@ -70,25 +65,13 @@ def _cross_force(s: Spatial, f: Spatial) -> Spatial:
     return v3.add(v3.cross(ws, n), v3.cross(us, fl)), v3.cross(ws, fl)
 
 
-def _apply_inertia(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial) -> Spatial:
-    """The spatial inertia (m, h, I) times a motion (w, u): (I w + h x u, m u - h x w)."""
-    w, u = v
-    return v3.add(v3.mul(I, w), v3.cross(h, u)), v3.sub(v3.scale(m, u), v3.cross(h, w))
-
-
-def _to_parent(frame: JointFrame, f: Spatial) -> Spatial:
-    """A force carried from a body frame into its parent's: (R n + p x R f, R f)."""
-    R, p = frame.R, frame.p
-    Rf = v3.mul(R, f[1])
-    return v3.add(v3.mul(R, f[0]), v3.cross(p, Rf)), Rf
-
-
 def _inertia_rate(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial, program: Program, k: str) -> Composite:
     """The world rate of change v x* I - I v x of a body's spatial inertia (m, h, I) moving
     with v = (w, u), as a zero-mass inertia (dh, dI)."""
     w, u = v
-    dh = _named(program, v3.add(v3.cross(w, h), v3.scale(m, u)), f"Pd{k}_")
-    K = [[v3.dot(row, (I[0][c], I[1][c], I[2][c])) for c in range(3)] for row in _skew(w)]
+    dh = program.let_vector(v3.add(v3.cross(w, h), v3.scale(m, u)), f"Pd{k}_")
+    columns = [v3.cross(w, (I[0][c], I[1][c], I[2][c])) for c in range(3)]  # [w x] I by columns
+    K = [[columns[c][r] for c in range(3)] for r in range(3)]
     uh2 = v3._prod(2, v3.dot(u, h))
     dI = [
         [
@@ -100,17 +83,12 @@ def _inertia_rate(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial, program: Program
     return sp.S.Zero, dh, sym3(program, dI, f"PI{k}_")
 
 
-def _skew(w: v3.Vec) -> v3.Mat:
-    z = sp.S.Zero
-    return ((z, -w[2], w[1]), (w[2], z, -w[0]), (-w[1], w[0], z))  # type: ignore[return-value]
-
-
 def coriolis_matrix_composite(robot: Robot, frames: list[JointFrame], qd, program: Program) -> sp.Matrix:
     """C(q, qd) with V = C qd and dM/dt - 2C skew-symmetric (Christoffel symbols), over the
     program's intermediates; see the module docstring for the recursion."""
     n = robot.n
     mass, hc, Ic = composite_inertias(robot, frames, program)
-    s = [_motion_subspace(link) for link in robot.links]
+    s = [motion_subspace(link) for link in robot.links]
     # outward: body velocities and psi_k = v_k x s_k
     vel: list[Spatial] = []
     w, u = _ZERO3, _ZERO3
@@ -118,10 +96,10 @@ def coriolis_matrix_composite(robot: Robot, frames: list[JointFrame], qd, progra
         R, p = frames[i].R, frames[i].p
         u = v3.mul_t(R, v3.add(u, v3.cross(w, p)))
         w = v3.mul_t(R, w)
-        w = _named(program, v3.add(w, v3.scale(qd[i], s[i][0])), f"w{i + 1}_")
-        u = _named(program, v3.add(u, v3.scale(qd[i], s[i][1])), f"u{i + 1}_")
+        w = program.let_vector(v3.add(w, v3.scale(qd[i], s[i][0])), f"w{i + 1}_")
+        u = program.let_vector(v3.add(u, v3.scale(qd[i], s[i][1])), f"u{i + 1}_")
         vel.append((w, u))
-    psi = [tuple(_named(program, x, f"psi{k + 1}_") for x in _cross_motion(vel[k], s[k])) for k in range(n)]
+    psi = [_let_spatial(program, _cross_motion(vel[k], s[k]), f"psi{k + 1}_") for k in range(n)]
     # inward: half momentum H and half inertia rate P of every subtree
     H: list[Spatial] = [((), ())] * n  # type: ignore[list-item]
     P: list[Composite] = [(sp.S.Zero, _ZERO3, ((sp.S.Zero,) * 3,) * 3)] * n  # type: ignore[list-item]
@@ -131,27 +109,28 @@ def coriolis_matrix_composite(robot: Robot, frames: list[JointFrame], qd, progra
         m = sp.sympify(link.mass)
         h = v3.vec(v3.scale(m, v3.vec(link.com)))
         m2, h2, I2 = _HALF * m, v3.scale(_HALF, h), _halved(origin_inertia(link))
-        half = _apply_inertia(m2, h2, I2, vel[i])
+        half = apply_inertia(m2, h2, I2, vel[i])
         own = _inertia_rate(m2, h2, I2, vel[i], program, k)
         if i + 1 < n:
-            child = _to_parent(frames[i + 1], H[i + 1])
+            child = frames[i + 1].force_to_parent(*H[i + 1], program, f"RH{k}_")
             half = (v3.add(half[0], child[0]), v3.add(half[1], child[1]))
             own = shift_inertia(frames[i + 1], P[i + 1], own, program, f"P{k}_")
-        H[i] = (_named(program, half[0], f"Hn{k}_"), _named(program, half[1], f"Hf{k}_"))
+        H[i] = _let_spatial(program, half, f"H{k}_")
         P[i] = own
     C = sp.zeros(n, n)
     for j in reversed(range(n)):
         k = str(j + 1)
-        Ps = tuple(_named(program, x, f"Ps{k}_") for x in _apply_inertia(sp.S.Zero, P[j][1], P[j][2], s[j]))
-        sH = tuple(_named(program, x, f"sH{k}_") for x in _cross_force(s[j], H[j]))
-        Ipsi = _apply_inertia(mass[j], hc[j], Ic[j], psi[j])
-        Y = tuple(_named(program, v3.add(Ps[r], sH[r], Ipsi[r]), f"Y{k}_") for r in range(2))
-        A = tuple(_named(program, v3.sub(Ps[r], sH[r]), f"A{k}_") for r in range(2))
-        F = tuple(_named(program, x, f"F{k}_") for x in _apply_inertia(mass[j], hc[j], Ic[j], s[j]))
+        Ps = apply_inertia(sp.S.Zero, P[j][1], P[j][2], s[j])
+        sH = _cross_force(s[j], H[j])
+        Ipsi = apply_inertia(mass[j], hc[j], Ic[j], psi[j])
+        Y = _let_spatial(program, (v3.add(Ps[0], sH[0], Ipsi[0]), v3.add(Ps[1], sH[1], Ipsi[1])), f"Y{k}_")
+        A = _let_spatial(program, (v3.sub(Ps[0], sH[0]), v3.sub(Ps[1], sH[1])), f"A{k}_")
+        F = _let_spatial(program, apply_inertia(mass[j], hc[j], Ic[j], s[j]), f"F{k}_")
         C[j, j] = program.let(_project(s[j], Y), "C")
         for i in reversed(range(j)):
+            frame = frames[i + 1]
             Y, A, F = (
-                tuple(_named(program, x, f"{tag}{k}_") for x in _to_parent(frames[i + 1], vec))
+                _let_spatial(program, frame.force_to_parent(*vec, program, f"R{tag}{k}_"), f"{tag}{k}_")
                 for tag, vec in (("Y", Y), ("A", A), ("F", F))
             )
             C[i, j] = program.let(_project(s[i], Y), "C")

@@ -26,10 +26,13 @@ from . import vectors as v3
 from .frames import JointFrame
 from .newton_euler import origin_inertia
 from .program import Program
-from .robot import Robot
+from .robot import Link, Robot
 
 __all__ = [
     "Composite",
+    "Spatial",
+    "motion_subspace",
+    "apply_inertia",
     "composite_inertias",
     "shift_inertia",
     "sym3",
@@ -39,6 +42,22 @@ __all__ = [
 
 
 Composite = tuple[sp.Expr, v3.Vec, v3.Mat]  # mass, first moment, rotational inertia about the origin
+
+
+Spatial = tuple[v3.Vec, v3.Vec]  # (angular, linear): a motion (w, u) or a force (n, f)
+_ZERO3: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
+
+
+def motion_subspace(link: Link) -> Spatial:
+    """The joint's motion for a unit rate: (a, 0) revolute, (0, a) prismatic (body frame)."""
+    a = v3.vec(link.axis)
+    return (a, _ZERO3) if link.joint == "revolute" else (_ZERO3, a)
+
+
+def apply_inertia(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial) -> Spatial:
+    """The spatial inertia (m, h, I) times a motion (w, u): (I w + h x u, m u - h x w)."""
+    w, u = v
+    return v3.add(v3.mul(I, w), v3.cross(h, u)), v3.sub(v3.scale(m, u), v3.cross(h, w))
 
 
 def sym3(program: Program, I: Sequence[Sequence[sp.Expr]], hint: str) -> v3.Mat:
@@ -74,9 +93,9 @@ def shift_inertia(
     R, p = frame.R, frame.p
     mj, hj, Ij = child
     mo, ho, Io = own
-    Rh = tuple(program.let(x, f"{hint}Rh") for x in v3.mul(R, hj))
+    Rh = program.let_vector(v3.mul(R, hj), f"{hint}Rh")
     m = program.let(v3._sum((mo, mj)), f"{hint}m")
-    h = tuple(program.let(x, f"{hint}h") for x in v3.add(ho, Rh, v3.scale(mj, p)))
+    h = program.let_vector(v3.add(ho, Rh, v3.scale(mj, p)), f"{hint}h")
     RIR = frame.rotate_symmetric(Ij, program, f"{hint}r")
     cross = _sym_cross_term(Rh, p)  # type: ignore[arg-type]
     pp = _skew_sq(p)
@@ -103,7 +122,7 @@ def composite_inertias(
         m = sp.sympify(link.mass)
         own: Composite = (
             m,
-            tuple(program.let(v3._prod(m, x), "h") for x in v3.vec(link.com)),  # type: ignore[arg-type]
+            program.let_vector(v3.scale(m, v3.vec(link.com)), "h"),
             sym3(program, origin_inertia(link), "Io"),
         )
         comp[j] = own if j + 1 == n else shift_inertia(frames[j + 1], comp[j + 1], own, program, "c")
@@ -116,19 +135,12 @@ def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -
     mass, h, I = composite_inertias(robot, frames, program)
     M = sp.zeros(n, n)
     for j in range(n):
-        a = v3.vec(robot.links[j].axis)
-        if robot.links[j].joint == "revolute":
-            nf = tuple(program.let(x, "Fn") for x in v3.mul(I[j], a))
-            ff = tuple(program.let(x, "Ff") for x in v3.cross(a, h[j]))
-        else:
-            nf = tuple(program.let(x, "Fn") for x in v3.cross(h[j], a))
-            ff = tuple(program.let(x, "Ff") for x in v3.scale(mass[j], a))
+        nf, ff = apply_inertia(mass[j], h[j], I[j], motion_subspace(robot.links[j]))
+        nf, ff = program.let_vector(nf, "Fn"), program.let_vector(ff, "Ff")
         for i in range(j, -1, -1):
             if i < j:
-                R, p = frames[i + 1].R, frames[i + 1].p
-                ff_new = tuple(program.let(x, "Ff") for x in v3.mul(R, ff))
-                nf = tuple(program.let(x, "Fn") for x in v3.add(v3.mul(R, nf), v3.cross(p, ff_new)))
-                ff = ff_new
+                nf, ff = frames[i + 1].force_to_parent(nf, ff, program, "Ff")
+                nf = program.let_vector(nf, "Fn")
             ai = v3.vec(robot.links[i].axis)
             entry = v3.dot(ai, nf if robot.links[i].joint == "revolute" else ff)
             if i == j:
@@ -151,7 +163,7 @@ def gravity_composite(robot: Robot, frames: list[JointFrame], program: Program) 
     G: list[sp.Expr] = []
     for k, link in enumerate(robot.links):
         R = frames[k].R
-        g = tuple(program.let(x, f"gk{k + 1}_") for x in v3.mul_t(R, g))  # type: ignore[assignment]
+        g = program.let_vector(v3.mul_t(R, g), f"gk{k + 1}_")  # type: ignore[assignment]
         a = v3.vec(link.axis)
         if link.joint == "revolute":
             G.append(v3.dot(a, v3.cross(g, h[k])))

@@ -67,6 +67,12 @@ class JointFrame:
             out[r][q] = out[q][r]
         return _congruence(self.B, out)
 
+    def force_to_parent(self, n: v3.Vec, f: v3.Vec, program: Program, hint: str) -> tuple[v3.Vec, v3.Vec]:
+        """A force (moment n about the body origin, force f) carried into the parent frame:
+        (R n + p x R f, R f), with R f named (it appears in both)."""
+        Rf = program.let_vector(v3.mul(self.R, f), hint)
+        return v3.add(v3.mul(self.R, n), v3.cross(self.p, Rf)), Rf  # type: ignore[return-value]
+
 
 def _congruence(R: v3.Mat, J: Sequence[Sequence[sp.Expr]]) -> list[list[sp.Expr]]:
     """R J R^T, skipping zero and unit factors."""

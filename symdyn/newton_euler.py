@@ -44,10 +44,6 @@ from .robot import Link, Robot
 __all__ = ["newton_euler", "origin_inertia"]
 
 
-def _name(program: Program, v: v3.Vec, hint: str) -> v3.Vec:
-    return tuple(program.let(x, hint) for x in v)  # type: ignore[return-value]
-
-
 def origin_inertia(link: Link) -> v3.Mat:
     """I_o = I_c + m (c^T c 1 - c c^T): the inertia about the body origin (parallel axis)."""
     m = sp.sympify(link.mass)
@@ -80,15 +76,15 @@ def _body_wrench(
     if _about_origin(link):
         h = tuple(v3._prod(m, x) for x in c)
         I = origin_inertia(link)
-        F = _name(program, v3.add(v3.scale(m, vd), v3.mul(W, h)), f"F{k}_")
+        F = program.let_vector(v3.add(v3.scale(m, vd), v3.mul(W, h)), f"F{k}_")
         extra = v3.cross(h, vd)
     else:
         I = v3.mat(link.inertia)
-        vc = _name(program, v3.add(v3.mul(W, c), vd), f"vc{k}_")
-        F = _name(program, v3.scale(m, vc), f"F{k}_")
+        vc = program.let_vector(v3.add(v3.mul(W, c), vd), f"vc{k}_")
+        F = program.let_vector(v3.scale(m, vc), f"F{k}_")
         extra = v3.cross(c, F)
-    Iw = _name(program, v3.mul(I, w), f"Iw{k}_")
-    N = _name(program, v3.add(v3.mul(I, wd), v3.cross(w, Iw), extra), f"N{k}_")
+    Iw = program.let_vector(v3.mul(I, w), f"Iw{k}_")
+    N = program.let_vector(v3.add(v3.mul(I, wd), v3.cross(w, Iw), extra), f"N{k}_")
     return F, N
 
 
@@ -101,7 +97,7 @@ def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
         (v3._sum((xy, wd[2])), -v3._sum((sq[0], sq[2])), v3._sum((yz, -wd[0]))),
         (v3._sum((xz, -wd[1])), v3._sum((yz, wd[0])), -v3._sum((sq[0], sq[1]))),
     )
-    return tuple(_name(program, row, f"W{k}_") for row in W)  # type: ignore[return-value]
+    return tuple(program.let_vector(row, f"W{k}_") for row in W)  # type: ignore[return-value]
 
 
 def _outward(
@@ -123,16 +119,16 @@ def _outward(
     R, p = frame.R, frame.p
     a = v3.vec(link.axis)
     vd_new = v3.mul_t(R, v3.add(v3.mul(W, p), vd))
-    w_par = _name(program, v3.mul_t(R, w), f"wp{k}_")
+    w_par = program.let_vector(v3.mul_t(R, w), f"wp{k}_")
     wd_par = v3.mul_t(R, wd)
     if link.joint == "revolute":
-        w_new = _name(program, v3.add(w_par, v3.scale(qd, a)), f"w{k}_")
+        w_new = program.let_vector(v3.add(w_par, v3.scale(qd, a)), f"w{k}_")
         wd_new = v3.add(wd_par, v3.cross(w_par, v3.scale(qd, a)), v3.scale(qdd, a))
     else:
         w_new = w_par
         wd_new = wd_par
         vd_new = v3.add(vd_new, v3.scale(2, v3.cross(w_new, v3.scale(qd, a))), v3.scale(qdd, a))
-    return w_new, _name(program, wd_new, f"wd{k}_"), _name(program, vd_new, f"vd{k}_")
+    return w_new, program.let_vector(wd_new, f"wd{k}_"), program.let_vector(vd_new, f"vd{k}_")
 
 
 def newton_euler(
@@ -157,7 +153,7 @@ def newton_euler(
     zero: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
     w, wd = zero, zero
     W: v3.Mat = (zero, zero, zero)
-    vd = _name(program, v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
+    vd = program.let_vector(v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
     forces: list[v3.Vec] = []
     moments: list[v3.Vec] = []
     for i, link in enumerate(robot.links):
@@ -173,15 +169,14 @@ def newton_euler(
         link = robot.links[i]
         k = f"{tag}{i + 1}"
         if i + 1 < n:
-            R1, p1 = frames[i + 1].R, frames[i + 1].p
-            Rf = _name(program, v3.mul(R1, f_next), f"Rf{k}_")
-            n_new = v3.add(moments[i], v3.mul(R1, n_next), v3.cross(p1, Rf))
-            f_new = v3.add(Rf, forces[i])
+            n_par, f_par = frames[i + 1].force_to_parent(n_next, f_next, program, f"Rf{k}_")
+            n_new = v3.add(moments[i], n_par)
+            f_new = v3.add(f_par, forces[i])
         else:
             n_new = moments[i]
             f_new = forces[i]
-        f_next = _name(program, f_new, f"f{k}_")
-        n_next = _name(program, n_new, f"n{k}_")
+        f_next = program.let_vector(f_new, f"f{k}_")
+        n_next = program.let_vector(n_new, f"n{k}_")
         a = v3.vec(link.axis)
         tau[i] = v3.dot(a, n_next if link.joint == "revolute" else f_next)
     return tau

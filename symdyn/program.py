@@ -137,9 +137,9 @@ class Program:
         self._by_expr[expr] = sym
         return sym
 
-    def let_vector(self, v: Iterable, hint: str) -> sp.Matrix:
-        """Name each component of a vector (see `let`)."""
-        return sp.Matrix([self.let(x, hint) for x in v])
+    def let_vector(self, v: Iterable, hint: str) -> tuple:
+        """Name each component of a vector (see `let`): a tuple, as symdyn.vectors uses."""
+        return tuple(self.let(x, hint) for x in v)
 
     def _deps(self, expr: sp.Expr) -> set[sp.Symbol]:
         return {s for s in expr.free_symbols if s in self._index}

@@ -4,7 +4,7 @@
  * Operation counts per call:
  *   inverse_dynamics    434 ops: 230 mul, 188 add, 0 div, 10 trig, 6 other
  *   mass_matrix         184 ops: 96 mul, 80 add, 0 div, 8 trig, 0 other
- *   coriolis_matrix    1037 ops: 562 mul, 465 add, 0 div, 10 trig, 0 other
+ *   coriolis_matrix     951 ops: 519 mul, 422 add, 0 div, 10 trig, 0 other
  *   coriolis            352 ops: 199 mul, 143 add, 0 div, 10 trig, 0 other
  *   gravity              43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
  *   friction             24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
@@ -59,7 +59,7 @@ void puma560_mass_matrix(const double q[], const double p[], double M[]);
  * @param[in]  p   free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] C   Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V, puma560_NDOF*puma560_NDOF values, row-major: C[i*puma560_NDOF + j] is row i, column j
  *
- * Cost per call: 1037 operations: 562 multiplications, 465 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
+ * Cost per call: 951 operations: 519 multiplications, 422 additions, 0 divisions, 10 trigonometric calls, 0 other calls.
  */
 void puma560_coriolis_matrix(const double q[], const double qd[], const double p[], double C[]);
 

@@ -129,7 +129,7 @@ def build_coriolis_matrix() -> ca.Function:
     """casadi.Function coriolis_matrix(q[2], qd[2], p[5]) -> C[2x2].
 
     C(q, qd) from Christoffel symbols; C qd = V.
-    18 temporaries; 32 operations (21 mul, 9 add, 0 div, 2 trig, 0 other).
+    19 temporaries; 32 operations (21 mul, 9 add, 0 div, 2 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
@@ -151,10 +151,11 @@ def build_coriolis_matrix() -> ca.Function:
     x14 = x4 - x0*x3
     x15 = -2*x11 + x9
     x16 = 2*x7 - x6
-    x17 = x14 + p[1]*(x15*x1 + x16*x5)
+    x17 = x15*x1 + x16*x5
+    x18 = x14 + x17*p[1]
     C = ca.SX.zeros(2, 2)
     C[0, 0] = x13
-    C[0, 1] = x17
+    C[0, 1] = x18
     C[1, 0] = x4
     C[1, 1] = x14
     return ca.Function(

@@ -106,9 +106,10 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double x14 = x4 - x0*x3;
     const double x15 = -2.0*x11 + x9;
     const double x16 = 2.0*x7 - x6;
-    const double x17 = x14 + l1*(x15*x1 + x16*x5);
+    const double x17 = x15*x1 + x16*x5;
+    const double x18 = x14 + x17*l1;
     C[0] = x13;
-    C[1] = x17;
+    C[1] = x18;
     C[2] = x4;
     C[3] = x14;
 }

@@ -168,13 +168,14 @@ def coriolis_matrix(q, qd, p=None):
     x14 = -x0*x3 + x4
     x15 = -2*x11 + x9
     x16 = -x6 + 2*x7
-    x17 = l1*(x1*x15 + x16*x5) + x14
+    x17 = x1*x15 + x16*x5
+    x18 = l1*x17 + x14
     return _assemble(
         _lead,
         (2, 2),
         [
             x13,
-            x17,
+            x18,
             x4,
             x14,
         ],
