@@ -21,12 +21,12 @@ three times faster than `sympy.cse` for the same operation counts.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 
 import sympy as sp
 from sympy.core.mul import _keep_coeff
 
-__all__ = ["fast_cse", "original_forms"]
+__all__ = ["fast_cse"]
 
 _cse_main = importlib.import_module("sympy.simplify.cse_main")  # sympy.simplify is also a function
 _Unevaluated = _cse_main.Unevaluated
@@ -91,25 +91,15 @@ def _optimisations(exprs: Sequence[sp.Expr]) -> dict:
     return opt_subs
 
 
-def fast_cse(
-    exprs: Sequence[sp.Expr],
-    prefix: str,
-    *,
-    optimise: bool = True,
-    known: dict[sp.Expr, sp.Symbol] | None = None,
-) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
-    """(temporaries in evaluation order, reduced exprs); temporaries are named prefix0, prefix1, ...
-
-    `optimise=False` does the tree CSE alone. Subexpressions found in `known` (from an
-    earlier pass) are replaced by their symbol instead of being computed again."""
-    known = known or {}
-    opt_subs = _optimisations(exprs) if optimise else {}
+def fast_cse(exprs: Sequence[sp.Expr], prefix: str) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """(temporaries in evaluation order, reduced exprs); temporaries are named prefix0, prefix1, ..."""
+    opt_subs = _optimisations(exprs)
     seen: set = set()
     repeated: set = set()
     stack: list = list(reversed(exprs))
     while stack:
         x = stack.pop()
-        if isinstance(x, sp.Basic) and (x.is_Atom or _is_negated_atom(x) or x in known):
+        if isinstance(x, sp.Basic) and (x.is_Atom or _is_negated_atom(x)):
             continue
         if x in seen:
             repeated.add(x)
@@ -125,8 +115,6 @@ def fast_cse(
         if isinstance(x, sp.Basic) and x.is_Atom:
             return x
         hit = memo.get(x)
-        if hit is None:
-            hit = known.get(x)
         if hit is not None:
             return hit
         y = opt_subs.get(x, x)
@@ -147,12 +135,3 @@ def fast_cse(
         return new
 
     return replacements, [rebuild(e) for e in exprs]
-
-
-def original_forms(replacements: Iterable[tuple[sp.Symbol, sp.Expr]]) -> dict[sp.Expr, sp.Symbol]:
-    """original subexpression -> temporary, for the `known` of a later pass (so that sin(q2)
-    computed by one pass is not computed again by the next)."""
-    full: dict[sp.Symbol, sp.Expr] = {}
-    for sym, e in replacements:
-        full[sym] = e.xreplace(full)
-    return {e: sym for sym, e in full.items()}
