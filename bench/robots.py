@@ -45,9 +45,9 @@ def _dh_link(a, alpha, d, prev_frame: Transform) -> tuple[Transform, sp.Immutabl
 
 def _to_body(frame: Transform, com, inertia) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
     """Centre of mass and inertia given in DH frame i, re-expressed in the body frame."""
-    com_body = frame.apply(com)
-    R = sp.Matrix(frame.R)
-    return com_body, sp.ImmutableMatrix(R * sp.Matrix(inertia) * R.T)
+    from symdyn.loaders.dh import to_body
+
+    return to_body(frame, com, inertia)
 
 
 def _link(name: str, a, alpha, d, prev: Transform, mass, com, inertia) -> Link:

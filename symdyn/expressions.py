@@ -167,8 +167,7 @@ class _Builder:
         self.names: list[str] = []
 
     def _segment(self, node: ast.AST) -> str:
-        seg = ast.get_source_segment(self.text, node) or ""
-        return seg if len(seg) <= 60 else seg[:57] + "..."
+        return _short(ast.get_source_segment(self.text, node) or "")
 
     def _refuse(self, node: ast.AST, what: str | None = None) -> SymdynError:
         if what is None:

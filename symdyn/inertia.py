@@ -35,6 +35,7 @@ __all__ = [
     "rotate",
     "principal_axes",
     "check_inertia",
+    "tensor_from_components",
 ]
 
 Tensor = sp.ImmutableMatrix | np.ndarray
@@ -176,6 +177,21 @@ def rotate(I: Any, R: Any) -> Tensor:
         return sp.ImmutableMatrix(Rm * sp.Matrix(I) * Rm.T)
     Rm = np.asarray(R, dtype=float)
     return Rm @ np.asarray(I, dtype=float) @ Rm.T
+
+
+def tensor_from_components(entries: dict[str, Any]) -> sp.ImmutableMatrix:
+    """The symmetric SymPy tensor from the entries ixx, iyy, izz, ixy, ixz, iyz (a missing one is 0).
+
+    The entries are the tensor's own (as in URDF and the robot file), placed unchanged.
+    """
+    e = {k: entries.get(k, sp.S.Zero) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+    return sp.ImmutableMatrix(
+        [
+            [e["ixx"], e["ixy"], e["ixz"]],
+            [e["ixy"], e["iyy"], e["iyz"]],
+            [e["ixz"], e["iyz"], e["izz"]],
+        ]
+    )
 
 
 def _numeric_matrix(I: Any) -> np.ndarray | None:

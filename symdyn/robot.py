@@ -22,11 +22,14 @@ from dataclasses import dataclass, field, replace
 
 import sympy as sp
 
-from .transform import Transform
+from .errors import SymdynError
+from .transform import Transform, rot_axis
 
-__all__ = ["Friction", "Motor", "Link", "Robot", "JOINT_TYPES"]
+__all__ = ["Friction", "Motor", "Link", "Robot", "JOINT_TYPES", "DEFAULT_GRAVITY"]
 
 JOINT_TYPES = ("revolute", "prismatic")
+#: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
+DEFAULT_GRAVITY = (sp.Integer(0), sp.Integer(0), sp.Float(-9.81))
 
 
 @dataclass(frozen=True)
@@ -67,8 +70,6 @@ class Link:
     def joint_transform(self, q) -> Transform:
         """parent_T_i(q): the body frame of this link in its parent's body frame."""
         if self.joint == "revolute":
-            from .transform import rot_axis
-
             return self.placement @ Transform.from_rotation(rot_axis(list(self.axis), q))
         return self.placement @ Transform.from_translation(list(self.axis * q))
 
@@ -125,35 +126,23 @@ class Robot:
         """This robot with every valued parameter substituted: only `params` stay symbolic."""
         if not self.values:
             return self
-        mapping = self.value_map
-        return replace(
-            self,
-            links=tuple(link.subs(mapping) for link in self.links),
-            gravity=self.gravity.xreplace(mapping),
-            values=(),
-        )
+        return self._substituted(self.value_map, values=())
 
     def param_values(self, params=None) -> dict[sp.Symbol, float]:
         """Numbers for the free parameters: a sequence in `params` order or a name/symbol map."""
         if not self.params:
             return {}
         if params is None:
-            from .errors import SymdynError
-
             names = ", ".join(str(p) for p in self.params)
             raise SymdynError(f"robot '{self.name}' has free parameters ({names}); give their values")
         if isinstance(params, Mapping):
             by_name = {str(k): v for k, v in params.items()}
             missing = [str(p) for p in self.params if str(p) not in by_name]
             if missing:
-                from .errors import SymdynError
-
                 raise SymdynError(f"no value for parameter(s) {', '.join(missing)}")
             return {p: float(by_name[str(p)]) for p in self.params}
         seq = list(params)
         if len(seq) != len(self.params):
-            from .errors import SymdynError
-
             raise SymdynError(f"expected {len(self.params)} parameter values, got {len(seq)}")
         return {p: float(v) for p, v in zip(self.params, seq, strict=True)}
 
@@ -163,9 +152,13 @@ class Robot:
         if not r.params:
             return r
         mapping = {p: sp.Float(v, 17) for p, v in r.param_values(params).items()}
+        return r._substituted(mapping, params=())
+
+    def _substituted(self, mapping: Mapping, **changes) -> Robot:
+        """A copy with `mapping` substituted into every link and gravity, and `changes` applied."""
         return replace(
-            r,
-            links=tuple(link.subs(mapping) for link in r.links),
-            gravity=r.gravity.xreplace(mapping),
-            params=(),
+            self,
+            links=tuple(link.subs(mapping) for link in self.links),
+            gravity=self.gravity.xreplace(mapping),
+            **changes,
         )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 
+from ..errors import SymdynError
 from ..robot import Robot
 from .robot_file import load_robot, robot_from_data
 from .urdf import load_urdf
@@ -16,7 +17,5 @@ def load(path: str | os.PathLike, base: str | None = None, tip: str | None = Non
     if str(path).lower().endswith(".urdf"):
         return load_urdf(path, base=base, tip=tip)
     if base or tip:
-        from ..errors import SymdynError
-
         raise SymdynError(f"{path}: a base or tip link applies to URDF files only")
     return load_robot(path)

@@ -19,9 +19,10 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..inertia import rotate
 from ..transform import Transform
 
-__all__ = ["CONVENTIONS", "Z_AXIS", "dh_link", "dh_transform", "to_body"]
+__all__ = ["CONVENTIONS", "Z_AXIS", "dh_link", "to_body"]
 
 CONVENTIONS = ("standard", "modified")
 Z_AXIS = sp.ImmutableMatrix([0, 0, 1])
@@ -66,22 +67,9 @@ def dh_link(
     return placement, Z_AXIS, frame
 
 
-def dh_transform(convention: str, a, alpha, d, theta) -> Transform:
-    """The full DH transform frame_{i-1} -> frame_i for the given (joint-included) values."""
-    a, alpha, d, theta = _exprs(a, alpha, d, theta)
-    if convention == "standard":
-        return Transform.rz(theta) @ Transform.tz(d) @ Transform.tx(a) @ Transform.rx(alpha)
-    if convention == "modified":
-        return Transform.rx(alpha) @ Transform.tx(a) @ Transform.rz(theta) @ Transform.tz(d)
-    raise ValueError(f"convention must be 'standard' or 'modified', not {convention!r}")
-
-
 def to_body(frame: Transform, com, inertia) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
     """Centre of mass and inertia tensor given in DH frame i, re-expressed in the body frame.
 
     com_body = frame.apply(com); I_body = R I R^T with R = frame.R.
     """
-    com_body = frame.apply(com)
-    R = frame.R
-    I_body = sp.ImmutableMatrix(R * sp.Matrix(inertia) * R.T)
-    return com_body, I_body
+    return frame.apply(com), rotate(inertia, frame.R)

@@ -31,7 +31,8 @@ from ..expressions import (
     is_c_identifier,
     parse_expression_names,
 )
-from ..robot import JOINT_TYPES, Friction, Link, Motor, Robot
+from ..inertia import check_inertia, tensor_from_components
+from ..robot import DEFAULT_GRAVITY, JOINT_TYPES, Friction, Link, Motor, Robot
 from ..transform import Transform
 from .dh import CONVENTIONS, dh_link, to_body
 from .source import read_source
@@ -55,7 +56,6 @@ LINK_KEYS = (
 INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 FRICTION_KEYS = ("viscous", "coulomb")
 MOTOR_KEYS = ("inertia", "gear_ratio")
-DEFAULT_GRAVITY = (0, 0, -9.81)
 _AXES = ("x", "y", "z")
 _LINK_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*\Z")
 #: Largest resolved parameter value (nodes of its expression tree / bits of a number).
@@ -91,8 +91,13 @@ def robot_from_data(data: dict, source: str | None = None) -> Robot:
 
 def _parse_text(text: str, file: str) -> object:
     try:
-        _check_duplicate_keys(yaml.compose(text, Loader=yaml.SafeLoader), file)
-        return yaml.safe_load(text)
+        loader = yaml.SafeLoader(text)
+        try:
+            node = loader.get_single_node()
+            _check_duplicate_keys(node, file)
+            return None if node is None else loader.construct_document(node)
+        finally:
+            loader.dispose()
     except yaml.YAMLError as exc:
         if text.lstrip().startswith("{"):
             # Tab-indented JSON is valid JSON but not YAML; read it as the JSON it is.
@@ -468,12 +473,10 @@ def _number(expr: sp.Expr) -> float | None:
         return None
 
 
-def _check_link_numbers(reader: _Reader, link: _LinkData, subs: dict) -> None:
-    from ..inertia import check_inertia
-
+def _check_link_numbers(reader: _Reader, link: _LinkData, tensor: sp.ImmutableMatrix, subs: dict) -> None:
+    """Refuse impossible numbers of a link (`tensor`: its inertia as written) once parameters have values."""
     mass = link.mass.xreplace(subs)
-    tensor = _tensor(link.inertia).xreplace(subs)
-    check_inertia(mass, tensor, file=reader.file, link_index=link.index, link_name=link.name)
+    check_inertia(mass, tensor.xreplace(subs), file=reader.file, link_index=link.index, link_name=link.name)
     for fld, value in (
         ("friction.viscous", link.viscous),
         ("friction.coulomb", link.coulomb),
@@ -487,17 +490,6 @@ def _check_link_numbers(reader: _Reader, link: _LinkData, subs: dict) -> None:
         raise reader.error("gear ratio must not be zero", link=link, field="motor.gear_ratio")
 
 
-def _tensor(entries: dict[str, sp.Expr]) -> sp.ImmutableMatrix:
-    e = {k: entries.get(k, sp.S.Zero) for k in INERTIA_KEYS}
-    return sp.ImmutableMatrix(
-        [
-            [e["ixx"], e["ixy"], e["ixz"]],
-            [e["ixy"], e["iyy"], e["iyz"]],
-            [e["ixz"], e["iyz"], e["izz"]],
-        ]
-    )
-
-
 def _build(data: object, file: str | None, digest: str | None) -> Robot:
     reader = _Reader(file)
     reader.read(data)
@@ -508,10 +500,11 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
     links: list[Link] = []
     prev = Transform.identity()
     for ld in reader.links:
-        _check_link_numbers(reader, ld, subs)
+        tensor = tensor_from_components(ld.inertia)
+        _check_link_numbers(reader, ld, tensor, subs)
         placement, axis, frame = dh_link(reader.convention, ld.joint, ld.a, ld.alpha, ld.d, ld.theta, prev)
         prev = frame
-        com, inertia = to_body(frame, ld.com, _tensor(ld.inertia))
+        com, inertia = to_body(frame, ld.com, tensor)
         links.append(
             Link(
                 name=ld.name,
@@ -529,7 +522,7 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
 
     gravity = reader.gravity
     if gravity is None:
-        gravity = (sp.Integer(0), sp.Integer(0), sp.Float(DEFAULT_GRAVITY[2]))
+        gravity = DEFAULT_GRAVITY
     assert reader.name is not None
     return Robot(
         name=reader.name,

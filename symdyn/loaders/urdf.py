@@ -53,8 +53,8 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..expressions import C_KEYWORDS
-from ..inertia import check_inertia, parallel_axis, rotate
-from ..robot import Friction, Link, Robot
+from ..inertia import check_inertia, parallel_axis, rotate, tensor_from_components
+from ..robot import DEFAULT_GRAVITY, Friction, Link, Robot
 from ..transform import Transform, rot_axis, rpy_matrix
 from .source import MAX_BYTES, read_source
 
@@ -65,7 +65,6 @@ _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "pris
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\Z")
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 _SNAP_TOLERANCE = 1e-9
-DEFAULT_GRAVITY = (sp.Integer(0), sp.Integer(0), sp.Float(-9.81))
 
 
 # --------------------------------------------------------------------------- XML
@@ -317,14 +316,7 @@ class _Reader:
             )
             for k in _INERTIA_KEYS
         }
-        tensor = sp.ImmutableMatrix(
-            [
-                [e["ixx"], e["ixy"], e["ixz"]],
-                [e["ixy"], e["iyy"], e["iyz"]],
-                [e["ixz"], e["iyz"], e["izz"]],
-            ]
-        )
-        link.inertial = _Inertial(mass, origin, tensor)
+        link.inertial = _Inertial(mass, origin, tensor_from_components(e))
 
     def _read_joint(self, el: _Element) -> None:
         name = el.attrib.get("name", "")
@@ -347,10 +339,9 @@ class _Reader:
                 "<joint> needs the attribute 'type'", line=el.line, **_at(where, label + ".type")
             )
         if kind not in JOINT_TYPES:
-            close = difflib.get_close_matches(kind, JOINT_TYPES, n=1)
-            hint = f" (did you mean '{close[0]}'?)" if close else ""
             raise self.error(
-                f"unknown joint type '{kind}'{hint}; URDF joint types: {', '.join(JOINT_TYPES)}",
+                f"unknown joint type '{kind}'{_suggest(kind, JOINT_TYPES)}; "
+                f"URDF joint types: {', '.join(JOINT_TYPES)}",
                 line=el.line,
                 **_at(where, label + ".type"),
             )
