@@ -96,25 +96,17 @@ def _gains(items, n: int, what: str, default: float) -> np.ndarray:
 
 
 def _load(args: argparse.Namespace):
-    """The robot of args.robot (URDF too, when symdyn.cli knows how)."""
-    from . import cli
+    """The robot of args.robot: a robot file or a URDF file (symdyn.cli's loader)."""
+    from . import cli  # here, not at the top: symdyn.cli imports this module
 
-    loader = getattr(cli, "_load", None)
-    if loader is not None:
-        return loader(args)
-    from .loaders import load_robot
-
-    return load_robot(args.robot)
+    return cli._load(args)
 
 
 def _add_robot_argument(parser: argparse.ArgumentParser) -> None:
-    from . import cli
+    """The robot argument and --base/--tip, as symdyn.cli's own subcommands have them."""
+    from . import cli  # here, not at the top: symdyn.cli imports this module
 
-    adder = getattr(cli, "_add_robot_argument", None)
-    if adder is not None:
-        adder(parser)
-    else:
-        parser.add_argument("robot", help="robot file (YAML or JSON)")
+    cli._add_robot_argument(parser)
 
 
 def _with_params(robot, params: dict[str, float], option: str = "--params"):

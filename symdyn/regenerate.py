@@ -52,10 +52,11 @@ def main(argv=None) -> int:
     root = Path(args.root)
     stale = []
     stamp = root / "generated" / TOOLCHAIN_FILE
-    if not stamp.is_file() or stamp.read_text() != toolchain():
+    versions = toolchain()
+    if not stamp.is_file() or stamp.read_text() != versions:
         stale.append(str(stamp))
         if not args.check:
-            write_files(stamp.parent, {TOOLCHAIN_FILE: toolchain()}, force=True)
+            write_files(stamp.parent, {TOOLCHAIN_FILE: versions}, force=True)
     for name, files in render_all(root).items():
         folder = root / "generated" / name
         for fname, content in files.items():

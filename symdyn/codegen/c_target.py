@@ -26,7 +26,7 @@ from ..errors import SymdynError
 from ..expressions import C_KEYWORDS
 from ..simplify import MAX_UNROLLED_POWER
 from .functions import FunctionSpec
-from .render import RenderContext, environment, header_lines
+from .render import PRECISIONS, RenderContext, environment, header_lines
 
 __all__ = ["render", "CPrinter", "c_names"]
 
@@ -138,11 +138,10 @@ class CPrinter:
     _CALLS = {sp.sin: "sin", sp.cos: "cos", sp.tan: "tan", sp.Abs: "fabs"}
 
     def __init__(self, names: dict[sp.Symbol, str], precision: str = "double"):
-        if precision not in ("double", "float"):
+        if precision not in PRECISIONS:
             raise SymdynError(f"unknown precision '{precision}' (double or float)")
         self.names = names
         self.precision = precision
-        self.ctype = precision
         self.suffix = "f" if precision == "float" else ""
 
     # numbers
@@ -196,7 +195,7 @@ class CPrinter:
             return self._pow(e)
         if isinstance(e, sp.sign):
             x = self._print(e.args[0])[0]
-            return f"(({self.ctype})(({x} > 0) - ({x} < 0)))", ATOM
+            return f"(({self.precision})(({x} > 0) - ({x} < 0)))", ATOM
         call = self._CALLS.get(type(e))
         if call is not None:
             if not e.free_symbols:
@@ -299,11 +298,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
             )
         symbol_names[sym] = sym.name
     printer = CPrinter(symbol_names, real)
-    used_symbols: set[sp.Symbol] = set()
-    for _, e in spec.temporaries:
-        used_symbols |= e.free_symbols
-    for e in spec.outputs:
-        used_symbols |= sp.sympify(e).free_symbols
+    used_symbols = spec.free_symbols
 
     args: list[str] = []
     params_doc: list[tuple[str, str, str]] = []

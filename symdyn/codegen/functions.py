@@ -65,13 +65,13 @@ class FunctionSpec:
     def outputs(self):
         return self.code.outputs
 
-    def used(self, inp: Input) -> bool:
-        """Whether any temporary or output reads the input vector."""
-        names = set(inp.symbols)
-        if not names:
-            return False
-        exprs = [e for _, e in self.code.temporaries] + list(self.code.outputs)
-        return any(names & e.free_symbols for e in exprs)
+    @property
+    def free_symbols(self) -> set[sp.Symbol]:
+        """Every symbol the temporaries and outputs read (input symbols and temporaries)."""
+        return set().union(
+            *(e.free_symbols for _, e in self.code.temporaries),
+            *(sp.sympify(e).free_symbols for e in self.code.outputs),
+        )
 
 
 def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:

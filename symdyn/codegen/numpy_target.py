@@ -111,11 +111,10 @@ def _local_names(ctx: RenderContext) -> dict[sp.Symbol, str]:
     return names
 
 
-def _function(spec: FunctionSpec, names: dict[sp.Symbol, str], printer: NumpyPrinter) -> dict:
+def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
     inputs = [inp for inp in spec.inputs if inp.name != "p"]
     params = next((inp for inp in spec.inputs if inp.name == "p"), None)
-    exprs = [e for _, e in spec.temporaries] + list(spec.outputs)
-    free = set().union(*(e.free_symbols for e in exprs)) if exprs else set()
+    free = spec.free_symbols
     unpack = []
     for inp in spec.inputs:
         for k, s in enumerate(inp.symbols):
@@ -127,14 +126,13 @@ def _function(spec: FunctionSpec, names: dict[sp.Symbol, str], printer: NumpyPri
     shape = (rows, cols) if spec.output in _MATRICES else (rows,)
     entries = [printer.doprint(e) for e in spec.outputs]
     args = [inp.name for inp in inputs] + (["p=None"] if params is not None else [])
-    arrays = [inp.name for inp in spec.inputs]
     return {
         "name": spec.name,
         "doc": spec.doc,
         "args": ", ".join(args),
         "inputs": [inp.name for inp in inputs],
         "has_p": params is not None,
-        "lead": ", ".join(arrays),
+        "lead": [inp.name for inp in spec.inputs],
         "unpack": unpack,
         "body": body,
         "output": spec.output,
@@ -151,11 +149,8 @@ def _tuple_literal(items: list[str]) -> str:
 
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_numpy.py: module text} for the robot of `ctx`."""
-    names = _local_names(ctx)
-    printer = NumpyPrinter(names)
-    for s in (*ctx.dynamics.q, *ctx.dynamics.qd, *ctx.dynamics.qdd):
-        names.setdefault(s, s.name)
-    functions = [_function(spec, names, printer) for spec in ctx.functions]
+    printer = NumpyPrinter(_local_names(ctx))
+    functions = [_function(spec, printer) for spec in ctx.functions]
     text = (
         environment()
         .get_template("python/module.py.j2")

@@ -19,6 +19,12 @@ from .render import GENERATED_MARKER
 __all__ = ["write_files", "is_generated"]
 
 
+def _has_header(path: Path) -> bool:
+    """Whether the symdyn header is in the first 2048 bytes of the file (read no further)."""
+    with open(path, "rb") as f:
+        return GENERATED_MARKER.encode() in f.read(2048)
+
+
 def is_generated(path: Path, files: Mapping[str, str | bytes]) -> bool:
     """Whether an existing file was written by symdyn (header in its first lines).
 
@@ -27,16 +33,13 @@ def is_generated(path: Path, files: Mapping[str, str | bytes]) -> bool:
     already exists there with the symdyn header.
     """
     try:
-        head = path.read_bytes()[:2048]
+        if _has_header(path):
+            return True
     except OSError:
         return False
-    if GENERATED_MARKER.encode() in head:
-        return True
     siblings = [name for name, content in files.items() if isinstance(content, str)]
     return isinstance(files.get(path.name), bytes) and any(
-        GENERATED_MARKER.encode() in (path.parent / s).read_bytes()[:2048]
-        for s in siblings
-        if (path.parent / s).is_file()
+        _has_header(path.parent / s) for s in siblings if (path.parent / s).is_file()
     )
 
 
