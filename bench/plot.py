@@ -36,10 +36,7 @@ def measure(sizes, gen_runs: int = 2) -> list[dict]:
             path = files[f"chain_{n}"]
             gen_dir = Path(tmp) / f"chain_{n}"
             run.log(f"[chain_{n}] symdyn generate --target c ...")
-            runs = [run.generate(path, gen_dir) for _ in range(gen_runs)]
-            wall, cpu = min(w for w, _ in runs), min(c for _, c in runs)
-            robot = run.load(path)
-            ops = run.op_counts((gen_dir / f"{robot.name}_dynamics.c").read_text(), robot.name, robot)
+            wall, cpu, robot, ops = run.generate_best(path, gen_dir, gen_runs)
             fns = casadi_route.casadi_functions(robot)
             out.append(
                 {
@@ -73,12 +70,11 @@ def plot(data: list[dict], path: Path) -> None:
     ax1.legend()
 
     styles = {"inverse_dynamics": "o-", "mass_matrix": "s-", "coriolis_matrix": "^-"}
-    labels = {"inverse_dynamics": "tau", "mass_matrix": "M", "coriolis_matrix": "C"}
     for fn, style in styles.items():
-        ax2.plot(n, [d["ops"][fn] for d in data], style, label=f"symdyn {labels[fn]}")
+        ax2.plot(n, [d["ops"][fn] for d in data], style, label=f"symdyn {run.SHORT[fn]}")
     for fn, style in (("inverse_dynamics", "o:"), ("mass_matrix", "s:")):
         ax2.plot(
-            n, [d["casadi_ops"][fn] for d in data], style, color="gray", label=f"CasADi route {labels[fn]}"
+            n, [d["casadi_ops"][fn] for d in data], style, color="gray", label=f"CasADi route {run.SHORT[fn]}"
         )
     ax2.set_xlabel("joints")
     ax2.set_ylabel("operations per call")

@@ -49,6 +49,8 @@ sys.path.insert(0, str(BENCH))
 import casadi_route  # noqa: E402
 import chains  # noqa: E402
 
+from symdyn.codegen import FUNCTION_NAMES  # noqa: E402
+
 C_COMPILER = "gcc"
 CXX_COMPILER = "g++"
 FLAGS = ("-O3", "-march=native")  # the same for symdyn's C, the CasADi route's C and the harness
@@ -59,15 +61,7 @@ PIN_DEFINES = (  # what pinocchio's CMake target pinocchio_headers adds
     "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS",
     "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
 )
-FUNCTIONS = (
-    "inverse_dynamics",
-    "mass_matrix",
-    "coriolis_matrix",
-    "coriolis",
-    "gravity",
-    "friction",
-    "forward_dynamics",
-)
+FUNCTIONS = FUNCTION_NAMES
 SHORT = {
     "inverse_dynamics": "tau",
     "mass_matrix": "M",
@@ -272,6 +266,18 @@ def generate(path: Path, out_dir: Path) -> tuple[float, float]:
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return wall, cpu
+
+
+def generate_best(path: Path, out_dir: Path, runs: int) -> tuple[float, float, object, dict]:
+    """`generate` `runs` times (fastest wall and CPU kept), then load the robot and read op_counts.
+
+    Returns (wall s, CPU s, robot, op counts of OUT_DIR/NAME_dynamics.c).
+    """
+    times = [generate(path, out_dir) for _ in range(runs)]
+    wall, cpu = min(w for w, _ in times), min(c for _, c in times)
+    robot = load(path)
+    ops = op_counts((out_dir / f"{robot.name}_dynamics.c").read_text(), robot.name, robot)
+    return wall, cpu, robot, ops
 
 
 # --------------------------------------------------------------------------- states
@@ -522,11 +528,12 @@ def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
     return exe
 
 
-def check_c(row: Row, robot, exe: Path, states_file: Path, states) -> None:
+def check_c(row: Row, robot, exe: Path, states_file: Path, states, refs: list[dict]) -> None:
+    """Compare the harness's outputs at the first NCHECK states with `refs` (see `references`)."""
     checks, _ = parse_harness(run([exe, states_file, "check", NCHECK]).stdout)
     worst: dict[str, float] = {}
     for k in range(NCHECK):
-        ref = references(robot, states, k)
+        ref = refs[k]
         qd = states["qd"][k]
         n = robot.n
         got = {fn: checks[fn][k] for fn in FUNCTIONS}
@@ -674,8 +681,8 @@ def build_pinocchio(prefix: Path, build_dir: Path) -> tuple[Path, str]:
     return exe, f"compiled in {time.perf_counter() - t0:.0f} s"
 
 
-def pinocchio_model_text(robot, states) -> str:
-    """The MODEL.txt of bench/pinocchio_harness.cpp, with symdyn.rnea's reference numbers."""
+def pinocchio_model_text(robot, states, refs: list[dict]) -> str:
+    """The MODEL.txt of bench/pinocchio_harness.cpp, with symdyn.rnea's reference numbers `refs`."""
     m = casadi_route.robot_arrays(robot)
     lines = [f"n {m.n}", "gravity " + " ".join(repr(float(x)) for x in m.gravity)]
     for i in range(m.n):
@@ -701,7 +708,7 @@ def pinocchio_model_text(robot, states) -> str:
         lines.append(" ".join(repr(float(v)) for v in vec))
     lines.append(f"ncheck {NCHECK}")
     for k in range(NCHECK):
-        ref = references(robot, states, k)
+        ref = refs[k]
         vec = np.concatenate(
             [
                 ref["rnea_nofriction"],
@@ -715,10 +722,10 @@ def pinocchio_model_text(robot, states) -> str:
     return "\n".join(lines) + "\n"
 
 
-def check_pinocchio(row: Row, robot, exe: Path, work: Path, states) -> list:
+def check_pinocchio(row: Row, robot, exe: Path, work: Path, states, refs: list[dict]) -> list:
     """Write MODEL.txt, run the harness once (it checks, then times briefly); the command to time."""
     model = work / f"pinocchio_{row.name}.txt"
-    model.write_text(pinocchio_model_text(robot, states))
+    model.write_text(pinocchio_model_text(robot, states, refs))
     checks, _ = parse_harness(run([exe, model, 1, 0.1]).stdout)
     row.checks.update({f"Pinocchio {k}": v for k, v in checks.items() if isinstance(v, float)})
     bad = {k: v for k, v in checks.items() if isinstance(v, float) and not v <= CHECK_TOL}
@@ -734,12 +741,8 @@ def bench_robot(name: str, path: Path, work: Path, opts, pin_exe: Path | None) -
     row = Row(name=name, file=str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path))
     gen_dir = work / f"gen_{name}"
     log(f"[{name}] symdyn generate --target c ...")
-    runs = [generate(path, gen_dir) for _ in range(opts.gen_runs)]
-    row.gen_wall, row.gen_cpu = min(w for w, _ in runs), min(c for _, c in runs)
-    robot = load(path)
+    row.gen_wall, row.gen_cpu, robot, row.ops = generate_best(path, gen_dir, opts.gen_runs)
     row.n = robot.n
-    c_text = (gen_dir / f"{robot.name}_dynamics.c").read_text()
-    row.ops = op_counts(c_text, robot.name, robot)
     if robot.params:
         row.notes.append("free parameters: not timed")
         return row
@@ -759,11 +762,12 @@ def bench_robot(name: str, path: Path, work: Path, opts, pin_exe: Path | None) -
     states_file = work / f"states_{name}.bin"
     write_states(states, states_file)
     exe = build_c(row, robot, gen_dir, work, fns)
-    check_c(row, robot, exe, states_file, states)
+    refs = [references(robot, states, k) for k in range(NCHECK)]  # symdyn.rnea, shared by both checks
+    check_c(row, robot, exe, states_file, states, refs)
     pin_cmd = None
     if pin_exe is not None:
         log(f"[{name}] check Pinocchio ...")
-        pin_cmd = check_pinocchio(row, robot, pin_exe, work, states)
+        pin_cmd = check_pinocchio(row, robot, pin_exe, work, states, refs)
     log(f"[{name}] time the C" + (" and Pinocchio" if pin_cmd else "") + " ...")
     time_compiled(row, [exe, states_file, "time"], pin_cmd, opts)
 

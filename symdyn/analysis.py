@@ -37,7 +37,7 @@ import json
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import lru_cache
 from itertools import combinations, product
 
@@ -362,7 +362,7 @@ def _torque_limits(limits, n: int) -> np.ndarray:
 class Analysis:
     """Everything `analyze` computes at one state (see the module docstring for the formulas).
 
-    `polytope` is the biased acceleration polytope, `unbiased_polytope` the same around zero.
+    `polytope` is the biased acceleration polytope.
     """
 
     robot: str
@@ -381,7 +381,6 @@ class Analysis:
     inertia: InertiaEllipsoid
     manipulability: DynamicManipulability
     polytope: AccelerationPolytope
-    unbiased_polytope: AccelerationPolytope = field(repr=False, default=None)  # type: ignore[assignment]
 
     @property
     def bias(self) -> np.ndarray:
@@ -511,7 +510,6 @@ def analyze(
         inertia=inertia_ellipsoid(M),
         manipulability=dynamic_manipulability(J, M, limits, bias),
         polytope=acceleration_polytope(A, bias),
-        unbiased_polytope=acceleration_polytope(A, np.zeros_like(bias)),
     )
 
 

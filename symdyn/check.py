@@ -24,9 +24,7 @@ simplification counts as matching numerically.
 
 from __future__ import annotations
 
-import inspect
 import os
-import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,44 +47,14 @@ SAMPLES = 16
 RTOL = 1e-9
 SIMPLIFY_MAX_OPS = 400  # larger differences are judged numerically only
 
-_JOINT = re.compile(r"(?<![\w.])(q|qd|qdd)([0-9]+)(?!\w)")
-_PLACEHOLDER = re.compile(r"(?<![\w.])(Q|QD|QDD)([0-9]+)(?!\w)")
-
 
 def _entry_label(name: str, index: tuple[int, ...]) -> str:
     return f"{name}[{','.join(str(i) for i in index)}]"
 
 
 def _parse_entry(value: object, file: str | None, label: str) -> sp.Expr:
-    """Parse one answer entry, letting the joint symbols q<k>, qd<k>, qdd<k> through.
-
-    Uses parse_expression(..., allow_joint_symbols=True) when the parser offers it.
-    Otherwise the joint symbols are renamed to placeholders of the same length (q2 -> Q2,
-    qd2 -> QD2, qdd2 -> QDD2; such names are then refused in answers) before parsing and
-    renamed back after: the text is still only ever parsed by the whitelist parser.
-    """
-    if "allow_joint_symbols" in inspect.signature(parse_expression).parameters:
-        return parse_expression(value, file=file, field=label, allow_joint_symbols=True)
-    if not isinstance(value, str):
-        return parse_expression(value, file=file, field=label)
-    clash = _PLACEHOLDER.search(value)
-    if clash:
-        raise SymdynError(
-            f"the name '{clash.group(0)}' is reserved in answers (joint symbols are lower case: "
-            f"{clash.group(0).lower()})",
-            file=file,
-            field=label,
-        )
-    renamed = _JOINT.sub(lambda m: m.group(1).upper() + m.group(2), value)
-    try:
-        expr = parse_expression(renamed, file=file, field=label)
-    except SymdynError as exc:
-        reason = _PLACEHOLDER.sub(lambda m: m.group(1).lower() + m.group(2), exc.reason)
-        raise SymdynError(reason, file=file, field=label) from None
-    back = {
-        s: sp.Symbol(s.name.lower()) for s in expr.free_symbols if _PLACEHOLDER.fullmatch(s.name) is not None
-    }
-    return expr.xreplace(back)
+    """Parse one answer entry, letting the joint symbols q<k>, qd<k>, qdd<k> through."""
+    return parse_expression(value, file=file, field=label, allow_joint_symbols=True)
 
 
 def parse_answers(data: object, robot: Robot, file: str | None = None) -> dict[str, sp.Matrix]:

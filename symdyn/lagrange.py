@@ -42,7 +42,9 @@ def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dic
         P -= link.mass * (g.T * sp.Matrix(pc))[0]
     for i, link in enumerate(robot.links):
         M[i, i] += link.motor.reflected_inertia
-    M = M.applyfunc(lambda x: program.let(x, "M"))
+    for i in range(n):
+        for j in range(i, n):
+            M[i, j] = program.let(M[i, j], "M")
     for i in range(n):
         for j in range(i):
             M[i, j] = M[j, i]

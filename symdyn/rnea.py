@@ -220,10 +220,11 @@ def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
     forces = []
     for i in range(n):
         v = _mv(X[i], v) + S[i] * qd[:, i, None]
-        a = _mv(X[i], a) + S[i] * qdd[:, i, None] + _mv(_crm(v), S[i]) * qd[:, i, None]
+        vx = _crm(v)
+        a = _mv(X[i], a) + S[i] * qdd[:, i, None] + _mv(vx, S[i]) * qd[:, i, None]
         Iv = _mv(mdl.spatial_inertia[i], v)
         # f = I a + v x* (I v), with v x* = -(v x)^T the force cross product.
-        forces.append(_mv(mdl.spatial_inertia[i], a) - _mv(np.swapaxes(_crm(v), -1, -2), Iv))
+        forces.append(_mv(mdl.spatial_inertia[i], a) - _mv(np.swapaxes(vx, -1, -2), Iv))
     tau = np.zeros((N, n))
     for i in reversed(range(n)):
         tau[:, i] = forces[i] @ S[i]

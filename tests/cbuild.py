@@ -85,10 +85,7 @@ def compile_shared(
     extra: Sequence[str] = (),
 ) -> Path:
     """Compile C sources into a shared library (-shared -fPIC, linked with libm)."""
-    out = Path(output)
-    cmd = [compiler, *flags, opt, *extra, "-shared", "-fPIC", "-o", str(out), *map(str, sources), "-lm"]
-    _run(cmd)
-    return out
+    return compile_program(sources, output, compiler, opt, flags, (*extra, "-shared", "-fPIC"))
 
 
 def compile_program(

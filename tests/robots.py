@@ -389,7 +389,3 @@ def build_robot(spec: RobotSpec) -> Robot:
 
 def without_motors(robot: Robot) -> Robot:
     return replace(robot, links=tuple(replace(lk, motor=Motor()) for lk in robot.links))
-
-
-def without_friction(robot: Robot) -> Robot:
-    return replace(robot, links=tuple(replace(lk, friction=Friction()) for lk in robot.links))

@@ -49,15 +49,7 @@ ROBOTS = sorted(p.stem for p in EXAMPLES.glob("*.yaml"))
 PRECISIONS = ("double", "float")
 TOLERANCE = {"double": 1e-9, "float": 1e-4}
 STATES = 50
-FUNCTIONS = (
-    "inverse_dynamics",
-    "mass_matrix",
-    "coriolis_matrix",
-    "coriolis",
-    "gravity",
-    "friction",
-    "forward_dynamics",
-)
+FUNCTIONS = symdyn.codegen.FUNCTION_NAMES
 
 
 def _load(path: Path):

@@ -13,34 +13,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+from robots import ZERO3, Z, mat, roger_arm_robot, rotation, vec
 
 from symdyn import rnea as rn
 from symdyn.errors import SymdynError
 from symdyn.robot import Friction, Link, Motor, Robot
 from symdyn.transform import Transform, rot_x, rot_y
 
-Z = sp.ImmutableMatrix([0, 0, 1])
-ZERO3 = sp.ImmutableMatrix(sp.zeros(3, 3))
-
-
-def _vec(v) -> sp.ImmutableMatrix:
-    return sp.ImmutableMatrix(3, 1, [sp.sympify(x) for x in v])
-
-
-def _mat(a) -> sp.ImmutableMatrix:
-    return sp.ImmutableMatrix(np.asarray(a, dtype=float).tolist())
-
-
 # --- Roger's eye and arm (slides 17-18) -------------------------------------------------
-
-m1, m2, l1, l2, g = sp.symbols("m1 m2 l1 l2 g")
-
-
-def roger_arm() -> Robot:
-    """Two revolute z joints, point masses at the distal ends, hanging along +x (gravity)."""
-    upper = Link("upper", "revolute", Transform.identity(), Z, m1, _vec([l1, 0, 0]), ZERO3)
-    fore = Link("fore", "revolute", Transform.tx(l1), Z, m2, _vec([l2, 0, 0]), ZERO3)
-    return Robot("roger_arm", (upper, fore), _vec([g, 0, 0]), params=(m1, m2, l1, l2, g))
 
 
 def roger_closed_form(p, q, qd, qdd):
@@ -64,7 +44,7 @@ def roger_closed_form(p, q, qd, qdd):
 @pytest.mark.parametrize("seed", range(5))
 def test_roger_arm_matches_lecture_closed_form(seed):
     rng = np.random.default_rng(seed)
-    robot = roger_arm()
+    robot = roger_arm_robot()
     p = rng.uniform(0.1, 2.0, 5)
     p[4] = rng.uniform(-10, 10)
     named = dict(zip(("m1", "m2", "l1", "l2", "g"), p, strict=True))
@@ -87,8 +67,8 @@ def test_roger_arm_matches_lecture_closed_form(seed):
 
 def test_roger_eye_pendulum():
     m, ll, gg = 0.7, 0.4, 9.81
-    eye = Link("eye", "revolute", Transform.identity(), Z, sp.Float(m), _vec([ll, 0, 0]), ZERO3)
-    robot = Robot("roger_eye", (eye,), _vec([gg, 0, 0]))
+    eye = Link("eye", "revolute", Transform.identity(), Z, sp.Float(m), vec([ll, 0, 0]), ZERO3)
+    robot = Robot("roger_eye", (eye,), vec([gg, 0, 0]))
     for q, qd, qdd in [(0.3, 1.0, -2.0), (-2.0, 0.0, 0.5)]:
         expect = m * ll**2 * qdd + m * gg * ll * np.sin(q)
         np.testing.assert_allclose(rn.rnea(robot, [q], [qd], [qdd]), [expect], atol=1e-12)
@@ -99,9 +79,9 @@ def test_roger_eye_pendulum():
 
 def test_vertical_slider():
     m, gg = 1.3, 9.81
-    inertia = _mat(np.diag([0.1, 0.2, 0.25]))
-    slider = Link("s", "prismatic", Transform.tx(0.5), Z, sp.Float(m), _vec([0.1, -0.2, 0.3]), inertia)
-    robot = Robot("slider", (slider,), _vec([0, 0, -gg]))
+    inertia = mat(np.diag([0.1, 0.2, 0.25]))
+    slider = Link("s", "prismatic", Transform.tx(0.5), Z, sp.Float(m), vec([0.1, -0.2, 0.3]), inertia)
+    robot = Robot("slider", (slider,), vec([0, 0, -gg]))
     for q, qd, qdd in [(0.2, 0.5, 1.5), (-1.0, -3.0, -0.4)]:
         np.testing.assert_allclose(rn.rnea(robot, [q], [qd], [qdd]), [m * (qdd + gg)], atol=1e-12)
     np.testing.assert_allclose(rn.potential_energy(robot, [0.7]), m * gg * (0.7 + 0.3), atol=1e-12)
@@ -110,16 +90,16 @@ def test_vertical_slider():
 def polar_arm(I1, m, c, gg):
     """Revolute joint about the vertical, carrying a radial slider; placements rotated."""
     # Body frame 1: base z is the body's y axis (Rx(pi/2)), origin shifted.
-    pl1 = Transform(sp.ImmutableMatrix(rot_x(sp.pi / 2)), _vec([0.3, -0.2, 0.5]))
-    inertia1 = _mat(np.diag([0.4, I1, 0.3]))  # Iyy = I1 about the joint axis
-    link1 = Link("turn", "revolute", pl1, _vec([0, 1, 0]), sp.Float(2.0), _vec([0, 0.1, 0]), inertia1)
+    pl1 = Transform(sp.ImmutableMatrix(rot_x(sp.pi / 2)), vec([0.3, -0.2, 0.5]))
+    inertia1 = mat(np.diag([0.4, I1, 0.3]))  # Iyy = I1 about the joint axis
+    link1 = Link("turn", "revolute", pl1, vec([0, 1, 0]), sp.Float(2.0), vec([0, 0.1, 0]), inertia1)
     # Body frame 2: rotated about the joint-1 axis and lifted along it; the slide
     # direction, written in body 2's axes, is body 1's x axis (radial).
     Ry = rot_y(sp.Rational(7, 10))
-    pl2 = Transform(sp.ImmutableMatrix(Ry), _vec([0, 0.2, 0]))
+    pl2 = Transform(sp.ImmutableMatrix(Ry), vec([0, 0.2, 0]))
     axis2 = sp.ImmutableMatrix(Ry.T * sp.Matrix([1, 0, 0]))
     link2 = Link("slide", "prismatic", pl2, axis2, sp.Float(m), sp.ImmutableMatrix(axis2 * c), ZERO3)
-    return Robot("polar", (link1, link2), _vec([0, 0, -gg]))
+    return Robot("polar", (link1, link2), vec([0, 0, -gg]))
 
 
 def test_polar_arm_closed_form():
@@ -137,18 +117,6 @@ def test_polar_arm_closed_form():
 # --- random robots --------------------------------------------------------------------
 
 
-def _rotation(rng) -> np.ndarray:
-    quat = rng.normal(size=4)
-    w, x, y, z = quat / np.linalg.norm(quat)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def random_robot(seed: int, n: int | None = None, *, extras: bool = True) -> Robot:
     """A seeded random chain: rotated placements, unit axes, mixed joints, valid inertias."""
     rng = np.random.default_rng(seed)
@@ -163,7 +131,7 @@ def random_robot(seed: int, n: int | None = None, *, extras: bool = True) -> Rob
             axis /= np.linalg.norm(axis)
         # principal moments a = y+z, b = x+z, c = x+y satisfy the triangle inequality
         x, y, z = rng.uniform(0.01, 0.3, 3)
-        R = _rotation(rng)
+        R = rotation(rng)
         inertia = R @ np.diag([y + z, x + z, x + y]) @ R.T
         friction = Friction(*(sp.Float(v) for v in rng.uniform(0, 0.5, 2)))
         motor = Motor(sp.Float(rng.uniform(0, 0.01)), sp.Float(rng.uniform(1, 50)))
@@ -171,17 +139,17 @@ def random_robot(seed: int, n: int | None = None, *, extras: bool = True) -> Rob
             Link(
                 name=f"link{i + 1}",
                 joint="revolute" if rng.random() < 0.65 else "prismatic",
-                placement=Transform(_mat(_rotation(rng)), _mat(rng.uniform(-0.5, 0.5, (3, 1)))),
-                axis=_mat(axis.reshape(3, 1)),
+                placement=Transform(mat(rotation(rng)), mat(rng.uniform(-0.5, 0.5, (3, 1)))),
+                axis=mat(axis.reshape(3, 1)),
                 mass=sp.Float(rng.uniform(0.2, 3.0)),
-                com=_mat(rng.uniform(-0.3, 0.3, (3, 1))),
-                inertia=_mat(inertia),
+                com=mat(rng.uniform(-0.3, 0.3, (3, 1))),
+                inertia=mat(inertia),
                 friction=friction if extras else Friction(),
                 motor=motor if extras else Motor(),
             )
         )
     gravity = rng.normal(size=3) * 4
-    return Robot(f"random{seed}", tuple(links), _mat(gravity.reshape(3, 1)))
+    return Robot(f"random{seed}", tuple(links), mat(gravity.reshape(3, 1)))
 
 
 def random_state(robot: Robot, seed: int, N: int | None = None):
@@ -316,7 +284,7 @@ def test_forward_kinematics_composes_joint_transforms():
 
 
 def test_params_errors_and_cache():
-    robot = roger_arm()
+    robot = roger_arm_robot()
     with pytest.raises(SymdynError):
         rn.rnea(robot, [0, 0], [0, 0], [0, 0])
     with pytest.raises(SymdynError):
