@@ -36,7 +36,7 @@ from __future__ import annotations
 import sympy as sp
 
 from . import vectors as v3
-from .crba import Composite, Spatial, apply_inertia, composite_inertias, motion_subspace, shift_inertia, sym3
+from .crba import Composite, Composites, Spatial, apply_inertia, motion_subspace, project, shift_inertia, sym3
 from .frames import JointFrame
 from .newton_euler import origin_inertia
 from .program import Program
@@ -83,11 +83,14 @@ def _inertia_rate(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial, program: Program
     return sp.S.Zero, dh, sym3(program, dI, f"PI{k}_")
 
 
-def coriolis_matrix_composite(robot: Robot, frames: list[JointFrame], qd, program: Program) -> sp.Matrix:
+def coriolis_matrix_composite(
+    robot: Robot, frames: list[JointFrame], composites: Composites, qd, program: Program
+) -> sp.Matrix:
     """C(q, qd) with V = C qd and dM/dt - 2C skew-symmetric (Christoffel symbols), over the
-    program's intermediates; see the module docstring for the recursion."""
+    program's intermediates (`composites` from crba.composite_inertias); see the module
+    docstring for the recursion."""
     n = robot.n
-    mass, hc, Ic = composite_inertias(robot, frames, program)
+    mass, hc, Ic = composites
     s = [motion_subspace(link) for link in robot.links]
     # outward: body velocities and psi_k = v_k x s_k
     vel: list[Spatial] = []
@@ -126,21 +129,16 @@ def coriolis_matrix_composite(robot: Robot, frames: list[JointFrame], qd, progra
         Y = _let_spatial(program, (v3.add(Ps[0], sH[0], Ipsi[0]), v3.add(Ps[1], sH[1], Ipsi[1])), f"Y{k}_")
         A = _let_spatial(program, (v3.sub(Ps[0], sH[0]), v3.sub(Ps[1], sH[1])), f"A{k}_")
         F = _let_spatial(program, apply_inertia(mass[j], hc[j], Ic[j], s[j]), f"F{k}_")
-        C[j, j] = program.let(_project(s[j], Y), "C")
+        C[j, j] = program.let(project(s[j], Y), "C")
         for i in reversed(range(j)):
             frame = frames[i + 1]
             Y, A, F = (
                 _let_spatial(program, frame.force_to_parent(*vec, program, f"R{tag}{k}_"), f"{tag}{k}_")
                 for tag, vec in (("Y", Y), ("A", A), ("F", F))
             )
-            C[i, j] = program.let(_project(s[i], Y), "C")
-            C[j, i] = program.let(v3._sum((_project(s[i], A), _project(psi[i], F))), "C")
+            C[i, j] = program.let(project(s[i], Y), "C")
+            C[j, i] = program.let(v3._sum((project(s[i], A), project(psi[i], F))), "C")
     return C
-
-
-def _project(m: Spatial, f: Spatial) -> sp.Expr:
-    """m^T f for a motion m and a force f."""
-    return v3._sum((v3.dot(m[0], f[0]), v3.dot(m[1], f[1])))
 
 
 def _halved(I: v3.Mat) -> v3.Mat:

@@ -33,7 +33,9 @@ __all__ = [
     "Spatial",
     "motion_subspace",
     "apply_inertia",
+    "Composites",
     "composite_inertias",
+    "project",
     "shift_inertia",
     "sym3",
     "mass_matrix_crba",
@@ -58,6 +60,11 @@ def apply_inertia(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial) -> Spatial:
     """The spatial inertia (m, h, I) times a motion (w, u): (I w + h x u, m u - h x w)."""
     w, u = v
     return v3.add(v3.mul(I, w), v3.cross(h, u)), v3.sub(v3.scale(m, u), v3.cross(h, w))
+
+
+def project(m: Spatial, f: Spatial) -> sp.Expr:
+    """m^T f for a motion m and a force f (a joint's share of a force, for m = s)."""
+    return v3._sum((v3.dot(m[0], f[0]), v3.dot(m[1], f[1])))
 
 
 def sym3(program: Program, I: Sequence[Sequence[sp.Expr]], hint: str) -> v3.Mat:
@@ -110,9 +117,10 @@ def shift_inertia(
     return m, h, I  # type: ignore[return-value]
 
 
-def composite_inertias(
-    robot: Robot, frames: list[JointFrame], program: Program
-) -> tuple[list[sp.Expr], list[v3.Vec], list[v3.Mat]]:
+Composites = tuple[list[sp.Expr], list[v3.Vec], list[v3.Mat]]  # per link: mass, h, I of its subtree
+
+
+def composite_inertias(robot: Robot, frames: list[JointFrame], program: Program) -> Composites:
     """Mass, first moment and rotational inertia (about the body origin, body axes) of the
     subtree rooted at each link (the link and everything outboard of it)."""
     n = robot.n
@@ -129,10 +137,13 @@ def composite_inertias(
     return [c[0] for c in comp], [c[1] for c in comp], [c[2] for c in comp]
 
 
-def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -> sp.Matrix:
-    """M(q) of the rigid bodies plus reflected motor inertia, over the program's intermediates."""
+def mass_matrix_crba(
+    robot: Robot, frames: list[JointFrame], composites: Composites, program: Program
+) -> sp.Matrix:
+    """M(q) of the rigid bodies plus reflected motor inertia, over the program's intermediates
+    (`composites` from `composite_inertias`)."""
     n = robot.n
-    mass, h, I = composite_inertias(robot, frames, program)
+    mass, h, I = composites
     M = sp.zeros(n, n)
     for j in range(n):
         nf, ff = apply_inertia(mass[j], h[j], I[j], motion_subspace(robot.links[j]))
@@ -141,15 +152,16 @@ def mass_matrix_crba(robot: Robot, frames: list[JointFrame], program: Program) -
             if i < j:
                 nf, ff = frames[i + 1].force_to_parent(nf, ff, program, "Ff")
                 nf = program.let_vector(nf, "Fn")
-            ai = v3.vec(robot.links[i].axis)
-            entry = v3.dot(ai, nf if robot.links[i].joint == "revolute" else ff)
+            entry = project(motion_subspace(robot.links[i]), (nf, ff))
             if i == j:
                 entry = entry + robot.links[j].motor.reflected_inertia
             M[i, j] = M[j, i] = program.let(entry, "M")
     return M
 
 
-def gravity_composite(robot: Robot, frames: list[JointFrame], program: Program) -> list[sp.Expr]:
+def gravity_composite(
+    robot: Robot, frames: list[JointFrame], composites: Composites, program: Program
+) -> list[sp.Expr]:
     """G(q) from the composite bodies: with g_k the gravitational acceleration in frame k
     (g_k = R_k^T g_{k-1}) and m^c_k, h^c_k the subtree's mass and first moment about origin k,
 
@@ -158,7 +170,7 @@ def gravity_composite(robot: Robot, frames: list[JointFrame], program: Program) 
 
     which is dP/dq_k for P = -sum_i m_i g^T p_ci. One rotation per link and no inward
     force recursion, against a Newton-Euler pass with qd = qdd = 0."""
-    mass, h, _ = composite_inertias(robot, frames, program)
+    mass, h, _ = composites
     g = v3.vec(robot.gravity)
     G: list[sp.Expr] = []
     for k, link in enumerate(robot.links):

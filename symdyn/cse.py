@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import sympy as sp
 from sympy.core.mul import _keep_coeff
 
-__all__ = ["fast_cse"]
+__all__ = ["fast_cse", "is_negated_atom"]
 
 _cse_main = importlib.import_module("sympy.simplify.cse_main")  # sympy.simplify is also a function
 _Unevaluated = _cse_main.Unevaluated
@@ -55,7 +55,8 @@ def _negation(expr: sp.Expr) -> sp.Expr | None:
     return None
 
 
-def _is_negated_atom(x: sp.Expr) -> bool:
+def is_negated_atom(x: sp.Expr) -> bool:
+    """-x for a symbol or number x: printed as a unary minus, never worth a temporary."""
     return x.is_Mul and len(x.args) == 2 and x.args[0] is _NEG_ONE and x.args[1].is_Atom
 
 
@@ -99,7 +100,7 @@ def fast_cse(exprs: Sequence[sp.Expr], prefix: str) -> tuple[list[tuple[sp.Symbo
     stack: list = list(reversed(exprs))
     while stack:
         x = stack.pop()
-        if isinstance(x, sp.Basic) and (x.is_Atom or _is_negated_atom(x)):
+        if isinstance(x, sp.Basic) and (x.is_Atom or is_negated_atom(x)):
             continue
         if x in seen:
             repeated.add(x)

@@ -25,7 +25,7 @@ import sympy as sp
 from sympy.core.parameters import distribute
 
 from .coriolis import coriolis_matrix_composite
-from .crba import gravity_composite, mass_matrix_crba
+from .crba import composite_inertias, gravity_composite, mass_matrix_crba
 from .errors import SymdynError
 from .frames import joint_frames
 from .lagrange import lagrange
@@ -154,13 +154,13 @@ def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str,
     n = robot.n
     rot = joint_frames(robot, q)
     zeros = [0] * n
-    G = sp.Matrix(gravity_composite(robot, rot, program))
-    V = sp.Matrix(newton_euler(robot, q, list(qd), zeros, program, gravity=False, tag="V", rotations=rot))
     with distribute(True):  # numbers times sums fold into the coefficients of the composites
-        M = mass_matrix_crba(robot, rot, program)
+        composites = composite_inertias(robot, rot, program)
+        G = sp.Matrix(gravity_composite(robot, rot, composites, program))
+        M = mass_matrix_crba(robot, rot, composites, program)
+        C = coriolis_matrix_composite(robot, rot, composites, list(qd), program)
+    V = sp.Matrix(newton_euler(robot, q, list(qd), zeros, program, gravity=False, tag="V", rotations=rot))
     Vn = [program.let(v, "V") for v in V]
-    with distribute(True):
-        C = coriolis_matrix_composite(robot, rot, list(qd), program)
     bias = newton_euler(robot, q, list(qd), zeros, program, gravity=True, tag="B", rotations=rot)
     body = newton_euler(robot, q, list(qd), list(qdd), program, gravity=True, tag="T", rotations=rot)
     tau = sp.Matrix([body[i] + link.motor.reflected_inertia * qdd[i] for i, link in enumerate(robot.links)])

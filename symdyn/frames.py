@@ -27,6 +27,7 @@ import sympy as sp
 from . import vectors as v3
 from .program import Program
 from .robot import Robot
+from .transform import coordinate_axis
 
 __all__ = ["JointFrame", "joint_frames"]
 
@@ -80,21 +81,13 @@ def _congruence(R: v3.Mat, J: Sequence[Sequence[sp.Expr]]) -> list[list[sp.Expr]
     return [[v3.dot(RJ[r], R[c]) for c in range(3)] for r in range(3)]
 
 
-def _coordinate_axis(axis: Sequence[sp.Expr]) -> tuple[int, int] | None:
-    """(k, sign) when the axis is +-e_k, else None."""
-    for k in range(3):
-        if axis[k] in (1, -1) and all(axis[o] == 0 for o in range(3) if o != k):
-            return k, int(axis[k])
-    return None
-
-
 def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
     """R_i, p_i (and the factors of R_i) per link: body i in its parent's body frame."""
     out = []
     for link, qi in zip(robot.links, q, strict=True):
         T = link.joint_transform(qi)
         turn = None
-        coord = _coordinate_axis(list(link.axis)) if link.joint == "revolute" else None
+        coord = coordinate_axis(list(link.axis)) if link.joint == "revolute" else None
         if coord is not None:
             k, sign = coord
             angle = qi if sign == 1 else -qi

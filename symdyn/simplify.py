@@ -24,7 +24,7 @@ from functools import cached_property
 
 import sympy as sp
 
-from .cse import fast_cse
+from .cse import fast_cse, is_negated_atom
 
 __all__ = ["OpCount", "count_ops", "eliminate", "eliminate_many", "Eliminated", "chop_float_noise"]
 
@@ -178,10 +178,7 @@ def _cse_nodes(
 
     # inline temporaries that are a bare symbol or number (no work, only a name), to a fixpoint
     # since an alias may name another alias
-    def is_alias(e: sp.Expr) -> bool:
-        return e.is_Atom or (e.is_Mul and len(e.args) == 2 and e.args[0] == -1 and e.args[1].is_Atom)
-
-    alias = {s: e for s, e in nodes.items() if is_alias(e)}
+    alias = {s: e for s, e in nodes.items() if e.is_Atom or is_negated_atom(e)}
     while True:
         resolved = {s: e.xreplace(alias) for s, e in alias.items()}
         if resolved == alias:
@@ -231,8 +228,7 @@ def eliminate(
     prefix: str = "x",
 ) -> Eliminated:
     """CSE over a program's assignments and outputs; temporaries renamed prefix0, prefix1, ..."""
-    nodes, outs = _cse_nodes(assignments, [sp.sympify(e) for e in outputs])
-    return _extract(nodes, outs, prefix, _inputs(nodes, outs))
+    return eliminate_many(assignments, {"": outputs}, prefix)[""]
 
 
 def eliminate_many(

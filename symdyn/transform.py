@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-__all__ = ["Transform", "rot_x", "rot_y", "rot_z", "rot_axis", "rpy_matrix"]
+__all__ = ["Transform", "rot_x", "rot_y", "rot_z", "rot_axis", "coordinate_axis", "rpy_matrix"]
 
 
 def _vec(v) -> sp.ImmutableMatrix:
@@ -36,13 +36,22 @@ def rot_z(a) -> sp.ImmutableMatrix:
     return sp.ImmutableMatrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
 
 
+def coordinate_axis(axis) -> tuple[int, int] | None:
+    """(k, sign) when the axis is sign * e_k (a coordinate axis, either way), else None."""
+    ax = [sp.sympify(x) for x in axis]
+    for k in range(3):
+        if ax[k] in (1, -1) and all(ax[j] == 0 for j in range(3) if j != k):
+            return k, int(ax[k])
+    return None
+
+
 def rot_axis(axis, a) -> sp.ImmutableMatrix:
     """Rotation by angle a about a unit axis (Rodrigues); coordinate axes give the plain forms."""
+    coord = coordinate_axis(axis)
+    if coord is not None:
+        k, sign = coord
+        return (rot_x, rot_y, rot_z)[k](a if sign == 1 else -a)
     ax = [sp.sympify(x) for x in axis]
-    for idx, fn in enumerate((rot_x, rot_y, rot_z)):
-        others = [ax[j] for j in range(3) if j != idx]
-        if all(o == 0 for o in others) and ax[idx] in (1, -1):
-            return fn(a if ax[idx] == 1 else -a)
     k = sp.Matrix(ax)
     K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     c, s = sp.cos(a), sp.sin(a)
