@@ -20,10 +20,10 @@ Functions (all with numeric parameters; inputs are column vectors of length n):
   triangles filled, reflected rotor inertia on the diagonal, dense n x n.
 * ``gravity(q) -> G``: the same RNEA traced with qd = qdd = 0 and no friction.
 
-The robot is read from the same `symdyn.robot.Robot` the generated C comes from:
+The robot is read from the same `symdyn.model.robot.Robot` the generated C comes from:
 `robot.numeric()` gives SymPy numbers, converted to floats here; joint i moves
 by parent_T_i(q_i) = placement @ Rot(axis, q_i) (revolute) or placement @
-Trans(axis q_i) (prismatic), as `symdyn.robot.Link.joint_transform` defines.
+Trans(axis q_i) (prismatic), as `symdyn.model.robot.Link.joint_transform` defines.
 
     fns = casadi_functions(robot)              # {"inverse_dynamics": casadi.Function, ...}
     flops(fns["inverse_dynamics"])             # OpCount-like dict of the SX algorithm

@@ -1,7 +1,7 @@
 """Robot files for bench/run.py: generic n-joint chains and the PUMA 560 with symbolic inertia.
 
 * `chain_data(n)`: an n-joint spatial revolute arm as a robot-file dict (the format
-  of design.md): standard DH, twists cycling 0, +pi/2, -pi/2, nonzero a and d,
+  of docs/robot-files.md): standard DH, twists cycling 0, +pi/2, -pi/2, nonzero a and d,
   numeric masses, centres of mass and FULL inertia tensors (non-zero products of
   inertia, positive definite, triangle inequality kept), gravity (0, 0, -9.81).
   The numbers follow a fixed formula (no randomness), so every run and every

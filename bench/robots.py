@@ -21,8 +21,8 @@ from pathlib import Path
 
 import sympy as sp
 
-from symdyn.robot import Friction, Link, Motor, Robot
-from symdyn.transform import Transform, rot_x
+from symdyn.model.robot import Friction, Link, Motor, Robot
+from symdyn.spatial.transform import Transform, rot_x
 
 __all__ = ["generic_arm", "puma560_symbolic", "kane_model", "KaneModel", "PUMA_FILE"]
 
@@ -35,7 +35,7 @@ _INERTIA_KEYS = ("xx", "xy", "xz", "yy", "yz", "zz")
 def _dh_link(a, alpha, d, prev_frame: Transform) -> tuple[Transform, sp.ImmutableMatrix, Transform]:
     """(placement, axis, frame) of a standard-DH revolute row with theta offset 0."""
     try:
-        from symdyn.loaders.dh import dh_link
+        from symdyn.parsers.dh import dh_link
     except ImportError:  # fall back to the same construction written out
         placement = prev_frame @ Transform.tz(d)
         frame = Transform.tx(a) @ Transform.rx(alpha)
@@ -45,7 +45,7 @@ def _dh_link(a, alpha, d, prev_frame: Transform) -> tuple[Transform, sp.Immutabl
 
 def _to_body(frame: Transform, com, inertia) -> tuple[sp.ImmutableMatrix, sp.ImmutableMatrix]:
     """Centre of mass and inertia given in DH frame i, re-expressed in the body frame."""
-    from symdyn.loaders.dh import to_body
+    from symdyn.parsers.dh import to_body
 
     return to_body(frame, com, inertia)
 
@@ -110,7 +110,7 @@ def puma560_symbolic() -> tuple[Robot, str]:
     base = None
     if PUMA_FILE.exists():
         try:
-            from symdyn.loaders.robot_file import load_robot
+            from symdyn.parsers.robot_file import load_robot
         except ImportError:
             load_robot = None
         if load_robot is not None:

@@ -215,11 +215,11 @@ def symdyn_command() -> list[str]:
     exe = Path(sys.executable).with_name("symdyn")
     if exe.exists():
         return [str(exe)]
-    return [sys.executable, "-c", "import sys; from symdyn.cli import main; sys.exit(main())"]
+    return [sys.executable, "-c", "import sys; from symdyn.cli.main import main; sys.exit(main())"]
 
 
 def load(path: Path):
-    from symdyn.loaders import load as load_any
+    from symdyn.parsers import load as load_any
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # implausible-but-published inertia (PUMA link 1)

@@ -31,7 +31,7 @@ import sys
 from pathlib import Path
 
 import symdyn
-from symdyn.analysis import analyze, plot_workspace
+from symdyn.apps.analysis import analyze, plot_workspace
 
 HERE = Path(__file__).resolve().parent
 TORQUE_LIMIT = 2.0  # N m, both joints

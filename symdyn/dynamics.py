@@ -1,17 +1,17 @@
 """`derive`: the equations of motion tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (slide 16).
 
 Two independent routes fill the same `Dynamics`:
-- "newton-euler" (symdyn.newton_euler, symdyn.crba, symdyn.coriolis): V = NE(q, qd, 0)
+- "newton-euler" (algorithms.newton_euler, .crba, .coriolis): V = NE(q, qd, 0)
   with gravity off; M by the composite-rigid-body algorithm and G from the same
   composite bodies (both equal to NE with unit accelerations, resp. NE(q, 0, 0));
   tau from one full pass; C = 1/2 dV/dqd from composite inertias, momenta and
   inertia rates, which equals the Christoffel-symbol matrix because
   V_k = sum_ij Gamma^k_ij qd_i qd_j with Gamma^k_ij symmetric in i, j.
-- "lagrange" (symdyn.lagrange): M from the link Jacobians, C from the
+- "lagrange" (symdyn.algorithms.lagrange): M from the link Jacobians, C from the
   Christoffel symbols of M, G from the potential energy, V = C qd.
 
 Both keep their results as expressions over named intermediates
-(symdyn.program); `Dynamics.M` etc. give closed forms over q, qd, qdd and the
+(symdyn.symbolic.program); `Dynamics.M` etc. give closed forms over q, qd, qdd and the
 free parameters, simplified with trigonometric identities when requested
 (by default for robots of up to 3 joints).
 """
@@ -24,16 +24,16 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
-from .coriolis import coriolis_matrix_composite
-from .crba import composite_inertias, gravity_composite, mass_matrix_crba
+from .algorithms.coriolis import coriolis_matrix_composite
+from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
+from .algorithms.frames import joint_frames
+from .algorithms.lagrange import lagrange
+from .algorithms.newton_euler import newton_euler
 from .errors import SymdynError
-from .frames import joint_frames
-from .lagrange import lagrange
-from .newton_euler import newton_euler
-from .program import Program
-from .robot import Robot
-from .simplify import chop_float_noise
-from .symbols import joint_symbols
+from .model.robot import Robot
+from .model.symbols import joint_symbols
+from .symbolic.program import Program
+from .symbolic.simplify import chop_float_noise
 
 __all__ = ["Dynamics", "derive", "METHODS", "QUANTITIES", "friction_vector"]
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from .codegen import TARGETS, render
 from .codegen.output import write_files
-from .loaders import load_robot
+from .parsers import load_robot
 
 __all__ = ["EXAMPLES", "render_all", "main"]
 

@@ -372,7 +372,7 @@ def potential_energy(robot, q, params=None) -> float | np.ndarray:
 
 
 class _CallableModule(types.ModuleType):
-    """`symdyn.rnea` is both this module and the function of design.md: symdyn.rnea(robot, q, qd, qdd)."""
+    """`symdyn.rnea` is both this module and the public function symdyn.rnea(robot, q, qd, qdd)."""
 
     def __call__(self, robot, q, qd, qdd, params=None, **kwargs):
         return rnea(robot, q, qd, qdd, params, **kwargs)

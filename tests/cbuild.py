@@ -6,7 +6,7 @@ A small helper shared by the tests of generated C:
     lib = build_dynamics(files, tmp_dir, robot.name)          # compiles NAME_dynamics.c
     lib.mass_matrix(q, p)                                        # -> (n, n) NumPy array
 
-Compilation uses the strict flags of design.md (`STRICT_FLAGS`, with -Werror), so
+Compilation uses the C contract's strict flags (`STRICT_FLAGS`, with -Werror; docs/generated-code.md), so
 a warning is a failure. `compile_shared` and `compile_program` raise
 `CompileError` with the compiler's messages.
 """

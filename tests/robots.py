@@ -25,9 +25,9 @@ from hypothesis import strategies as st
 
 from symdyn.dynamics import derive
 from symdyn.errors import SymdynWarning
-from symdyn.loaders.robot_file import load_robot, robot_from_data
-from symdyn.robot import Friction, Link, Motor, Robot
-from symdyn.transform import Transform
+from symdyn.model.robot import Friction, Link, Motor, Robot
+from symdyn.parsers.robot_file import load_robot, robot_from_data
+from symdyn.spatial.transform import Transform
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
 EXAMPLE_NAMES = tuple(sorted(p.stem for p in EXAMPLES_DIR.glob("*.yaml")))

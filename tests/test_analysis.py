@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import symdyn.cli as cli
-from symdyn.analysis import (
+from symdyn import cli
+from symdyn.algorithms.kinematics import numeric_jacobian, numeric_pose
+from symdyn.apps.analysis import (
     acceleration_polytope,
     analyze,
     convex_hull_2d,
@@ -28,8 +29,7 @@ from symdyn.analysis import (
     zonotope_vertex_signs,
 )
 from symdyn.errors import SymdynError
-from symdyn.kinematics import numeric_jacobian, numeric_pose
-from symdyn.loaders import load_robot
+from symdyn.parsers import load_robot
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 ROGER = EXAMPLES / "roger_arm_values.yaml"

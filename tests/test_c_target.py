@@ -1,4 +1,4 @@
-"""The C target (design.md, "Generated C") compiled with gcc and judged by the numeric oracle.
+"""The C target (docs/generated-code.md) compiled with gcc and judged by the numeric oracle.
 
 Every example robot is derived once, rendered in double and float precision,
 compiled warning-free with the strict flags (-Werror) and loaded with ctypes
@@ -39,7 +39,7 @@ from cbuild import (
 import symdyn.codegen
 from symdyn.codegen import c_target
 from symdyn.codegen.render import RenderContext
-from symdyn.loaders import load_robot, robot_from_data
+from symdyn.parsers import load_robot, robot_from_data
 
 oracle = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 
@@ -430,7 +430,7 @@ def test_rendering_is_deterministic(builds):
 def test_rendering_does_not_depend_on_hash_seed(tmp_path):
     script = (
         "import sys, warnings; warnings.simplefilter('ignore')\n"
-        "from symdyn.loaders import load_robot\n"
+        "from symdyn.parsers import load_robot\n"
         "from symdyn.codegen import render\n"
         "files = render(load_robot(sys.argv[1]), targets=('c',))\n"
         "sys.stdout.write(files['scara_dynamics.c'] + files['scara_dynamics.h'])\n"

@@ -201,7 +201,7 @@ _HASH_SCRIPT = """
 import hashlib, sys, warnings
 warnings.simplefilter("ignore")
 from symdyn.codegen import render
-from symdyn.loaders import load_robot
+from symdyn.parsers import load_robot
 files = render(load_robot(sys.argv[1]), targets=("casadi",))
 for name in sorted(files):
     data = files[name]

@@ -12,11 +12,11 @@ import pytest
 import sympy as sp
 import yaml
 
-import symdyn.check as check_module
-import symdyn.cli as cli
-from symdyn.check import check_answers, load_answers
+import symdyn.apps.check as check_module
+from symdyn import cli
+from symdyn.apps.check import check_answers, load_answers
 from symdyn.errors import SymdynError
-from symdyn.loaders import load_robot
+from symdyn.parsers import load_robot
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 ROGER = EXAMPLES / "roger_arm.yaml"

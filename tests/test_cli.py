@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
-from symdyn.cli import main
+from symdyn.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -19,7 +19,7 @@ BAD = ROOT / "tests" / "data" / "bad"
 
 
 def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run `python -m symdyn.cli ...` exactly as the console script would."""
+    """Run `python -m symdyn.cli.main ...` exactly as the console script would."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     return subprocess.run(
         [sys.executable, "-m", "symdyn.cli", *args],

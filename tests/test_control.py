@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 import yaml
 
-import symdyn.cli as cli
-from symdyn.control import ComputedTorque, Reference, pd_gains, track
+from symdyn import cli
+from symdyn.apps.control import ComputedTorque, Reference, pd_gains, track
+from symdyn.apps.simulate import with_parameters
 from symdyn.errors import SymdynError
-from symdyn.loaders import load_robot, robot_from_data
-from symdyn.simulate import with_parameters
+from symdyn.parsers import load_robot, robot_from_data
 
 rn = importlib.import_module("symdyn.rnea")
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -1,4 +1,4 @@
-"""The composite-body Coriolis matrix (symdyn.coriolis) against routes that do not share its algebra.
+"""The composite-body Coriolis matrix (algorithms.coriolis) against routes that do not share its algebra.
 
 - exactly: C = 1/2 dV/dqd, with dV/dqd from Program.diff (forward-mode differentiation of the
   Newton-Euler pass for V) for arms of up to 3 joints, both DH conventions and a prismatic joint;
@@ -34,7 +34,7 @@ from robots import (
 )
 
 from symdyn.codegen.functions import build_functions
-from symdyn.loaders.robot_file import robot_from_data
+from symdyn.parsers.robot_file import robot_from_data
 from symdyn.rnea import bias_torque
 
 SMALL = {

@@ -1,4 +1,4 @@
-"""symdyn.cse: temporaries that rebuild the input exactly, sharing of x and -x, common arguments,
+"""symdyn.symbolic.cse: temporaries that rebuild the input exactly, sharing of x and -x, common arguments,
 deterministic names, and operation counts no worse than sympy.cse."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import sympy as sp
 from robots import derived
 
 from symdyn.codegen.functions import build_functions
-from symdyn.cse import fast_cse
-from symdyn.simplify import count_ops
+from symdyn.symbolic.cse import fast_cse
+from symdyn.symbolic.simplify import count_ops
 
 x, y, z, u, v, w = sp.symbols("x y z u v w")
 

@@ -46,9 +46,9 @@ from robots import (
 
 from symdyn.dynamics import METHODS, derive
 from symdyn.errors import SymdynError
-from symdyn.loaders.robot_file import robot_from_data
+from symdyn.model.robot import Motor
+from symdyn.parsers.robot_file import robot_from_data
 from symdyn.rnea import bias_torque, friction_torque, gravity_torque, mass_matrix, rnea
-from symdyn.robot import Motor
 
 SYM3 = {conv: robot_from_data(sym3_data(conv)) for conv in ("standard", "modified")}
 PLANAR_3R_RATIONAL = rational_example("planar_3r")
@@ -96,7 +96,7 @@ def test_roger_arm_is_slide_18(method, source, simplify):
 
 
 def test_roger_arm_file_parameter_order():
-    """design.md: free parameters in order of first appearance (gravity, then link by link)."""
+    """docs/python-api.md: free parameters in order of first appearance (gravity, then link by link)."""
     robot = example("roger_arm")
     assert robot.params == sp.symbols("g l1 m1 l2 m2")
     for method in METHODS:

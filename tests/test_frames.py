@@ -1,4 +1,4 @@
-"""Joint frames and the rotation of symmetric tensors into the parent frame (symdyn.frames)."""
+"""Joint frames and the rotation of symmetric tensors into the parent frame (symdyn.algorithms.frames)."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ import pytest
 import sympy as sp
 from robots import assert_matrix_zero, mat
 
-from symdyn.frames import joint_frames
-from symdyn.program import Program
-from symdyn.robot import Link, Robot
-from symdyn.transform import Transform, rot_x, rot_z
+from symdyn.algorithms.frames import joint_frames
+from symdyn.model.robot import Link, Robot
+from symdyn.spatial.transform import Transform, rot_x, rot_z
+from symdyn.symbolic.program import Program
 
 a, b, c, d, e, f = sp.symbols("a b c d e f")
 J = ((a, d, e), (d, b, f), (e, f, c))
@@ -47,7 +47,7 @@ def _rotated(robot: Robot, tensor) -> sp.Matrix:
 @pytest.mark.parametrize("axis", AXES)
 def test_rotate_symmetric_is_R_J_RT(axis, placement):
     robot = _robot(axis, PLACEMENTS[placement])
-    R = robot.links[0].joint_transform(q1).R  # independent of symdyn.frames
+    R = robot.links[0].joint_transform(q1).R  # independent of symdyn.algorithms.frames
     assert_matrix_zero(_rotated(robot, J) - R * sp.Matrix(J) * R.T, 1, f"axis {axis}, {placement}")
 
 

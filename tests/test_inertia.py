@@ -1,4 +1,4 @@
-"""Tests for symdyn.inertia, checked against values obtained another way.
+"""Tests for symdyn.model.inertia, checked against values obtained another way.
 
 Independent references: the lecture's printed matrices (slides 6-9), exact SymPy
 integration of the defining integrals, and NumPy grid integration over the solids.
@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symdyn.errors import SymdynError, SymdynWarning
-from symdyn.inertia import (
+from symdyn.model.inertia import (
     box,
     check_inertia,
     cylinder,

@@ -1,4 +1,4 @@
-"""Forward kinematics and Jacobians (symdyn.kinematics) against hand-written DH matrices,
+"""Forward kinematics and Jacobians (symdyn.algorithms.kinematics) against hand-written DH matrices,
 finite differences and the numeric oracle's poses (symdyn.rnea.forward_kinematics)."""
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from robots import (
     sym3_data,
 )
 
-from symdyn.kinematics import (
+from symdyn.algorithms.kinematics import (
     end_effector_jacobian,
     forward_kinematics,
     frame_poses,
@@ -30,7 +30,7 @@ from symdyn.kinematics import (
     numeric_pose,
     point_jacobian,
 )
-from symdyn.loaders.robot_file import robot_from_data
+from symdyn.parsers.robot_file import robot_from_data
 from symdyn.rnea import forward_kinematics as rnea_poses
 
 # --------------------------------------------------------------------------- DH by hand

@@ -26,7 +26,7 @@ from robots import (
 )
 
 from symdyn.dynamics import QUANTITIES, derive
-from symdyn.loaders.robot_file import robot_from_data
+from symdyn.parsers.robot_file import robot_from_data
 from symdyn.rnea import bias_torque, gravity_torque, kinetic_energy, mass_matrix, potential_energy, rnea
 
 SMALL = {

@@ -21,13 +21,13 @@ from robots import (
     without_motors,
 )
 
+from symdyn.algorithms.newton_euler import newton_euler
 from symdyn.dynamics import METHODS, derive
-from symdyn.newton_euler import newton_euler
-from symdyn.program import Program
+from symdyn.model.robot import Link, Robot
+from symdyn.model.symbols import joint_symbols
 from symdyn.rnea import bias_torque, gravity_torque, mass_matrix, rnea
-from symdyn.robot import Link, Robot
-from symdyn.symbols import joint_symbols
-from symdyn.transform import Transform
+from symdyn.spatial.transform import Transform
+from symdyn.symbolic.program import Program
 
 
 @settings(max_examples=25, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])

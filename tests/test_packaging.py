@@ -42,7 +42,7 @@ def test_wheel_contains_every_target_template(wheel):
     names = zipfile.ZipFile(wheel).namelist()
     for target in ("c", "casadi", "python", "latex"):
         assert any(n.startswith(f"symdyn/templates/{target}/") and n.endswith(".j2") for n in names), target
-    assert "symdyn/cli.py" in names
+    assert "symdyn/cli/main.py" in names
     assert not any(n.startswith("tests/") or n.startswith("generated/") for n in names)
 
 

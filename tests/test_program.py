@@ -1,4 +1,4 @@
-"""Straight-line programs (symdyn.program): naming, sharing, differentiation, expansion."""
+"""Straight-line programs (symdyn.symbolic.program): naming, sharing, differentiation, expansion."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 import sympy as sp
 from sympy.core.parameters import distribute
 
-from symdyn.program import Program, is_trivial
+from symdyn.symbolic.program import Program, is_trivial
 
 x, y, z = sp.symbols("x y z")
 

@@ -17,8 +17,8 @@ from robots import ZERO3, Z, mat, roger_arm_robot, rotation, vec
 
 from symdyn import rnea as rn
 from symdyn.errors import SymdynError
-from symdyn.robot import Friction, Link, Motor, Robot
-from symdyn.transform import Transform, rot_x, rot_y
+from symdyn.model.robot import Friction, Link, Motor, Robot
+from symdyn.spatial.transform import Transform, rot_x, rot_y
 
 # --- Roger's eye and arm (slides 17-18) -------------------------------------------------
 

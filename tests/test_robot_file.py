@@ -13,9 +13,9 @@ import sympy as sp
 import yaml
 
 from symdyn.errors import SymdynError, SymdynWarning
-from symdyn.loaders import load_robot, robot_from_data
-from symdyn.loaders.dh import dh_link
-from symdyn.transform import Transform
+from symdyn.parsers import load_robot, robot_from_data
+from symdyn.parsers.dh import dh_link
+from symdyn.spatial.transform import Transform
 
 DATA = Path(__file__).parent / "data"
 GOOD = DATA / "good"

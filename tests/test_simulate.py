@@ -15,10 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import symdyn.cli as cli
-from symdyn.errors import SymdynError
-from symdyn.loaders import load_robot
-from symdyn.simulate import (
+from symdyn import cli
+from symdyn.apps.simulate import (
     CompiledDynamics,
     _Progress,
     simulate,
@@ -26,6 +24,8 @@ from symdyn.simulate import (
     torque_function,
     with_parameters,
 )
+from symdyn.errors import SymdynError
+from symdyn.parsers import load_robot
 
 rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -4,7 +4,7 @@ Expected values never come from the loader itself: they come from the same arm
 written as a DH robot file, from robots built by hand with NumPy rotations,
 from closed forms, from serial chains in which a fixed or locked joint is an
 extra joint held at zero (judged by the numeric oracle symdyn.rnea), from
-inertias merged by hand with symdyn.inertia, from the raw XML read with
+inertias merged by hand with symdyn.model.inertia, from the raw XML read with
 ElementTree, and from the manufacturers' published DH tables.
 
 The real robots (Panda, UR5, UR10, a double pendulum) come from the
@@ -30,15 +30,15 @@ from robots import assert_close, mat, random_state, vec
 
 import symdyn.codegen
 from symdyn import inertia as si
-from symdyn.cli import main
+from symdyn.cli.main import main
 from symdyn.codegen import c_target
 from symdyn.dynamics import derive
 from symdyn.errors import SymdynError, SymdynWarning
-from symdyn.loaders import robot_from_data
-from symdyn.loaders.urdf import load_urdf, urdf_robot_name
+from symdyn.model.robot import Friction, Link, Robot
+from symdyn.parsers import robot_from_data
+from symdyn.parsers.urdf import load_urdf, urdf_robot_name
 from symdyn.rnea import forward_kinematics, gravity_torque, mass_matrix, rnea
-from symdyn.robot import Friction, Link, Robot
-from symdyn.transform import Transform
+from symdyn.spatial.transform import Transform
 
 DATA = Path(__file__).parent / "data" / "urdf"
 G = 9.81
@@ -348,7 +348,7 @@ def test_prismatic_cartesian_closed_form(rng):
 
 
 def test_fixed_joints_merged(rng):
-    """l1 + bracket merged by hand with symdyn.inertia; the ground mount and the tool frame vanish."""
+    """l1 + bracket merged by hand with symdyn.model.inertia; the ground mount and the tool frame vanish."""
     robot = load("fixed_offset.urdf")
     assert [lk.name for lk in robot.links] == ["l1", "l2"]
     I1 = np.array([[0.01, 0.001, 0], [0.001, 0.02, 0], [0, 0, 0.02]])

@@ -1,4 +1,4 @@
-"""Code generation: the seven functions of design.md rendered for C, CasADi, NumPy and LaTeX.
+"""Code generation: the seven functions of docs/generated-code.md rendered for C, CasADi, NumPy and LaTeX.
 
 A target is a module `symdyn.codegen.<target>` with `render(ctx) -> {file name:
 text or bytes}`: a small printer plus its templates in templates/<target>/.
@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ..dynamics import derive
 from ..errors import SymdynError
-from ..robot import Robot
+from ..model.robot import Robot
 from .functions import FUNCTION_NAMES, build_functions
 from .output import write_files
 from .render import PRECISIONS, RenderContext
@@ -64,7 +64,7 @@ def generate(
 ) -> list[Path]:
     """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir."""
     if not isinstance(robot, Robot):
-        from ..loaders import load
+        from ..parsers import load
 
         robot = load(robot)
     files = render(robot, targets, precision, method)

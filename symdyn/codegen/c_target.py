@@ -1,6 +1,6 @@
 """The C target: NAME_dynamics.h and NAME_dynamics.c (C99, no allocation, libm only).
 
-The contract is design.md's "Generated C" section. Each of the seven functions
+The contract is docs/generated-code.md. Each of the seven functions
 (symdyn.codegen.functions) becomes straight-line code: the inputs it reads are
 copied into named locals (`const double q1 = q[0];`, `const double m1 =
 p[NAME_P_m1];`), then one `const double x<k> = ...;` per temporary, then the
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import SymdynError
-from ..expressions import C_KEYWORDS
-from ..simplify import MAX_UNROLLED_POWER
+from ..model.expressions import C_KEYWORDS
+from ..symbolic.simplify import MAX_UNROLLED_POWER
 from .functions import FunctionSpec
 from .render import PRECISIONS, RenderContext, environment, header_lines
 

@@ -3,7 +3,7 @@
 For a robot NAME, `render` returns
 * `NAME_casadi.py`: imports only casadi (and math when pi appears); its
   `functions()` returns {name: casadi.Function} for the seven functions of
-  design.md, each with the inputs of its FunctionSpec (q, qd, qdd or tau, p;
+  docs/generated-code.md, each with the inputs of its FunctionSpec (q, qd, qdd or tau, p;
   p of size k, possibly 0), named so, and one output named like the spec
   (M and C n x n, vectors n x 1). Every function body is the eliminated
   straight-line code, one Python statement per temporary
@@ -31,7 +31,7 @@ from dataclasses import replace
 import sympy as sp
 
 from ..errors import SymdynError
-from ..simplify import MAX_UNROLLED_POWER
+from ..symbolic.simplify import MAX_UNROLLED_POWER
 from .functions import FunctionSpec
 from .render import RenderContext, environment, header_lines
 

@@ -1,8 +1,8 @@
-"""The seven generated functions of design.md, as target-independent straight-line code.
+"""The seven generated functions (docs/generated-code.md), as target-independent straight-line code.
 
 Each `FunctionSpec` names its inputs (q, qd, qdd or tau, p: vectors of SymPy
 symbols), one output (tau, M, C, V, G, F or qdd, row-major), and the
-eliminated temporaries (symdyn.simplify) that compute it. Printers for C,
+eliminated temporaries (symdyn.symbolic.simplify) that compute it. Printers for C,
 CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
 
 forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..dynamics import QUANTITIES, Dynamics
-from ..program import Program
-from ..simplify import Eliminated, OpCount, eliminate_many
+from ..symbolic.program import Program
+from ..symbolic.simplify import Eliminated, OpCount, eliminate_many
 
 __all__ = ["FunctionSpec", "Input", "build_functions", "FUNCTION_NAMES"]
 
@@ -95,7 +95,7 @@ def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
 
 
 def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
-    """The seven functions of design.md for a derived robot, with CSE applied per function."""
+    """The seven generated functions for a derived robot, with CSE applied per function."""
     n = dyn.n
     q = Input("q", tuple(dyn.q))
     qd = Input("qd", tuple(dyn.qd))

@@ -35,7 +35,7 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from ..dynamics import AUTO_SIMPLIFY_MAX_JOINTS, Dynamics
-from ..simplify import chop_float_noise, eliminate
+from ..symbolic.simplify import chop_float_noise, eliminate
 from .render import RenderContext, environment, header_lines
 
 __all__ = [

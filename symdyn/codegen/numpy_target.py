@@ -1,6 +1,6 @@
 """The NumPy target: `NAME_numpy.py`, a standalone module (imports only numpy).
 
-It holds the seven functions of design.md with the C target's names and
+It holds the seven functions of docs/generated-code.md with the C target's names and
 arguments (p optional when the robot has no free parameters), plus NDOF,
 NPARAM and PARAM_NAMES. Every function evaluates the eliminated form of its
 FunctionSpec, one statement per temporary, elementwise: it works for one
@@ -20,7 +20,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ..simplify import MAX_UNROLLED_POWER
+from ..symbolic.simplify import MAX_UNROLLED_POWER
 from .functions import FunctionSpec
 from .render import RenderContext, environment, header_lines
 

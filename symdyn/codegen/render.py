@@ -16,7 +16,7 @@ import jinja2
 from .. import __version__
 from ..dynamics import Dynamics
 from ..errors import SymdynError
-from ..robot import Robot
+from ..model.robot import Robot
 from .functions import FunctionSpec
 
 __all__ = ["RenderContext", "environment", "header_lines", "GENERATED_MARKER", "PRECISIONS"]
@@ -64,8 +64,8 @@ def header_lines(ctx: RenderContext) -> list[str]:
 
 
 def _template_root() -> Path:
-    here = Path(__file__).resolve().parent.parent
-    for candidate in (here / "templates", here.parent / "templates"):
+    package = Path(__file__).resolve().parents[1]  # symdyn/
+    for candidate in (package / "templates", package.parent / "templates"):
         if candidate.is_dir():
             return candidate
     raise SymdynError("symdyn's templates folder is missing from this installation")

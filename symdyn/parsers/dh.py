@@ -1,4 +1,4 @@
-"""Denavit-Hartenberg rows onto the general joint model of `symdyn.robot`.
+"""Denavit-Hartenberg rows onto the general joint model of `symdyn.model.robot`.
 
 With theta = q + theta_offset (revolute) and d = q + d_offset (prismatic):
 
@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..inertia import rotate
-from ..transform import Transform
+from ..model.inertia import rotate
+from ..spatial.transform import Transform
 
 __all__ = ["CONVENTIONS", "Z_AXIS", "dh_link", "to_body"]
 
@@ -47,7 +47,7 @@ def dh_link(
     theta,
     prev_frame: Transform | None = None,
 ) -> tuple[Transform, sp.ImmutableMatrix, Transform]:
-    """One DH row -> (placement, axis, frame) of `symdyn.robot.Link`.
+    """One DH row -> (placement, axis, frame) of `symdyn.model.robot.Link`.
 
     `theta` is the offset for a revolute joint, `d` the offset for a prismatic one.
     `prev_frame` is the previous link's `frame` (None or identity for the first link).

@@ -1,11 +1,11 @@
-"""Loaders from robot description formats onto the general model of `symdyn.robot`."""
+"""Loaders from robot description formats onto the general model of `symdyn.model.robot`."""
 
 from __future__ import annotations
 
 import os
 
 from ..errors import SymdynError
-from ..robot import Robot
+from ..model.robot import Robot
 from .robot_file import load_robot, robot_from_data
 from .urdf import load_urdf
 

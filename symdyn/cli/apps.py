@@ -24,8 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import SymdynError
-from .expressions import parse_expression
+from ..errors import SymdynError
+from ..model.expressions import parse_expression
+from .common import add_robot_argument, load_robot_argument
 
 __all__ = ["register", "cmd_simulate", "cmd_analyze", "cmd_check"]
 
@@ -95,23 +96,9 @@ def _gains(items, n: int, what: str, default: float) -> np.ndarray:
     return np.array(values)
 
 
-def _load(args: argparse.Namespace):
-    """The robot of args.robot: a robot file or a URDF file (symdyn.cli's loader)."""
-    from . import cli  # here, not at the top: symdyn.cli imports this module
-
-    return cli._load(args)
-
-
-def _add_robot_argument(parser: argparse.ArgumentParser) -> None:
-    """The robot argument and --base/--tip, as symdyn.cli's own subcommands have them."""
-    from . import cli  # here, not at the top: symdyn.cli imports this module
-
-    cli._add_robot_argument(parser)
-
-
 def _with_params(robot, params: dict[str, float], option: str = "--params"):
     """The robot with parameter values applied; every free parameter must then have one."""
-    from .simulate import with_parameters
+    from ..apps.simulate import with_parameters
 
     robot = with_parameters(robot, params)
     if robot.params:
@@ -137,7 +124,7 @@ def _check_out_path(path: str | None, option: str) -> None:
 def _check_plot_path(path: str | None) -> None:
     if path is None:
         return
-    from .simulate import _format_of
+    from ..apps.simulate import _format_of
 
     _check_out_path(path, "--plot")
     _format_of(path)
@@ -151,12 +138,12 @@ def _check_plot_path(path: str | None) -> None:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from .control import ComputedTorque, Reference, track
-    from .simulate import plot_trajectory, simulate, time_expressions, write_atomic
+    from ..apps.control import ComputedTorque, Reference, track
+    from ..apps.simulate import plot_trajectory, simulate, time_expressions, write_atomic
 
     _check_out_path(args.out, "--out")
     _check_plot_path(args.plot)
-    robot = _with_params(_load(args), _assignments(args.params, "--params"))
+    robot = _with_params(load_robot_argument(args), _assignments(args.params, "--params"))
     n = robot.n
     if args.track is not None and args.tau is not None:
         raise SymdynError("--tau and --track exclude each other (--track computes the torque)")
@@ -225,13 +212,13 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
-    from .analysis import analyze, parse_axes, plot_analysis
+    from ..apps.analysis import analyze, parse_axes, plot_analysis
 
     _check_plot_path(args.plot)
     axes = parse_axes(args.axes)
     if args.plot and axes is not None and len(axes) != 2:
         raise SymdynError(f"--plot draws a 2-D task space: give two --axes (got {args.axes})")
-    robot = _with_params(_load(args), _assignments(args.params, "--params"))
+    robot = _with_params(load_robot_argument(args), _assignments(args.params, "--params"))
     n = robot.n
     q = _vector(args.q, n, "--q")
     qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
@@ -247,7 +234,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         image = plot_analysis(result, robot=robot)
     sys.stdout.write(result.to_json() if args.format == "json" else result.to_text())
     if image is not None:
-        from .simulate import write_atomic
+        from ..apps.simulate import write_atomic
 
         write_atomic(args.plot, image)
     return 0
@@ -257,11 +244,11 @@ def cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from .check import check_answers
+    from ..apps.check import check_answers
 
     if args.samples < 1:
         raise SymdynError("--samples must be at least 1")
-    robot = _load(args)
+    robot = load_robot_argument(args)
     report = check_answers(robot, args.answers, method=args.method, samples=args.samples)
     sys.stdout.write(report.text(verbose=args.verbose))
     return 0 if report.ok else 1
@@ -282,8 +269,8 @@ def _positive(text: str) -> float:
 
 def register(subparsers) -> None:
     """Add the subcommands simulate, analyze and check to `symdyn`'s subparsers."""
-    from .dynamics import METHODS
-    from .simulate import INTEGRATORS
+    from ..apps.simulate import INTEGRATORS
+    from ..dynamics import METHODS
 
     vec = {"nargs": "+", "metavar": "V"}
 
@@ -294,7 +281,7 @@ def register(subparsers) -> None:
         "as CSV. Vectors: values separated by spaces or commas; expressions allowed (pi/4), "
         "torques and references may use t.",
     )
-    _add_robot_argument(s)
+    add_robot_argument(s)
     s.add_argument("--q0", **vec, help="initial joint positions (default 0, or q_ref(0) with --track)")
     s.add_argument("--qd0", **vec, help="initial joint velocities (default 0, or qd_ref(0) with --track)")
     s.add_argument(
@@ -340,7 +327,7 @@ def register(subparsers) -> None:
         "sqrt of eigenvalues of M M^T), the dynamic manipulability ellipsoid with its bias and "
         "kappa_d = sqrt(det(J (M^T M)^-1 J^T)), and the acceleration polytope.",
     )
-    _add_robot_argument(a)
+    add_robot_argument(a)
     a.add_argument("--q", **vec, required=True, help="joint positions")
     a.add_argument("--qd", **vec, help="joint velocities (default 0)")
     a.add_argument(
@@ -363,7 +350,7 @@ def register(subparsers) -> None:
         "robot's symbols and q1.., qd1.., qdd1..) with symdyn's derivation, symbolically and, when "
         "inconclusive, numerically. Exit status 0 when every entry matches, 1 otherwise.",
     )
-    _add_robot_argument(c)
+    add_robot_argument(c)
     c.add_argument("answers", help="answers file (YAML)")
     c.add_argument("--method", choices=METHODS, default="newton-euler")
     c.add_argument("--samples", type=int, default=16, help="random points for the numeric comparison")

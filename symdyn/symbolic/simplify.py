@@ -1,11 +1,11 @@
 """Common-subexpression elimination and operation counts for generated functions.
 
 `eliminate` turns a set of outputs, given over a program's named intermediates
-(symdyn.program), into one straight-line sequence of temporaries x0, x1, ...
+(symdyn.symbolic.program), into one straight-line sequence of temporaries x0, x1, ...
 followed by the outputs:
 1. only the intermediates the outputs need are kept;
-2. common-subexpression elimination (symdyn.cse: SymPy's algorithm with
-   order="none", see design.md's speed notes, rebuilt for speed) runs over the
+2. common-subexpression elimination (symdyn.symbolic.cse: SymPy's algorithm with
+   order="none", see docs/speed.md, rebuilt for speed) runs over the
    intermediates and outputs together, so sin/cos of a joint and repeated
    products are computed once across every output of the function;
 3. the result is ordered topologically (each temporary before its first use)
@@ -168,7 +168,7 @@ def _topological(nodes: dict[sp.Symbol, sp.Expr], roots: Sequence[sp.Expr]) -> l
 def _cse_nodes(
     assignments: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[sp.Expr]
 ) -> tuple[dict[sp.Symbol, sp.Expr], list[sp.Expr]]:
-    """CSE over assignments and outputs together (symdyn.cse): (symbol -> expression nodes,
+    """CSE over assignments and outputs together (symdyn.symbolic.cse): (symbol -> expression nodes,
     reduced outputs)."""
     syms = [s for s, _ in assignments]
     repl, reduced = fast_cse([e for _, e in assignments] + list(outputs), "_cse")

@@ -1,7 +1,7 @@
 """Forward kinematics and geometric Jacobians, symbolic (SymPy) and numeric.
 
 All poses are body frames of the links expressed in the base frame:
-base_T_i = parent_T_1(q_1) @ ... @ parent_T_i(q_i) (see `symdyn.robot`). The
+base_T_i = parent_T_1(q_1) @ ... @ parent_T_i(q_i) (see `symdyn.model.robot`). The
 geometric Jacobian J = [Jv; Jw] (6 x n) of a point r fixed to link k maps joint
 velocities to the point's linear velocity and the link's angular velocity, both
 in the base frame:
@@ -18,10 +18,10 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from .program import Program
-from .robot import Robot
-from .symbols import joint_symbols
-from .transform import Transform
+from ..model.robot import Robot
+from ..model.symbols import joint_symbols
+from ..spatial.transform import Transform
+from ..symbolic.program import Program
 
 __all__ = [
     "link_transforms",

@@ -20,8 +20,8 @@ from collections.abc import Sequence
 import numpy as np
 import sympy as sp
 
-from .errors import SymdynError
-from .robot import Robot
+from ..errors import SymdynError
+from ..model.robot import Robot
 from .simulate import (
     TIME,
     CompiledDynamics,

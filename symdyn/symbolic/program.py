@@ -138,7 +138,7 @@ class Program:
         return sym
 
     def let_vector(self, v: Iterable, hint: str) -> tuple:
-        """Name each component of a vector (see `let`): a tuple, as symdyn.vectors uses."""
+        """Name each component of a vector (see `let`): a tuple, as symdyn.spatial.vectors uses."""
         return tuple(self.let(x, hint) for x in v)
 
     def _deps(self, expr: sp.Expr) -> set[sp.Symbol]:

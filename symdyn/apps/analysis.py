@@ -44,11 +44,11 @@ from itertools import combinations, product
 import numpy as np
 import sympy as sp
 
-from .errors import SymdynError
-from .kinematics import end_effector_jacobian
-from .robot import Robot
+from ..algorithms.kinematics import end_effector_jacobian
+from ..errors import SymdynError
+from ..model.robot import Robot
+from ..model.symbols import joint_symbols
 from .simulate import CompiledDynamics, _figure, _format_of, compiled_dynamics, figure_bytes, write_atomic
-from .symbols import joint_symbols
 
 __all__ = [
     "TASK_AXES",
@@ -564,7 +564,7 @@ def _draw_shapes(ax, a: Analysis, origin=(0.0, 0.0), scale: float = 1.0, swap=Fa
 
 def _gravity_layout(robot: Robot, axes: tuple[str, ...], params=None) -> tuple[bool, bool, bool]:
     """(swap, invert vertical, invert horizontal) so that gravity points down on the page."""
-    from .rnea import numeric_model
+    from ..rnea import numeric_model
 
     g = numeric_model(robot, robot.param_values(params) if robot.params else None).gravity
     idx = [TASK_AXES.index(a) for a in axes]
@@ -630,7 +630,7 @@ def plot_workspace(
     unbiased ellipse, the gravity-biased ellipse and the gravity-biased polytope, drawn
     to scale (`scale` metres per unit acceleration; automatic when None). Axes x, y only.
     """
-    from .kinematics import numeric_pose
+    from ..algorithms.kinematics import numeric_pose
 
     if not analyses:
         raise SymdynError("plot_workspace needs at least one analysis")

@@ -33,11 +33,11 @@ import numpy as np
 import sympy as sp
 import yaml
 
-from .dynamics import METHODS, derive
-from .errors import SymdynError
-from .expressions import parse_expression
-from .robot import Robot
-from .symbols import joint_symbols
+from ..dynamics import METHODS, derive
+from ..errors import SymdynError
+from ..model.expressions import parse_expression
+from ..model.robot import Robot
+from ..model.symbols import joint_symbols
 
 __all__ = ["QUANTITIES", "EntryResult", "CheckReport", "load_answers", "parse_answers", "check_answers"]
 

@@ -15,9 +15,9 @@ and loaded, so every step is straight-line NumPy, never SymPy. Integrators
       qd <- qd + a h,   q <- q + qd_new h.
 
 The applied torque is a function tau(t, q, qd): zero, constants, expressions
-of t (parsed by the safe parser `symdyn.expressions.parse_expression`, never
+of t (parsed by the safe parser `symdyn.model.expressions.parse_expression`, never
 evaluated as Python), or any callable such as a computed-torque law
-(`symdyn.control`). Initial states may be one state (n,) or a batch (B, n).
+(`symdyn.apps.control`). Initial states may be one state (n,) or a batch (B, n).
 """
 
 from __future__ import annotations
@@ -35,9 +35,9 @@ from pathlib import Path
 import numpy as np
 import sympy as sp
 
-from .errors import SymdynError
-from .expressions import parse_expression
-from .robot import Robot
+from ..errors import SymdynError
+from ..model.expressions import parse_expression
+from ..model.robot import Robot
 
 __all__ = [
     "INTEGRATORS",
@@ -67,7 +67,7 @@ PROGRESS_MIN_STEPS = 2000
 @lru_cache(maxsize=32)
 def _generated_module(robot: Robot) -> types.ModuleType:
     """The NumPy module symdyn generates for `robot`, rendered in memory and loaded."""
-    from .codegen import render
+    from ..codegen import render
 
     files = render(robot, targets=("python",))
     ((name, text),) = ((k, v) for k, v in files.items() if k.endswith("_numpy.py"))

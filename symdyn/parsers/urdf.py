@@ -1,4 +1,4 @@
-"""URDF -> `symdyn.robot.Robot`: one serial chain of a URDF tree, from a base link to a tip link.
+"""URDF -> `symdyn.model.robot.Robot`: one serial chain of a URDF tree, from a base link to a tip link.
 
 The URDF joint frame is the child link's frame, so each URDF link frame becomes
 a symdyn body frame unchanged (`Link.frame` is the identity):
@@ -52,10 +52,10 @@ from xml.parsers import expat
 import sympy as sp
 
 from ..errors import SymdynError
-from ..expressions import C_KEYWORDS
-from ..inertia import check_inertia, parallel_axis, rotate, tensor_from_components
-from ..robot import DEFAULT_GRAVITY, Friction, Link, Robot
-from ..transform import Transform, rot_axis, rpy_matrix
+from ..model.expressions import C_KEYWORDS
+from ..model.inertia import check_inertia, parallel_axis, rotate, tensor_from_components
+from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Robot
+from ..spatial.transform import Transform, rot_axis, rpy_matrix
 from .source import MAX_BYTES, read_source
 
 __all__ = ["load_urdf", "urdf_robot_name", "MAX_BYTES"]
@@ -636,7 +636,7 @@ def _merge(
 
 def _numeric(x: sp.Expr) -> sp.Expr:
     """Exact rationals stay; other numeric constants (e.g. sqrt(2)*0.3) become Floats."""
-    x = sp.sympify(x)
+    x = sp.sympify(x, strict=True)
     if x.is_Rational or isinstance(x, sp.Float) or x.free_symbols:
         return x
     return sp.Float(x.evalf(17), 17)

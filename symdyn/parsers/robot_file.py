@@ -1,8 +1,8 @@
-"""The robot description file (YAML; JSON is valid YAML) -> `symdyn.robot.Robot`.
+"""The robot description file (YAML; JSON is valid YAML) -> `symdyn.model.robot.Robot`.
 
-The format is fixed in design.md ("Robot description file"). Loading is data
+The format is documented in docs/robot-files.md. Loading is data
 only: the text is read with ``yaml.safe_load`` and every number-or-expression
-goes through the whitelisting parser of `symdyn.expressions`; nothing from the
+goes through the whitelisting parser of `symdyn.model.expressions`; nothing from the
 file is executed.
 
 Free parameters (`Robot.params`) are ordered by first appearance in the
@@ -26,14 +26,14 @@ import sympy as sp
 import yaml
 
 from ..errors import SymdynError
-from ..expressions import (
+from ..model.expressions import (
     check_parameter_name,
     is_c_identifier,
     parse_expression_names,
 )
-from ..inertia import check_inertia, tensor_from_components
-from ..robot import DEFAULT_GRAVITY, JOINT_TYPES, Friction, Link, Motor, Robot
-from ..transform import Transform
+from ..model.inertia import check_inertia, tensor_from_components
+from ..model.robot import DEFAULT_GRAVITY, JOINT_TYPES, Friction, Link, Motor, Robot
+from ..spatial.transform import Transform
 from .dh import CONVENTIONS, dh_link, to_body
 from .source import read_source
 

@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 import sympy as sp
 
-from .errors import SymdynError
+from ..errors import SymdynError
 
 __all__ = [
     "parse_expression",

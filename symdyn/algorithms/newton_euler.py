@@ -2,7 +2,7 @@
 
 Every quantity of link i is expressed in link i's body frame. With
 R_i = parent_R_i(q_i) and p_i the origin of body i in its parent's frame
-(symdyn.robot), the outward recursion from a base at rest, gravity entered as
+(symdyn.model.robot), the outward recursion from a base at rest, gravity entered as
 a base acceleration vd_0 = -g, is
 
     revolute:  w_i  = R_i^T w_{i-1} + a_i qd_i
@@ -36,10 +36,10 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-from . import vectors as v3
+from ..model.robot import Link, Robot
+from ..spatial import vectors as v3
+from ..symbolic.program import Program
 from .frames import JointFrame, joint_frames
-from .program import Program
-from .robot import Link, Robot
 
 __all__ = ["newton_euler", "origin_inertia"]
 
@@ -146,7 +146,7 @@ def newton_euler(
 
     `q`, `qd`, `qdd` may hold symbols or numbers (zeros fold away). The result
     is a list of expressions over the program's intermediates. `rotations`
-    (per link, from `symdyn.frames.joint_frames`) may be passed in to share them.
+    (per link, from `symdyn.algorithms.frames.joint_frames`) may be passed in to share them.
     """
     n = robot.n
     frames = rotations if rotations is not None else joint_frames(robot, q)

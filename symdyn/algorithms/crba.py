@@ -22,11 +22,11 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-from . import vectors as v3
+from ..model.robot import Link, Robot
+from ..spatial import vectors as v3
+from ..symbolic.program import Program
 from .frames import JointFrame
 from .newton_euler import origin_inertia
-from .program import Program
-from .robot import Link, Robot
 
 __all__ = [
     "Composite",

@@ -1,4 +1,4 @@
-"""The `symdyn` command line: derive and generate (design.md, "Command line").
+"""The `symdyn` command line: the parser, derive and generate, and the one error policy.
 
 Bad input prints one line, `symdyn: error: <file>: link <i> (<name>): field '<f>': <why>`,
 and exits with status 1; warnings print as `symdyn: warning: ...`. No
@@ -15,29 +15,17 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-from . import __version__
-from .app_cli import register
-from .dynamics import METHODS, derive
-from .errors import SymdynError, SymdynWarning
+from .. import __version__
+from ..dynamics import METHODS, derive
+from ..errors import SymdynError, SymdynWarning
+from .apps import register
+from .common import add_robot_argument, load_robot_argument
 
 __all__ = ["main"]
 
 EXIT_BAD_INPUT = 1
 EXIT_INTERNAL = 3
 PRINTED = ("M", "C", "V", "G", "F")
-
-
-def _load(args: argparse.Namespace):
-    """A robot from a robot file, or from a URDF file (by its .urdf suffix) with --base/--tip."""
-    from .loaders import load
-
-    return load(args.robot, base=args.base, tip=args.tip)
-
-
-def _add_robot_argument(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("robot", help="robot file (YAML or JSON) or URDF file (.urdf)")
-    parser.add_argument("--base", help="URDF: the chain's base link (default: the root link)")
-    parser.add_argument("--tip", help="URDF: the chain's tip link (default: the single leaf)")
 
 
 def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
@@ -81,13 +69,13 @@ def _derive_json(dyn) -> str:
 
 
 def _derive_latex(dyn) -> str:
-    from .codegen.latex_target import dynamics_latex
+    from ..codegen.latex_target import dynamics_latex
 
     return dynamics_latex(dyn)
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
-    robot = _load(args)
+    robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
     text = {"text": _derive_text, "json": _derive_json, "latex": _derive_latex}[args.format](dyn)
@@ -96,9 +84,9 @@ def cmd_derive(args: argparse.Namespace) -> int:
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
-    from .codegen import generate
+    from ..codegen import generate
 
-    robot = _load(args)
+    robot = load_robot_argument(args)
     targets = args.target or ["c", "casadi"]
     paths = generate(
         robot,
@@ -122,7 +110,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     d = sub.add_parser("derive", help="print M, C, V, G, F of a robot")
-    _add_robot_argument(d)
+    add_robot_argument(d)
     d.add_argument("--method", choices=METHODS, default="newton-euler")
     d.add_argument("--format", choices=("text", "latex", "json"), default="text")
     d.add_argument(
@@ -134,7 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.set_defaults(func=cmd_derive)
 
     g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
-    _add_robot_argument(g)
+    add_robot_argument(g)
     g.add_argument(
         "--target",
         action="append",

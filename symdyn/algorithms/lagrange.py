@@ -10,16 +10,16 @@ centre of mass (body axes):
     C_kj = sum_i 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) qd_i
 
 Derivatives are taken by forward-mode differentiation through the program's
-named intermediates (symdyn.program), never by expanding M.
+named intermediates (symdyn.symbolic.program), never by expanding M.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
+from ..model.robot import Robot
+from ..symbolic.program import Program
 from .kinematics import forward_kinematics, point_jacobian
-from .program import Program
-from .robot import Robot
 
 __all__ = ["lagrange"]
 

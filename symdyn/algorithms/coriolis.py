@@ -35,12 +35,12 @@ from __future__ import annotations
 
 import sympy as sp
 
-from . import vectors as v3
+from ..model.robot import Robot
+from ..spatial import vectors as v3
+from ..symbolic.program import Program
 from .crba import Composite, Composites, Spatial, apply_inertia, motion_subspace, project, shift_inertia, sym3
 from .frames import JointFrame
 from .newton_euler import origin_inertia
-from .program import Program
-from .robot import Robot
 
 __all__ = ["coriolis_matrix_composite"]
 

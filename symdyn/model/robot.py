@@ -22,8 +22,8 @@ from dataclasses import dataclass, field, replace
 
 import sympy as sp
 
-from .errors import SymdynError
-from .transform import Transform, rot_axis
+from ..errors import SymdynError
+from ..spatial.transform import Transform, rot_axis
 
 __all__ = ["Friction", "Motor", "Link", "Robot", "JOINT_TYPES", "DEFAULT_GRAVITY"]
 

@@ -2,7 +2,7 @@
 
 Link i's body frame sits in its parent's at p_i with orientation
 R_i = B_i Rot(a_i, q_i) (revolute) or R_i = B_i (prismatic), B_i the constant
-rotation of the joint's placement (symdyn.robot). The composite-body
+rotation of the joint's placement (symdyn.model.robot). The composite-body
 recursions move symmetric 3x3 tensors (rotational inertias and their rates of
 change) into the parent frame, R J R^T. For a joint about a coordinate axis k,
 with (i, j) the other two axes in right-handed order, c = cos q and s = sin q,
@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from . import vectors as v3
-from .program import Program
-from .robot import Robot
-from .transform import coordinate_axis
+from ..model.robot import Robot
+from ..spatial import vectors as v3
+from ..spatial.transform import coordinate_axis
+from ..symbolic.program import Program
 
 __all__ = ["JointFrame", "joint_frames"]
 

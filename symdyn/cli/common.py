@@ -1,0 +1,20 @@
+"""What every subcommand shares: the robot argument (a robot file or a URDF) and its loader."""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["add_robot_argument", "load_robot_argument"]
+
+
+def load_robot_argument(args: argparse.Namespace):
+    """A robot from a robot file, or from a URDF file (by its .urdf suffix) with --base/--tip."""
+    from ..parsers import load
+
+    return load(args.robot, base=args.base, tip=args.tip)
+
+
+def add_robot_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("robot", help="robot file (YAML or JSON) or URDF file (.urdf)")
+    parser.add_argument("--base", help="URDF: the chain's base link (default: the root link)")
+    parser.add_argument("--tip", help="URDF: the chain's tip link (default: the single leaf)")
