@@ -1,10 +1,31 @@
-"""Shared pytest set-up: make the helper module `robots` importable from every test file."""
+"""Shared pytest set-up.
+
+- The helper modules of tests/ (`robots`, `cbuild`) are importable from every test file.
+- Under CI (the environment variable CI set to true, as .ci/run is run), a skipped test is a
+  failure: CI installs every tool the tests use (a C compiler, pdflatex, the test extra), so a
+  skip there would only hide a missing install step. Locally, tests of absent tools still skip.
+"""
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
+
+import pytest
 
 HERE = str(Path(__file__).resolve().parent)
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
+
+IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    if IN_CI and report.skipped and not hasattr(report, "wasxfail"):
+        reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else str(report.longrepr)
+        report.outcome = "failed"
+        report.longrepr = f"skipped under CI, where every tool the tests use is installed: {reason}"

@@ -66,3 +66,27 @@ def test_installed_wheel_generates_code_outside_the_source_tree(wheel, tmp_path)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "4"
     assert (work / "out" / "roger_arm_dynamics.c").read_text().startswith("/*")
+
+
+def test_build_requires_only_the_backend():
+    """Building the package downloads nothing it does not use (no robot data, no test tools)."""
+    tomllib = pytest.importorskip("tomllib", reason="Python 3.11 reads TOML")
+    requires = tomllib.loads((ROOT / "pyproject.toml").read_text())["build-system"]["requires"]
+    assert [r.split(">")[0].split("=")[0].strip() for r in requires] == ["hatchling"]
+
+
+def test_sdist_carries_the_docs_and_the_pinned_toolchain(tmp_path):
+    import tarfile
+
+    pytest.importorskip("hatchling", reason="the test extra installs hatchling to build the sdist")
+    subprocess.run(
+        [sys.executable, "-m", "hatchling", "build", "-t", "sdist", "-d", str(tmp_path)],
+        cwd=ROOT,
+        check=True,
+        capture_output=True,
+        timeout=600,
+    )
+    (sdist,) = tmp_path.glob("symdyn-*.tar.gz")
+    names = {n.split("/", 1)[1] for n in tarfile.open(sdist).getnames() if "/" in n}
+    for needed in ("mkdocs.yml", "constraints.txt", "docs/index.md", "templates/c/dynamics.h.j2", "README.md"):
+        assert needed in names, needed
