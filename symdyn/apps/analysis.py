@@ -48,7 +48,8 @@ from ..algorithms.kinematics import end_effector_jacobian
 from ..errors import SymdynError
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
-from .simulate import CompiledDynamics, _figure, _format_of, compiled_dynamics, figure_bytes, write_atomic
+from .compiled import CompiledDynamics, compiled_dynamics
+from .output import figure, figure_bytes, plot_format, write_atomic
 
 __all__ = [
     "TASK_AXES",
@@ -587,8 +588,8 @@ def plot_analysis(
     """Task-space acceleration plot (2 axes only): unbiased and biased ellipses, biased polytope."""
     if len(a.axes) != 2:
         raise SymdynError(f"--plot draws a 2-D task space: give two --axes (got {','.join(a.axes)})")
-    fmt = _format_of(path) if path is not None else "png"
-    fig = _figure(1, width=6.4, height_per_row=6.0)
+    fmt = plot_format(path) if path is not None else "png"
+    fig = figure(1, width=6.4, height_per_row=6.0)
     ax = fig.subplots()
     swap, inv_v, inv_h = (
         _gravity_layout(robot, a.axes, params) if robot is not None else (False, False, False)
@@ -637,7 +638,7 @@ def plot_workspace(
     axes = analyses[0].axes
     if any(a.axes != axes for a in analyses) or len(axes) != 2 or any(x not in ("x", "y", "z") for x in axes):
         raise SymdynError("plot_workspace draws two linear task axes (e.g. x,y), the same for all analyses")
-    fmt = _format_of(path) if path is not None else "png"
+    fmt = plot_format(path) if path is not None else "png"
     rows = [TASK_AXES.index(x) for x in axes]
     frames = [lk.frame.p for lk in robot.resolved().links]  # points with the values substituted
     arms, hands = [], []
@@ -663,7 +664,7 @@ def plot_workspace(
         room = 0.5 * min(gaps) if gaps else 0.3 * reach
         scale = room / extent if extent > 0 else 1.0
     swap, inv_v, inv_h = _gravity_layout(robot, axes, params)
-    fig = _figure(1, width=8.0, height_per_row=7.4)
+    fig = figure(1, width=8.0, height_per_row=7.4)
     ax = fig.subplots()
     for k, (a, arm) in enumerate(zip(analyses, arms, strict=True)):
         xs, ys = (arm[:, 1], arm[:, 0]) if swap else (arm[:, 0], arm[:, 1])
