@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from ..errors import SymdynError
+from ..model.angles import snap_angle
 from ..model.expressions import check_parameter_name, is_c_identifier, parse_expression_names
 from ..model.robot import JOINT_TYPES
 from .dh import CONVENTIONS
@@ -107,6 +108,16 @@ class RobotFileReader:
         )
         self.order.extend(names)
         return expr
+
+    def angle(self, value: object, field: str, link: LinkData) -> sp.Expr:
+        """A DH angle (rad), parsed like `expr`; a decimal multiple of pi/2 made exact (snap_angle)."""
+        return snap_angle(
+            self.expr(value, field, link),
+            file=self.file,
+            link_index=link.index,
+            link_name=link.name,
+            field=field,
+        )
 
     def vector(self, value: object, field: str, link: LinkData | None = None):
         if not isinstance(value, list) or len(value) != 3:
@@ -246,7 +257,9 @@ class RobotFileReader:
                         field="joint",
                     )
                 link.joint = value
-            elif key in ("a", "alpha", "d", "theta", "mass"):
+            elif key in ("alpha", "theta"):
+                setattr(link, key, self.angle(value, key, link))
+            elif key in ("a", "d", "mass"):
                 setattr(link, key, self.expr(value, key, link))
             elif key == "com":
                 link.com = self.vector(value, "com", link)

@@ -12,6 +12,10 @@ an appearance), and within an expression left to right. A name with a value
 in `parameters` is not free; its value (which may use other parameters) is
 resolved and stored in `Robot.values`, in file order.
 
+DH angles written as decimals (alpha, theta) within 1e-9 rad of a multiple of
+pi/2 are taken as that exact multiple; within 1e-3 rad of a nonzero multiple but
+not 1e-9 (1.5708) they are kept with a SymdynWarning (symdyn.model.angles).
+
 The text is parsed by symdyn.parsers.yaml_text, its fields read by
 symdyn.parsers.robot_fields; this module resolves parameter values, checks the
 numbers and builds the Robot with the DH rows of symdyn.parsers.dh.
