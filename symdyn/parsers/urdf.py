@@ -32,7 +32,8 @@ Floating and planar joints, and mimic joints that would have to move with the
 chain, are refused. Numbers are read as exact SymPy numbers: integers as
 Integer, others as Float of the written text; an rpy angle within 1e-9 rad of a
 multiple of pi/2 is taken as that exact multiple, so that its sine and cosine are
-exactly 0 or +-1 (the 1.5707963267948966 of xacro output).
+exactly 0 or +-1 (the 1.5707963267948966 of xacro output), and one within 1e-3 rad
+of a nonzero multiple but not 1e-9 (1.5708) warns (symdyn.model.angles).
 
 The XML is read with the standard library's expat parser, hardened: a document
 type declaration (<!DOCTYPE ...>, which a URDF never needs) is refused, so no

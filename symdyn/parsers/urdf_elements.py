@@ -6,9 +6,13 @@ from these records by symdyn.parsers.urdf_tree and symdyn.parsers.urdf.
 
 Numbers are read as exact SymPy numbers: integers as Integer, others as Float of
 the written text. An origin's rotation is R = Rz(yaw) Ry(pitch) Rx(roll) (the URDF
-rpy convention), its entries numbers (cos(1) becomes 0.5403...); an rpy angle
-within 1e-9 rad of a multiple of pi/2 is taken as that exact multiple, so that
-its sine and cosine are exactly 0 or +-1 (the 1.5707963267948966 of xacro output).
+rpy convention), its entries numbers (cos(1) becomes 0.5403...). Each rpy angle
+passes through symdyn.model.angles.snap_angle, the rule of the DH loader too:
+within 1e-9 rad of a multiple of pi/2 it is taken as that exact multiple, so that
+its sine and cosine are exactly 0 or +-1 (the 1.5707963267948966 of xacro output);
+within 1e-3 rad of a nonzero multiple but not 1e-9 (1.5708) it is kept as written
+with a SymdynWarning naming the file, the link, the field and the line, whether or
+not that link ends up in the chain (the whole file is read).
 A joint's <axis xyz> (default 1 0 0) is normalised.
 """
 
@@ -21,6 +25,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import SymdynError
+from ..model.angles import snap_angle
 from ..model.expressions import C_KEYWORDS
 from ..model.inertia import tensor_from_components
 from ..spatial.transform import Transform, rpy_matrix
@@ -43,7 +48,6 @@ JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "plan
 MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\Z")
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-_SNAP_TOLERANCE = 1e-9
 
 
 @dataclass
@@ -99,16 +103,6 @@ def urdf_robot_name(name: str) -> str:
     if s in C_KEYWORDS:
         s += "_robot"
     return s
-
-
-def _snap_angle(x: sp.Expr) -> sp.Expr:
-    """x, or the exact multiple of pi/2 within 1e-9 rad of it."""
-    if not isinstance(x, sp.Float):
-        return x
-    k = round(float(x) / (math.pi / 2))
-    if abs(float(x) - k * math.pi / 2) <= _SNAP_TOLERANCE:
-        return k * sp.pi / 2
-    return x
 
 
 class UrdfReader:
@@ -169,7 +163,21 @@ class UrdfReader:
             return Transform.identity()
         xyz = self.vector(el.attrib.get("xyz", "0 0 0"), _at(where, prefix + "origin.xyz"), el.line)
         rpy = self.vector(el.attrib.get("rpy", "0 0 0"), _at(where, prefix + "origin.rpy"), el.line)
-        R = rpy_matrix(*(_snap_angle(a) for a in rpy)).applyfunc(numeric)  # cos(1) -> 0.5403...
+        link = where.get("link")
+        angles = [
+            snap_angle(
+                a,
+                file=self.file,
+                link_index=None if link is None else link.index,
+                link_name=None if link is None else link.name,
+                field=prefix + "origin.rpy",
+                angle=name,
+                line=el.line,
+                expressions=False,
+            )
+            for a, name in zip(rpy, ("roll", "pitch", "yaw"), strict=True)
+        ]
+        R = rpy_matrix(*angles).applyfunc(numeric)  # cos(1) -> 0.5403...
         return Transform(R, sp.ImmutableMatrix(3, 1, xyz))
 
     # -- the document
