@@ -89,6 +89,18 @@ def _gravity_layout(robot: Robot, axes: tuple[str, ...], params=None) -> tuple[b
     return swap, inv_v, inv_h
 
 
+def _finish_axes(ax, xlabel: str, ylabel: str, invert_v: bool, invert_h: bool) -> None:
+    """Axis labels, the inversions of `_gravity_layout` (gravity down), equal scales and a grid."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel + (", gravity down" if invert_v else ""))
+    if invert_v:
+        ax.invert_yaxis()
+    if invert_h:
+        ax.invert_xaxis()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+
+
 def plot_analysis(
     a: Analysis, path: str | os.PathLike | None = None, robot: Robot | None = None, params=None
 ) -> bytes:
@@ -103,14 +115,7 @@ def plot_analysis(
     )
     _draw_shapes(ax, a, swap=swap)
     h, v = (a.axes[1], a.axes[0]) if swap else a.axes
-    ax.set_xlabel(f"acceleration {h} ({_unit(h)})")
-    ax.set_ylabel(f"acceleration {v} ({_unit(v)})" + (", gravity down" if inv_v else ""))
-    if inv_v:
-        ax.invert_yaxis()
-    if inv_h:
-        ax.invert_xaxis()
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
+    _finish_axes(ax, f"acceleration {h} ({_unit(h)})", f"acceleration {v} ({_unit(v)})", inv_v, inv_h)
     ax.legend(loc="best", fontsize="small")
     q = ", ".join(f"{x:.3g}" for x in a.q)
     qd = f", qd = ({', '.join(f'{x:.3g}' for x in a.qd)})" if np.any(a.qd) else ""
@@ -179,14 +184,7 @@ def plot_workspace(
         _draw_shapes(ax, a, origin=arm[-1], scale=scale, swap=swap, labels=k == 0)
     ax.plot([0], [0], "ks", ms=7, label="base (joint 1)")
     h, v = (axes[1], axes[0]) if swap else axes
-    ax.set_xlabel(f"{h} (m)")
-    ax.set_ylabel(f"{v} (m)" + (", gravity down" if inv_v else ""))
-    if inv_v:
-        ax.invert_yaxis()
-    if inv_h:
-        ax.invert_xaxis()
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
+    _finish_axes(ax, f"{h} (m)", f"{v} (m)", inv_v, inv_h)
     ax.legend(loc="upper left", fontsize="small", framealpha=0.9)
     lim = analyses[0].torque_limits
     lim_text = f"{lim[0]:g}" if np.all(lim == lim[0]) else ", ".join(f"{x:g}" for x in lim)
@@ -197,3 +195,4 @@ def plot_workspace(
     data = figure_bytes(fig, fmt)
     if path is not None:
         write_atomic(path, data)
+    return data
