@@ -25,6 +25,8 @@ from symdyn.apps.analysis import (
     default_axes,
     inertia_ellipsoid,
     parse_axes,
+    plot_analysis,
+    plot_workspace,
     task_jacobian,
     zonotope_vertex_signs,
 )
@@ -266,3 +268,18 @@ def test_slide24_script(roger, tmp_path):
         assert all(cross(v[(k + 1) % len(v)] - v[k], -v[k]) > 0 for k in range(len(v)))
         # the gravity bias is visible but smaller than the ellipse's smaller semi-axis
         assert 5 < np.linalg.norm(a.bias) < a.manipulability.lengths[-1]
+
+
+def test_plots_return_the_image_they_write(roger, tmp_path):
+    """plot_analysis and plot_workspace give back the very bytes they write, in each format."""
+    analyses = [analyze(roger, q, torque_limits=2.0, axes="x,y") for q, _ in STATES[:2]]
+    draws = {
+        "analysis": lambda path: plot_analysis(analyses[0], path, robot=roger),
+        "workspace": lambda path: plot_workspace(roger, analyses, path),
+    }
+    for name, draw in draws.items():
+        for suffix, magic in ((".png", b"\x89PNG\r\n\x1a\n"), (".pdf", b"%PDF"), (".svg", b"<?xml")):
+            path = tmp_path / f"{name}{suffix}"
+            data = draw(path)
+            assert isinstance(data, bytes) and data.startswith(magic), (name, suffix)
+            assert path.read_bytes() == data, (name, suffix)

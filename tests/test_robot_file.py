@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import difflib
 import hashlib
+import importlib
+import math
 import warnings
 from pathlib import Path
 
@@ -12,10 +14,14 @@ import pytest
 import sympy as sp
 import yaml
 
+import symdyn.codegen
+from symdyn.apps.compiled import CompiledDynamics
 from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.parsers import load_robot, robot_from_data
 from symdyn.parsers.dh import dh_link
 from symdyn.spatial.transform import Transform
+
+rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 
 DATA = Path(__file__).parent / "data"
 GOOD = DATA / "good"
@@ -480,3 +486,137 @@ def test_zero_mass_with_inertia_warns_with_the_location():
         robot = load_robot(path)
     assert robot.links[0].mass == 0
     assert any(f"{path}: link 1 (base)" in str(w.message) for w in record)
+
+
+# ------------------------------------------------------------------ decimal angles
+
+PUMA = Path(__file__).resolve().parents[1] / "examples" / "puma560.yaml"
+#: The PUMA 560's exact angles as a Python or MATLAB user writes them.
+DECIMAL = {"pi/2": math.pi / 2, "-pi/2": -math.pi / 2, 0: 0.0}
+
+
+def _loaded(path):
+    """The robot of a file and the messages of every warning it gave, with the path left out."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robot = load_robot(path)
+    return robot, [str(w.message).replace(str(path), "FILE") for w in caught]
+
+
+def test_puma560_with_decimal_angles_is_the_pi_over_2_robot(tmp_path):
+    """Every alpha and theta written as a double: the same links, op counts and dynamics as pi/2."""
+    data = yaml.safe_load(PUMA.read_text())
+    for link in data["links"]:
+        for key in ("alpha", "theta"):
+            link[key] = DECIMAL[link[key]]
+    path = tmp_path / "puma560_decimal.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    text = path.read_text()
+    assert text.count("alpha: 1.5707963267948966") == 2 and text.count("alpha: -1.5707963267948966") == 2
+    assert text.count("theta: 0.0") == 6 and "pi" not in text
+
+    exact, exact_warnings = _loaded(PUMA)
+    decimal, decimal_warnings = _loaded(path)
+    assert decimal_warnings == exact_warnings  # the file's inertia warnings only, no angle warning
+    assert decimal.links == exact.links
+
+    ops = {f.name: f.ops for f in symdyn.codegen.context(exact).functions}
+    assert ops["inverse_dynamics"].total == 434  # the count in generated/puma560/puma560_dynamics.h
+    decimal_functions = symdyn.codegen.context(decimal).functions
+    assert {f.name: f.ops for f in decimal_functions} == ops
+    assert len(ops) == 7
+
+    # the decimal robot's generated functions against the oracle on the pi/2 robot
+    plant = CompiledDynamics(decimal)
+    rng = np.random.default_rng(560)
+    q, qd, qdd, tau = rng.uniform(-2.0, 2.0, (4, 16, 6))
+    scale = {"atol": 1e-9, "rtol": 1e-9}
+    np.testing.assert_allclose(plant.inverse_dynamics(q, qd, qdd), rn.rnea(exact, q, qd, qdd), **scale)
+    np.testing.assert_allclose(plant.mass_matrix(q), rn.mass_matrix(exact, q), **scale)
+    np.testing.assert_allclose(plant.coriolis(q, qd), rn.bias_torque(exact, q, qd), **scale)
+    np.testing.assert_allclose(plant.gravity(q), rn.gravity_torque(exact, q), **scale)
+    np.testing.assert_allclose(plant.friction(qd), rn.friction_torque(exact, qd), **scale)
+    np.testing.assert_allclose(
+        plant.forward_dynamics(q, qd, tau), rn.forward_dynamics(exact, q, qd, tau), **scale
+    )
+    C = plant.module.coriolis_matrix(q, qd, None)  # C qd = V
+    np.testing.assert_allclose(np.einsum("nij,nj->ni", C, qd), rn.bias_torque(exact, q, qd), **scale)
+
+
+def _one_link(**row) -> dict:
+    link = {"name": "upper", "joint": "revolute", "a": 0.4318, "alpha": 0, "d": 0, "theta": 0, "mass": 1}
+    link.update(row)
+    return {"name": "arm", "links": [{"name": "base", "joint": "revolute", "mass": 1}, link]}
+
+
+@pytest.mark.parametrize(
+    "field, row, multiple",
+    [
+        ("alpha", {"alpha": 1.5708}, "pi/2"),
+        ("alpha", {"alpha": "-1.5708"}, "-pi/2"),
+        ("theta", {"theta": 3.1416}, "pi"),
+        ("theta", {"joint": "prismatic", "theta": -4.7124}, "-3*pi/2"),
+    ],
+)
+def test_a_printed_right_angle_warns_once_and_is_kept(tmp_path, field, row, multiple):
+    path = tmp_path / "printed.yaml"
+    path.write_text(yaml.safe_dump(_one_link(**row)))
+    with pytest.warns(SymdynWarning) as record:
+        robot = load_robot(path)
+    (message,) = [str(w.message) for w in record]
+    assert message.startswith(f"{path}: link 2 (upper): field '{field}': ")
+    assert f"write {multiple} if {multiple} is meant" in message
+    written = sp.Float(float(row[field]))
+    link = robot.links[1]
+    if field == "alpha":  # standard DH: frame = Tx(a) Rx(alpha)
+        assert link.frame.R == Transform.rx(written).R
+        assert link.frame.R[1, 1] == sp.cos(written) != 0
+    else:  # placement = Rz(theta) Tz(d) after the previous frame
+        assert link.placement.R == (robot.links[0].frame @ Transform.rz(written)).R
+
+
+@pytest.mark.parametrize(
+    "offset, exact",
+    [(0.99e-9, True), (-0.99e-9, True), (1.01e-9, False), (-1.01e-9, False)],
+)
+def test_dh_angles_snap_within_1e9_and_not_beyond(offset, exact):
+    alpha = -math.pi / 2 + offset
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robot = robot_from_data(_one_link(alpha=alpha), "edge")
+    assert len(caught) == (0 if exact else 1)
+    rotation = robot.links[1].frame.R
+    assert rotation == Transform.rx(-sp.pi / 2 if exact else sp.Float(alpha)).R
+    assert (rotation[1, 1] == 0) is exact
+
+
+def test_negative_multiples_and_multiples_beyond_two_pi_are_exact():
+    data = _one_link(alpha=-3 * math.pi / 2, theta=5 * math.pi / 2)
+    data["links"][0].update(alpha=-4 * math.pi, theta=-13 * math.pi / 2)
+    robot = _load_data(data)
+    base, upper = robot.links
+    assert base.frame.R == Transform.rx(-4 * sp.pi).R == sp.eye(3)
+    assert base.placement.R == Transform.rz(-13 * sp.pi / 2).R
+    assert upper.frame.R == Transform.rx(-3 * sp.pi / 2).R
+    assert upper.placement.R == (base.frame @ Transform.rz(5 * sp.pi / 2)).R
+    assert all(x.is_Integer for T in (base.frame, upper.frame, upper.placement) for x in T.R)
+
+
+def test_lengths_and_masses_are_never_rounded():
+    """A length or mass equal to pi/2 as a double, or printed like 1.5708, stays as written."""
+    data = _one_link(a=math.pi / 2, d=1.5708, mass=1.5707963267948966)
+    data["links"][0].update(a=0.4318, d=3.141592653589793, mass=3.1416)
+    robot = _load_data(data)
+    base, upper = robot.links
+    assert upper.frame.p[0] == sp.Float(math.pi / 2) and upper.frame.p[0].is_Float
+    assert upper.placement.p[2] == sp.Float(1.5708)
+    assert upper.mass == sp.Float(1.5707963267948966) and base.mass == sp.Float(3.1416)
+    assert base.frame.p[0] == sp.Float(0.4318)
+    assert base.placement.p[2] == sp.Float(3.141592653589793)
+
+
+def _load_data(data):
+    """robot_from_data; any warning is a failure."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return robot_from_data(data, "data")

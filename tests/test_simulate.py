@@ -18,7 +18,7 @@ import pytest
 from symdyn import cli
 from symdyn.apps.simulate import (
     CompiledDynamics,
-    _Progress,
+    ProgressBar,
     simulate,
     time_expressions,
     torque_function,
@@ -189,14 +189,14 @@ def test_divergence_is_an_error(roger):
 
 def test_progress_bar():
     out = io.StringIO()
-    bar = _Progress(200, 2.0, True, out)
+    bar = ProgressBar(200, 2.0, True, out)
     for k in range(1, 201):
         bar.update(k, k / 100)
     bar.close()
     text = out.getvalue()
     assert text.count("\r") == 101 and "100%" in text and text.endswith("\n")  # 0 % .. 100 %
     off = io.StringIO()
-    _Progress(10, 1.0, False, off).update(5, 0.5)
+    ProgressBar(10, 1.0, False, off).update(5, 0.5)
     assert off.getvalue() == ""
 
 

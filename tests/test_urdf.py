@@ -186,25 +186,83 @@ def test_exact_numbers():
     assert b.axis == sp.ImmutableMatrix([0, 0, -1])
 
 
+SNAP_BODY = (
+    '<robot name="s"><link name="b"/><link name="l"><inertial><mass value="1"/>'
+    '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
+    '<joint name="j" type="revolute"><parent link="b"/><child link="l"/>'
+    '<origin rpy="{} 0 0"/></joint></robot>'
+)
+
+
 def test_angle_snapping_tolerance(tmp_path):
-    body = (
-        '<robot name="s"><link name="b"/><link name="l"><inertial><mass value="1"/>'
-        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>'
-        '<joint name="j" type="revolute"><parent link="b"/><child link="l"/>'
-        '<origin rpy="{} 0 0"/></joint></robot>'
-    )
-    for text, exact in (
-        ("1.57079632679", True),
-        ("1.5707963", False),
-        ("-1.5707963267948966", True),
-        ("1", False),
+    """(text, k of the exact multiple k pi/2 it becomes or None, whether it warns)."""
+    for text, k, warns in (
+        ("1.57079632679", 1, False),  # 4.9e-12 from pi/2
+        ("1.5707963", None, True),  # 2.7e-8: kept, with a warning
+        ("-1.5707963267948966", -1, False),
+        ("1.5707963267948966e0", 1, False),
+        ("1", None, False),
+        ("0.0000000001", 0, False),  # 1e-10 from 0
     ):
         f = tmp_path / "s.urdf"
-        f.write_text(body.format(text))
-        R = load_urdf(f).links[0].placement.R
-        assert (R[1, 1] == 0) is exact, text
-        assert abs(float(R[2, 1]) - math.sin(float(text))) < 1e-12
+        f.write_text(SNAP_BODY.format(text))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            R = load_urdf(f).links[0].placement.R
+        assert len(caught) == warns, text
+        angle = float(text) if k is None else k * math.pi / 2
+        assert (R[1, 1] == sp.cos(k * sp.pi / 2)) if k is not None else R[1, 1].is_Float, text
+        assert np.allclose(np.array(R, dtype=float), rx(angle), rtol=0, atol=1e-15), text
         assert all(x.is_Integer or x.is_Float for x in R), R  # numbers, not cos(1)
+
+
+def test_rpy_angles_snap_on_both_sides_of_1e9(tmp_path):
+    f = tmp_path / "s.urdf"
+    for offset, exact in ((0.99e-9, True), (-0.99e-9, True), (1.01e-9, False), (-1.01e-9, False)):
+        text = repr(-math.pi + offset)
+        f.write_text(SNAP_BODY.format(text))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            R = load_urdf(f).links[0].placement.R
+        assert len(caught) == (0 if exact else 1), text
+        want = sp.ImmutableMatrix([[1, 0, 0], [0, -1, 0], [0, 0, -1]])  # Rx(-pi)
+        assert (want == R) is exact, text
+        angle = -math.pi if exact else float(text)
+        assert np.allclose(np.array(R, dtype=float), rx(angle), rtol=0, atol=1e-15), text
+
+
+def test_printed_right_angles_in_rpy_warn_naming_file_link_field_and_line(tmp_path):
+    """1.5708 in a joint origin and -3.1416 in an inertial origin: kept as written, one warning each."""
+    f = tmp_path / "printed.urdf"
+    f.write_text(
+        (DATA / "two_link.urdf")
+        .read_text()
+        .replace('<origin xyz="0 0 1.0" rpy="0 0 0"/>', '<origin xyz="0 0 1.0" rpy="0 1.5708 0"/>')
+        .replace('<origin xyz="0.25 0 0"/>', '<origin xyz="0.25 0 0" rpy="0 0 -3.1416"/>')
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robot = load_urdf(f)
+    messages = [str(w.message) for w in caught]
+    assert all(issubclass(w.category, SymdynWarning) for w in caught) and len(messages) == 2
+    lower, upper = messages  # links are read before joints
+    assert upper.startswith(f"{f}: link 2 (upper): field 'joint(shoulder).origin.rpy': pitch 1.5708 rad")
+    assert "write 1.5707963267948966 if pi/2 is meant (line 26)" in upper
+    assert lower.startswith(f"{f}: link 3 (lower): field 'inertial.origin.rpy': yaw -3.1416 rad")
+    assert "write -3.141592653589793 if -pi is meant (line 18)" in lower
+    R = robot.links[0].placement.R
+    assert R[0, 0] == sp.cos(sp.Float("1.5708")) != 0  # not snapped: Ry(1.5708) as written
+    assert np.allclose(np.array(R, dtype=float), ry(1.5708), atol=1e-15)
+
+
+def test_rpy_multiples_beyond_two_pi_and_negative_are_exact(tmp_path):
+    f = tmp_path / "s.urdf"
+    for k in (-7, -4, 5, 9):
+        text = repr(k * math.pi / 2)
+        f.write_text(SNAP_BODY.format(text))
+        R = load(f).links[0].placement.R
+        assert all(x.is_Integer for x in R), (k, R)
+        assert np.array_equal(np.array(R, dtype=float), np.round(rx(k * math.pi / 2))), k
 
 
 def test_robot_name_as_c_identifier():

@@ -22,15 +22,9 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..model.robot import Robot
-from .simulate import (
-    TIME,
-    CompiledDynamics,
-    Trajectory,
-    _lambdify_time,
-    compiled_dynamics,
-    simulate,
-    time_expressions,
-)
+from .compiled import CompiledDynamics, compiled_dynamics
+from .simulate import TIME, lambdify_time, simulate, time_expressions
+from .trajectory import Trajectory
 
 __all__ = ["Reference", "ComputedTorque", "pd_gains", "track"]
 
@@ -56,7 +50,7 @@ class Reference:
         self.exprs = time_expressions(exprs, n, "reference", broadcast=False)
         self.d_exprs = [sp.diff(e, TIME) for e in self.exprs]
         self.dd_exprs = [sp.diff(e, TIME) for e in self.d_exprs]
-        self._f = [_lambdify_time(x) for x in (self.exprs, self.d_exprs, self.dd_exprs)]
+        self._f = [lambdify_time(x) for x in (self.exprs, self.d_exprs, self.dd_exprs)]
 
     @property
     def n(self) -> int:

@@ -18,19 +18,17 @@ The applied torque is a function tau(t, q, qd): zero, constants, expressions
 of t (parsed by the safe parser `symdyn.model.expressions.parse_expression`, never
 evaluated as Python), or any callable such as a computed-torque law
 (`symdyn.apps.control`). Initial states may be one state (n,) or a batch (B, n).
+
+The compiled dynamics live in symdyn.apps.compiled, the `Trajectory` (CSV, plot)
+in symdyn.apps.trajectory and the file writing in symdyn.apps.output; their
+public names are re-exported here.
 """
 
 from __future__ import annotations
 
 import math
-import os
 import sys
-import tempfile
-import types
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, replace
-from functools import lru_cache
-from pathlib import Path
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import sympy as sp
@@ -38,6 +36,9 @@ import sympy as sp
 from ..errors import SymdynError
 from ..model.expressions import parse_expression
 from ..model.robot import Robot
+from .compiled import CompiledDynamics, compiled_dynamics, with_parameters
+from .output import write_atomic
+from .trajectory import Trajectory, plot_trajectory
 
 __all__ = [
     "INTEGRATORS",
@@ -46,6 +47,7 @@ __all__ = [
     "compiled_dynamics",
     "with_parameters",
     "time_expressions",
+    "lambdify_time",
     "torque_function",
     "simulate",
     "write_atomic",
@@ -59,95 +61,6 @@ INTEGRATORS = ("rk4", "euler", "lecture", "semi-implicit")
 TIME = sp.Symbol("t")
 #: Runs of at least this many steps show a progress bar by default (when stderr is a terminal).
 PROGRESS_MIN_STEPS = 2000
-
-
-# --------------------------------------------------------------------------- compiled dynamics
-
-
-@lru_cache(maxsize=32)
-def _generated_module(robot: Robot) -> types.ModuleType:
-    """The NumPy module symdyn generates for `robot`, rendered in memory and loaded."""
-    from ..codegen import render
-
-    files = render(robot, targets=("python",))
-    ((name, text),) = ((k, v) for k, v in files.items() if k.endswith("_numpy.py"))
-    module = types.ModuleType(name[:-3])
-    module.__file__ = f"<symdyn generated {name}>"
-    # the text is symdyn's own output for a parsed robot, not user-supplied code
-    exec(compile(text, module.__file__, "exec"), module.__dict__)
-    return module
-
-
-def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
-    """`robot` with the named parameters set to numbers (free ones or ones the file gave a value).
-
-    The result has those parameters as values (no longer free). A value the file
-    wrote as an expression of another parameter keeps the number it had.
-    """
-    if not values:
-        return robot
-    known = {str(s): s for s in (*robot.params, *(s for s, _ in robot.values))}
-    unknown = [k for k in values if str(k) not in known]
-    if unknown:
-        names = ", ".join(sorted(known)) or "none"
-        raise SymdynError(f"unknown parameter(s) {', '.join(map(str, unknown))} (robot parameters: {names})")
-    numbers = {known[str(k)]: sp.Float(float(v), 17) for k, v in values.items()}
-    old = {s: sp.sympify(v).xreplace(numbers) for s, v in robot.values}
-    old.update(numbers)
-    return replace(
-        robot,
-        params=tuple(p for p in robot.params if p not in numbers),
-        values=tuple(old.items()),
-    )
-
-
-class CompiledDynamics:
-    """The generated NumPy functions of a robot, bound to values of its free parameters.
-
-    Every method accepts one state (n,) or a batch (B, n), like the generated module.
-    """
-
-    def __init__(self, robot: Robot, params=None) -> None:
-        self.robot = robot
-        self.module = _generated_module(robot)
-        values = robot.param_values(params) if robot.params else {}
-        by_name = {str(k): v for k, v in values.items()}
-        names = self.module.PARAM_NAMES
-        self.p = np.array([by_name[n] for n in names], dtype=float) if names else None
-
-    @property
-    def n(self) -> int:
-        return self.robot.n
-
-    def mass_matrix(self, q) -> np.ndarray:
-        return self.module.mass_matrix(q, self.p)
-
-    def coriolis(self, q, qd) -> np.ndarray:
-        """V(q, qd) = C(q, qd) qd."""
-        return self.module.coriolis(q, qd, self.p)
-
-    def gravity(self, q) -> np.ndarray:
-        return self.module.gravity(q, self.p)
-
-    def friction(self, qd) -> np.ndarray:
-        return self.module.friction(qd, self.p)
-
-    def inverse_dynamics(self, q, qd, qdd) -> np.ndarray:
-        return self.module.inverse_dynamics(q, qd, qdd, self.p)
-
-    def forward_dynamics(self, q, qd, tau) -> np.ndarray:
-        return self.module.forward_dynamics(q, qd, tau, self.p)
-
-
-def compiled_dynamics(robot: Robot | CompiledDynamics, params=None) -> CompiledDynamics:
-    """A CompiledDynamics for a Robot (or the given one unchanged when params is None)."""
-    if isinstance(robot, CompiledDynamics):
-        if params is not None:
-            return CompiledDynamics(robot.robot, params)
-        return robot
-    if not isinstance(robot, Robot):
-        raise SymdynError(f"expected a Robot, not {type(robot).__name__}")
-    return CompiledDynamics(robot, params)
 
 
 # --------------------------------------------------------------------------- torque inputs
@@ -173,7 +86,7 @@ def time_expressions(values: Sequence, n: int, what: str = "tau", broadcast: boo
     return exprs
 
 
-def _lambdify_time(exprs: Sequence[sp.Expr]) -> Callable[[float], np.ndarray]:
+def lambdify_time(exprs: Sequence[sp.Expr]) -> Callable[[float], np.ndarray]:
     """A function t -> array (n,) (or (n, len(t)) for an array t) of the parsed expressions."""
     funcs = [sp.lambdify(TIME, e, modules="numpy") for e in exprs]
 
@@ -196,71 +109,14 @@ def torque_function(tau, n: int) -> Callable:
     if all(not e.free_symbols for e in exprs):
         const = np.array([float(e) for e in exprs])
         return lambda t, q, qd: const
-    f = _lambdify_time(exprs)
+    f = lambdify_time(exprs)
     return lambda t, q, qd: f(t)
 
 
-# --------------------------------------------------------------------------- trajectories
+# --------------------------------------------------------------------------- integration
 
 
-@dataclass
-class Trajectory:
-    """A simulated run: sample times t (N,), states q, qd and torque tau (N, n), or (N, B, n) for a batch.
-
-    tau[k] is the torque at (t_k, q_k, qd_k), the one applied at the start of step k.
-    `q_ref`, `qd_ref` hold a tracked reference at the same times (None without one).
-    """
-
-    robot: Robot
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    tau: np.ndarray
-    integrator: str
-    q_ref: np.ndarray | None = None
-    qd_ref: np.ndarray | None = None
-
-    @property
-    def n(self) -> int:
-        return self.robot.n
-
-    def csv_text(self) -> str:
-        """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision."""
-        if self.q.ndim != 2:
-            raise SymdynError("CSV output holds one trajectory, not a batch")
-        n = self.n
-        header = ["t"] + [f"q{i}" for i in range(1, n + 1)] + [f"qd{i}" for i in range(1, n + 1)]
-        rows = np.column_stack([self.t, self.q, self.qd])
-        lines = [",".join(header)]
-        lines += [",".join(f"{x:.17g}" for x in row) for row in rows]
-        return "\n".join(lines) + "\n"
-
-    def write_csv(self, path: str | os.PathLike) -> Path:
-        """Write csv_text() atomically (temporary file in the same folder, then rename)."""
-        return write_atomic(path, self.csv_text())
-
-
-def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
-    """Write a file all at once: a temporary file beside it, then os.replace."""
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise SymdynError(f"{target}: folder {folder} does not exist")
-    if target.is_dir():
-        raise SymdynError(f"{target}: is a folder")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(content.encode() if isinstance(content, str) else content)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return target
-
-
-class _Progress:
+class ProgressBar:
     """A one-line progress bar on stderr: `simulate [#####-----]  50%  t = 1.50 / 3.00 s`."""
 
     def __init__(self, total_steps: int, duration: float, enabled: bool, stream=None) -> None:
@@ -350,7 +206,7 @@ def simulate(
     T[0], Q[0], QD[0] = 0.0, q, qd
     if progress is None:
         progress = steps >= PROGRESS_MIN_STEPS and sys.stderr.isatty()
-    bar = _Progress(steps, duration, bool(progress))
+    bar = ProgressBar(steps, duration, bool(progress))
     scheme = "euler" if integrator == "lecture" else integrator
     t = 0.0
     try:
@@ -386,74 +242,3 @@ def simulate(
     finally:
         bar.close()
     return Trajectory(plant.robot, T, Q, QD, U, scheme)
-
-
-# --------------------------------------------------------------------------- plots
-
-
-def _figure(rows: int, width: float = 8.0, height_per_row: float = 2.6):
-    """A Matplotlib Figure with the Agg canvas (no pyplot, no global backend change)."""
-    try:
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
-    except ImportError as exc:  # pragma: no cover - matplotlib is in the test extras
-        raise SymdynError("plots need matplotlib (pip install 'symdyn[plot]')") from exc
-    fig = Figure(figsize=(width, height_per_row * rows), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def figure_bytes(fig, fmt: str = "png", dpi: int = 120) -> bytes:
-    """A figure rendered to bytes (written by the caller with write_atomic)."""
-    import io
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, dpi=dpi)
-    return buf.getvalue()
-
-
-def _format_of(path: str | os.PathLike) -> str:
-    fmt = Path(path).suffix.lower().lstrip(".") or "png"
-    if fmt not in ("png", "pdf", "svg"):
-        raise SymdynError(f"{path}: plot format '{fmt}' is not supported (use .png, .pdf or .svg)")
-    return fmt
-
-
-def plot_trajectory(traj: Trajectory, path: str | os.PathLike | None = None) -> bytes:
-    """Joint positions and velocities against time; with a reference also the tracking error.
-
-    Returns the image bytes; writes them atomically to `path` when given.
-    """
-    fmt = _format_of(path) if path is not None else "png"
-    if traj.q.ndim != 2:
-        raise SymdynError("plots show one trajectory, not a batch")
-    tracking = traj.q_ref is not None
-    fig = _figure(3 if tracking else 2)
-    axes = fig.subplots(3 if tracking else 2, 1, sharex=True)
-    colors = [f"C{i % 10}" for i in range(traj.n)]
-    for i in range(traj.n):
-        axes[0].plot(traj.t, traj.q[:, i], color=colors[i], label=f"q{i + 1}")
-        axes[1].plot(traj.t, traj.qd[:, i], color=colors[i], label=f"qd{i + 1}")
-        if tracking:
-            axes[0].plot(traj.t, traj.q_ref[:, i], "--", color=colors[i], label=f"q{i + 1} reference")
-            if traj.qd_ref is not None:
-                axes[1].plot(traj.t, traj.qd_ref[:, i], "--", color=colors[i], label=f"qd{i + 1} reference")
-            err = np.abs(traj.q_ref[:, i] - traj.q[:, i])
-            axes[2].semilogy(
-                traj.t, np.maximum(err, 1e-16), color=colors[i], label=f"|q{i + 1}_ref - q{i + 1}|"
-            )
-    axes[0].set_ylabel("q (rad or m)")
-    axes[1].set_ylabel("qd (rad/s or m/s)")
-    if tracking:
-        axes[2].set_ylabel("tracking error")
-        axes[0].set_title(f"{traj.robot.name}: reference (dashed) and actual (solid), {traj.integrator}")
-    else:
-        axes[0].set_title(f"{traj.robot.name}: simulation ({traj.integrator})")
-    axes[-1].set_xlabel("t (s)")
-    for ax in axes:
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize="small", ncol=2)
-    data = figure_bytes(fig, fmt)
-    if path is not None:
-        write_atomic(path, data)
-    return data

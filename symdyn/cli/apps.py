@@ -98,7 +98,7 @@ def _gains(items, n: int, what: str, default: float) -> np.ndarray:
 
 def _with_params(robot, params: dict[str, float], option: str = "--params"):
     """The robot with parameter values applied; every free parameter must then have one."""
-    from ..apps.simulate import with_parameters
+    from ..apps.compiled import with_parameters
 
     robot = with_parameters(robot, params)
     if robot.params:
@@ -124,10 +124,10 @@ def _check_out_path(path: str | None, option: str) -> None:
 def _check_plot_path(path: str | None) -> None:
     if path is None:
         return
-    from ..apps.simulate import _format_of
+    from ..apps.output import plot_format
 
     _check_out_path(path, "--plot")
-    _format_of(path)
+    plot_format(path)
     try:
         import matplotlib  # noqa: F401
     except ImportError:
@@ -139,7 +139,9 @@ def _check_plot_path(path: str | None) -> None:
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     from ..apps.control import ComputedTorque, Reference, track
-    from ..apps.simulate import plot_trajectory, simulate, time_expressions, write_atomic
+    from ..apps.output import write_atomic
+    from ..apps.simulate import simulate, time_expressions
+    from ..apps.trajectory import plot_trajectory
 
     _check_out_path(args.out, "--out")
     _check_plot_path(args.plot)
@@ -234,7 +236,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         image = plot_analysis(result, robot=robot)
     sys.stdout.write(result.to_json() if args.format == "json" else result.to_text())
     if image is not None:
-        from ..apps.simulate import write_atomic
+        from ..apps.output import write_atomic
 
         write_atomic(args.plot, image)
     return 0

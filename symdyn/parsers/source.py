@@ -1,13 +1,16 @@
-"""Reading a description file's bytes, with the errors every loader gives for it."""
+"""Reading a description file's bytes, with the errors every loader gives for it, and the
+"did you mean" hint loaders add to a misspelt name."""
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import os
+from collections.abc import Iterable
 
 from ..errors import SymdynError
 
-__all__ = ["read_source", "MAX_BYTES"]
+__all__ = ["read_source", "did_you_mean", "MAX_BYTES"]
 
 #: Larger files are refused before parsing (a robot description is kilobytes).
 MAX_BYTES = 64 * 2**20
@@ -34,3 +37,9 @@ def read_source(path: str | os.PathLike, kind: str) -> tuple[str, bytes, str]:
     if len(raw) > MAX_BYTES:
         raise SymdynError(f"file larger than {MAX_BYTES // 2**20} MiB", file=file)
     return file, raw, hashlib.sha256(raw).hexdigest()
+
+
+def did_you_mean(name: str, names: Iterable[str]) -> str:
+    """The hint " (did you mean 'x'?)" naming the closest of `names` to a misspelt `name`, or ""."""
+    close = difflib.get_close_matches(name, list(names), n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ""

@@ -1,0 +1,91 @@
+"""The task space of the end-effector: its axes, and its Jacobian J with the bias Jdot qd as numbers.
+
+J is the geometric Jacobian of the origin of the last convention frame, in the
+base frame (`symdyn.algorithms.kinematics.end_effector_jacobian`), rows x, y, z
+(linear) and rx, ry, rz (angular); a task picks some of these rows. Jdot qd is
+exact: the symbolic time derivative of J, sum_j dJ/dq_j qd_j, times qd.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from functools import lru_cache
+
+import numpy as np
+import sympy as sp
+
+from ..algorithms.kinematics import end_effector_jacobian
+from ..errors import SymdynError
+from ..model.robot import Robot
+from ..model.symbols import joint_symbols
+
+__all__ = ["TASK_AXES", "parse_axes", "default_axes", "task_jacobian", "joint_vector"]
+
+TASK_AXES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
+    """Task axes from "x,y" or a sequence of names among x, y, z, rx, ry, rz (None: default)."""
+    if axes is None:
+        return None
+    names = [a.strip() for a in axes.split(",")] if isinstance(axes, str) else [str(a).strip() for a in axes]
+    names = [a for a in names if a]
+    if not names:
+        raise SymdynError(f"--axes: no axis given (any of {', '.join(TASK_AXES)})")
+    bad = [a for a in names if a not in TASK_AXES]
+    if bad:
+        raise SymdynError(f"--axes: unknown axis {', '.join(bad)} (any of {', '.join(TASK_AXES)})")
+    if len(set(names)) != len(names):
+        raise SymdynError(f"--axes: repeated axis in {','.join(names)}")
+    return tuple(names)
+
+
+@lru_cache(maxsize=32)
+def _kinematics(robot: Robot):
+    """(f(q, qd, p) -> (J 6xn, Jdot qd 6), the linear rows not identically zero, free params)."""
+    r = robot.resolved()
+    q, qd, _ = joint_symbols(r.n)
+    J = end_effector_jacobian(r, list(q))
+    Jdot = sp.zeros(*J.shape)
+    for j in range(r.n):
+        Jdot += J.diff(q[j]) * qd[j]
+    bias = Jdot * qd
+    f = sp.lambdify([list(q), list(qd), list(r.params)], [J, bias], modules="numpy", cse=True)
+    live = tuple(TASK_AXES[i] for i in range(3) if any(x != 0 for x in J[i, :]))
+    return f, live, r.params
+
+
+def default_axes(robot: Robot) -> tuple[str, ...]:
+    """The linear axes x, y, z whose Jacobian rows are not identically zero (x, y for a planar arm)."""
+    live = _kinematics(robot)[1]
+    return live or ("x", "y", "z")
+
+
+def task_jacobian(robot: Robot, q, qd=None, axes=None, params=None) -> tuple[np.ndarray, np.ndarray]:
+    """(J, Jdot qd) of the end-effector, rows `axes` (default `default_axes`), as numbers."""
+    f, _, free = _kinematics(robot)
+    names = parse_axes(axes) or default_axes(robot)
+    n = robot.n
+    q = joint_vector(q, n, "q")
+    qd = np.zeros(n) if qd is None else joint_vector(qd, n, "qd")
+    values = robot.param_values(params) if robot.params else {}
+    by_name = {str(k): v for k, v in values.items()}
+    p = [by_name[str(s)] for s in free]
+    J, b = f(q, qd, p)
+    J = np.asarray(J, dtype=float).reshape(6, n)
+    b = np.asarray(b, dtype=float).reshape(6)
+    rows = [TASK_AXES.index(a) for a in names]
+    return J[rows], b[rows]
+
+
+def joint_vector(x, n: int, name: str) -> np.ndarray:
+    """`x` as a finite float vector of n entries (one per joint); SymdynError naming `name` otherwise."""
+    try:
+        a = np.array(x, dtype=float).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise SymdynError(f"{name}: expected numbers, got {x!r}") from exc
+    if a.shape != (n,):
+        raise SymdynError(f"{name} must have {n} entries (one per joint), got {a.size}")
+    if not np.all(np.isfinite(a)):
+        raise SymdynError(f"{name} must be finite")
+    return a

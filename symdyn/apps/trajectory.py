@@ -1,0 +1,97 @@
+"""A simulated run (`Trajectory`): its samples, its CSV text, and its plot against time.
+
+Joint positions q (rad or m), velocities qd and the applied torques tau (N m or N)
+are sampled at the times t of the integrator (symdyn.apps.simulate); a tracked
+reference (symdyn.apps.control) adds q_ref and qd_ref at the same times.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SymdynError
+from ..model.robot import Robot
+from .output import figure, figure_bytes, plot_format, write_atomic
+
+__all__ = ["Trajectory", "plot_trajectory"]
+
+
+@dataclass
+class Trajectory:
+    """A simulated run: sample times t (N,), states q, qd and torque tau (N, n), or (N, B, n) for a batch.
+
+    tau[k] is the torque at (t_k, q_k, qd_k), the one applied at the start of step k.
+    `q_ref`, `qd_ref` hold a tracked reference at the same times (None without one).
+    """
+
+    robot: Robot
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    tau: np.ndarray
+    integrator: str
+    q_ref: np.ndarray | None = None
+    qd_ref: np.ndarray | None = None
+
+    @property
+    def n(self) -> int:
+        return self.robot.n
+
+    def csv_text(self) -> str:
+        """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision."""
+        if self.q.ndim != 2:
+            raise SymdynError("CSV output holds one trajectory, not a batch")
+        n = self.n
+        header = ["t"] + [f"q{i}" for i in range(1, n + 1)] + [f"qd{i}" for i in range(1, n + 1)]
+        rows = np.column_stack([self.t, self.q, self.qd])
+        lines = [",".join(header)]
+        lines += [",".join(f"{x:.17g}" for x in row) for row in rows]
+        return "\n".join(lines) + "\n"
+
+    def write_csv(self, path: str | os.PathLike) -> Path:
+        """Write csv_text() atomically (temporary file in the same folder, then rename)."""
+        return write_atomic(path, self.csv_text())
+
+
+def plot_trajectory(traj: Trajectory, path: str | os.PathLike | None = None) -> bytes:
+    """Joint positions and velocities against time; with a reference also the tracking error.
+
+    Returns the image bytes; writes them atomically to `path` when given.
+    """
+    fmt = plot_format(path) if path is not None else "png"
+    if traj.q.ndim != 2:
+        raise SymdynError("plots show one trajectory, not a batch")
+    tracking = traj.q_ref is not None
+    fig = figure(3 if tracking else 2)
+    axes = fig.subplots(3 if tracking else 2, 1, sharex=True)
+    colors = [f"C{i % 10}" for i in range(traj.n)]
+    for i in range(traj.n):
+        axes[0].plot(traj.t, traj.q[:, i], color=colors[i], label=f"q{i + 1}")
+        axes[1].plot(traj.t, traj.qd[:, i], color=colors[i], label=f"qd{i + 1}")
+        if tracking:
+            axes[0].plot(traj.t, traj.q_ref[:, i], "--", color=colors[i], label=f"q{i + 1} reference")
+            if traj.qd_ref is not None:
+                axes[1].plot(traj.t, traj.qd_ref[:, i], "--", color=colors[i], label=f"qd{i + 1} reference")
+            err = np.abs(traj.q_ref[:, i] - traj.q[:, i])
+            axes[2].semilogy(
+                traj.t, np.maximum(err, 1e-16), color=colors[i], label=f"|q{i + 1}_ref - q{i + 1}|"
+            )
+    axes[0].set_ylabel("q (rad or m)")
+    axes[1].set_ylabel("qd (rad/s or m/s)")
+    if tracking:
+        axes[2].set_ylabel("tracking error")
+        axes[0].set_title(f"{traj.robot.name}: reference (dashed) and actual (solid), {traj.integrator}")
+    else:
+        axes[0].set_title(f"{traj.robot.name}: simulation ({traj.integrator})")
+    axes[-1].set_xlabel("t (s)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize="small", ncol=2)
+    data = figure_bytes(fig, fmt)
+    if path is not None:
+        write_atomic(path, data)
+    return data

@@ -1,0 +1,296 @@
+"""The fields of a robot file, read and checked in written order (docs/robot-files.md).
+
+`RobotFileReader` walks the data of a robot file (as from symdyn.parsers.yaml_text)
+once, in the order it was written: the top-level keys, then each link's keys. Every
+number-or-expression goes through the whitelisting parser of
+`symdyn.model.expressions`, and the parameter names met are recorded in order of
+appearance (`order`), which fixes the order of `Robot.params`. Unknown keys, wrong
+kinds and bad names raise SymdynError naming file, link and field. The values are
+kept as written; symdyn.parsers.robot_file builds the Robot from them.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+from ..errors import SymdynError
+from ..model.angles import snap_angle
+from ..model.expressions import check_parameter_name, is_c_identifier, parse_expression_names
+from ..model.robot import JOINT_TYPES
+from .dh import CONVENTIONS
+from .source import did_you_mean
+
+__all__ = [
+    "TOP_KEYS",
+    "LINK_KEYS",
+    "INERTIA_KEYS",
+    "FRICTION_KEYS",
+    "MOTOR_KEYS",
+    "LinkData",
+    "RobotFileReader",
+]
+
+TOP_KEYS = ("name", "convention", "gravity", "parameters", "links")
+LINK_KEYS = (
+    "name",
+    "joint",
+    "a",
+    "alpha",
+    "d",
+    "theta",
+    "mass",
+    "com",
+    "inertia",
+    "friction",
+    "motor",
+)
+INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+FRICTION_KEYS = ("viscous", "coulomb")
+MOTOR_KEYS = ("inertia", "gear_ratio")
+_AXES = ("x", "y", "z")
+_LINK_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*\Z")
+
+
+@dataclass
+class LinkData:
+    """One link entry as written: DH row, inertial data, friction and motor (defaults for omitted keys)."""
+
+    index: int
+    name: str
+    joint: str = ""
+    a: sp.Expr = sp.S.Zero
+    alpha: sp.Expr = sp.S.Zero
+    d: sp.Expr = sp.S.Zero
+    theta: sp.Expr = sp.S.Zero
+    mass: sp.Expr = sp.S.Zero
+    com: tuple[sp.Expr, ...] = (sp.S.Zero,) * 3
+    inertia: dict[str, sp.Expr] = field(default_factory=dict)
+    viscous: sp.Expr = sp.S.Zero
+    coulomb: sp.Expr = sp.S.Zero
+    motor_inertia: sp.Expr = sp.S.Zero
+    gear_ratio: sp.Expr = sp.S.One
+
+
+class RobotFileReader:
+    """One pass over the document in written order, recording name appearances."""
+
+    def __init__(self, file: str | None) -> None:
+        self.file = file
+        self.order: list[str] = []  # names in order of appearance (with repeats)
+        self.values: dict[str, sp.Expr] = {}
+        self.value_names: dict[str, tuple[str, ...]] = {}
+        self.name: str | None = None
+        self.convention = "standard"
+        self.gravity: tuple[sp.Expr, ...] | None = None
+        self.links: list[LinkData] = []
+
+    # -- helpers
+    def error(self, message: str, *, link: LinkData | None = None, field: str | None = None):
+        return SymdynError(
+            message,
+            file=self.file,
+            link_index=None if link is None else link.index,
+            link_name=None if link is None else link.name,
+            field=field,
+        )
+
+    def expr(self, value: object, field: str, link: LinkData | None = None) -> sp.Expr:
+        expr, names = parse_expression_names(
+            value,
+            file=self.file,
+            link_index=None if link is None else link.index,
+            link_name=None if link is None else link.name,
+            field=field,
+        )
+        self.order.extend(names)
+        return expr
+
+    def angle(self, value: object, field: str, link: LinkData) -> sp.Expr:
+        """A DH angle (rad), parsed like `expr`; a decimal multiple of pi/2 made exact (snap_angle)."""
+        return snap_angle(
+            self.expr(value, field, link),
+            file=self.file,
+            link_index=link.index,
+            link_name=link.name,
+            field=field,
+        )
+
+    def vector(self, value: object, field: str, link: LinkData | None = None):
+        if not isinstance(value, list) or len(value) != 3:
+            got = f"{len(value)} entries" if isinstance(value, list) else _kind(value)
+            raise self.error(
+                f"expected a list of 3 numbers or expressions [x, y, z], got {got}",
+                link=link,
+                field=field,
+            )
+        return tuple(self.expr(v, f"{field}.{ax}", link) for v, ax in zip(value, _AXES, strict=True))
+
+    def mapping(
+        self,
+        value: object,
+        allowed: Iterable[str],
+        field: str | None,
+        link: LinkData | None = None,
+    ) -> dict:
+        """A mapping with only `allowed` keys (null counts as empty)."""
+        allowed = tuple(allowed)
+        if value is None:
+            return {}
+        if not isinstance(value, dict):
+            raise self.error(
+                f"expected a mapping with keys {', '.join(allowed)}, got {_kind(value)}",
+                link=link,
+                field=field,
+            )
+        for key in value:
+            if key not in allowed:
+                where = f"{field}.{key}" if field else str(key)
+                raise self.error(_unknown_key(key, allowed), link=link, field=where)
+        return value
+
+    # -- the document
+    def read(self, data: object) -> None:
+        if not isinstance(data, dict):
+            got = "an empty document" if data is None else _kind(data)
+            raise self.error(f"the top level must be a mapping (name, links, ...), got {got}")
+        self.mapping(data, TOP_KEYS, None)
+        for key in ("name", "links"):
+            if key not in data:
+                raise self.error("missing required field", field=key)
+        for key, value in data.items():
+            getattr(self, f"_read_{key}")(value)
+
+    def _read_name(self, value: object) -> None:
+        if not isinstance(value, str):
+            raise self.error(f"robot name must be a string, got {_kind(value)}", field="name")
+        if not re.match(r"[A-Za-z_][A-Za-z0-9_]*\Z", value):
+            raise self.error(
+                f"robot name '{value}' is not a valid C identifier (letters, digits and "
+                "underscores, not starting with a digit)",
+                field="name",
+            )
+        if not is_c_identifier(value):
+            raise self.error(f"robot name '{value}' is a C keyword", field="name")
+        if value.startswith("__") or re.match(r"_[A-Z]", value):
+            raise self.error(
+                f"robot name '{value}' is reserved in C (leading __ or _ and a capital)",
+                field="name",
+            )
+        self.name = value
+
+    def _read_convention(self, value: object) -> None:
+        if value not in CONVENTIONS:
+            raise self.error(
+                f"convention must be 'standard' or 'modified', not {value!r}", field="convention"
+            )
+        self.convention = value
+
+    def _read_gravity(self, value: object) -> None:
+        self.gravity = self.vector(value, "gravity")
+
+    def _read_parameters(self, value: object) -> None:
+        if value is None:
+            return
+        if not isinstance(value, dict):
+            raise self.error(
+                f"expected a mapping of parameter names to values, got {_kind(value)}",
+                field="parameters",
+            )
+        for key, v in value.items():
+            fld = f"parameters.{key}"
+            name = check_parameter_name(key, file=self.file, field=fld)
+            self.order.append(name)
+            if v is None:
+                continue
+            if isinstance(v, (list, dict)):
+                raise self.error(
+                    f"a parameter value must be a number, an expression or null, got {_kind(v)}",
+                    field=fld,
+                )
+            start = len(self.order)
+            self.values[name] = self.expr(v, fld)
+            self.value_names[name] = tuple(dict.fromkeys(self.order[start:]))
+
+    def _read_links(self, value: object) -> None:
+        if not isinstance(value, list):
+            raise self.error(f"expected a list of links, got {_kind(value)}", field="links")
+        if not value:
+            raise self.error("a robot needs at least one link", field="links")
+        names: dict[str, int] = {}
+        for i, raw in enumerate(value, start=1):
+            link = self._read_link(i, raw)
+            if link.name in names:
+                raise self.error(
+                    f"duplicate link name '{link.name}' (also link {names[link.name]})",
+                    link=link,
+                    field="name",
+                )
+            names[link.name] = i
+            self.links.append(link)
+
+    def _read_link(self, i: int, raw: object) -> LinkData:
+        given = raw.get("name") if isinstance(raw, dict) else None
+        link = LinkData(index=i, name=given if isinstance(given, str) else f"link{i}")
+        if not isinstance(raw, dict):
+            raise self.error(f"a link must be a mapping, got {_kind(raw)}", link=link)
+        self.mapping(raw, LINK_KEYS, None, link)
+        for key in ("joint", "mass"):
+            if key not in raw:
+                raise self.error("missing required field", link=link, field=key)
+        for key, value in raw.items():
+            if key == "name":
+                if not isinstance(value, str) or not _LINK_NAME.match(value):
+                    raise self.error(
+                        f"link name must be letters, digits, '_', '.' or '-', got {value!r}",
+                        link=link,
+                        field="name",
+                    )
+            elif key == "joint":
+                if value not in JOINT_TYPES:
+                    raise self.error(
+                        f"joint must be 'revolute' or 'prismatic', not {value!r}",
+                        link=link,
+                        field="joint",
+                    )
+                link.joint = value
+            elif key in ("alpha", "theta"):
+                setattr(link, key, self.angle(value, key, link))
+            elif key in ("a", "d", "mass"):
+                setattr(link, key, self.expr(value, key, link))
+            elif key == "com":
+                link.com = self.vector(value, "com", link)
+            elif key == "inertia":
+                entries = self.mapping(value, INERTIA_KEYS, "inertia", link)
+                link.inertia = {k: self.expr(v, f"inertia.{k}", link) for k, v in entries.items()}
+            elif key == "friction":
+                entries = self.mapping(value, FRICTION_KEYS, "friction", link)
+                for k, v in entries.items():
+                    setattr(link, k, self.expr(v, f"friction.{k}", link))
+            elif key == "motor":
+                entries = self.mapping(value, MOTOR_KEYS, "motor", link)
+                for k, v in entries.items():
+                    attr = "motor_inertia" if k == "inertia" else k
+                    setattr(link, attr, self.expr(v, f"motor.{k}", link))
+        return link
+
+
+def _kind(value: object) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return f"the boolean {value}"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, dict):
+        return "a mapping"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    return f"{type(value).__name__} {value!r}"
+
+
+def _unknown_key(key: object, allowed: tuple[str, ...]) -> str:
+    return f"unknown key '{key}'{did_you_mean(str(key), allowed)}; allowed: {', '.join(allowed)}"
