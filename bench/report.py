@@ -232,6 +232,14 @@ def _notes(rows: list[Row], info: RunInfo) -> list[str]:
         "puma560_symbolic: bench/chains/puma560_symbolic.yaml (examples/puma560.yaml with all 60 inertial "
         "parameters free, no motor inertia, no friction); generated, not timed",
     ]
+    if any(r.name == "puma560_float" for r in rows):
+        notes.append(
+            "puma560_float: bench/chains/puma560_float.yaml, examples/puma560.yaml with every twist pi/2 "
+            "written as the float 1.5707963267948966 (bench/robots.py); the same arm as puma560, but "
+            "cos(alpha) = 6.1e-17 instead of 0 unless the loader snaps such angles to exact multiples of "
+            "pi/2, so its extra operations are what that snapping saves (the CasADi route, too, folds "
+            "only exact zeros)"
+        )
     before, after = info.digests
     if after == before:
         notes.append(f"symdyn source digest {before} (unchanged during the run)")

@@ -16,11 +16,16 @@ For bench/derive.py (built in memory as symdyn Robots):
 For bench/run.py (robot files, as `symdyn generate` reads them):
 
 * `ROBOTS`: name -> robot file; `QUICK_ROBOTS`, `ARMS` (the arms the targets judge),
-  `URDF_TIPS` (URDF file -> tip link), `load(path)` and `write_robot_files()`.
+  `URDF_TIPS` (URDF file -> tip link) and `load(path)`.
+* `puma560_float_text()`: examples/puma560.yaml with every twist pi/2 written as the
+  float 1.5707963267948966 (the robot `puma560_float`, file bench/chains/puma560_float.yaml,
+  written by `write_robot_files()` with the chains of bench/chains.py).
 """
 
 from __future__ import annotations
 
+import math
+import re
 import warnings
 from dataclasses import replace
 from pathlib import Path
@@ -34,6 +39,7 @@ from symdyn.spatial.transform import Transform
 __all__ = [
     "generic_arm",
     "puma560_symbolic",
+    "puma560_float_text",
     "write_robot_files",
     "load",
     "PUMA_FILE",
@@ -163,6 +169,28 @@ def puma560_symbolic() -> tuple[Robot, str]:
 
 
 EXAMPLES = chains.ROOT / "examples"
+FLOAT_PUMA_FILE = chains.CHAIN_DIR / "puma560_float.yaml"
+HALF_PI = repr(math.pi / 2)  # "1.5707963267948966", the double nearest pi/2
+_PI_HALF_TWIST = re.compile(r"^(\s*alpha:\s*)(-?)pi/2\s*$", re.MULTILINE)
+
+
+def puma560_float_text(path: Path = PUMA_FILE) -> str:
+    """examples/puma560.yaml with every twist `pi/2` written as the float 1.5707963267948966.
+
+    Text substitution on the file, so every other field (and the source comments) stays as
+    published; only the twists alpha_i = +-pi/2 of the standard DH table and the robot's name
+    change. cos(1.5707963267948966) is 6.1e-17, not 0: a loader that keeps the float carries
+    those terms through the derivation, where the exact pi/2 makes them vanish.
+    """
+    text, count = _PI_HALF_TWIST.subn(rf"\g<1>\g<2>{HALF_PI}", path.read_text(encoding="utf-8"))
+    assert count == 4, f"expected the PUMA 560's four pi/2 twists, found {count}"
+    text, renamed = re.subn(r"^name: puma560$", "name: puma560_float", text, flags=re.MULTILINE)
+    assert renamed == 1
+    header = (
+        f"# examples/puma560.yaml with every twist pi/2 written as the float {HALF_PI}.\n"
+        "# Written by bench/robots.py; do not edit by hand.\n"
+    )
+    return header + text
 
 
 def _panda_urdf() -> Path | None:
@@ -181,6 +209,7 @@ def _panda_urdf() -> Path | None:
 ROBOTS = {  # name -> robot file (chains are written by bench/chains.py)
     "roger_arm_values": EXAMPLES / "roger_arm_values.yaml",
     "puma560": PUMA_FILE,
+    "puma560_float": FLOAT_PUMA_FILE,
     "stanford": EXAMPLES / "stanford.yaml",
     "panda": EXAMPLES / "panda.yaml",
     "chain_9": chains.chain_file(9),
@@ -195,8 +224,12 @@ ARMS = ("puma560", "stanford", "panda")  # the issue's "6-7 joint arms with nume
 
 
 def write_robot_files() -> dict[str, Path]:
-    """(Re)write bench/chains/*.yaml if their text changed; {name: path}."""
-    return chains.write_robot_files()
+    """(Re)write bench/chains/*.yaml and puma560_float.yaml if their text changed; {name: path}."""
+    files = chains.write_robot_files()
+    text = puma560_float_text()
+    if not FLOAT_PUMA_FILE.exists() or FLOAT_PUMA_FILE.read_text(encoding="utf-8") != text:
+        FLOAT_PUMA_FILE.write_text(text, encoding="utf-8")
+    return {**files, "puma560_float": FLOAT_PUMA_FILE}
 
 
 def load(path: Path) -> Robot:
