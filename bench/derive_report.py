@@ -166,7 +166,8 @@ def _notes(rows: list[Row], args, origin: str, loads: tuple[float, float]) -> li
             else "."
         ),
         "cpu (s): CPU time of the worker process over the same span; wall time exceeds it when other "
-        "processes compete for the CPUs (load average above the CPU count).",
+        "processes compete for the CPUs (load average above the CPU count). The machine is shared with other "
+        "work, so times move from run to run: compare rows within one run ('vs Kane'), not across runs.",
         "vs Kane: Kane's wall time on the same robot in this run divided by this row's time "
         "(> 1x = faster than Kane).",
         "ops: sympy.count_ops summed over the named intermediates the quantity needs "
