@@ -19,13 +19,13 @@ import sys
 import tempfile
 from pathlib import Path
 
-BENCH = Path(__file__).resolve().parent
-RESULTS = BENCH / "results"
-sys.path.insert(0, str(BENCH))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import casadi_route  # noqa: E402
 import chains  # noqa: E402
-import run  # noqa: E402
+from generation import generate_best  # noqa: E402
+from machine import RESULTS, log, machine, pin_to_one_core  # noqa: E402
+from row import FUNCTIONS, SHORT  # noqa: E402
 
 
 def measure(sizes, gen_runs: int = 2) -> list[dict]:
@@ -35,15 +35,15 @@ def measure(sizes, gen_runs: int = 2) -> list[dict]:
         for n in sizes:
             path = files[f"chain_{n}"]
             gen_dir = Path(tmp) / f"chain_{n}"
-            run.log(f"[chain_{n}] symdyn generate --target c ...")
-            wall, cpu, robot, ops = run.generate_best(path, gen_dir, gen_runs)
+            log(f"[chain_{n}] symdyn generate --target c ...")
+            wall, cpu, robot, ops = generate_best(path, gen_dir, gen_runs)
             fns = casadi_route.casadi_functions(robot)
             out.append(
                 {
                     "n": n,
                     "gen_wall": wall,
                     "gen_cpu": cpu,
-                    "ops": {fn: ops[fn]["total"] for fn in run.FUNCTIONS},
+                    "ops": {fn: ops[fn]["total"] for fn in FUNCTIONS},
                     "casadi_ops": {
                         fn: casadi_route.flops(fns[fn])["total"] for fn in ("inverse_dynamics", "mass_matrix")
                     },
@@ -71,10 +71,10 @@ def plot(data: list[dict], path: Path) -> None:
 
     styles = {"inverse_dynamics": "o-", "mass_matrix": "s-", "coriolis_matrix": "^-"}
     for fn, style in styles.items():
-        ax2.plot(n, [d["ops"][fn] for d in data], style, label=f"symdyn {run.SHORT[fn]}")
+        ax2.plot(n, [d["ops"][fn] for d in data], style, label=f"symdyn {SHORT[fn]}")
     for fn, style in (("inverse_dynamics", "o:"), ("mass_matrix", "s:")):
         ax2.plot(
-            n, [d["casadi_ops"][fn] for d in data], style, color="gray", label=f"CasADi route {run.SHORT[fn]}"
+            n, [d["casadi_ops"][fn] for d in data], style, color="gray", label=f"CasADi route {SHORT[fn]}"
         )
     ax2.set_xlabel("joints")
     ax2.set_ylabel("operations per call")
@@ -100,18 +100,17 @@ def main(argv=None) -> int:
     if opts.from_json:
         data = json.loads(data_file.read_text())["chains"]
     else:
-        run.pin_to_one_core()
+        pin_to_one_core()
         data = measure(range(2, opts.max_joints + 1), opts.gen_runs)
         RESULTS.mkdir(parents=True, exist_ok=True)
-        data_file.write_text(json.dumps({"machine": run.machine(), "chains": data}, indent=1))
+        data_file.write_text(json.dumps({"machine": machine(), "chains": data}, indent=1))
     png = RESULTS / "scaling.png"
     plot(data, png)
     for d in data:
         print(
             f"chain_{d['n']:<3d} gen {d['gen_wall']:6.2f} s wall {d['gen_cpu']:6.2f} s CPU   "
             + "  ".join(
-                f"{run.SHORT[f]} {d['ops'][f]}"
-                for f in ("inverse_dynamics", "mass_matrix", "coriolis_matrix")
+                f"{SHORT[f]} {d['ops'][f]}" for f in ("inverse_dynamics", "mass_matrix", "coriolis_matrix")
             )
         )
     print(f"wrote {png}")

@@ -1,4 +1,6 @@
-"""Robots for the derivation benchmark (bench/derive.py) and their sympy.physics.mechanics twins.
+"""The robots of both benchmarks: bench/derive.py's arms and bench/run.py's robot files.
+
+For bench/derive.py (built in memory as symdyn Robots):
 
 * `generic_arm(n)`: an n-joint spatial arm in standard DH, every joint revolute,
   twists cycling 0, +pi/2, -pi/2, nonzero a and d, numeric masses, centres of
@@ -9,24 +11,45 @@
   centre of mass (3) and inertia tensor (6) replaced by free symbols, written in
   DH frame i and converted to the body frame. Motor inertia and friction are
   left out so that all three methods derive the same rigid-body equations.
-* `kane_model(robot)`: the same chain in sympy.physics.mechanics (frames,
-  points, rigid bodies, gravity as forces, u_i = qd_i), ready for KanesMethod.
+  Its sympy.physics.mechanics twin is built by bench/kane.py.
+
+For bench/run.py (robot files, as `symdyn generate` reads them):
+
+* `ROBOTS`: name -> robot file; `QUICK_ROBOTS`, `ARMS` (the arms the targets judge),
+  `URDF_TIPS` (URDF file -> tip link) and `load(path)`.
+* `puma560_float_text()`: examples/puma560.yaml with every twist pi/2 written as the
+  float 1.5707963267948966 (the robot `puma560_float`, file bench/chains/puma560_float.yaml,
+  written by `write_robot_files()` with the chains of bench/chains.py).
 """
 
 from __future__ import annotations
 
+import math
+import re
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
+import chains
 import sympy as sp
 
 from symdyn.model.robot import Friction, Link, Motor, Robot
-from symdyn.spatial.transform import Transform, rot_x
+from symdyn.spatial.transform import Transform
 
-__all__ = ["generic_arm", "puma560_symbolic", "kane_model", "KaneModel", "PUMA_FILE"]
+__all__ = [
+    "generic_arm",
+    "puma560_symbolic",
+    "puma560_float_text",
+    "write_robot_files",
+    "load",
+    "PUMA_FILE",
+    "ROBOTS",
+    "QUICK_ROBOTS",
+    "ARMS",
+    "URDF_TIPS",
+]
 
-PUMA_FILE = Path(__file__).resolve().parent.parent / "examples" / "puma560.yaml"
+PUMA_FILE = chains.PUMA_FILE
 GRAVITY = (0, 0, -9.81)
 _TWISTS = (sp.S.Zero, sp.pi / 2, -sp.pi / 2)
 _INERTIA_KEYS = ("xx", "xy", "xz", "yy", "yz", "zz")
@@ -119,7 +142,7 @@ def puma560_symbolic() -> tuple[Robot, str]:
                 base = load_robot(PUMA_FILE).resolved()
     links, params = [], []
     if base is not None:
-        origin = f"geometry from {PUMA_FILE.relative_to(PUMA_FILE.parent.parent)}"
+        origin = f"geometry from {PUMA_FILE.relative_to(chains.ROOT)}"
         for k, link in enumerate(base.links, start=1):
             m, com, tensor, syms = _inertial_symbols(k)
             com_b, inertia_b = _to_body(link.frame, com, tensor)
@@ -142,71 +165,77 @@ def puma560_symbolic() -> tuple[Robot, str]:
     return robot, origin
 
 
-# --------------------------------------------------------------------------- sympy.physics.mechanics
+# --------------------------------------------------------------------------- bench/run.py's robots
 
 
-@dataclass
-class KaneModel:
-    """The chain in sympy.physics.mechanics, with what KanesMethod needs."""
-
-    frame: object  # inertial ReferenceFrame
-    q: list  # generalized coordinates (dynamicsymbols)
-    u: list  # generalized speeds u_i = qd_i
-    kd_eqs: list
-    bodies: list
-    loads: list
+EXAMPLES = chains.ROOT / "examples"
+FLOAT_PUMA_FILE = chains.CHAIN_DIR / "puma560_float.yaml"
+HALF_PI = repr(math.pi / 2)  # "1.5707963267948966", the double nearest pi/2
+_PI_HALF_TWIST = re.compile(r"^(\s*alpha:\s*)(-?)pi/2\s*$", re.MULTILINE)
 
 
-def _orient_fixed(parent, R: sp.Matrix, name: str):
-    """A frame fixed in `parent` with parent_R_frame = R (an x rotation when possible)."""
-    from sympy.physics.mechanics import ReferenceFrame
+def puma560_float_text(path: Path = PUMA_FILE) -> str:
+    """examples/puma560.yaml with every twist `pi/2` written as the float 1.5707963267948966.
 
-    if sp.eye(3) == R:
-        return parent
-    frame = ReferenceFrame(name)
-    if R[0, 0] == 1:
-        angle = sp.atan2(R[2, 1], R[1, 1])
-        if sp.Matrix(rot_x(angle)) == R:
-            frame.orient_axis(parent, parent.x, angle)
-            return frame
-    frame.orient_explicit(parent, R)  # sets parent.dcm(frame) = R
-    return frame
+    Text substitution on the file, so every other field (and the source comments) stays as
+    published; only the twists alpha_i = +-pi/2 of the standard DH table and the robot's name
+    change. cos(1.5707963267948966) is 6.1e-17, not 0: a loader that keeps the float carries
+    those terms through the derivation, where the exact pi/2 makes them vanish.
+    """
+    text, count = _PI_HALF_TWIST.subn(rf"\g<1>\g<2>{HALF_PI}", path.read_text(encoding="utf-8"))
+    assert count == 4, f"expected the PUMA 560's four pi/2 twists, found {count}"
+    text, renamed = re.subn(r"^name: puma560$", "name: puma560_float", text, flags=re.MULTILINE)
+    assert renamed == 1
+    header = (
+        f"# examples/puma560.yaml with every twist pi/2 written as the float {HALF_PI}.\n"
+        "# Written by bench/robots.py; do not edit by hand.\n"
+    )
+    return header + text
 
 
-def _vector(frame, v) -> object:
-    return sum((sp.sympify(c) * e for c, e in zip(v, (frame.x, frame.y, frame.z), strict=True)), 0 * frame.x)
+def _panda_urdf() -> Path | None:
+    """The Franka Panda URDF that example-robot-data (the test extra) ships, if installed."""
+    try:
+        from importlib.metadata import PackageNotFoundError, distribution
+
+        share = "cmeel.prefix/share/example-robot-data/robots"
+        robots = distribution("example-robot-data").locate_file(share)
+    except (ImportError, PackageNotFoundError):
+        return None
+    path = Path(str(robots)) / "panda_description" / "urdf" / "panda.urdf"
+    return path if path.is_file() else None
 
 
-def kane_model(robot: Robot) -> KaneModel:
-    """Frames, points and rigid bodies of `robot` (revolute joints only) for KanesMethod."""
-    from sympy.physics.mechanics import Point, ReferenceFrame, RigidBody, dynamicsymbols, inertia
+ROBOTS = {  # name -> robot file (chains are written by bench/chains.py)
+    "roger_arm_values": EXAMPLES / "roger_arm_values.yaml",
+    "puma560": PUMA_FILE,
+    "puma560_float": FLOAT_PUMA_FILE,
+    "stanford": EXAMPLES / "stanford.yaml",
+    "panda": EXAMPLES / "panda.yaml",
+    "chain_9": chains.chain_file(9),
+    "chain_12": chains.chain_file(12),
+}
+URDF_TIPS: dict[Path, str] = {}  # URDF file -> the tip link of its chain
+if (_urdf := _panda_urdf()) is not None:  # the same arm as panda.yaml, through the URDF loader
+    ROBOTS["panda_urdf"] = _urdf
+    URDF_TIPS[_urdf] = "panda_hand"
+QUICK_ROBOTS = ("roger_arm_values", "puma560", "panda")
+ARMS = ("puma560", "stanford", "panda")  # the issue's "6-7 joint arms with numeric parameters"
 
-    n = robot.n
-    q = list(dynamicsymbols(f"q1:{n + 1}"))
-    u = list(dynamicsymbols(f"u1:{n + 1}"))
-    N = ReferenceFrame("N")
-    O = Point("O")
-    O.set_vel(N, 0)
-    g = _vector(N, robot.gravity)
-    parent, origin = N, O
-    bodies, loads = [], []
-    for i, link in enumerate(robot.links):
-        if link.joint != "revolute":
-            raise ValueError("kane_model handles revolute joints only")
-        k = i + 1
-        fixed = _orient_fixed(parent, sp.Matrix(link.placement.R), f"P{k}")
-        B = ReferenceFrame(f"B{k}")
-        axis = _vector(fixed, link.axis)
-        B.orient_axis(fixed, axis, q[i])
-        B.set_ang_vel(fixed, u[i] * _vector(B, link.axis))
-        Oi = origin.locatenew(f"O{k}", _vector(parent, link.placement.p))
-        Oi.v2pt_theory(origin, N, parent)
-        Ci = Oi.locatenew(f"C{k}", _vector(B, link.com))
-        Ci.v2pt_theory(Oi, N, B)
-        I = sp.Matrix(link.inertia)
-        dyadic = inertia(B, I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[0, 2])
-        bodies.append(RigidBody(f"body{k}", Ci, B, link.mass, (dyadic, Ci)))
-        loads.append((Ci, link.mass * g))
-        parent, origin = B, Oi
-    kd = [qi.diff(dynamicsymbols._t) - ui for qi, ui in zip(q, u, strict=True)]
-    return KaneModel(N, q, u, kd, bodies, loads)
+
+def write_robot_files() -> dict[str, Path]:
+    """(Re)write bench/chains/*.yaml and puma560_float.yaml if their text changed; {name: path}."""
+    files = chains.write_robot_files()
+    text = puma560_float_text()
+    if not FLOAT_PUMA_FILE.exists() or FLOAT_PUMA_FILE.read_text(encoding="utf-8") != text:
+        FLOAT_PUMA_FILE.write_text(text, encoding="utf-8")
+    return {**files, "puma560_float": FLOAT_PUMA_FILE}
+
+
+def load(path: Path) -> Robot:
+    """The robot of a file of ROBOTS (or bench/chains/), through symdyn's loaders."""
+    from symdyn.parsers import load as load_any
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # implausible-but-published inertia (PUMA link 1)
+        return load_any(path, tip=URDF_TIPS.get(path))

@@ -1,0 +1,279 @@
+"""The compiled harnesses of bench/run.py: symdyn's C and the CasADi route's C, built and timed.
+
+One small C program per robot (`HARNESS`) links symdyn's NAME_dynamics.c and the CasADi
+route's CodeGenerator C (separate translation units, compiled with machine.FLAGS, no LTO).
+`STATES check K` prints every function's output at the first K states (`check_c` compares
+them with symdyn.rnea); `STATES time REPS TARGET_MS` prints ns per call of every repetition,
+the repetitions interleaved across the functions. `time_compiled` runs this program and
+bench/pin_harness.py's Pinocchio program in alternating rounds and keeps the medians.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from pathlib import Path
+
+import casadi_route
+import numpy as np
+from machine import C_COMPILER, FLAGS, run
+from row import FUNCTIONS, Row
+from states import CHECK_TOL, NCHECK, NSTATES, rel_err
+
+__all__ = ["HARNESS", "parse_harness", "build_c", "check_c", "time_compiled"]
+
+HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench/run.py), do not edit. */
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "{prefix}_dynamics.h"
+#include "cr_{name}.h"
+
+#define N {n}
+#define K {nstates}
+#define MAXREPS 1000
+#define NB 10
+
+static double Q[K][N], QD[K][N], QDD[K][N], TAU[K][N];
+static double OUT[N * N];
+static volatile double sink;
+static const double *P = NULL; /* numeric robot: no free parameters */
+static const casadi_real *cr_arg[64];
+static casadi_real *cr_res[64];
+static casadi_int *cr_iw;
+static casadi_real *cr_w;
+
+static const char *LABELS[NB] = {{
+    "inverse_dynamics", "cr_inverse_dynamics", "mass_matrix", "cr_mass_matrix", "gravity",
+    "cr_gravity", "coriolis_matrix", "coriolis", "friction", "forward_dynamics"}};
+
+static double now_ns(void)
+{{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
+}}
+
+static void cr_work(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_int *),
+                    casadi_int *sz_iw, casadi_int *sz_w)
+{{
+    casadi_int a, r, i, w;
+    work(&a, &r, &i, &w);
+    if (a > 64 || r > 64) {{
+        fprintf(stderr, "casadi work sizes too large\n");
+        exit(2);
+    }}
+    if (i > *sz_iw) *sz_iw = i;
+    if (w > *sz_w) *sz_w = w;
+}}
+
+#define CR(FN, ...)                                                                       \
+    do {{                                                                                  \
+        const casadi_real *a_[] = {{__VA_ARGS__}};                                         \
+        memcpy(cr_arg, a_, sizeof a_);                                                    \
+        cr_res[0] = OUT;                                                                  \
+        FN(cr_arg, cr_res, cr_iw, cr_w, 0);                                               \
+    }} while (0)
+
+/* IT calls of CALL on states k = 0, 1, ... (cycling: the state changes every call), one output
+   element per call into the volatile sink. */
+#define LOOP(OUTLEN, CALL)                                                                \
+    {{                                                                                     \
+        long i_;                                                                          \
+        int k = 0;                                                                        \
+        for (i_ = 0; i_ < it; ++i_) {{                                                     \
+            CALL;                                                                         \
+            sink += OUT[k % (OUTLEN)];                                                    \
+            if (++k == K) k = 0;                                                          \
+        }}                                                                                 \
+    }}                                                                                     \
+    break
+
+/* ns per call of benchmark b over `it` calls */
+static double run_bench(int b, long it)
+{{
+    double s = now_ns();
+    switch (b) {{
+    case 0: LOOP(N, {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT));
+    case 1: LOOP(N, CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]));
+    case 2: LOOP(N * N, {prefix}_mass_matrix(Q[k], P, OUT));
+    case 3: LOOP(N * N, CR(cr_{prefix}_mass_matrix, Q[k]));
+    case 4: LOOP(N, {prefix}_gravity(Q[k], P, OUT));
+    case 5: LOOP(N, CR(cr_{prefix}_gravity, Q[k]));
+    case 6: LOOP(N * N, {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT));
+    case 7: LOOP(N, {prefix}_coriolis(Q[k], QD[k], P, OUT));
+    case 8: LOOP(N, {prefix}_friction(QD[k], P, OUT));
+    case 9: LOOP(N, {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT));
+    default: return -1.0;
+    }}
+    return (now_ns() - s) / (double)it;
+}}
+
+static void print_out(const char *label, int k, int len)
+{{
+    int i;
+    printf("check %s %d", label, k);
+    for (i = 0; i < len; ++i) printf(" %.17g", OUT[i]);
+    printf("\n");
+}}
+
+int main(int argc, char **argv)
+{{
+    static double ns[NB][MAXREPS];
+    long iters[NB];
+    FILE *f;
+    int k, b, r, reps;
+    double target_ns;
+    casadi_int sz_iw = 1, sz_w = 1;
+    if (argc < 3) {{
+        fprintf(stderr, "usage: %s STATES check NCHECK | STATES time REPS TARGET_MS\n", argv[0]);
+        return 2;
+    }}
+    f = fopen(argv[1], "rb");
+    if (!f) {{
+        perror(argv[1]);
+        return 2;
+    }}
+    for (k = 0; k < K; ++k) {{
+        if (fread(Q[k], sizeof(double), N, f) != N || fread(QD[k], sizeof(double), N, f) != N
+            || fread(QDD[k], sizeof(double), N, f) != N || fread(TAU[k], sizeof(double), N, f) != N) {{
+            fprintf(stderr, "short states file\n");
+            return 2;
+        }}
+    }}
+    fclose(f);
+    cr_work(cr_{prefix}_inverse_dynamics_work, &sz_iw, &sz_w);
+    cr_work(cr_{prefix}_mass_matrix_work, &sz_iw, &sz_w);
+    cr_work(cr_{prefix}_gravity_work, &sz_iw, &sz_w);
+    cr_iw = malloc(sizeof(casadi_int) * (size_t)sz_iw);
+    cr_w = malloc(sizeof(casadi_real) * (size_t)sz_w);
+
+    if (strcmp(argv[2], "check") == 0) {{
+        int ncheck = argc > 3 ? atoi(argv[3]) : 4;
+        for (k = 0; k < ncheck && k < K; ++k) {{
+            {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT); print_out("inverse_dynamics", k, N);
+            {prefix}_mass_matrix(Q[k], P, OUT); print_out("mass_matrix", k, N * N);
+            {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT); print_out("coriolis_matrix", k, N * N);
+            {prefix}_coriolis(Q[k], QD[k], P, OUT); print_out("coriolis", k, N);
+            {prefix}_gravity(Q[k], P, OUT); print_out("gravity", k, N);
+            {prefix}_friction(QD[k], P, OUT); print_out("friction", k, N);
+            {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT); print_out("forward_dynamics", k, N);
+            CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]); print_out("cr_inverse_dynamics", k, N);
+            CR(cr_{prefix}_mass_matrix, Q[k]); print_out("cr_mass_matrix", k, N * N);
+            CR(cr_{prefix}_gravity, Q[k]); print_out("cr_gravity", k, N);
+        }}
+        return 0;
+    }}
+    reps = argc > 3 ? atoi(argv[3]) : 11;
+    if (reps < 1) reps = 1;
+    if (reps > MAXREPS) reps = MAXREPS;
+    target_ns = 1e6 * (argc > 4 ? atof(argv[4]) : 10.0);
+    /* calibrate (this also warms up): iterations per repetition for ~target_ns */
+    for (b = 0; b < NB; ++b) {{
+        long it = 64;
+        double t;
+        while ((t = run_bench(b, it) * (double)it) < 0.25 * target_ns) it *= 2;
+        iters[b] = (long)(target_ns / (t / (double)it)) + 1;
+        run_bench(b, iters[b]);
+    }}
+    /* repetitions interleaved across the functions, so a change of machine load during the run
+       falls on all of them alike */
+    for (r = 0; r < reps; ++r)
+        for (b = 0; b < NB; ++b) ns[b][r] = run_bench(b, iters[b]);
+    for (b = 0; b < NB; ++b) {{
+        printf("time %s %ld", LABELS[b], iters[b]);
+        for (r = 0; r < reps; ++r) printf(" %.3f", ns[b][r]);
+        printf("\n");
+    }}
+    return 0;
+}}
+"""
+
+
+def parse_harness(text: str) -> tuple[dict, dict]:
+    """('check' lines -> {label: {k: values} or max error}, 'time' lines -> {label: [ns per rep]})."""
+    checks: dict = {}
+    times: dict = {}
+    for line in text.splitlines():
+        parts = line.split()
+        if not parts:
+            continue
+        if parts[0] == "check" and len(parts) > 3:
+            checks.setdefault(parts[1], {})[int(parts[2])] = np.array([float(x) for x in parts[3:]])
+        elif parts[0] == "check" and len(parts) == 3:
+            checks[parts[1]] = float(parts[2])
+        elif parts[0] == "time":
+            times[parts[1]] = [float(x) for x in parts[3:]]
+    return checks, times
+
+
+def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
+    """Write the CasADi route's C and the harness; compile all three with FLAGS."""
+    casadi_route.write_c(fns, f"cr_{row.name}", work)
+    harness = work / f"bench_{row.name}.c"
+    harness.write_text(HARNESS.format(name=row.name, prefix=robot.name, n=robot.n, nstates=NSTATES))
+    exe = work / f"bench_{row.name}"
+    sources = [harness, gen_dir / f"{robot.name}_dynamics.c", work / f"cr_{row.name}.c"]
+    t0 = time.perf_counter()
+    run([C_COMPILER, *FLAGS, "-I", gen_dir, "-I", work, "-o", exe, *sources, "-lm"])
+    row.notes.append(f"C build {time.perf_counter() - t0:.1f} s")
+    return exe
+
+
+def check_c(row: Row, robot, exe: Path, states_file: Path, states, refs: list[dict]) -> None:
+    """Compare the harness's outputs at the first NCHECK states with `refs` (see `references`)."""
+    checks, _ = parse_harness(run([exe, states_file, "check", NCHECK]).stdout)
+    worst: dict[str, float] = {}
+    for k in range(NCHECK):
+        ref = refs[k]
+        qd = states["qd"][k]
+        n = robot.n
+        got = {fn: checks[fn][k] for fn in FUNCTIONS}
+        errs = {
+            "inverse_dynamics": rel_err(got["inverse_dynamics"], ref["inverse_dynamics"]),
+            "mass_matrix": rel_err(got["mass_matrix"], ref["mass_matrix"]),
+            # C itself is not unique; C qd = V is what the oracle can judge.
+            "coriolis_matrix": rel_err(got["coriolis_matrix"].reshape(n, n) @ qd, ref["coriolis"]),
+            "coriolis": rel_err(got["coriolis"], ref["coriolis"]),
+            "gravity": rel_err(got["gravity"], ref["gravity"]),
+            "friction": rel_err(got["friction"], ref["friction"]),
+            "forward_dynamics": rel_err(got["forward_dynamics"], ref["forward_dynamics"]),
+            "cr_inverse_dynamics": rel_err(checks["cr_inverse_dynamics"][k], ref["inverse_dynamics"]),
+            "cr_mass_matrix": rel_err(checks["cr_mass_matrix"][k], ref["mass_matrix"].T.ravel()),
+            "cr_gravity": rel_err(checks["cr_gravity"][k], ref["gravity"]),
+        }
+        for key, e in errs.items():
+            worst[key] = max(worst.get(key, 0.0), e)
+    row.checks.update({f"C {k}": v for k, v in worst.items()})
+    bad = {k: v for k, v in worst.items() if not v <= CHECK_TOL}
+    if bad:
+        raise SystemExit(f"{row.name}: compiled code disagrees with symdyn.rnea: {bad}")
+
+
+def time_compiled(row: Row, c_cmd: list, pin_cmd: list | None, opts) -> None:
+    """Time the C harness and (if given) the Pinocchio harness in alternating rounds.
+
+    Each harness interleaves its functions repetition by repetition; running the two
+    programs in `opts.rounds` alternating rounds of reps/rounds repetitions spreads any
+    change of machine load over both. The median is over all repetitions of all rounds.
+    """
+    samples: dict[str, list[float]] = {}
+    per_round = max(1, -(-opts.reps // opts.rounds))
+    for _ in range(opts.rounds):
+        for cmd, prefix in ((c_cmd, ""), (pin_cmd, "pin_")):
+            if cmd is None:
+                continue
+            _, times = parse_harness(run([*cmd, per_round, opts.target_ms]).stdout)
+            for label, values in times.items():
+                samples.setdefault(prefix + label, []).extend(values)
+    row.samples = samples
+    for label, values in samples.items():
+        med = statistics.median(values)
+        if label.startswith("pin_"):
+            row.pin_ns[label[4:]] = med
+        elif label.startswith("cr_"):
+            row.cr_c_ns[label[3:]] = med
+        else:
+            row.c_ns[label] = med
