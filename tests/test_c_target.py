@@ -37,7 +37,7 @@ from cbuild import (
 )
 
 import symdyn.codegen
-from symdyn.codegen import c_target
+from symdyn.codegen import c as c_backend
 from symdyn.codegen.render import RenderContext
 from symdyn.parsers import load_robot, robot_from_data
 
@@ -78,7 +78,7 @@ class Builds:
         key = (robot, precision)
         if key not in self._files:
             ctx = dataclasses.replace(self.context(robot), precision=precision)
-            self._files[key] = c_target.render(ctx)
+            self._files[key] = c_backend.render(ctx)
         return self._files[key]
 
     def directory(self, robot: str, precision: str) -> Path:
@@ -456,8 +456,8 @@ def test_rendering_does_not_depend_on_hash_seed(tmp_path):
 def test_printer():
     x, y, z = sp.symbols("x y z")
     names = {x: "x", y: "y", z: "z"}
-    pd = c_target.CPrinter(names, "double")
-    pf = c_target.CPrinter(names, "float")
+    pd = c_backend.CPrinter(names, "double")
+    pf = c_backend.CPrinter(names, "float")
     assert pd.doprint(x**2) == "x*x"
     assert pd.doprint(x**3 * y) in ("x*x*x*y", "y*x*x*x")
     assert pd.doprint(1 / x) == "1.0/x"
@@ -521,14 +521,14 @@ def _clash_robot(temporary_like: bool):
 
 def _check_clash_robot(robot, tmp_path, bad: tuple[str, ...]):
     ctx = symdyn.codegen.context(robot)
-    names = c_target.c_names(ctx)
+    names = c_backend.c_names(ctx)
     local = {str(s): v for s, v in names.locals.items()}
     for name in bad:
         assert local[name] != name
     assert len(set(names.locals.values())) == len(names.locals)
     assert "CLASH_P_M" not in dict(names.aliases)  # m and M would both become CLASH_P_M
     assert "CLASH_P_G" in dict(names.aliases)
-    files = c_target.render(ctx)
+    files = c_backend.render(ctx)
     write_files(files, tmp_path)
     macros = header_macros(files["clash_dynamics.h"])
     params = ctx.dynamics.params
