@@ -33,7 +33,8 @@ import pytest
 import sympy as sp
 from robots import EXAMPLE_NAMES, assert_close, derived, example, random_params, random_state
 
-from symdyn.codegen import FUNCTION_NAMES, casadi_target
+from symdyn.codegen import FUNCTION_NAMES
+from symdyn.codegen import casadi as casadi_backend
 from symdyn.codegen import render as render_targets
 from symdyn.codegen.functions import build_functions
 from symdyn.codegen.render import RenderContext
@@ -53,7 +54,7 @@ def _context(name: str) -> RenderContext:
 
 @cache
 def _files(name: str) -> dict[str, str | bytes]:
-    return casadi_target.render(_context(name))
+    return casadi_backend.render(_context(name))
 
 
 @dataclass
@@ -347,7 +348,7 @@ def test_casadi_codegen_compiles(generated, tmp_path):
 
 def test_printer():
     x, y, z = sp.symbols("x y z")
-    pr = casadi_target.CasadiPrinter({x: "q[0]", y: "p[1]", z: "x3"})
+    pr = casadi_backend.CasadiPrinter({x: "q[0]", y: "p[1]", z: "x3"})
     assert pr.doprint(x**2 * y) == "p[1]*q[0]*q[0]"
     assert pr.doprint(1 / x**2) == "1/(q[0]*q[0])"
     assert pr.doprint(y / (x * z)) == "p[1]/(q[0]*x3)"
