@@ -22,7 +22,7 @@ from .render import PRECISIONS, RenderContext
 
 __all__ = ["generate", "render", "TARGETS", "FUNCTION_NAMES"]
 
-TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex_target"}
+TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex"}
 
 
 def _target_module(name: str):
