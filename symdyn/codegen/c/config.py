@@ -28,13 +28,15 @@ log1p log2 logb lrint lround modf nan nearbyint nextafter nexttoward pow remaind
 rint round scalbln scalbn sin sinh sqrt tan tanh tgamma trunc
 """.split()  # noqa: SIM905
 
+#: Functions POSIX (and the BSDs) add to <math.h>, each with float and long double variants in glibc.
+_POSIX_FUNCTIONS = "j0 j1 jn y0 y1 yn gamma drem finite isinf isnan scalb significand".split()  # noqa: SIM905
+
 #: Names a local variable of the generated C must not take: keywords, everything <math.h>
 #: may declare or define (C99 and POSIX), and the argument names of the seven functions.
 C_RESERVED = frozenset(
     set(C_KEYWORDS)
-    | set(_MATH_FUNCTIONS)
-    | {f + "f" for f in _MATH_FUNCTIONS}
-    | {f + "l" for f in _MATH_FUNCTIONS}
+    | {f + suffix for f in _MATH_FUNCTIONS + _POSIX_FUNCTIONS for suffix in ("", "f", "l")}
+    | {"lgamma_r", "lgammaf_r", "lgammal_r"}
     | set(
         """
         HUGE_VAL HUGE_VALF HUGE_VALL INFINITY NAN FP_INFINITE FP_NAN FP_NORMAL FP_SUBNORMAL
@@ -42,8 +44,7 @@ C_RESERVED = frozenset(
         MATH_ERREXCEPT math_errhandling fpclassify isfinite isinf isnan isnormal signbit
         isgreater isgreaterequal isless islessequal islessgreater isunordered float_t
         double_t M_E M_LOG2E M_LOG10E M_LN2 M_LN10 M_PI M_PI_2 M_PI_4 M_1_PI M_2_PI
-        M_2_SQRTPI M_SQRT2 M_SQRT1_2 j0 j1 jn y0 y1 yn gamma signgam errno drem finite
-        significand main NULL
+        M_2_SQRTPI M_SQRT2 M_SQRT1_2 signgam errno main NULL
         q qd qdd tau p M C V G F
         """.split()  # noqa: SIM905
     )
