@@ -24,7 +24,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import sympy as sp
 from cbuild import (
     SANITIZE_FLAGS,
     STRICT_FLAGS,
@@ -450,34 +449,7 @@ def test_rendering_does_not_depend_on_hash_seed(tmp_path):
     assert outputs[0] == outputs[1]
 
 
-# --- the printer and names ------------------------------------------------------------------
-
-
-def test_printer():
-    x, y, z = sp.symbols("x y z")
-    names = {x: "x", y: "y", z: "z"}
-    pd = c_backend.CPrinter(names, "double")
-    pf = c_backend.CPrinter(names, "float")
-    assert pd.doprint(x**2) == "x*x"
-    assert pd.doprint(x**3 * y) in ("x*x*x*y", "y*x*x*x")
-    assert pd.doprint(1 / x) == "1.0/x"
-    assert pd.doprint(y / x**2) == "y/(x*x)"
-    assert pd.doprint((x + y) ** 2) == "(x + y)*(x + y)"
-    assert pd.doprint(-x) == "-x"
-    assert pd.doprint(x - y) in ("x - y", "-y + x")
-    assert pd.doprint(sp.sqrt(x)) == "sqrt(x)"
-    assert pd.doprint(sp.sign(x)) == "((double)((x > 0) - (x < 0)))"
-    assert pf.doprint(sp.sign(x)) == "((float)((x > 0) - (x < 0)))"
-    assert pf.doprint(sp.sin(x) + sp.cos(y)) in ("sinf(x) + cosf(y)", "cosf(y) + sinf(x)")
-    assert pf.doprint(sp.Rational(1, 2) * x) == "0.5f*x"
-    assert pd.doprint(2 * x) == "2.0*x"
-    assert pd.doprint(sp.pi * x) == "3.141592653589793*x"
-    assert float(pd.doprint(sp.pi**2)) == pytest.approx(np.pi**2, rel=1e-15)
-    third = pd.doprint(sp.Rational(1, 3))
-    assert float(third) == 1 / 3 and len(third.replace(".", "")) >= 16
-    assert pd.doprint(sp.Float("0.1", 17)) == "0.1"
-    assert pd.doprint(x * (y + z)) in ("x*(y + z)", "(y + z)*x")
-    assert pd.doprint(-x * (y + z)) in ("-x*(y + z)", "-(y + z)*x")
+# --- names (the printer has tests/test_c_printer.py) ------------------------------------
 
 
 def _clash_robot(temporary_like: bool):
