@@ -67,7 +67,7 @@ def test_reserved_names_cover_math_h(defines):
     assert sorted(functions - C_RESERVED) == []
 
 
-def _robot_with_parameters(names: list[str]):
+def robot_with_parameters(names: list[str]):
     """One revolute link whose mass, inertia and friction are sums of the given parameter names
     (each field below the robot file's expression length limit)."""
     fields = [names[k::3] for k in range(3)]
@@ -106,7 +106,7 @@ def test_every_reserved_name_as_a_parameter(tmp_path):
         and not re.fullmatch(r"(q|qd|qdd|tau)[0-9]+", n)
     )
     names = [*accepted, "x0", "x0_", "x12", "reserved_NDOF", "reserved_P_M"]
-    robot = _robot_with_parameters(names)
+    robot = robot_with_parameters(names)
     ctx = symdyn.codegen.context(robot)
     assert sorted(str(p) for p in ctx.dynamics.params) == sorted(names)
     c_names = c_backend.c_names(ctx)

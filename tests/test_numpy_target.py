@@ -222,17 +222,3 @@ def test_float_precision(tmp_path):
     assert tau_.dtype == np.float32
     params = dict(zip(mod.PARAM_NAMES, p, strict=True))
     _close(tau_, rn.rnea(_robot(EXAMPLES / "roger_arm.yaml"), q, qd, qdd, params), rtol=1e-4)
-
-
-def test_printer():
-    import sympy as sp
-
-    x, y = sp.symbols("x y")
-    pr = numpy_backend.NumpyPrinter({x: "p_x"})
-    assert pr.doprint(x**2 * y) == "(p_x*p_x)*y"
-    assert pr.doprint(1 / x**2) == "1/(p_x*p_x)"
-    assert pr.doprint(sp.Rational(1, 3) * y) == "0.3333333333333333*y"
-    assert pr.doprint(sp.sign(y) + sp.sin(x)) == "np.sin(p_x) + np.sign(y)"
-    assert pr.doprint(-sp.Rational(1, 2) * x / (x + y) ** 2) == "-0.5*p_x/((p_x + y)*(p_x + y))"
-    assert pr.doprint((x + y) ** 3) == "(p_x + y)*(p_x + y)*(p_x + y)"
-    assert pr.doprint(sp.Float(0.1) + sp.Float(0.2)) == repr(0.1 + 0.2)
