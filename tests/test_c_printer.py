@@ -144,7 +144,7 @@ def test_sign_idiom(precision, tmp_path):
         assert got == float(sp.sign(sp.Float(a) - sp.Float(b))), (a, b)
 
 
-def _doubles() -> np.ndarray:
+def awkward_doubles() -> np.ndarray:
     """Awkward doubles: short and long decimals, extremes, subnormals, and random ones."""
     rng = np.random.default_rng(2024)
     random = rng.uniform(1.0, 2.0, 200) * np.exp2(rng.integers(-1020, 1020, 200).astype(float))
@@ -153,46 +153,35 @@ def _doubles() -> np.ndarray:
     return np.concatenate([special, random])
 
 
+def _read_back(literals: list[str], precision: str, tmp_path) -> np.ndarray:
+    """The values the compiler makes of `literals`, in an array of the precision's type."""
+    table = f"static const {precision} table[] = {{{', '.join(literals)}}};"
+    copy = f"for (k = 0; k < {len(literals)}u; ++k) out[k] = table[k];"
+    lib = _library([table, "unsigned k;", copy], precision, tmp_path, "literals")
+    return _evaluate(lib, [0.0, 0.0, 0.0], len(literals), precision)
+
+
 def test_literals_round_trip_a_double(tmp_path):
     printer = CPrinter(NAMES)
-    values = _doubles()
+    values = awkward_doubles()
     literals = [printer.literal(v) for v in values]
     for v, text in zip(values, literals, strict=True):
         assert float(text) == v and any(c in text for c in ".eE"), text  # a floating literal
-    table = ", ".join(literals)
-    lib = _library(
-        [f"static const double table[] = {{{table}}};", "unsigned k;"]
-        + [f"for (k = 0; k < {len(values)}u; ++k) out[k] = table[k];"],
-        "double",
-        tmp_path,
-        "literals",
-    )
-    got = _evaluate(lib, [0.0, 0.0, 0.0], len(values), "double")
-    np.testing.assert_array_equal(got, values)  # the compiler reads back every bit
-    assert CPrinter(NAMES).doprint(sp.Rational(1, 3)) == repr(1 / 3)
-    assert CPrinter(NAMES).doprint(-sp.Float(0.1) * x) == "-0.1*x"
+    np.testing.assert_array_equal(_read_back(literals, "double", tmp_path), values)  # every bit
+    assert printer.doprint(sp.Rational(1, 3)) == repr(1 / 3)
+    assert printer.doprint(-sp.Float(0.1) * x) == "-0.1*x"
 
 
 def test_float_literals_carry_the_suffix(tmp_path):
     printer = CPrinter(NAMES, "float")
     rng = np.random.default_rng(7)
-    values = np.concatenate(
-        [[0.0, 0.1, 1 / 3, 1.0, 3.4e38], rng.uniform(1, 2, 50) * np.exp2(rng.integers(-120, 120, 50))]
-    )
+    scaled = rng.uniform(1, 2, 50) * np.exp2(rng.integers(-120, 120, 50))
+    values = np.concatenate([[0.0, 0.1, 1 / 3, 1.0, 3.4e38], scaled])
     literals = [printer.literal(v) for v in values]
     assert all(text.endswith("f") and float(text[:-1]) == v for v, text in zip(values, literals, strict=True))
-    table = ", ".join(literals)
-    lib = _library(
-        [f"static const float table[] = {{{table}}};", "unsigned k;"]
-        + [f"for (k = 0; k < {len(values)}u; ++k) out[k] = table[k];"],
-        "float",
-        tmp_path,
-        "float_literals",
-    )
-    got = _evaluate(lib, [0.0, 0.0, 0.0], len(values), "float")
-    nearest = values.astype(np.float32)
+    got = _read_back(literals, "float", tmp_path)
     # the compiler rounds the decimal to a nearest float: within half a float spacing of the value
-    assert np.all(np.abs(got - values) <= 0.5 * np.spacing(np.abs(nearest)) * (1 + 1e-6))
+    assert np.all(np.abs(got - values) <= 0.5 * np.spacing(np.abs(values.astype(np.float32))) * (1 + 1e-6))
 
 
 def test_float_precision_calls_float_functions():

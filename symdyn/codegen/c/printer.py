@@ -11,8 +11,9 @@ M_PI and an F suffix). The rules, docs/generated-code.md:
   digits); pi and other constants by their value;
 * under --precision float the literal suffix f and the float functions sinf, cosf, ...
 
-Each `_print` returns the text and its precedence (ADD < MUL < UNARY < ATOM), and an
-operand is parenthesised only when it binds less tightly than its context needs.
+Each node prints as its text and its precedence (ADD < MUL < UNARY < ATOM), and an
+operand is parenthesised only when it binds less tightly than its context needs
+(symdyn.codegen.printing).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...symbolic.simplify import MAX_UNROLLED_POWER
+from ..printing import TreePrinter
 from .config import MATH_CALLS, CConfig
 
 __all__ = ["CPrinter", "ADD", "MUL", "UNARY", "ATOM"]
@@ -30,7 +32,7 @@ __all__ = ["CPrinter", "ADD", "MUL", "UNARY", "ATOM"]
 ADD, MUL, UNARY, ATOM = 1, 3, 4, 5
 
 
-class CPrinter:
+class CPrinter(TreePrinter):
     """SymPy expression -> C99 expression text for one floating type ("double" or "float").
 
     `names` maps every symbol that may appear (input locals, temporaries) to its C name.
@@ -62,28 +64,15 @@ class CPrinter:
             return "-" + self.literal(-value), UNARY
         return self.literal(value), ATOM
 
-    # expressions
-    def doprint(self, e) -> str:
-        return self._print(sp.sympify(e))[0]
+    # the nodes
+    def _symbol(self, e: sp.Symbol) -> tuple[str, int]:
+        assert e in self.names, f"symbol '{e}' is neither an input nor a temporary"
+        return self.names[e], ATOM
 
-    def _wrap(self, e: sp.Expr, need: int) -> str:
-        text, prec = self._print(e)
-        return f"({text})" if prec < need else text
+    def _constant(self, e: sp.Expr) -> tuple[str, int]:
+        return self._number(e)
 
-    def _print(self, e: sp.Expr) -> tuple[str, int]:
-        if e.is_Symbol:
-            assert e in self.names, f"symbol '{e}' is neither an input nor a temporary"
-            return self.names[e], ATOM
-        if e.is_Number or e.is_NumberSymbol:
-            return self._number(e)
-        if e.is_Add:
-            return self._add(e)
-        if e.is_Mul:
-            return self._mul(e)
-        if e.is_Pow:
-            if not e.free_symbols:
-                return self._number(e)
-            return self._pow(e)
+    def _call(self, e: sp.Expr) -> tuple[str, int]:
         if isinstance(e, sp.sign):
             x = self._print(e.args[0])[0]
             return f"(({self.config.real})(({x} > 0) - ({x} < 0)))", ATOM
@@ -141,6 +130,8 @@ class CPrinter:
         return f"{top}/{bottom}", MUL
 
     def _pow(self, e: sp.Pow) -> tuple[str, int]:
+        if not e.free_symbols:
+            return self._number(e)
         base, exp = e.base, e.exp
         if exp.is_Integer and 0 < exp <= MAX_UNROLLED_POWER:
             b = self._wrap(base, ATOM)

@@ -15,6 +15,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...symbolic.simplify import MAX_UNROLLED_POWER
+from ..printing import TreePrinter
 
 __all__ = ["CasadiPrinter", "CASADI_FUNCTIONS", "input_names"]
 
@@ -44,7 +45,7 @@ CASADI_FUNCTIONS = {
 }
 
 
-class CasadiPrinter:
+class CasadiPrinter(TreePrinter):
     """Print SymPy expressions as Python over casadi SX values.
 
     `names` maps every symbol that may appear (input elements, temporaries) to
@@ -56,15 +57,7 @@ class CasadiPrinter:
         self.names = names
         self.uses_math = False
 
-    def doprint(self, expr) -> str:
-        return self._print(sp.sympify(expr))[0]
-
     # -- helpers -----------------------------------------------------------
-    def _wrap(self, expr, min_prec: int) -> str:
-        """Print `expr`, parenthesised unless it binds at least as tightly as min_prec."""
-        text, prec = self._print(expr)
-        return text if prec >= min_prec else f"({text})"
-
     @staticmethod
     def _float(value) -> str:
         return repr(float(value))
@@ -97,13 +90,14 @@ class CasadiPrinter:
             return "*".join([b] * k), _MUL
         return f"{b}**{k}", _POW
 
-    # -- the tree ----------------------------------------------------------
-    def _print(self, e) -> tuple[str, int]:
-        if e.is_Symbol:
-            try:
-                return self.names[e], _ATOM
-            except KeyError:
-                raise SymdynError(f"casadi target: unexpected symbol '{e}' in generated code") from None
+    # -- the nodes ---------------------------------------------------------
+    def _symbol(self, e: sp.Symbol) -> tuple[str, int]:
+        try:
+            return self.names[e], _ATOM
+        except KeyError:
+            raise SymdynError(f"casadi target: unexpected symbol '{e}' in generated code") from None
+
+    def _constant(self, e: sp.Expr) -> tuple[str, int]:
         if e is sp.pi:
             self.uses_math = True
             return "math.pi", _ATOM
@@ -112,12 +106,9 @@ class CasadiPrinter:
             return "math.e", _ATOM
         if e.is_Number:
             return self._number(e)
-        if e.is_Add:
-            return self._add(e)
-        if e.is_Mul:
-            return self._mul(e)
-        if e.is_Pow:
-            return self._pow(e)
+        raise SymdynError(f"casadi target: cannot print {type(e).__name__} ({e})")
+
+    def _call(self, e: sp.Expr) -> tuple[str, int]:
         if e.is_Function and e.func in CASADI_FUNCTIONS:
             args = ", ".join(self._print(a)[0] for a in e.args)
             return f"{CASADI_FUNCTIONS[e.func]}({args})", _ATOM
