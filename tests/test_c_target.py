@@ -24,7 +24,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import sympy as sp
 from cbuild import (
     SANITIZE_FLAGS,
     STRICT_FLAGS,
@@ -37,7 +36,7 @@ from cbuild import (
 )
 
 import symdyn.codegen
-from symdyn.codegen import c_target
+from symdyn.codegen import c as c_backend
 from symdyn.codegen.render import RenderContext
 from symdyn.parsers import load_robot, robot_from_data
 
@@ -78,7 +77,7 @@ class Builds:
         key = (robot, precision)
         if key not in self._files:
             ctx = dataclasses.replace(self.context(robot), precision=precision)
-            self._files[key] = c_target.render(ctx)
+            self._files[key] = c_backend.render(ctx)
         return self._files[key]
 
     def directory(self, robot: str, precision: str) -> Path:
@@ -450,34 +449,7 @@ def test_rendering_does_not_depend_on_hash_seed(tmp_path):
     assert outputs[0] == outputs[1]
 
 
-# --- the printer and names ------------------------------------------------------------------
-
-
-def test_printer():
-    x, y, z = sp.symbols("x y z")
-    names = {x: "x", y: "y", z: "z"}
-    pd = c_target.CPrinter(names, "double")
-    pf = c_target.CPrinter(names, "float")
-    assert pd.doprint(x**2) == "x*x"
-    assert pd.doprint(x**3 * y) in ("x*x*x*y", "y*x*x*x")
-    assert pd.doprint(1 / x) == "1.0/x"
-    assert pd.doprint(y / x**2) == "y/(x*x)"
-    assert pd.doprint((x + y) ** 2) == "(x + y)*(x + y)"
-    assert pd.doprint(-x) == "-x"
-    assert pd.doprint(x - y) in ("x - y", "-y + x")
-    assert pd.doprint(sp.sqrt(x)) == "sqrt(x)"
-    assert pd.doprint(sp.sign(x)) == "((double)((x > 0) - (x < 0)))"
-    assert pf.doprint(sp.sign(x)) == "((float)((x > 0) - (x < 0)))"
-    assert pf.doprint(sp.sin(x) + sp.cos(y)) in ("sinf(x) + cosf(y)", "cosf(y) + sinf(x)")
-    assert pf.doprint(sp.Rational(1, 2) * x) == "0.5f*x"
-    assert pd.doprint(2 * x) == "2.0*x"
-    assert pd.doprint(sp.pi * x) == "3.141592653589793*x"
-    assert float(pd.doprint(sp.pi**2)) == pytest.approx(np.pi**2, rel=1e-15)
-    third = pd.doprint(sp.Rational(1, 3))
-    assert float(third) == 1 / 3 and len(third.replace(".", "")) >= 16
-    assert pd.doprint(sp.Float("0.1", 17)) == "0.1"
-    assert pd.doprint(x * (y + z)) in ("x*(y + z)", "(y + z)*x")
-    assert pd.doprint(-x * (y + z)) in ("-x*(y + z)", "-(y + z)*x")
+# --- names (the printer has tests/test_c_printer.py) ------------------------------------
 
 
 def _clash_robot(temporary_like: bool):
@@ -521,14 +493,14 @@ def _clash_robot(temporary_like: bool):
 
 def _check_clash_robot(robot, tmp_path, bad: tuple[str, ...]):
     ctx = symdyn.codegen.context(robot)
-    names = c_target.c_names(ctx)
+    names = c_backend.c_names(ctx)
     local = {str(s): v for s, v in names.locals.items()}
     for name in bad:
         assert local[name] != name
     assert len(set(names.locals.values())) == len(names.locals)
     assert "CLASH_P_M" not in dict(names.aliases)  # m and M would both become CLASH_P_M
     assert "CLASH_P_G" in dict(names.aliases)
-    files = c_target.render(ctx)
+    files = c_backend.render(ctx)
     write_files(files, tmp_path)
     macros = header_macros(files["clash_dynamics.h"])
     params = ctx.dynamics.params

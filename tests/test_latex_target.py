@@ -24,7 +24,7 @@ import sympy as sp
 from robots import derived, example, m1, roger_arm_lecture, roger_eye_lecture
 from sympy.printing.latex import LatexPrinter
 
-from symdyn.codegen import latex_target
+from symdyn.codegen import latex as latex_backend
 from symdyn.codegen import render as render_targets
 from symdyn.dynamics import AUTO_SIMPLIFY_MAX_JOINTS
 
@@ -220,7 +220,7 @@ def _vector(entries: dict[str, str], name: str, n: int, read):
 
 
 def test_roger_arm_reads_back_as_the_lecture():
-    tex = latex_target.latex_document_body(_dynamics("roger_arm"))
+    tex = latex_backend.latex_document_body(_dynamics("roger_arm"))
     _, entries = _blocks(tex)
     read = _symbolic_reader()
     M = sp.Matrix(_matrix(entries, "M", 2, read, symmetric=True))
@@ -240,7 +240,7 @@ def test_roger_arm_reads_back_as_the_lecture():
 
 
 def test_roger_eye_reads_back_as_the_lecture():
-    _, entries = _blocks(latex_target.latex_document_body(_dynamics("roger_eye")))
+    _, entries = _blocks(latex_backend.latex_document_body(_dynamics("roger_eye")))
     read = _symbolic_reader()
     M_l, V_l, G_l = roger_eye_lecture()
     assert sp.expand(read(entries["M_{11}"]) - M_l[0, 0]) == 0
@@ -253,9 +253,9 @@ def test_every_example_renders_and_reads_back_as_the_oracle(name):
     """Parse M, V, G, F (and C) back, evaluate at random states, compare with the RNEA."""
     dyn = _dynamics(name)
     robot, n = dyn.robot, dyn.n
-    tex = latex_target.dynamics_latex(dyn)
+    tex = latex_backend.dynamics_latex(dyn)
     assert tex.startswith("% ") and "amsmath" in tex.splitlines()[0]
-    assert latex_target.dynamics_latex(dyn) == tex  # deterministic
+    assert latex_backend.dynamics_latex(dyn) == tex  # deterministic
     assert len(tex.encode()) < MAX_BYTES
     assert "\\documentclass" not in tex and "\\usepackage" not in tex.split("\n", 1)[1]
     assert not re.search(r"~|(?<![\\\w])_\w|qd\d|\bx\d", tex), "internal names leaked"
@@ -321,18 +321,18 @@ def test_file_through_the_codegen_entry_point():
     header = [ln for ln in lines if ln.startswith("% ")]
     assert any("amsmath" in ln for ln in header)
     # the file's body is the fragment of the simplified closed forms
-    assert text.endswith(latex_target.latex_document_body(_dynamics("roger_arm")))
+    assert text.endswith(latex_backend.latex_document_body(_dynamics("roger_arm")))
 
 
 def test_long_entries_break_over_lines():
-    tex = latex_target.latex_document_body(_dynamics("planar_3r"))
+    tex = latex_backend.latex_document_body(_dynamics("planar_3r"))
     assert r"&\qquad" in tex  # planar_3r's V_1 is longer than a line
 
 
 def test_parameter_names_like_the_notation_are_spelled_out():
     s1, x1, q1 = sp.symbols("s1 x1 q1")
     dyn = SimpleNamespace(n=1, q=[q1], qd=[sp.Symbol("qd1")], qdd=[sp.Symbol("qdd1")], params=(s1, x1, m1))
-    nt = latex_target._Notation(dyn)
+    nt = latex_backend.Notation(dyn)
     assert nt.params == [r"\mathrm{s1}", r"\mathrm{x1}", "m_{1}"]
     assert nt.latex(nt.prepare(s1 * sp.sin(q1))) == r"\mathrm{s1} s_{1}"
 
@@ -340,7 +340,7 @@ def test_parameter_names_like_the_notation_are_spelled_out():
 @pytest.mark.skipif(not (shutil.which("pdflatex") or shutil.which("latexmk")), reason="no pdflatex/latexmk")
 @pytest.mark.parametrize("name", ["roger_arm", "planar_3r", "puma560"])
 def test_fragment_compiles(name, tmp_path):
-    files = {f"{name}_dynamics.tex": latex_target.dynamics_latex(_dynamics(name))}
+    files = {f"{name}_dynamics.tex": latex_backend.dynamics_latex(_dynamics(name))}
     for file, text in files.items():
         (tmp_path / file).write_text(text)
     doc = tmp_path / "doc.tex"

@@ -1,9 +1,13 @@
 """Code generation: the seven functions of docs/generated-code.md rendered for C, CasADi, NumPy and LaTeX.
 
-A target is a module `symdyn.codegen.<target>` with `render(ctx) -> {file name:
-text or bytes}`: a small printer plus its templates in templates/<target>/.
-`generate` renders every requested target in memory first and writes nothing
-unless all of them succeed (symdyn.codegen.output).
+Each target is a backend package `symdyn.codegen.<backend>` (TARGETS maps target
+names to them) shaped like a SymForce backend: a config of names and a printer
+of SymPy expressions in the package, every statement of the target language in
+templates/<target>/*.j2, and `render(ctx) -> {file name: text or bytes}` in
+between, which passes the templates plain data. `TOOLS` in each backend says
+which tools' versions (besides symdyn's) the bytes of each of its files depend
+on. `generate` renders every requested target in memory first and writes
+nothing unless all of them succeed (symdyn.codegen.output).
 """
 
 from __future__ import annotations
@@ -20,15 +24,27 @@ from .functions import FUNCTION_NAMES, build_functions
 from .output import write_files
 from .render import PRECISIONS, RenderContext
 
-__all__ = ["generate", "render", "TARGETS", "FUNCTION_NAMES"]
+__all__ = ["generate", "render", "file_tools", "TARGETS", "FUNCTION_NAMES"]
 
-TARGETS = {"c": "c_target", "casadi": "casadi_target", "python": "numpy_target", "latex": "latex_target"}
+TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex"}
 
 
 def _target_module(name: str):
     if name not in TARGETS:
         raise SymdynError(f"unknown target '{name}' (one of {', '.join(TARGETS)})")
     return importlib.import_module(f"{__name__}.{TARGETS[name]}")
+
+
+def file_tools(file_name: str) -> tuple[str, ...]:
+    """The tools whose versions the bytes of a generated file depend on (sympy, casadi).
+
+    Read from the backends' TOOLS tables, keyed by how the file name ends.
+    """
+    tools = {ending: deps for target in TARGETS for ending, deps in _target_module(target).TOOLS.items()}
+    matches = sorted((e for e in tools if file_name.endswith(e)), key=len)
+    if not matches:
+        raise ValueError(f"{file_name}: not a file name any target generates")
+    return tools[matches[-1]]
 
 
 def context(robot: Robot, precision: str = "double", method: str = "newton-euler") -> RenderContext:

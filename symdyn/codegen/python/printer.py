@@ -1,14 +1,10 @@
-"""The NumPy target: `NAME_numpy.py`, a standalone module (imports only numpy).
+"""SymPy expression -> NumPy text, and the Python names of the NumPy backend.
 
-It holds the seven functions of docs/generated-code.md with the C target's names and
-arguments (p optional when the robot has no free parameters), plus NDOF,
-NPARAM and PARAM_NAMES. Every function evaluates the eliminated form of its
-FunctionSpec, one statement per temporary, elementwise: it works for one
-state (vectors of shape (n,)) or a batch with leading axes ((N, n); p either
-(k,) or (N, k)). The outputs are assembled by broadcasting every entry to the
-common leading shape, so constant entries (0) get the batch shape too.
-Inputs and outputs are float64 (DTYPE), float32 with precision "float".
-forward_dynamics is the unrolled LDL^T solve of the spec, elementwise as well.
+`NumpyPrinter` is SymPy's NumPyPrinter with `np.` functions, small integer
+powers as products (as the operation counts assume), floats and rationals in
+full precision (repr) and sign as np.sign. `local_names` gives every free
+parameter a Python name that shadows nothing the generated module defines.
+The statements around the expressions are spelled in templates/python/module.py.j2.
 """
 
 from __future__ import annotations
@@ -20,23 +16,17 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.precedence import PRECEDENCE
 
-from ..symbolic.simplify import MAX_UNROLLED_POWER
-from .functions import FunctionSpec
-from .render import RenderContext, environment, header_lines
+from ...symbolic.simplify import MAX_UNROLLED_POWER
+from ..render import RenderContext
 
-__all__ = ["render", "NumpyPrinter", "file_name"]
+__all__ = ["NumpyPrinter", "local_names", "dtype"]
 
 #: Names the generated function bodies use besides their locals.
 _RESERVED = frozenset(
     {"np", "q", "qd", "qdd", "tau", "p", "NDOF", "NPARAM", "PARAM_NAMES"}
     | {"_vector", "_params", "_assemble", "_lead"}
 )
-_MATRICES = ("M", "C")
 _GENERATED_NAME = re.compile(r"(x|q|qd|qdd|tau)[0-9]+\Z")
-
-
-def file_name(name: str) -> str:
-    return f"{name}_numpy.py"
 
 
 def _small_power(expr: sp.Expr) -> bool:
@@ -96,7 +86,7 @@ class NumpyPrinter(NumPyPrinter):
         return super().parenthesize(item, level, strict)
 
 
-def _local_names(ctx: RenderContext) -> dict[sp.Symbol, str]:
+def local_names(ctx: RenderContext) -> dict[sp.Symbol, str]:
     """Python names of the free parameters: their own name when that is safe, else p_<name>."""
     taken = set(_RESERVED)
     names: dict[sp.Symbol, str] = {}
@@ -111,57 +101,6 @@ def _local_names(ctx: RenderContext) -> dict[sp.Symbol, str]:
     return names
 
 
-def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
-    inputs = [inp for inp in spec.inputs if inp.name != "p"]
-    params = next((inp for inp in spec.inputs if inp.name == "p"), None)
-    free = spec.free_symbols
-    unpack = []
-    for inp in spec.inputs:
-        for k, s in enumerate(inp.symbols):
-            if s in free:
-                unpack.append(f"{printer.doprint(s)} = {inp.name}[..., {k}]")
-    body = [f"{printer.doprint(s)} = {printer.doprint(e)}" for s, e in spec.temporaries]
-    rows, cols = spec.shape
-    # vectors are (n, 1) specs; M and C stay matrices even for one joint (1, 1)
-    shape = (rows, cols) if spec.output in _MATRICES else (rows,)
-    entries = [printer.doprint(e) for e in spec.outputs]
-    args = [inp.name for inp in inputs] + (["p=None"] if params is not None else [])
-    return {
-        "name": spec.name,
-        "doc": spec.doc,
-        "args": ", ".join(args),
-        "inputs": [inp.name for inp in inputs],
-        "has_p": params is not None,
-        "lead": [inp.name for inp in spec.inputs],
-        "unpack": unpack,
-        "body": body,
-        "output": spec.output,
-        "shape": repr(shape),
-        "batch_shape": "(N, " + ", ".join(str(d) for d in shape) + ")",
-        "entries": entries,
-    }
-
-
-def _tuple_literal(items: list[str]) -> str:
-    quoted = [f'"{x}"' for x in items]
-    return "(" + ", ".join(quoted) + ("," if len(quoted) == 1 else "") + ")"
-
-
-def render(ctx: RenderContext) -> dict[str, str]:
-    """{NAME_numpy.py: module text} for the robot of `ctx`."""
-    printer = NumpyPrinter(_local_names(ctx))
-    functions = [_function(spec, printer) for spec in ctx.functions]
-    text = (
-        environment()
-        .get_template("python/module.py.j2")
-        .render(
-            header=header_lines(ctx),
-            name=ctx.name,
-            ndof=ctx.robot.n,
-            param_names=_tuple_literal([s.name for s in ctx.dynamics.params]),
-            nparam=len(ctx.dynamics.params),
-            dtype="float32" if ctx.precision == "float" else "float64",
-            functions=functions,
-        )
-    )
-    return {file_name(ctx.name): text}
+def dtype(precision: str) -> str:
+    """The NumPy dtype of every input and output for --precision double or float."""
+    return "float32" if precision == "float" else "float64"

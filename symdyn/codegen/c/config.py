@@ -1,0 +1,174 @@
+"""The C backend's configuration: floating type, literals, <math.h> names, reserved words, naming.
+
+Nothing here prints an expression or a statement (that is symdyn.codegen.c.printer
+and templates/c/): this module only decides *names*. `CConfig` holds what
+depends on --precision (the type `double` or `float`, the literal suffix,
+`sin` or `sinf`); `c_names` gives one robot's macros, function names and the
+locals its function bodies declare, collision-free against `C_RESERVED`.
+The contract of the names is docs/generated-code.md.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ...errors import SymdynError
+from ...model.expressions import C_KEYWORDS
+from ..render import PRECISIONS, RenderContext
+
+__all__ = ["CConfig", "CNames", "c_names", "C_RESERVED", "MATH_CALLS", "TEMPORARY"]
+
+_MATH_FUNCTIONS = """
+acos acosh asin asinh atan atan2 atanh cbrt ceil copysign cos cosh erf erfc exp exp2 expm1
+fabs fdim floor fma fmax fmin fmod frexp hypot ilogb ldexp lgamma llrint llround log log10
+log1p log2 logb lrint lround modf nan nearbyint nextafter nexttoward pow remainder remquo
+rint round scalbln scalbn sin sinh sqrt tan tanh tgamma trunc
+""".split()  # noqa: SIM905
+
+#: Functions POSIX (and the BSDs) add to <math.h>, each with float and long double variants in glibc.
+_POSIX_FUNCTIONS = "j0 j1 jn y0 y1 yn gamma drem finite isinf isnan scalb significand".split()  # noqa: SIM905
+
+#: Names a local variable of the generated C must not take: keywords, everything <math.h>
+#: may declare or define (C99 and POSIX), and the argument names of the seven functions.
+C_RESERVED = frozenset(
+    set(C_KEYWORDS)
+    | {f + suffix for f in _MATH_FUNCTIONS + _POSIX_FUNCTIONS for suffix in ("", "f", "l")}
+    | {"lgamma_r", "lgammaf_r", "lgammal_r"}
+    | set(
+        """
+        HUGE_VAL HUGE_VALF HUGE_VALL INFINITY NAN FP_INFINITE FP_NAN FP_NORMAL FP_SUBNORMAL
+        FP_ZERO FP_FAST_FMA FP_FAST_FMAF FP_FAST_FMAL FP_ILOGB0 FP_ILOGBNAN MATH_ERRNO
+        MATH_ERREXCEPT math_errhandling fpclassify isfinite isinf isnan isnormal signbit
+        isgreater isgreaterequal isless islessequal islessgreater isunordered float_t
+        double_t M_E M_LOG2E M_LOG10E M_LN2 M_LN10 M_PI M_PI_2 M_PI_4 M_1_PI M_2_PI
+        M_2_SQRTPI M_SQRT2 M_SQRT1_2 signgam errno main NULL
+        q qd qdd tau p M C V G F
+        """.split()  # noqa: SIM905
+    )
+)
+
+#: SymPy functions of one argument and their double-precision <math.h> names.
+MATH_CALLS = {sp.sin: "sin", sp.cos: "cos", sp.tan: "tan", sp.Abs: "fabs"}
+
+#: The names of the eliminated temporaries (symdyn.symbolic.simplify): x0, x1, ...
+TEMPORARY = re.compile(r"x[0-9]+\Z")
+
+
+@dataclass(frozen=True)
+class CConfig:
+    """What the generated C depends on besides the robot: the floating type ("double" or "float")."""
+
+    precision: str = "double"
+
+    def __post_init__(self) -> None:
+        if self.precision not in PRECISIONS:
+            raise SymdynError(f"unknown precision '{self.precision}' (double or float)")
+
+    @property
+    def real(self) -> str:
+        """The C type of every input, output, local and temporary."""
+        return self.precision
+
+    @property
+    def literal_suffix(self) -> str:
+        """Appended to every floating literal: 1.5f is a float constant, 1.5 a double."""
+        return "f" if self.precision == "float" else ""
+
+    def math(self, name: str) -> str:
+        """The <math.h> function for `name` (a double function) in this precision: sin or sinf."""
+        return name + self.literal_suffix
+
+
+@dataclass(frozen=True)
+class CNames:
+    """Every identifier the generated files define, and the locals of the function bodies."""
+
+    header_file: str
+    source_file: str
+    guard: str
+    ndof: str
+    nparam: str
+    param_pattern: str  # how the index macros are spelled, for the documentation: NAME_P_<name>
+    param_macros: tuple[tuple[str, int], ...]  # (NAME_P_<param>, index) in dyn.params order
+    aliases: tuple[tuple[str, str], ...]  # (UPPER_CASE alias, macro it stands for)
+    functions: dict[str, str]  # spec name -> C function name
+    locals: dict[sp.Symbol, str]  # input symbol -> C local name
+    param_macro: dict[sp.Symbol, str]  # parameter symbol -> its index macro
+
+
+def _aliases(written: list[str], taken: set[str]) -> tuple[tuple[str, str], ...]:
+    """UPPER_CASE aliases of the macros whose upper-case spelling is free and unambiguous."""
+    upper_count: dict[str, int] = {}
+    for m in written:
+        upper_count[m.upper()] = upper_count.get(m.upper(), 0) + 1
+    return tuple(
+        (m.upper(), m)
+        for m in written
+        if m.upper() != m and upper_count[m.upper()] == 1 and m.upper() not in taken
+    )
+
+
+def _joint_symbols(ctx: RenderContext) -> list[sp.Symbol]:
+    """The symbols of the q, qd, qdd and tau arguments, in first-use order over the functions."""
+    symbols: list[sp.Symbol] = []
+    for f in ctx.functions:
+        for inp in f.inputs:
+            if inp.name != "p":
+                symbols.extend(s for s in inp.symbols if s not in symbols)
+    return symbols
+
+
+def c_names(ctx: RenderContext) -> CNames:
+    """The file, macro, function and local names for one robot (deterministic, collision-free).
+
+    Joint symbols keep their names (q1, qd2, ...); a parameter whose name is reserved, taken
+    or looks like a temporary gets `_` then `_1`, `_2`, ... appended.
+    """
+    name = ctx.name
+    params = tuple(ctx.dynamics.params)
+    ndof, nparam = f"{name}_NDOF", f"{name}_NPARAM"
+    param_macros = tuple((f"{name}_P_{p}", k) for k, p in enumerate(params))
+    functions = {f.name: f"{name}_{f.name}" for f in ctx.functions}
+    guard = f"{name.upper()}_DYNAMICS_H"
+    written = [ndof, nparam] + [m for m, _ in param_macros]
+    taken = set(written) | set(functions.values()) | {guard}
+    aliases = _aliases(written, taken)
+
+    joint_symbols = _joint_symbols(ctx)
+    clash = sorted(str(p) for p in params if p in joint_symbols)
+    if clash:
+        raise SymdynError(
+            f"robot '{name}': parameter name(s) {', '.join(clash)} clash with the joint or effort "
+            "symbols of the generated functions"
+        )
+    reserved = C_RESERVED | taken | {a for a, _ in aliases}
+    used = {str(s) for s in joint_symbols}
+    local_names: dict[sp.Symbol, str] = {s: str(s) for s in joint_symbols}
+    for s in joint_symbols:
+        assert str(s) not in reserved and not TEMPORARY.match(str(s)), f"joint symbol '{s}' is a C name"
+    for p in params:
+        base = str(p)
+        candidate = base
+        k = 0
+        while candidate in reserved or candidate in used or TEMPORARY.match(candidate):
+            candidate = f"{base}_" if k == 0 else f"{base}_{k}"
+            k += 1
+        local_names[p] = candidate
+        used.add(candidate)
+    param_macro = {p: m for p, (m, _) in zip(params, param_macros, strict=True)}
+    return CNames(
+        header_file=f"{name}_dynamics.h",
+        source_file=f"{name}_dynamics.c",
+        guard=guard,
+        ndof=ndof,
+        nparam=nparam,
+        param_pattern=f"{name}_P_<name>",
+        param_macros=param_macros,
+        aliases=aliases,
+        functions=functions,
+        locals=local_names,
+        param_macro=param_macro,
+    )

@@ -1,0 +1,97 @@
+"""The C target: NAME_dynamics.h and NAME_dynamics.c (C99, no allocation, libm only).
+
+The contract is docs/generated-code.md. Each of the seven functions
+(symdyn.codegen.functions) becomes straight-line code: the inputs it reads are
+copied into named locals, then one constant per temporary, then the outputs
+(row-major for M and C). Inputs a function does not read are cast to void so
+-Wextra stays quiet, and `p` is never read when the robot has no free
+parameters (it may be NULL then).
+
+This module builds the render context as plain data: names (symdyn.codegen.c.config)
+and expression texts (symdyn.codegen.c.printer) in lists of pairs and triples.
+Every C statement, declaration, signature, macro and comment is spelled in
+templates/c/*.j2.
+"""
+
+from __future__ import annotations
+
+from ...errors import SymdynError
+from ..functions import FunctionSpec
+from ..render import RenderContext, environment, header_lines
+from .config import TEMPORARY, CConfig, CNames, c_names
+from .printer import CPrinter
+
+__all__ = ["render", "render_context", "TOOLS"]
+
+#: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
+TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
+
+
+def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
+    """One function as data: its inputs, the locals it reads, temporaries and output stores."""
+    symbol_names = dict(names.locals)
+    for sym, _ in spec.temporaries:
+        if sym in symbol_names or not TEMPORARY.match(sym.name):
+            raise SymdynError(
+                f"robot '{ctx.name}': temporary '{sym}' of {spec.name} has the name of an input "
+                "(or no C name); rename the parameter"
+            )
+        symbol_names[sym] = sym.name
+    printer = CPrinter(symbol_names, ctx.precision)
+    used_symbols = spec.free_symbols
+    inputs, unused, reads = [], [], []
+    for inp in spec.inputs:
+        used = [s for s in inp.symbols if s in used_symbols]
+        inputs.append({"name": inp.name, "read": bool(used)})
+        if not used:
+            unused.append(inp.name)
+        for s in used:
+            index = names.param_macro[s] if inp.name == "p" else str(inp.symbols.index(s))
+            reads.append((names.locals[s], inp.name, index))
+    rows, cols = spec.shape
+    assert len(spec.outputs) == rows * cols and cols in (1, ctx.robot.n), f"{spec.name}: shape {spec.shape}"
+    return {
+        "name": spec.name,
+        "c_name": names.functions[spec.name],
+        "doc": spec.doc,
+        "ops": spec.ops.summary(),
+        "inputs": inputs,
+        "output": spec.output,
+        "matrix": cols > 1,
+        "width": max(len(a) for a in [*(inp.name for inp in spec.inputs), spec.output]),
+        "unused": unused,
+        "reads": reads,
+        "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in spec.temporaries],
+        "stores": [(k, printer.doprint(e)) for k, e in enumerate(spec.outputs)],
+    }
+
+
+def render_context(ctx: RenderContext) -> dict:
+    """Everything templates/c/ needs for the robot of `ctx`: names, numbers and printed expressions."""
+    names = c_names(ctx)
+    return {
+        "name": ctx.name,
+        "real": CConfig(ctx.precision).real,
+        "header_lines": header_lines(ctx),
+        "header_file": names.header_file,
+        "source_file": names.source_file,
+        "guard": names.guard,
+        "ndof": names.ndof,
+        "n": ctx.robot.n,
+        "nparam": names.nparam,
+        "k": len(ctx.dynamics.params),
+        "param_pattern": names.param_pattern,
+        "param_macros": list(names.param_macros),
+        "aliases": list(names.aliases),
+        "functions": [_function_view(ctx, names, spec) for spec in ctx.functions],
+    }
+
+
+def render(ctx: RenderContext) -> dict[str, str]:
+    """NAME_dynamics.h and NAME_dynamics.c for the robot of `ctx`."""
+    values = render_context(ctx)
+    env = environment()
+    return {
+        values["header_file"]: env.get_template("c/dynamics.h.j2").render(values),
+        values["source_file"]: env.get_template("c/dynamics.c.j2").render(values),
+    }

@@ -1,0 +1,115 @@
+"""The CasADi target: a standalone Python module of SX graphs, plus one serialised file per function.
+
+For a robot NAME, `render` returns
+* `NAME_casadi.py`: imports only casadi (and math when pi appears); its
+  `functions()` returns {name: casadi.Function} for the seven functions of
+  docs/generated-code.md, each with the inputs of its FunctionSpec (q, qd, qdd or tau, p;
+  p of size k, possibly 0), named so, and one output named like the spec
+  (M and C n x n, vectors n x 1). Every function body is the eliminated
+  straight-line code, one Python statement per temporary, so the SX graph
+  shares what the CSE shared;
+* `NAME_<function>.casadi` (bytes): each function as written by
+  `casadi.Function.save`, readable with `casadi.Function.load`. They are made
+  by executing the rendered module text (symdyn's own output, never user
+  input) in a fresh namespace, so the files and the module cannot disagree.
+
+This module builds the render context as plain data (names, numbers, printed
+expressions); every Python statement is spelled in templates/casadi/module.py.j2.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from dataclasses import asdict, replace
+
+from ...errors import SymdynError
+from ..functions import FunctionSpec
+from ..render import RenderContext, environment, header_lines
+from .printer import CasadiPrinter, input_names
+
+__all__ = ["render", "render_module", "serialise", "module_name", "TOOLS"]
+
+#: The tools each file's bytes depend on besides symdyn. The module text is SymPy's expressions
+#: printed by symdyn; the serialised functions are also in CasADi's own format.
+TOOLS = {"_casadi.py": ("sympy",), ".casadi": ("sympy", "casadi")}
+
+
+def module_name(ctx: RenderContext) -> str:
+    return f"{ctx.name}_casadi"
+
+
+def _docstring(text: str) -> str:
+    """`text` made safe inside a triple-quoted Python docstring."""
+    return text.replace("\\", "\\\\").replace('"""', '\\"\\"\\"')
+
+
+def _function_view(spec: FunctionSpec) -> tuple[dict, bool]:
+    """What the template needs for one function: inputs, temporaries, output entries (and math use)."""
+    names = input_names(spec.inputs)
+    for x, _ in spec.temporaries:
+        if x in names:
+            raise SymdynError(f"casadi target: temporary '{x}' has the name of an input symbol")
+        names[x] = str(x)
+    if spec.output in {inp.name for inp in spec.inputs} | {str(x) for x, _ in spec.temporaries}:
+        raise SymdynError(f"casadi target: output name '{spec.output}' of {spec.name} is taken")
+    printer = CasadiPrinter(names)
+    rows, cols = spec.shape
+    o = spec.ops
+    cost = {"temporaries": len(spec.temporaries), "total": o.total, **asdict(o)} if spec.temporaries else None
+    view = {
+        "name": spec.name,
+        "doc": _docstring(re.sub(r",? row-major( n x n)?", "", spec.doc)),
+        "inputs": [(inp.name, len(inp.symbols)) for inp in spec.inputs],
+        "cost": cost,
+        "temporaries": [(str(x), printer.doprint(e)) for x, e in spec.temporaries],
+        "output": spec.output,
+        "rows": rows,
+        "cols": cols,
+        "entries": [(k // cols, k % cols, printer.doprint(e)) for k, e in enumerate(spec.outputs) if e != 0],
+    }
+    return view, printer.uses_math
+
+
+def render_module(ctx: RenderContext) -> str:
+    """The text of NAME_casadi.py."""
+    views, uses_math = [], False
+    for spec in ctx.functions:
+        view, m = _function_view(spec)
+        views.append(view)
+        uses_math = uses_math or m
+    template = environment().get_template("casadi/module.py.j2")
+    return template.render(
+        header=header_lines(ctx),
+        name=ctx.name,
+        module=module_name(ctx),
+        n=ctx.robot.n,
+        params=[str(p) for p in ctx.dynamics.params],
+        functions=views,
+        uses_math=uses_math,
+    )
+
+
+def serialise(text: str, ctx: RenderContext) -> dict[str, bytes]:
+    """Execute the module text in a fresh namespace and save every function with casadi."""
+    namespace: dict = {"__name__": module_name(ctx)}
+    exec(compile(text, f"<{module_name(ctx)}.py>", "exec"), namespace)  # our own generated text
+    functions = namespace["functions"]()
+    files: dict[str, bytes] = {}
+    with tempfile.TemporaryDirectory(prefix="symdyn-casadi-") as tmp:
+        for spec in ctx.functions:
+            path = os.path.join(tmp, f"{spec.name}.casadi")
+            functions[spec.name].save(path)
+            with open(path, "rb") as fh:
+                files[f"{ctx.name}_{spec.name}.casadi"] = fh.read()
+    return files
+
+
+def render(ctx: RenderContext) -> dict[str, str | bytes]:
+    """NAME_casadi.py and one NAME_<function>.casadi per function. CasADi's SX is double only,
+    so --precision float does not apply here (the header says double)."""
+    text = render_module(replace(ctx, precision="double"))
+    files: dict[str, str | bytes] = {f"{module_name(ctx)}.py": text}
+    files.update(serialise(text, ctx))
+    return files

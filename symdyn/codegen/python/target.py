@@ -1,0 +1,74 @@
+"""The NumPy target: `NAME_numpy.py`, a standalone module (imports only numpy).
+
+It holds the seven functions of docs/generated-code.md with the C target's names and
+arguments (p optional when the robot has no free parameters), plus NDOF,
+NPARAM and PARAM_NAMES. Every function evaluates the eliminated form of its
+FunctionSpec, one statement per temporary, elementwise: it works for one
+state (vectors of shape (n,)) or a batch with leading axes ((N, n); p either
+(k,) or (N, k)). The outputs are assembled by broadcasting every entry to the
+common leading shape, so constant entries (0) get the batch shape too.
+Inputs and outputs are float64 (DTYPE), float32 with precision "float".
+forward_dynamics is the unrolled LDL^T solve of the spec, elementwise as well.
+
+This module builds the render context as plain data (names, shapes, printed
+expressions); every Python statement is spelled in templates/python/module.py.j2.
+"""
+
+from __future__ import annotations
+
+from ..functions import FunctionSpec
+from ..render import RenderContext, environment, header_lines
+from .printer import NumpyPrinter, dtype, local_names
+
+__all__ = ["render", "file_name", "TOOLS"]
+
+#: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
+TOOLS = {"_numpy.py": ("sympy",)}
+
+#: Outputs that stay matrices even for one joint (shape (1, 1)); the others are vectors.
+_MATRICES = ("M", "C")
+
+
+def file_name(name: str) -> str:
+    return f"{name}_numpy.py"
+
+
+def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
+    """One function as data: arguments, the input elements it reads, temporaries, output entries."""
+    free = spec.free_symbols
+    rows, cols = spec.shape
+    return {
+        "name": spec.name,
+        "doc": spec.doc,
+        "inputs": [inp.name for inp in spec.inputs if inp.name != "p"],
+        "has_p": any(inp.name == "p" for inp in spec.inputs),
+        "lead": [inp.name for inp in spec.inputs],
+        "unpack": [
+            (printer.doprint(s), inp.name, k)
+            for inp in spec.inputs
+            for k, s in enumerate(inp.symbols)
+            if s in free
+        ],
+        "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in spec.temporaries],
+        "output": spec.output,
+        "shape": [rows, cols] if spec.output in _MATRICES else [rows],
+        "entries": [printer.doprint(e) for e in spec.outputs],
+    }
+
+
+def render(ctx: RenderContext) -> dict[str, str]:
+    """{NAME_numpy.py: module text} for the robot of `ctx`."""
+    printer = NumpyPrinter(local_names(ctx))
+    text = (
+        environment()
+        .get_template("python/module.py.j2")
+        .render(
+            header=header_lines(ctx),
+            name=ctx.name,
+            ndof=ctx.robot.n,
+            param_names=[s.name for s in ctx.dynamics.params],
+            dtype=dtype(ctx.precision),
+            functions=[_function(spec, printer) for spec in ctx.functions],
+        )
+    )
+    return {file_name(ctx.name): text}
