@@ -31,7 +31,7 @@ from robots import assert_close, mat, random_state, vec
 import symdyn.codegen
 from symdyn import inertia as si
 from symdyn.cli.main import main
-from symdyn.codegen import c_target
+from symdyn.codegen import c as c_target
 from symdyn.dynamics import derive
 from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.model.robot import Friction, Link, Robot

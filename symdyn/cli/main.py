@@ -69,7 +69,7 @@ def _derive_json(dyn) -> str:
 
 
 def _derive_latex(dyn) -> str:
-    from ..codegen.latex_target import dynamics_latex
+    from ..codegen.latex import dynamics_latex
 
     return dynamics_latex(dyn)
 
