@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import sys
 import types
-from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -95,23 +94,31 @@ def _floats(expr, shape, what: str) -> np.ndarray:
         raise SymdynError(f"{what} is not numeric after substitution: {expr}") from exc
 
 
-def _params_key(params):
-    if params is None:
-        return None
-    if isinstance(params, Mapping):
-        return ("map", tuple(sorted((str(k), float(v)) for k, v in params.items())))
-    return ("seq", tuple(float(v) for v in np.ravel(np.asarray(params, dtype=float))))
+def _model(robot, params, where: str) -> NumericModel:
+    """The cached numeric model, after checking the robot and its parameter values."""
+    if not all(hasattr(robot, a) for a in ("links", "params", "param_values", "numeric")):
+        raise SymdynError(f"{where}: robot must be a symdyn Robot, got {type(robot).__name__}")
+    values = robot.param_values(params, where)  # names, count and numbers checked here
+    return _numeric_model(robot, tuple(values[p] for p in robot.params))
 
 
 def numeric_model(robot, params=None) -> NumericModel:
-    """Convert `robot.numeric(params)` to NumPy arrays, once per (robot, params)."""
-    return _numeric_model(robot, _params_key(params))
+    """Convert `robot.numeric(params)` to NumPy arrays, once per (robot, parameter values).
+
+    Args:
+        robot: a `symdyn.Robot`.
+        params: values of its free parameters (`robot.params`): a sequence in that order or a
+            name -> number map; None when it has none.
+
+    Raises:
+        SymdynError: missing, extra, unknown or non-numeric parameter values.
+    """
+    return _model(robot, params, "numeric_model")
 
 
 @lru_cache(maxsize=256)
-def _numeric_model(robot, key) -> NumericModel:
-    params = None if key is None else (dict(key[1]) if key[0] == "map" else list(key[1]))
-    r = robot.numeric(params)
+def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
+    r = robot.numeric(list(values) if values else None)
     links = r.links
     for k, lk in enumerate(links, 1):
         if lk.joint not in ("revolute", "prismatic"):
@@ -145,11 +152,29 @@ def _numeric_model(robot, key) -> NumericModel:
     )  # fmt: skip
 
 
-def _batch(x, n: int, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
-    if a.shape[-1:] != (n,) or a.ndim > 2:
-        raise SymdynError(f"{name} must have shape ({n},) or (N, {n}); got {a.shape}")
-    return a.reshape(-1, n)
+def _states(where: str, n: int, *named: tuple[str, object]) -> tuple[list[np.ndarray], bool]:
+    """Joint vectors (name, value), each (n,) or (N, n) and all of one shape, as (N, n) arrays;
+    and whether they were single states."""
+    arrays = []
+    for name, x in named:
+        try:
+            a = np.asarray(x, dtype=float)
+        except (TypeError, ValueError):
+            raise SymdynError(f"{where}: {name} must hold numbers, got {x!r}") from None
+        if a.ndim == 1 and a.shape != (n,):
+            count = f"{a.size} entry" if a.size == 1 else f"{a.size} entries"
+            raise SymdynError(f"{where}: {name} has {count}, expected {n} (one per joint)")
+        if a.ndim not in (1, 2) or a.shape[-1] != n:
+            raise SymdynError(
+                f"{where}: {name} has shape {a.shape}, expected ({n},) or (N, {n}) (one column per joint)"
+            )
+        arrays.append(a)
+    if len({a.shape for a in arrays}) > 1:
+        shapes = ", ".join(f"{name} {a.shape}" for (name, _), a in zip(named, arrays, strict=True))
+        raise SymdynError(
+            f"{where}: the joint vectors differ in shape ({shapes}); give each one state or N states"
+        )
+    return [a.reshape(-1, n) for a in arrays], arrays[0].ndim == 1
 
 
 def _out(a: np.ndarray, single: bool) -> np.ndarray:
@@ -239,29 +264,34 @@ def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
 def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.ndarray:
     """Inverse dynamics tau = M(q) qdd + V(q, qd) + G(q) + F(qd), by the spatial RNEA.
 
+    Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 5.3; the lecture's 3-vector form
+    is R. Grupen, "Dynamics" (2015), slides 14-15 (symdyn.algorithms.newton_euler).
     Body frames, spatial vectors at each body origin. Outward: v_i = X_i v_{i-1} + S_i qd_i,
     a_i = X_i a_{i-1} + S_i qdd_i + v_i x S_i qd_i, from v_0 = 0 and a_0 = [0; -g] (gravity
     in the base frame; a_0 = 0 with gravity=False); body force f_i = I_i a_i + v_i x* I_i v_i.
     Inward: tau_i = S_i^T f_i, f_{i-1} += X_i^T f_i. Then tau_i += gear_ratio^2 J_m qdd_i
     (reflected rotor inertia) and, unless friction=False, viscous qd_i + coulomb sign(qd_i).
-    Shapes (n,) -> (n,), or (N, n) -> (N, n).
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd, qdd: joint positions, velocities, accelerations: (n,) each, or (N, n) each for
+            N states.
+        params: the free parameters' values (see `numeric_model`).
+        gravity, friction: include gravity, resp. joint friction.
+
+    Returns:
+        Joint efforts tau, (n,) or (N, n).
+
+    Raises:
+        SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q, qd, qdd = (_batch(x, mdl.n, nm) for x, nm in ((q, "q"), (qd, "qd"), (qdd, "qdd")))
+    mdl = _model(robot, params, "rnea")
+    (q, qd, qdd), single = _states("rnea", mdl.n, ("q", q), ("qd", qd), ("qdd", qdd))
     return _out(_rnea(mdl, q, qd, qdd, gravity, friction), single)
 
 
-def mass_matrix(robot, q, params=None) -> np.ndarray:
-    """Joint-space inertia M(q) by the composite-rigid-body algorithm (body frames).
-
-    Composite inertias Ic_{i-1} += X_i^T Ic_i X_i (inward); F = Ic_i S_i, M_ii = S_i^T F, and
-    for j < i, M_ij = M_ji = S_j^T (X_{j+1}^T ... X_i^T F). The diagonal also gets the
-    reflected rotor inertia gear_ratio^2 J_m. Shapes (n,) -> (n, n), (N, n) -> (N, n, n).
-    """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q = _batch(q, mdl.n, "q")
+def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
+    """M for a batch q (N, n) -> (N, n, n); see `mass_matrix`."""
     N, n = q.shape
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
@@ -275,26 +305,77 @@ def mass_matrix(robot, q, params=None) -> np.ndarray:
         for j in range(i, 0, -1):
             F = _mv(np.swapaxes(X[j], -1, -2), F)
             M[:, i, j - 1] = M[:, j - 1, i] = F @ S[j - 1]
-    return _out(M, single)
+    return M
+
+
+def mass_matrix(robot, q, params=None) -> np.ndarray:
+    """Joint-space inertia M(q) by the composite-rigid-body algorithm (body frames).
+
+    Featherstone (2008), sec. 6.2. Composite inertias Ic_{i-1} += X_i^T Ic_i X_i (inward);
+    F = Ic_i S_i, M_ii = S_i^T F, and for j < i, M_ij = M_ji = S_j^T (X_{j+1}^T ... X_i^T F).
+    The diagonal also gets the reflected rotor inertia gear_ratio^2 J_m.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        M, (n, n) or (N, n, n).
+    """
+    mdl = _model(robot, params, "mass_matrix")
+    (q,), single = _states("mass_matrix", mdl.n, ("q", q))
+    return _out(_mass_matrix(mdl, q), single)
 
 
 def gravity_torque(robot, q, params=None) -> np.ndarray:
-    """G(q) = rnea(q, 0, 0) without friction: the joint efforts that hold the arm still."""
-    z = np.zeros_like(np.asarray(q, dtype=float))
-    return rnea(robot, q, z, z, params, friction=False)
+    """G(q) = rnea(q, 0, 0) without friction: the joint efforts that hold the arm still.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        G, (n,) or (N, n).
+    """
+    mdl = _model(robot, params, "gravity_torque")
+    (q,), single = _states("gravity_torque", mdl.n, ("q", q))
+    z = np.zeros_like(q)
+    return _out(_rnea(mdl, q, z, z, True, False), single)
 
 
 def bias_torque(robot, q, qd, params=None) -> np.ndarray:
-    """V(q, qd) = rnea(q, qd, 0) with gravity and friction off: Coriolis and centrifugal terms."""
-    z = np.zeros_like(np.asarray(q, dtype=float))
-    return rnea(robot, q, qd, z, params, gravity=False, friction=False)
+    """V(q, qd) = rnea(q, qd, 0) with gravity and friction off: Coriolis and centrifugal terms.
+
+    (Not the "bias" V + G + F of `symdyn.Dynamics`.)
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd: (n,) each, or (N, n) each.
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        V, (n,) or (N, n).
+    """
+    mdl = _model(robot, params, "bias_torque")
+    (q, qd), single = _states("bias_torque", mdl.n, ("q", q), ("qd", qd))
+    return _out(_rnea(mdl, q, qd, np.zeros_like(q), False, False), single)
 
 
 def friction_torque(robot, qd, params=None) -> np.ndarray:
-    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0)."""
-    mdl = numeric_model(robot, params)
-    single = np.ndim(qd) == 1
-    qd = _batch(qd, mdl.n, "qd")
+    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0).
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        qd: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        F, (n,) or (N, n).
+    """
+    mdl = _model(robot, params, "friction_torque")
+    (qd,), single = _states("friction_torque", mdl.n, ("qd", qd))
     return _out(mdl.viscous * qd + mdl.coulomb * np.sign(qd), single)
 
 
@@ -302,12 +383,19 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
     """qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (numpy.linalg.solve, joint space).
 
     V + G + F comes from one RNEA pass with qdd = 0, M from the CRBA.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd, tau: (n,) each, or (N, n) each.
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        qdd, (n,) or (N, n).
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q, qd, tau = (_batch(x, mdl.n, nm) for x, nm in ((q, "q"), (qd, "qd"), (tau, "tau")))
+    mdl = _model(robot, params, "forward_dynamics")
+    (q, qd, tau), single = _states("forward_dynamics", mdl.n, ("q", q), ("qd", qd), ("tau", tau))
     h = _rnea(mdl, q, qd, np.zeros_like(q), True, True)
-    M = mass_matrix(robot, q, params)
+    M = _mass_matrix(mdl, q)
     return _out(np.linalg.solve(M, (tau - h)[..., None])[..., 0], single)
 
 
@@ -315,11 +403,18 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
     """T = sum_i 1/2 v_i^T I_i v_i + 1/2 gear_ratio_i^2 J_m,i qd_i^2 (= 1/2 qd^T M qd).
 
     v_i is the spatial velocity of body i and I_i its spatial inertia, both in body i's frame
-    at its origin. Shapes (n,) -> float, (N, n) -> (N,).
+    at its origin.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd: (n,) each, or (N, n) each.
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        T, a float or (N,).
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q, qd = _batch(q, mdl.n, "q"), _batch(qd, mdl.n, "qd")
+    mdl = _model(robot, params, "kinetic_energy")
+    (q, qd), single = _states("kinetic_energy", mdl.n, ("q", q), ("qd", qd))
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
     v = np.zeros((len(q), 6))
@@ -346,28 +441,55 @@ def _poses(mdl: NumericModel, q: np.ndarray) -> list[np.ndarray]:
 def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
     """The 4x4 pose base_T_i = prod_k parent_T_k(q_k) of every body frame, in the base frame.
 
-    Returns a list of n arrays (4, 4), or (N, 4, 4) for a batch q of shape (N, n).
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        A list of n arrays (4, 4), or (N, 4, 4) for a batch.
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    return [_out(T, single) for T in _poses(mdl, _batch(q, mdl.n, "q"))]
+    mdl = _model(robot, params, "forward_kinematics")
+    (q,), single = _states("forward_kinematics", mdl.n, ("q", q))
+    return [_out(T, single) for T in _poses(mdl, q)]
+
+
+def _com_positions(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
+    """Centres of mass in the base frame for a batch q (N, n) -> (N, n, 3)."""
+    Ts = _poses(mdl, q)
+    return np.stack([_mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
 
 
 def link_com_positions(robot, q, params=None) -> np.ndarray:
-    """Centres of mass in the base frame, p_ci = base_R_i com_i + base_p_i: (n, 3) or (N, n, 3)."""
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    Ts = _poses(mdl, _batch(q, mdl.n, "q"))
-    p = np.stack([_mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
-    return _out(p, single)
+    """Centres of mass in the base frame, p_ci = base_R_i com_i + base_p_i.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        (n, 3), or (N, n, 3) for a batch.
+    """
+    mdl = _model(robot, params, "link_com_positions")
+    (q,), single = _states("link_com_positions", mdl.n, ("q", q))
+    return _out(_com_positions(mdl, q), single)
 
 
 def potential_energy(robot, q, params=None) -> float | np.ndarray:
-    """U = -sum_i m_i g^T p_ci, gravity g and centres of mass p_ci in the base frame."""
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    p = link_com_positions(robot, _batch(q, mdl.n, "q"), params)
-    U = -np.einsum("i,nij,j->n", mdl.mass, p, mdl.gravity)
+    """U = -sum_i m_i g^T p_ci, gravity g and centres of mass p_ci in the base frame.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        U, a float or (N,).
+    """
+    mdl = _model(robot, params, "potential_energy")
+    (q,), single = _states("potential_energy", mdl.n, ("q", q))
+    U = -np.einsum("i,nij,j->n", mdl.mass, _com_positions(mdl, q), mdl.gravity)
     return float(U[0]) if single else U
 
 
