@@ -42,12 +42,26 @@ __all__ = [
 
 
 def link_inertia(link: Link) -> SpatialInertia:
-    """The link's spatial inertia (m, m c, I_o) about its body-frame origin, body axes."""
+    """The link's own spatial inertia.
+
+    Args:
+        link: mass m, centre of mass c and inertia I_c about c, in its body frame.
+
+    Returns:
+        (m, m c, I_o) about the body-frame origin, body axes (symdyn.spatial.inertia).
+    """
     return body_inertia(link.mass, link.com, link.inertia)
 
 
 def link_subspace(link: Link) -> Motion:
-    """The link's joint motion subspace in its body frame: (a, 0) revolute, (0, a) prismatic."""
+    """The motion subspace of the link's joint.
+
+    Args:
+        link: a revolute or prismatic joint with unit axis a in the link's body frame.
+
+    Returns:
+        (a, 0) revolute, (0, a) prismatic, in the body frame (Featherstone 2008, sec. 4.4).
+    """
     return motion_subspace(link.joint, link.axis)
 
 
@@ -147,6 +161,12 @@ def gravity_composite(
     which is dP/dq_k for P = -sum_i m_i g^T p_ci (Spong, Hutchinson, Vidyasagar, Robot
     Modeling and Control (2006), sec. 7.3). One rotation per link and no inward force
     recursion, against a Newton-Euler pass with qd = qdd = 0.
+
+    Args:
+        robot: the model, n links (gravity in the base frame).
+        frames: `joint_frames(robot, q)`.
+        composites: `composite_inertias(robot, frames, program)` (body frames).
+        program: receives the named intermediates (the g_k).
 
     Returns:
         n expressions over the program's intermediates.
