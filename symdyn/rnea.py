@@ -177,6 +177,13 @@ def _states(where: str, n: int, *named: tuple[str, object]) -> tuple[list[np.nda
     return [a.reshape(-1, n) for a in arrays], arrays[0].ndim == 1
 
 
+def _inputs(where: str, robot, params, *named: tuple[str, object]):
+    """The checked numeric model and joint vectors of a public function (see `_states`)."""
+    mdl = _model(robot, params, where)
+    arrays, single = _states(where, mdl.n, *named)
+    return mdl, arrays, single
+
+
 def _out(a: np.ndarray, single: bool) -> np.ndarray:
     return a[0] if single else a
 
@@ -285,8 +292,7 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
     Raises:
         SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
     """
-    mdl = _model(robot, params, "rnea")
-    (q, qd, qdd), single = _states("rnea", mdl.n, ("q", q), ("qd", qd), ("qdd", qdd))
+    mdl, (q, qd, qdd), single = _inputs("rnea", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
     return _out(_rnea(mdl, q, qd, qdd, gravity, friction), single)
 
 
@@ -323,8 +329,7 @@ def mass_matrix(robot, q, params=None) -> np.ndarray:
     Returns:
         M, (n, n) or (N, n, n).
     """
-    mdl = _model(robot, params, "mass_matrix")
-    (q,), single = _states("mass_matrix", mdl.n, ("q", q))
+    mdl, (q,), single = _inputs("mass_matrix", robot, params, ("q", q))
     return _out(_mass_matrix(mdl, q), single)
 
 
@@ -339,8 +344,7 @@ def gravity_torque(robot, q, params=None) -> np.ndarray:
     Returns:
         G, (n,) or (N, n).
     """
-    mdl = _model(robot, params, "gravity_torque")
-    (q,), single = _states("gravity_torque", mdl.n, ("q", q))
+    mdl, (q,), single = _inputs("gravity_torque", robot, params, ("q", q))
     z = np.zeros_like(q)
     return _out(_rnea(mdl, q, z, z, True, False), single)
 
@@ -358,8 +362,7 @@ def bias_torque(robot, q, qd, params=None) -> np.ndarray:
     Returns:
         V, (n,) or (N, n).
     """
-    mdl = _model(robot, params, "bias_torque")
-    (q, qd), single = _states("bias_torque", mdl.n, ("q", q), ("qd", qd))
+    mdl, (q, qd), single = _inputs("bias_torque", robot, params, ("q", q), ("qd", qd))
     return _out(_rnea(mdl, q, qd, np.zeros_like(q), False, False), single)
 
 
@@ -374,8 +377,7 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
     Returns:
         F, (n,) or (N, n).
     """
-    mdl = _model(robot, params, "friction_torque")
-    (qd,), single = _states("friction_torque", mdl.n, ("qd", qd))
+    mdl, (qd,), single = _inputs("friction_torque", robot, params, ("qd", qd))
     return _out(mdl.viscous * qd + mdl.coulomb * np.sign(qd), single)
 
 
@@ -392,8 +394,7 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
     Returns:
         qdd, (n,) or (N, n).
     """
-    mdl = _model(robot, params, "forward_dynamics")
-    (q, qd, tau), single = _states("forward_dynamics", mdl.n, ("q", q), ("qd", qd), ("tau", tau))
+    mdl, (q, qd, tau), single = _inputs("forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau))
     h = _rnea(mdl, q, qd, np.zeros_like(q), True, True)
     M = _mass_matrix(mdl, q)
     return _out(np.linalg.solve(M, (tau - h)[..., None])[..., 0], single)
@@ -413,8 +414,7 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
     Returns:
         T, a float or (N,).
     """
-    mdl = _model(robot, params, "kinetic_energy")
-    (q, qd), single = _states("kinetic_energy", mdl.n, ("q", q), ("qd", qd))
+    mdl, (q, qd), single = _inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
     v = np.zeros((len(q), 6))
@@ -449,8 +449,7 @@ def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
     Returns:
         A list of n arrays (4, 4), or (N, 4, 4) for a batch.
     """
-    mdl = _model(robot, params, "forward_kinematics")
-    (q,), single = _states("forward_kinematics", mdl.n, ("q", q))
+    mdl, (q,), single = _inputs("forward_kinematics", robot, params, ("q", q))
     return [_out(T, single) for T in _poses(mdl, q)]
 
 
@@ -471,8 +470,7 @@ def link_com_positions(robot, q, params=None) -> np.ndarray:
     Returns:
         (n, 3), or (N, n, 3) for a batch.
     """
-    mdl = _model(robot, params, "link_com_positions")
-    (q,), single = _states("link_com_positions", mdl.n, ("q", q))
+    mdl, (q,), single = _inputs("link_com_positions", robot, params, ("q", q))
     return _out(_com_positions(mdl, q), single)
 
 
@@ -487,8 +485,7 @@ def potential_energy(robot, q, params=None) -> float | np.ndarray:
     Returns:
         U, a float or (N,).
     """
-    mdl = _model(robot, params, "potential_energy")
-    (q,), single = _states("potential_energy", mdl.n, ("q", q))
+    mdl, (q,), single = _inputs("potential_energy", robot, params, ("q", q))
     U = -np.einsum("i,nij,j->n", mdl.mass, _com_positions(mdl, q), mdl.gravity)
     return float(U[0]) if single else U
 
