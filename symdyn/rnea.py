@@ -2,8 +2,9 @@
 
 Every symbolic derivation and every generated function is judged against this
 module, so it shares no code with them: it reads the `Robot` model, converts it
-once to NumPy arrays (`numeric_model`, cached per robot and parameter values)
-and never calls SymPy while evaluating. It also uses a different formulation
+once to NumPy arrays (`numeric_model`, cached per robot and parameter values, in
+symdyn.rnea_inputs with the checks of every argument) and never calls SymPy while
+evaluating. It also uses a different formulation
 from the lecture's link-frame recursion (slides 14-15): Featherstone's
 spatial-vector algorithms in body coordinates, with motion vectors
 v = [omega; v_O] and force vectors f = [n_O; f] (angular part first, both
@@ -24,12 +25,10 @@ from __future__ import annotations
 
 import sys
 import types
-from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
-from .errors import SymdynError
+from .rnea_inputs import NumericModel, checked_inputs, numeric_model, skew
 
 __all__ = [
     "NumericModel",
@@ -47,143 +46,6 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True, eq=False)
-class NumericModel:
-    """A robot as NumPy arrays (n links): everything the numeric algorithms read.
-
-    `revolute` (n,) bool; `R0`, `p0` (n,3,3), (n,3) the constant placement;
-    `axis` (n,3) in the body frame; `mass` (n,); `com` (n,3) body frame;
-    `inertia` (n,3,3) about the centre of mass; `spatial_inertia` (n,6,6) about
-    the body origin; `viscous`, `coulomb`, `reflected` (n,) friction and
-    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame.
-    """
-
-    revolute: np.ndarray
-    R0: np.ndarray
-    p0: np.ndarray
-    axis: np.ndarray
-    mass: np.ndarray
-    com: np.ndarray
-    inertia: np.ndarray
-    spatial_inertia: np.ndarray
-    viscous: np.ndarray
-    coulomb: np.ndarray
-    reflected: np.ndarray
-    gravity: np.ndarray
-
-    def __post_init__(self) -> None:
-        for value in vars(self).values():  # cached and shared: make every array read-only
-            value.flags.writeable = False
-
-    @property
-    def n(self) -> int:
-        return len(self.revolute)
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """The cross-product matrix [v]x, with v of shape (..., 3) -> (..., 3, 3)."""
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    o = np.zeros_like(x)
-    return np.stack([np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2)
-
-
-def _floats(expr, shape, what: str) -> np.ndarray:
-    try:
-        return np.array(np.asarray(expr).tolist(), dtype=float).reshape(shape)
-    except (TypeError, ValueError) as exc:
-        raise SymdynError(f"{what} is not numeric after substitution: {expr}") from exc
-
-
-def _model(robot, params, where: str) -> NumericModel:
-    """The cached numeric model, after checking the robot and its parameter values."""
-    if not all(hasattr(robot, a) for a in ("links", "params", "param_values", "numeric")):
-        raise SymdynError(f"{where}: robot must be a symdyn Robot, got {type(robot).__name__}")
-    values = robot.param_values(params, where)  # names, count and numbers checked here
-    return _numeric_model(robot, tuple(values[p] for p in robot.params))
-
-
-def numeric_model(robot, params=None) -> NumericModel:
-    """Convert `robot.numeric(params)` to NumPy arrays, once per (robot, parameter values).
-
-    Args:
-        robot: a `symdyn.Robot`.
-        params: values of its free parameters (`robot.params`): a sequence in that order or a
-            name -> number map; None when it has none.
-
-    Raises:
-        SymdynError: missing, extra, unknown or non-numeric parameter values.
-    """
-    return _model(robot, params, "numeric_model")
-
-
-@lru_cache(maxsize=256)
-def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
-    r = robot.numeric(list(values) if values else None)
-    links = r.links
-    for k, lk in enumerate(links, 1):
-        if lk.joint not in ("revolute", "prismatic"):
-            raise SymdynError(f"unknown joint type {lk.joint!r}", link_index=k, link_name=lk.name)
-    R0 = np.array([_floats(lk.placement.R, (3, 3), f"{lk.name} placement") for lk in links])
-    p0 = np.array([_floats(lk.placement.p, (3,), f"{lk.name} placement") for lk in links])
-    axis = np.array([_floats(lk.axis, (3,), f"{lk.name} axis") for lk in links])
-    mass = np.array([_floats(lk.mass, (), f"{lk.name} mass") for lk in links])
-    com = np.array([_floats(lk.com, (3,), f"{lk.name} com") for lk in links])
-    inertia = np.array([_floats(lk.inertia, (3, 3), f"{lk.name} inertia") for lk in links])
-    n = len(links)
-    R0, inertia = R0.reshape(n, 3, 3), inertia.reshape(n, 3, 3)
-    p0, axis, com, mass = p0.reshape(n, 3), axis.reshape(n, 3), com.reshape(n, 3), mass.reshape(n)
-    # Spatial inertia about the body origin: [[Ic + m cx cx^T, m cx], [m cx^T, m 1]].
-    cx = _skew(com)
-    m = mass[:, None, None]
-    spatial = np.zeros((n, 6, 6))
-    spatial[:, :3, :3] = inertia + m * cx @ np.swapaxes(cx, -1, -2)
-    spatial[:, :3, 3:] = m * cx
-    spatial[:, 3:, :3] = m * np.swapaxes(cx, -1, -2)
-    spatial[:, 3:, 3:] = m * np.eye(3)
-    fr = [(lk.friction.viscous, lk.friction.coulomb, lk.motor.reflected_inertia) for lk in links]
-    fr = np.array(
-        [[_floats(x, (), f"{lk.name} friction/motor") for x in t] for lk, t in zip(links, fr, strict=True)]
-    ).reshape(n, 3)
-    return NumericModel(
-        revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
-        R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
-        spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
-        gravity=_floats(r.gravity, (3,), "gravity"),
-    )  # fmt: skip
-
-
-def _states(where: str, n: int, *named: tuple[str, object]) -> tuple[list[np.ndarray], bool]:
-    """Joint vectors (name, value), each (n,) or (N, n) and all of one shape, as (N, n) arrays;
-    and whether they were single states."""
-    arrays = []
-    for name, x in named:
-        try:
-            a = np.asarray(x, dtype=float)
-        except (TypeError, ValueError):
-            raise SymdynError(f"{where}: {name} must hold numbers, got {x!r}") from None
-        if a.ndim == 1 and a.shape != (n,):
-            count = f"{a.size} entry" if a.size == 1 else f"{a.size} entries"
-            raise SymdynError(f"{where}: {name} has {count}, expected {n} (one per joint)")
-        if a.ndim not in (1, 2) or a.shape[-1] != n:
-            raise SymdynError(
-                f"{where}: {name} has shape {a.shape}, expected ({n},) or (N, {n}) (one column per joint)"
-            )
-        arrays.append(a)
-    if len({a.shape for a in arrays}) > 1:
-        shapes = ", ".join(f"{name} {a.shape}" for (name, _), a in zip(named, arrays, strict=True))
-        raise SymdynError(
-            f"{where}: the joint vectors differ in shape ({shapes}); give each one state or N states"
-        )
-    return [a.reshape(-1, n) for a in arrays], arrays[0].ndim == 1
-
-
-def _inputs(where: str, robot, params, *named: tuple[str, object]):
-    """The checked numeric model and joint vectors of a public function (see `_states`)."""
-    mdl = _model(robot, params, where)
-    arrays, single = _states(where, mdl.n, *named)
-    return mdl, arrays, single
-
-
 def _out(a: np.ndarray, single: bool) -> np.ndarray:
     return a[0] if single else a
 
@@ -195,7 +57,7 @@ def _joint_poses(mdl: NumericModel, q: np.ndarray):
         qi = q[:, i]
         if mdl.revolute[i]:
             k = mdl.axis[i]
-            K = _skew(k)
+            K = skew(k)
             c, s = np.cos(qi)[:, None, None], np.sin(qi)[:, None, None]
             rot = c * np.eye(3) + s * K + (1.0 - c) * np.outer(k, k)  # Rodrigues
             out.append((mdl.R0[i] @ rot, np.broadcast_to(mdl.p0[i], (len(qi), 3))))
@@ -213,7 +75,7 @@ def _motion_transforms(poses) -> list[np.ndarray]:
         X = np.zeros((len(E), 6, 6))
         X[:, :3, :3] = Et
         X[:, 3:, 3:] = Et
-        X[:, 3:, :3] = -Et @ _skew(r)
+        X[:, 3:, :3] = -Et @ skew(r)
         xs.append(X)
     return xs
 
@@ -228,7 +90,7 @@ def _subspaces(mdl: NumericModel) -> np.ndarray:
 
 def _crm(v: np.ndarray) -> np.ndarray:
     """Spatial motion cross product matrix v x = [[w x, 0], [v_O x, w x]] for v (N,6)."""
-    W, V = _skew(v[:, :3]), _skew(v[:, 3:])
+    W, V = skew(v[:, :3]), skew(v[:, 3:])
     out = np.zeros((len(v), 6, 6))
     out[:, :3, :3] = W
     out[:, 3:, 3:] = W
@@ -292,7 +154,7 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
     Raises:
         SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
     """
-    mdl, (q, qd, qdd), single = _inputs("rnea", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
+    mdl, (q, qd, qdd), single = checked_inputs("rnea", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
     return _out(_rnea(mdl, q, qd, qdd, gravity, friction), single)
 
 
@@ -329,7 +191,7 @@ def mass_matrix(robot, q, params=None) -> np.ndarray:
     Returns:
         M, (n, n) or (N, n, n).
     """
-    mdl, (q,), single = _inputs("mass_matrix", robot, params, ("q", q))
+    mdl, (q,), single = checked_inputs("mass_matrix", robot, params, ("q", q))
     return _out(_mass_matrix(mdl, q), single)
 
 
@@ -344,7 +206,7 @@ def gravity_torque(robot, q, params=None) -> np.ndarray:
     Returns:
         G, (n,) or (N, n).
     """
-    mdl, (q,), single = _inputs("gravity_torque", robot, params, ("q", q))
+    mdl, (q,), single = checked_inputs("gravity_torque", robot, params, ("q", q))
     z = np.zeros_like(q)
     return _out(_rnea(mdl, q, z, z, True, False), single)
 
@@ -362,7 +224,7 @@ def bias_torque(robot, q, qd, params=None) -> np.ndarray:
     Returns:
         V, (n,) or (N, n).
     """
-    mdl, (q, qd), single = _inputs("bias_torque", robot, params, ("q", q), ("qd", qd))
+    mdl, (q, qd), single = checked_inputs("bias_torque", robot, params, ("q", q), ("qd", qd))
     return _out(_rnea(mdl, q, qd, np.zeros_like(q), False, False), single)
 
 
@@ -377,7 +239,7 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
     Returns:
         F, (n,) or (N, n).
     """
-    mdl, (qd,), single = _inputs("friction_torque", robot, params, ("qd", qd))
+    mdl, (qd,), single = checked_inputs("friction_torque", robot, params, ("qd", qd))
     return _out(mdl.viscous * qd + mdl.coulomb * np.sign(qd), single)
 
 
@@ -394,7 +256,9 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
     Returns:
         qdd, (n,) or (N, n).
     """
-    mdl, (q, qd, tau), single = _inputs("forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau))
+    mdl, (q, qd, tau), single = checked_inputs(
+        "forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau)
+    )
     h = _rnea(mdl, q, qd, np.zeros_like(q), True, True)
     M = _mass_matrix(mdl, q)
     return _out(np.linalg.solve(M, (tau - h)[..., None])[..., 0], single)
@@ -414,7 +278,7 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
     Returns:
         T, a float or (N,).
     """
-    mdl, (q, qd), single = _inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
+    mdl, (q, qd), single = checked_inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
     v = np.zeros((len(q), 6))
@@ -449,7 +313,7 @@ def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
     Returns:
         A list of n arrays (4, 4), or (N, 4, 4) for a batch.
     """
-    mdl, (q,), single = _inputs("forward_kinematics", robot, params, ("q", q))
+    mdl, (q,), single = checked_inputs("forward_kinematics", robot, params, ("q", q))
     return [_out(T, single) for T in _poses(mdl, q)]
 
 
@@ -470,7 +334,7 @@ def link_com_positions(robot, q, params=None) -> np.ndarray:
     Returns:
         (n, 3), or (N, n, 3) for a batch.
     """
-    mdl, (q,), single = _inputs("link_com_positions", robot, params, ("q", q))
+    mdl, (q,), single = checked_inputs("link_com_positions", robot, params, ("q", q))
     return _out(_com_positions(mdl, q), single)
 
 
@@ -485,7 +349,7 @@ def potential_energy(robot, q, params=None) -> float | np.ndarray:
     Returns:
         U, a float or (N,).
     """
-    mdl, (q,), single = _inputs("potential_energy", robot, params, ("q", q))
+    mdl, (q,), single = checked_inputs("potential_energy", robot, params, ("q", q))
     U = -np.einsum("i,nij,j->n", mdl.mass, _com_positions(mdl, q), mdl.gravity)
     return float(U[0]) if single else U
 
