@@ -2,8 +2,9 @@
 
 Every symbolic derivation and every generated function is judged against this
 module, so it shares no code with them: it reads the `Robot` model, converts it
-once to NumPy arrays (`numeric_model`, cached per robot and parameter values)
-and never calls SymPy while evaluating. It also uses a different formulation
+once to NumPy arrays (`numeric_model`, cached per robot and parameter values, in
+symdyn.rnea_inputs with the checks of every argument) and never calls SymPy while
+evaluating. It also uses a different formulation
 from the lecture's link-frame recursion (slides 14-15): Featherstone's
 spatial-vector algorithms in body coordinates, with motion vectors
 v = [omega; v_O] and force vectors f = [n_O; f] (angular part first, both
@@ -24,13 +25,10 @@ from __future__ import annotations
 
 import sys
 import types
-from collections.abc import Mapping
-from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
-from .errors import SymdynError
+from .rnea_inputs import NumericModel, checked_inputs, numeric_model, skew
 
 __all__ = [
     "NumericModel",
@@ -48,110 +46,6 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True, eq=False)
-class NumericModel:
-    """A robot as NumPy arrays (n links): everything the numeric algorithms read.
-
-    `revolute` (n,) bool; `R0`, `p0` (n,3,3), (n,3) the constant placement;
-    `axis` (n,3) in the body frame; `mass` (n,); `com` (n,3) body frame;
-    `inertia` (n,3,3) about the centre of mass; `spatial_inertia` (n,6,6) about
-    the body origin; `viscous`, `coulomb`, `reflected` (n,) friction and
-    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame.
-    """
-
-    revolute: np.ndarray
-    R0: np.ndarray
-    p0: np.ndarray
-    axis: np.ndarray
-    mass: np.ndarray
-    com: np.ndarray
-    inertia: np.ndarray
-    spatial_inertia: np.ndarray
-    viscous: np.ndarray
-    coulomb: np.ndarray
-    reflected: np.ndarray
-    gravity: np.ndarray
-
-    def __post_init__(self) -> None:
-        for value in vars(self).values():  # cached and shared: make every array read-only
-            value.flags.writeable = False
-
-    @property
-    def n(self) -> int:
-        return len(self.revolute)
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """The cross-product matrix [v]x, with v of shape (..., 3) -> (..., 3, 3)."""
-    x, y, z = v[..., 0], v[..., 1], v[..., 2]
-    o = np.zeros_like(x)
-    return np.stack([np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2)
-
-
-def _floats(expr, shape, what: str) -> np.ndarray:
-    try:
-        return np.array(np.asarray(expr).tolist(), dtype=float).reshape(shape)
-    except (TypeError, ValueError) as exc:
-        raise SymdynError(f"{what} is not numeric after substitution: {expr}") from exc
-
-
-def _params_key(params):
-    if params is None:
-        return None
-    if isinstance(params, Mapping):
-        return ("map", tuple(sorted((str(k), float(v)) for k, v in params.items())))
-    return ("seq", tuple(float(v) for v in np.ravel(np.asarray(params, dtype=float))))
-
-
-def numeric_model(robot, params=None) -> NumericModel:
-    """Convert `robot.numeric(params)` to NumPy arrays, once per (robot, params)."""
-    return _numeric_model(robot, _params_key(params))
-
-
-@lru_cache(maxsize=256)
-def _numeric_model(robot, key) -> NumericModel:
-    params = None if key is None else (dict(key[1]) if key[0] == "map" else list(key[1]))
-    r = robot.numeric(params)
-    links = r.links
-    for k, lk in enumerate(links, 1):
-        if lk.joint not in ("revolute", "prismatic"):
-            raise SymdynError(f"unknown joint type {lk.joint!r}", link_index=k, link_name=lk.name)
-    R0 = np.array([_floats(lk.placement.R, (3, 3), f"{lk.name} placement") for lk in links])
-    p0 = np.array([_floats(lk.placement.p, (3,), f"{lk.name} placement") for lk in links])
-    axis = np.array([_floats(lk.axis, (3,), f"{lk.name} axis") for lk in links])
-    mass = np.array([_floats(lk.mass, (), f"{lk.name} mass") for lk in links])
-    com = np.array([_floats(lk.com, (3,), f"{lk.name} com") for lk in links])
-    inertia = np.array([_floats(lk.inertia, (3, 3), f"{lk.name} inertia") for lk in links])
-    n = len(links)
-    R0, inertia = R0.reshape(n, 3, 3), inertia.reshape(n, 3, 3)
-    p0, axis, com, mass = p0.reshape(n, 3), axis.reshape(n, 3), com.reshape(n, 3), mass.reshape(n)
-    # Spatial inertia about the body origin: [[Ic + m cx cx^T, m cx], [m cx^T, m 1]].
-    cx = _skew(com)
-    m = mass[:, None, None]
-    spatial = np.zeros((n, 6, 6))
-    spatial[:, :3, :3] = inertia + m * cx @ np.swapaxes(cx, -1, -2)
-    spatial[:, :3, 3:] = m * cx
-    spatial[:, 3:, :3] = m * np.swapaxes(cx, -1, -2)
-    spatial[:, 3:, 3:] = m * np.eye(3)
-    fr = [(lk.friction.viscous, lk.friction.coulomb, lk.motor.reflected_inertia) for lk in links]
-    fr = np.array(
-        [[_floats(x, (), f"{lk.name} friction/motor") for x in t] for lk, t in zip(links, fr, strict=True)]
-    ).reshape(n, 3)
-    return NumericModel(
-        revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
-        R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
-        spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
-        gravity=_floats(r.gravity, (3,), "gravity"),
-    )  # fmt: skip
-
-
-def _batch(x, n: int, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
-    if a.shape[-1:] != (n,) or a.ndim > 2:
-        raise SymdynError(f"{name} must have shape ({n},) or (N, {n}); got {a.shape}")
-    return a.reshape(-1, n)
-
-
 def _out(a: np.ndarray, single: bool) -> np.ndarray:
     return a[0] if single else a
 
@@ -163,7 +57,7 @@ def _joint_poses(mdl: NumericModel, q: np.ndarray):
         qi = q[:, i]
         if mdl.revolute[i]:
             k = mdl.axis[i]
-            K = _skew(k)
+            K = skew(k)
             c, s = np.cos(qi)[:, None, None], np.sin(qi)[:, None, None]
             rot = c * np.eye(3) + s * K + (1.0 - c) * np.outer(k, k)  # Rodrigues
             out.append((mdl.R0[i] @ rot, np.broadcast_to(mdl.p0[i], (len(qi), 3))))
@@ -181,7 +75,7 @@ def _motion_transforms(poses) -> list[np.ndarray]:
         X = np.zeros((len(E), 6, 6))
         X[:, :3, :3] = Et
         X[:, 3:, 3:] = Et
-        X[:, 3:, :3] = -Et @ _skew(r)
+        X[:, 3:, :3] = -Et @ skew(r)
         xs.append(X)
     return xs
 
@@ -196,7 +90,7 @@ def _subspaces(mdl: NumericModel) -> np.ndarray:
 
 def _crm(v: np.ndarray) -> np.ndarray:
     """Spatial motion cross product matrix v x = [[w x, 0], [v_O x, w x]] for v (N,6)."""
-    W, V = _skew(v[:, :3]), _skew(v[:, 3:])
+    W, V = skew(v[:, :3]), skew(v[:, 3:])
     out = np.zeros((len(v), 6, 6))
     out[:, :3, :3] = W
     out[:, 3:, 3:] = W
@@ -239,29 +133,33 @@ def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
 def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.ndarray:
     """Inverse dynamics tau = M(q) qdd + V(q, qd) + G(q) + F(qd), by the spatial RNEA.
 
+    Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 5.3; the lecture's 3-vector form
+    is R. Grupen, "Dynamics" (2015), slides 14-15 (symdyn.algorithms.newton_euler).
     Body frames, spatial vectors at each body origin. Outward: v_i = X_i v_{i-1} + S_i qd_i,
     a_i = X_i a_{i-1} + S_i qdd_i + v_i x S_i qd_i, from v_0 = 0 and a_0 = [0; -g] (gravity
     in the base frame; a_0 = 0 with gravity=False); body force f_i = I_i a_i + v_i x* I_i v_i.
     Inward: tau_i = S_i^T f_i, f_{i-1} += X_i^T f_i. Then tau_i += gear_ratio^2 J_m qdd_i
     (reflected rotor inertia) and, unless friction=False, viscous qd_i + coulomb sign(qd_i).
-    Shapes (n,) -> (n,), or (N, n) -> (N, n).
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd, qdd: joint positions, velocities, accelerations: (n,) each, or (N, n) each for
+            N states.
+        params: the free parameters' values (see `numeric_model`).
+        gravity, friction: include gravity, resp. joint friction.
+
+    Returns:
+        Joint efforts tau, (n,) or (N, n).
+
+    Raises:
+        SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q, qd, qdd = (_batch(x, mdl.n, nm) for x, nm in ((q, "q"), (qd, "qd"), (qdd, "qdd")))
+    mdl, (q, qd, qdd), single = checked_inputs("rnea", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
     return _out(_rnea(mdl, q, qd, qdd, gravity, friction), single)
 
 
-def mass_matrix(robot, q, params=None) -> np.ndarray:
-    """Joint-space inertia M(q) by the composite-rigid-body algorithm (body frames).
-
-    Composite inertias Ic_{i-1} += X_i^T Ic_i X_i (inward); F = Ic_i S_i, M_ii = S_i^T F, and
-    for j < i, M_ij = M_ji = S_j^T (X_{j+1}^T ... X_i^T F). The diagonal also gets the
-    reflected rotor inertia gear_ratio^2 J_m. Shapes (n,) -> (n, n), (N, n) -> (N, n, n).
-    """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q = _batch(q, mdl.n, "q")
+def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
+    """M for a batch q (N, n) -> (N, n, n); see `mass_matrix`."""
     N, n = q.shape
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
@@ -275,26 +173,73 @@ def mass_matrix(robot, q, params=None) -> np.ndarray:
         for j in range(i, 0, -1):
             F = _mv(np.swapaxes(X[j], -1, -2), F)
             M[:, i, j - 1] = M[:, j - 1, i] = F @ S[j - 1]
-    return _out(M, single)
+    return M
+
+
+def mass_matrix(robot, q, params=None) -> np.ndarray:
+    """Joint-space inertia M(q) by the composite-rigid-body algorithm (body frames).
+
+    Featherstone (2008), sec. 6.2. Composite inertias Ic_{i-1} += X_i^T Ic_i X_i (inward);
+    F = Ic_i S_i, M_ii = S_i^T F, and for j < i, M_ij = M_ji = S_j^T (X_{j+1}^T ... X_i^T F).
+    The diagonal also gets the reflected rotor inertia gear_ratio^2 J_m.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        M, (n, n) or (N, n, n).
+    """
+    mdl, (q,), single = checked_inputs("mass_matrix", robot, params, ("q", q))
+    return _out(_mass_matrix(mdl, q), single)
 
 
 def gravity_torque(robot, q, params=None) -> np.ndarray:
-    """G(q) = rnea(q, 0, 0) without friction: the joint efforts that hold the arm still."""
-    z = np.zeros_like(np.asarray(q, dtype=float))
-    return rnea(robot, q, z, z, params, friction=False)
+    """G(q) = rnea(q, 0, 0) without friction: the joint efforts that hold the arm still.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        G, (n,) or (N, n).
+    """
+    mdl, (q,), single = checked_inputs("gravity_torque", robot, params, ("q", q))
+    z = np.zeros_like(q)
+    return _out(_rnea(mdl, q, z, z, True, False), single)
 
 
 def bias_torque(robot, q, qd, params=None) -> np.ndarray:
-    """V(q, qd) = rnea(q, qd, 0) with gravity and friction off: Coriolis and centrifugal terms."""
-    z = np.zeros_like(np.asarray(q, dtype=float))
-    return rnea(robot, q, qd, z, params, gravity=False, friction=False)
+    """V(q, qd) = rnea(q, qd, 0) with gravity and friction off: Coriolis and centrifugal terms.
+
+    (Not the "bias" V + G + F of `symdyn.Dynamics`.)
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd: (n,) each, or (N, n) each.
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        V, (n,) or (N, n).
+    """
+    mdl, (q, qd), single = checked_inputs("bias_torque", robot, params, ("q", q), ("qd", qd))
+    return _out(_rnea(mdl, q, qd, np.zeros_like(q), False, False), single)
 
 
 def friction_torque(robot, qd, params=None) -> np.ndarray:
-    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0)."""
-    mdl = numeric_model(robot, params)
-    single = np.ndim(qd) == 1
-    qd = _batch(qd, mdl.n, "qd")
+    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0).
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        qd: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        F, (n,) or (N, n).
+    """
+    mdl, (qd,), single = checked_inputs("friction_torque", robot, params, ("qd", qd))
     return _out(mdl.viscous * qd + mdl.coulomb * np.sign(qd), single)
 
 
@@ -302,12 +247,20 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
     """qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (numpy.linalg.solve, joint space).
 
     V + G + F comes from one RNEA pass with qdd = 0, M from the CRBA.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd, tau: (n,) each, or (N, n) each.
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        qdd, (n,) or (N, n).
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q, qd, tau = (_batch(x, mdl.n, nm) for x, nm in ((q, "q"), (qd, "qd"), (tau, "tau")))
+    mdl, (q, qd, tau), single = checked_inputs(
+        "forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau)
+    )
     h = _rnea(mdl, q, qd, np.zeros_like(q), True, True)
-    M = mass_matrix(robot, q, params)
+    M = _mass_matrix(mdl, q)
     return _out(np.linalg.solve(M, (tau - h)[..., None])[..., 0], single)
 
 
@@ -315,11 +268,17 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
     """T = sum_i 1/2 v_i^T I_i v_i + 1/2 gear_ratio_i^2 J_m,i qd_i^2 (= 1/2 qd^T M qd).
 
     v_i is the spatial velocity of body i and I_i its spatial inertia, both in body i's frame
-    at its origin. Shapes (n,) -> float, (N, n) -> (N,).
+    at its origin.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q, qd: (n,) each, or (N, n) each.
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        T, a float or (N,).
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    q, qd = _batch(q, mdl.n, "q"), _batch(qd, mdl.n, "qd")
+    mdl, (q, qd), single = checked_inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
     v = np.zeros((len(q), 6))
@@ -346,28 +305,52 @@ def _poses(mdl: NumericModel, q: np.ndarray) -> list[np.ndarray]:
 def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
     """The 4x4 pose base_T_i = prod_k parent_T_k(q_k) of every body frame, in the base frame.
 
-    Returns a list of n arrays (4, 4), or (N, 4, 4) for a batch q of shape (N, n).
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        A list of n arrays (4, 4), or (N, 4, 4) for a batch.
     """
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    return [_out(T, single) for T in _poses(mdl, _batch(q, mdl.n, "q"))]
+    mdl, (q,), single = checked_inputs("forward_kinematics", robot, params, ("q", q))
+    return [_out(T, single) for T in _poses(mdl, q)]
+
+
+def _com_positions(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
+    """Centres of mass in the base frame for a batch q (N, n) -> (N, n, 3)."""
+    Ts = _poses(mdl, q)
+    return np.stack([_mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
 
 
 def link_com_positions(robot, q, params=None) -> np.ndarray:
-    """Centres of mass in the base frame, p_ci = base_R_i com_i + base_p_i: (n, 3) or (N, n, 3)."""
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    Ts = _poses(mdl, _batch(q, mdl.n, "q"))
-    p = np.stack([_mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
-    return _out(p, single)
+    """Centres of mass in the base frame, p_ci = base_R_i com_i + base_p_i.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        (n, 3), or (N, n, 3) for a batch.
+    """
+    mdl, (q,), single = checked_inputs("link_com_positions", robot, params, ("q", q))
+    return _out(_com_positions(mdl, q), single)
 
 
 def potential_energy(robot, q, params=None) -> float | np.ndarray:
-    """U = -sum_i m_i g^T p_ci, gravity g and centres of mass p_ci in the base frame."""
-    mdl = numeric_model(robot, params)
-    single = np.ndim(q) == 1
-    p = link_com_positions(robot, _batch(q, mdl.n, "q"), params)
-    U = -np.einsum("i,nij,j->n", mdl.mass, p, mdl.gravity)
+    """U = -sum_i m_i g^T p_ci, gravity g and centres of mass p_ci in the base frame.
+
+    Args:
+        robot: a `symdyn.Robot` with n joints.
+        q: (n,) or (N, n).
+        params: the free parameters' values (see `numeric_model`).
+
+    Returns:
+        U, a float or (N,).
+    """
+    mdl, (q,), single = checked_inputs("potential_energy", robot, params, ("q", q))
+    U = -np.einsum("i,nij,j->n", mdl.mass, _com_positions(mdl, q), mdl.gravity)
     return float(U[0]) if single else U
 
 

@@ -44,7 +44,7 @@ from robots import (
     without_motors,
 )
 
-from symdyn.dynamics import METHODS, derive
+from symdyn.dynamics import METHODS, derive, friction_vector
 from symdyn.errors import SymdynError
 from symdyn.model.robot import Motor
 from symdyn.parsers.robot_file import robot_from_data
@@ -209,6 +209,119 @@ def test_unknown_method_and_quantity_are_errors():
         derive(example("roger_eye"), method="kane")
     with pytest.raises(SymdynError):
         derived("roger_eye", "lagrange").closed_form("K")
+
+
+ARM_PARAMS = [9.81, 0.5, 1.2, 0.3, 0.8]  # g, l1, m1, l2, m2 of examples/roger_arm.yaml
+ARM_FREE = "g, l1, m1, l2, m2"
+BOUNDARY_ERRORS = {
+    "q too long": (
+        lambda d: d.evaluate("tau", [0, 0, 0], params=ARM_PARAMS),
+        "Dynamics.evaluate: q has 3 entries, expected 2 (one per joint)",
+    ),
+    "qd too short": (
+        lambda d: d.evaluate("V", [0, 0], [1], params=ARM_PARAMS),
+        "Dynamics.evaluate: qd has 1 entry, expected 2 (one per joint)",
+    ),
+    "qdd a batch": (
+        lambda d: d.evaluate("tau", [0, 0], [0, 0], [[0, 0]], params=ARM_PARAMS),
+        r"Dynamics.evaluate: qdd has shape (1, 2), expected (2,) (one per joint)",
+    ),
+    "q not numbers": (
+        lambda d: d.evaluate("G", ["a", 0], params=ARM_PARAMS),
+        "Dynamics.evaluate: q must hold numbers, got ['a', 0]",
+    ),
+    "unknown quantity": (
+        lambda d: d.evaluate("X", [0, 0], params=ARM_PARAMS),
+        "Dynamics.evaluate: unknown quantity 'X' (one of M, C, V, G, F, tau, bias)",
+    ),
+    "unknown closed form": (
+        lambda d: d.closed_form("K"),
+        "Dynamics.closed_form: unknown quantity 'K' (one of M, C, V, G, F, tau, bias)",
+    ),
+    "unknown assignment": (
+        lambda d: d.assignments(("M", "Q")),
+        "Dynamics.assignments: unknown quantity 'Q' (one of M, C, V, G, F, tau, bias)",
+    ),
+    "assignments of a bare name": (
+        lambda d: d.assignments("M"),
+        "Dynamics.assignments: names must be a sequence of names, got 'M'",
+    ),
+    "no params": (
+        lambda d: d.evaluate("M", [0, 0]),
+        f"Dynamics.evaluate: robot 'roger_arm' has free parameters ({ARM_FREE}); give their values",
+    ),
+    "too few params": (
+        lambda d: d.evaluate("M", [0, 0], params=ARM_PARAMS[:2]),
+        f"Dynamics.evaluate: params has 2 values, expected 5 (one per free parameter: {ARM_FREE})",
+    ),
+    "unknown param": (
+        lambda d: d.evaluate(
+            "M", [0, 0], params={"g": 9.81, "l1": 0.5, "m1": 1, "l2": 0.3, "m2": 1, "l3": 1}
+        ),
+        f"Dynamics.evaluate: unknown parameter(s) l3 (free parameters of robot 'roger_arm': {ARM_FREE})",
+    ),
+    "missing param": (
+        lambda d: d.evaluate("M", [0, 0], params={"g": 9.81}),
+        "Dynamics.evaluate: no value for parameter(s) l1, m1, l2, m2",
+    ),
+    "param not a number": (
+        lambda d: d.evaluate("M", [0, 0], params=["x", *ARM_PARAMS[1:]]),
+        "Dynamics.evaluate: parameter g must be a number, got 'x'",
+    ),
+    "params a bare number": (
+        lambda d: d.evaluate("M", [0, 0], params=9.81),
+        "Dynamics.evaluate: params must be a sequence of numbers or a name -> number map, got 9.81",
+    ),
+    "derive a non-robot": (
+        lambda d: derive([1, 2]),
+        "derive: robot must be a symdyn Robot (from load_robot or load_urdf), got list",
+    ),
+    "derive by an unknown method": (
+        lambda d: derive(d.robot, method="kane"),
+        "derive: unknown method 'kane' (use newton-euler or lagrange)",
+    ),
+    "friction of too few joints": (
+        lambda d: friction_vector(d.robot, [1]),
+        "friction_vector: qd has length 1, expected 2 (one per joint)",
+    ),
+    "derive with a bad simplify": (
+        lambda d: derive(d.robot, simplify="yes"),
+        "derive: simplify must be True, False or None, got 'yes'",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(BOUNDARY_ERRORS))
+def test_bad_arguments_say_what_was_expected_and_what_came(case):
+    call, message = BOUNDARY_ERRORS[case]
+    with pytest.raises(SymdynError) as err:
+        call(derived("roger_arm", "newton-euler"))
+    assert str(err.value) == message
+
+
+def test_params_for_a_robot_without_free_parameters():
+    dyn = derived("roger_arm_values", "newton-euler")
+    q = [0.1, 0.2]
+    assert_close(dyn.evaluate("G", q, params=[]), dyn.evaluate("G", q))
+    with pytest.raises(
+        SymdynError, match=r"params has 1 values, expected 0 \(one per free parameter: none\)"
+    ):
+        dyn.evaluate("G", q, params=[1.0])
+    with pytest.raises(SymdynError, match=r"unknown parameter\(s\) g \(free parameters of robot"):
+        dyn.evaluate("G", q, params={"g": 9.81})
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_bias_is_public_and_the_same_in_every_form(method):
+    """bias = V + G + F: its closed form against the other closed forms (an identity), its value
+    against the numeric oracle's tau at qdd = 0, through evaluate, closed_form and the property."""
+    dyn = derived("roger_arm", method)
+    assert _zero(dyn.bias - (dyn.V + dyn.G + dyn.F))
+    assert dyn.closed_form("bias") == dyn.bias
+    robot = example("roger_arm")
+    q, qd = np.array([0.4, -1.1]), np.array([0.7, -0.3])
+    assert_close(dyn.evaluate("bias", q, qd, params=ARM_PARAMS), rnea(robot, q, qd, np.zeros(2), ARM_PARAMS))
+    assert dyn.evaluate("bias", q, qd, params=ARM_PARAMS).shape == (2,)
 
 
 # --------------------------------------------------------------------------- 4. identities, numeric

@@ -30,6 +30,7 @@ from symdyn.algorithms.kinematics import (
     numeric_pose,
     point_jacobian,
 )
+from symdyn.errors import SymdynError
 from symdyn.parsers.robot_file import robot_from_data
 from symdyn.rnea import forward_kinematics as rnea_poses
 
@@ -233,6 +234,72 @@ def test_numeric_functions_take_parameters_by_order_or_name():
     ]
     assert_close(J, want_J)
     assert_close(numeric_jacobian(robot, q, *tip, params=p), want_J)
+
+
+ARM_P = [9.81, 0.5, 1.2, 0.3, 0.8]  # g, l1, m1, l2, m2
+
+
+@pytest.mark.parametrize("function", [numeric_pose, numeric_jacobian], ids=lambda f: f.__name__)
+def test_numeric_functions_check_their_arguments(function):
+    robot, name = example("roger_arm"), function.__name__
+    free = "g, l1, m1, l2, m2"
+    bad = {
+        "q too long": (
+            ([0, 0, 0],),
+            {"params": ARM_P},
+            f"{name}: q has 3 entries, expected 2 (one per joint)",
+        ),
+        "q a batch": (
+            ([[0, 0]],),
+            {"params": ARM_P},
+            f"{name}: q has shape (1, 2), expected (2,) (one per joint)",
+        ),
+        "link out of range": (
+            ([0, 0], 2),
+            {"params": ARM_P},
+            f"{name}: link 2 out of range: the robot has 2 links (0 .. 1)",
+        ),
+        "link not an index": (
+            ([0, 0], 1.0),
+            {"params": ARM_P},
+            f"{name}: link must be an integer index, got 1.0",
+        ),
+        "point of two": (
+            ([0, 0], 1, (1, 2)),
+            {"params": ARM_P},
+            f"{name}: point has 2 entries, expected 3 (x, y, z in the link's frame)",
+        ),
+        "point with an unknown symbol": (
+            ([0, 0], 1, ("l9", 0, 0)),
+            {"params": ARM_P},
+            f"{name}: point names unknown symbol(s) l9",
+        ),
+        "no params": (
+            ([0, 0],),
+            {},
+            f"{name}: robot 'roger_arm' has free parameters ({free}); give their values",
+        ),
+        "unknown param": (
+            ([0, 0],),
+            {"params": {"g": 1, "l1": 1, "m1": 1, "l2": 1, "m2": 1, "m9": 1}},
+            f"{name}: unknown parameter(s) m9 (free parameters of robot 'roger_arm': {free})",
+        ),
+    }
+    for case, (args, kwargs, message) in bad.items():
+        with pytest.raises(SymdynError) as err:
+            function(robot, *args, **kwargs)
+        assert str(err.value) == message, case
+    assert function(robot, [0, 0], -1, ("l2", 0, 0), params=ARM_P).shape == (
+        (4, 4) if name == "numeric_pose" else (6, 2)
+    )
+
+
+def test_symbolic_jacobian_checks_the_link_and_q():
+    robot = example("roger_arm")
+    with pytest.raises(SymdynError, match=r"^point_jacobian: link -3 out of range: the robot has 2 links"):
+        point_jacobian(robot, -3)
+    with pytest.raises(SymdynError, match=r"^link_transforms: q has length 1, expected 2 \(one per joint\)$"):
+        forward_kinematics(robot, [0])
 
 
 @pytest.mark.parametrize("seed", range(3))

@@ -295,8 +295,73 @@ def test_params_errors_and_cache():
     assert rn.numeric_model(robot, p) is rn.numeric_model(robot, tuple(p))
 
 
-def test_oracle_is_independent_of_symbolic_derivation():
-    source = Path(rn.__file__).read_text()
+P_ARM = [1.0, 2.0, 0.5, 0.5, 9.81]  # m1, m2, l1, l2, g of roger_arm_robot()
+Z2 = [0.0, 0.0]
+# every public function; `x` is the joint vector under test, the others are single states
+CALLS = {
+    "rnea": lambda r, x, p: rn.rnea(r, x, Z2, Z2, p),
+    "mass_matrix": lambda r, x, p: rn.mass_matrix(r, x, p),
+    "gravity_torque": lambda r, x, p: rn.gravity_torque(r, x, p),
+    "bias_torque": lambda r, x, p: rn.bias_torque(r, Z2, x, p),
+    "friction_torque": lambda r, x, p: rn.friction_torque(r, x, p),
+    "forward_dynamics": lambda r, x, p: rn.forward_dynamics(r, Z2, Z2, x, p),
+    "kinetic_energy": lambda r, x, p: rn.kinetic_energy(r, x, Z2, p),
+    "potential_energy": lambda r, x, p: rn.potential_energy(r, x, p),
+    "forward_kinematics": lambda r, x, p: rn.forward_kinematics(r, x, p),
+    "link_com_positions": lambda r, x, p: rn.link_com_positions(r, x, p),
+}
+ARGUMENT = {"bias_torque": "qd", "friction_torque": "qd", "forward_dynamics": "tau"}  # else q
+FREE = "m1, m2, l1, l2, g"
+
+
+@pytest.mark.parametrize("name", list(CALLS))
+def test_every_public_function_checks_its_arguments(name):
+    call, robot, arg = CALLS[name], roger_arm_robot(), ARGUMENT.get(name, "q")
+    call(robot, Z2, P_ARM)  # right as given
+    bad = {
+        "three entries": (([0, 0, 0], P_ARM), f"{name}: {arg} has 3 entries, expected 2 (one per joint)"),
+        "one entry": (([0], P_ARM), f"{name}: {arg} has 1 entry, expected 2 (one per joint)"),
+        "wide batch": (
+            ([[0, 0, 0]], P_ARM),
+            f"{name}: {arg} has shape (1, 3), expected (2,) or (N, 2) (one column per joint)",
+        ),
+        "not numbers": ((["a", 0], P_ARM), f"{name}: {arg} must hold numbers, got ['a', 0]"),
+        "no params": (
+            (Z2, None),
+            f"{name}: robot 'roger_arm' has free parameters ({FREE}); give their values",
+        ),
+        "too many params": (
+            (Z2, [*P_ARM, 1.0]),
+            f"{name}: params has 6 values, expected 5 (one per free parameter: {FREE})",
+        ),
+        "params missing": ((Z2, {"m1": 1.0}), f"{name}: no value for parameter(s) m2, l1, l2, g"),
+        "unknown param": (
+            (Z2, {**dict(zip(FREE.split(", "), P_ARM, strict=True)), "m3": 1.0}),
+            f"{name}: unknown parameter(s) m3 (free parameters of robot 'roger_arm': {FREE})",
+        ),
+    }
+    for case, (args, message) in bad.items():
+        with pytest.raises(SymdynError) as err:
+            call(robot, *args)
+        assert str(err.value) == message, case
+    with pytest.raises(SymdynError) as err:
+        call("roger_arm", Z2, P_ARM)
+    assert str(err.value) == f"{name}: robot must be a symdyn Robot, got str"
+    batch = [Z2, Z2, Z2]
+    if name in ("rnea", "bias_torque", "forward_dynamics", "kinetic_energy"):  # a batch among single states
+        with pytest.raises(SymdynError, match=rf"^{name}: the joint vectors differ in shape \("):
+            call(robot, batch, P_ARM)
+    elif name == "forward_kinematics":
+        assert [T.shape for T in call(robot, batch, P_ARM)] == [(3, 4, 4)] * robot.n
+    else:
+        assert np.shape(call(robot, batch, P_ARM))[0] == 3  # one result per state
+
+
+@pytest.mark.parametrize("module", ["rnea", "rnea_inputs"])
+def test_oracle_is_independent_of_symbolic_derivation(module):
+    """The oracle (rnea.py and its input side rnea_inputs.py) imports NumPy, the error type and
+    itself only: no SymPy, no symbolic derivation."""
+    source = (Path(rn.__file__).parent / f"{module}.py").read_text()
     imported = set()
     for node in ast.walk(ast.parse(source)):
         if isinstance(node, ast.ImportFrom):
@@ -310,6 +375,7 @@ def test_oracle_is_independent_of_symbolic_derivation():
         "functools",
         "numpy",
         "errors",
+        "rnea_inputs",
         "sys",  # the callable-module hook that makes symdyn.rnea(...) a function too
         "types",
     }

@@ -28,7 +28,15 @@ computed as 1/2 dV/dqd.
 
 A zero-mass spatial inertia (h, I) carries P: for a body with first moment h
 and rotational inertia I about its origin moving with (w, u),
-Idot = (dh, dI) with dh = w x h + m u and dI = [w x] I - I [w x] - ([u x][h x] + [h x][u x]).
+Idot = (dh, dI) with dh = w x h + m u and dI = [w x] I - I [w x] - ([u x][h x] + [h x][u x])
+(symdyn.spatial.inertia.inertia_rate).
+
+References: Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 7.3
+(Christoffel symbols) and sec. 7.5 (skew symmetry of dM/dt - 2C); Featherstone, Rigid Body
+Dynamics Algorithms (2008), sec. 2.9 (the cross products x and x*) and sec. 2.13 (spatial
+inertia); S. Echeandia and P. M. Wensing, "Numerical methods to compute the Coriolis matrix
+and Christoffel symbols for rigid-body systems", J. Comput. Nonlinear Dyn. 16(9), 2021;
+R. Grupen, "Dynamics" (2015), slide 16 (V = C qd in tau = M qdd + V + G + F).
 """
 
 from __future__ import annotations
@@ -37,109 +45,98 @@ import sympy as sp
 
 from ..model.robot import Robot
 from ..spatial import vectors as v3
+from ..spatial.inertia import SpatialInertia, apply_inertia, inertia_rate, scaled_inertia
+from ..spatial.motion import Force, Motion, cross_force, cross_motion, project, spatial_add, spatial_sub
 from ..symbolic.program import Program
-from .crba import Composite, Composites, Spatial, apply_inertia, motion_subspace, project, shift_inertia, sym3
+from .crba import link_inertia, link_subspace, shift_inertia
 from .frames import JointFrame
-from .newton_euler import origin_inertia
 
 __all__ = ["coriolis_matrix_composite"]
 
 _HALF = sp.Rational(1, 2)
-_ZERO3: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
 
 
-def _let_spatial(program: Program, v: Spatial, hint: str) -> Spatial:
-    """Name the six components of a spatial vector."""
-    return program.let_vector(v[0], hint), program.let_vector(v[1], hint)
+def _let_motion(program: Program, v: Motion, hint: str) -> Motion:
+    """Name the six components of a motion."""
+    return Motion(program.let_vector(v.angular, hint), program.let_vector(v.linear, hint))
 
 
-def _cross_motion(v: Spatial, s: Spatial) -> Spatial:
-    """v x s for motion vectors: (w x ws, w x us + u x ws)."""
-    (w, u), (ws, us) = v, s
-    return v3.cross(w, ws), v3.add(v3.cross(w, us), v3.cross(u, ws))
+def _let_force(program: Program, f: Force, hint: str) -> Force:
+    """Name the six components of a force."""
+    return Force(program.let_vector(f.angular, hint), program.let_vector(f.linear, hint))
 
 
-def _cross_force(s: Spatial, f: Spatial) -> Spatial:
-    """s x* f for a motion s and a force f: (ws x n + us x f, ws x f)."""
-    (ws, us), (n, fl) = s, f
-    return v3.add(v3.cross(ws, n), v3.cross(us, fl)), v3.cross(ws, fl)
-
-
-def _inertia_rate(m: sp.Expr, h: v3.Vec, I: v3.Mat, v: Spatial, program: Program, k: str) -> Composite:
-    """The world rate of change v x* I - I v x of a body's spatial inertia (m, h, I) moving
-    with v = (w, u), as a zero-mass inertia (dh, dI)."""
-    w, u = v
-    dh = program.let_vector(v3.add(v3.cross(w, h), v3.scale(m, u)), f"Pd{k}_")
-    columns = [v3.cross(w, (I[0][c], I[1][c], I[2][c])) for c in range(3)]  # [w x] I by columns
-    K = [[columns[c][r] for c in range(3)] for r in range(3)]
-    uh2 = v3._prod(2, v3.dot(u, h))
-    dI = [
-        [
-            v3._sum((K[r][c], K[c][r], -v3._prod(u[r], h[c]), -v3._prod(h[r], u[c]), uh2 if r == c else 0))
-            for c in range(3)
-        ]
-        for r in range(3)
-    ]
-    return sp.S.Zero, dh, sym3(program, dI, f"PI{k}_")
+def _named_rate(inertia: SpatialInertia, v: Motion, program: Program, k: str) -> SpatialInertia:
+    """The rate of change of a body's spatial inertia moving with v, every entry named."""
+    rate = inertia_rate(inertia, v)
+    dh = program.let_vector(rate.first_moment, f"Pd{k}_")
+    return SpatialInertia(rate.mass, dh, program.let_symmetric(rate.inertia, f"PI{k}_"))
 
 
 def coriolis_matrix_composite(
-    robot: Robot, frames: list[JointFrame], composites: Composites, qd, program: Program
+    robot: Robot, frames: list[JointFrame], composites: list[SpatialInertia], qd, program: Program
 ) -> sp.Matrix:
-    """C(q, qd) with V = C qd and dM/dt - 2C skew-symmetric (Christoffel symbols), over the
-    program's intermediates (`composites` from crba.composite_inertias); see the module
-    docstring for the recursion."""
+    """C(q, qd) with V = C qd and dM/dt - 2C skew-symmetric (the Christoffel-symbol matrix).
+
+    See the module docstring for the recursion.
+
+    Args:
+        robot: the model, n links.
+        frames: `symdyn.algorithms.frames.joint_frames(robot, q)`.
+        composites: `symdyn.algorithms.crba.composite_inertias(robot, frames, program)`,
+            subtree inertias about each body origin, body axes.
+        qd: n joint velocities (symbols).
+        program: receives the named intermediates.
+
+    Returns:
+        The n x n matrix C over the program's intermediates (joint space).
+    """
     n = robot.n
-    mass, hc, Ic = composites
-    s = [motion_subspace(link) for link in robot.links]
-    # outward: body velocities and psi_k = v_k x s_k
-    vel: list[Spatial] = []
-    w, u = _ZERO3, _ZERO3
+    assert len(qd) == n and len(composites) == n, (len(qd), len(composites), n)
+    s = [link_subspace(link) for link in robot.links]  # s[i] in frame i
+    # outward: body velocities v_i (frame i) and psi_k = v_k x s_k (frame k)
+    vel: list[Motion] = []
+    w, u = v3.ZERO3, v3.ZERO3  # velocity of body i-1 in frame i-1, then of body i in frame i
     for i in range(n):
         R, p = frames[i].R, frames[i].p
         u = v3.mul_t(R, v3.add(u, v3.cross(w, p)))
         w = v3.mul_t(R, w)
-        w = program.let_vector(v3.add(w, v3.scale(qd[i], s[i][0])), f"w{i + 1}_")
-        u = program.let_vector(v3.add(u, v3.scale(qd[i], s[i][1])), f"u{i + 1}_")
-        vel.append((w, u))
-    psi = [_let_spatial(program, _cross_motion(vel[k], s[k]), f"psi{k + 1}_") for k in range(n)]
-    # inward: half momentum H and half inertia rate P of every subtree
-    H: list[Spatial] = [((), ())] * n  # type: ignore[list-item]
-    P: list[Composite] = [(sp.S.Zero, _ZERO3, ((sp.S.Zero,) * 3,) * 3)] * n  # type: ignore[list-item]
+        w = program.let_vector(v3.add(w, v3.scale(qd[i], s[i].angular)), f"w{i + 1}_")
+        u = program.let_vector(v3.add(u, v3.scale(qd[i], s[i].linear)), f"u{i + 1}_")
+        vel.append(Motion(w, u))
+    psi = [_let_motion(program, cross_motion(vel[k], s[k]), f"psi{k + 1}_") for k in range(n)]
+    # inward: half momentum H and half inertia rate P of every subtree (frame i)
+    H: list[Force] = []
+    P: list[SpatialInertia] = []
     for i in reversed(range(n)):
-        link = robot.links[i]
         k = str(i + 1)
-        m = sp.sympify(link.mass)
-        h = v3.vec(v3.scale(m, v3.vec(link.com)))
-        m2, h2, I2 = _HALF * m, v3.scale(_HALF, h), _halved(origin_inertia(link))
-        half = apply_inertia(m2, h2, I2, vel[i])
-        own = _inertia_rate(m2, h2, I2, vel[i], program, k)
+        half_body = scaled_inertia(_HALF, link_inertia(robot.links[i]))
+        half = apply_inertia(half_body, vel[i])
+        own = _named_rate(half_body, vel[i], program, k)
         if i + 1 < n:
-            child = frames[i + 1].force_to_parent(*H[i + 1], program, f"RH{k}_")
-            half = (v3.add(half[0], child[0]), v3.add(half[1], child[1]))
-            own = shift_inertia(frames[i + 1], P[i + 1], own, program, f"P{k}_")
-        H[i] = _let_spatial(program, half, f"H{k}_")
-        P[i] = own
+            child = frames[i + 1].force_to_parent(H[-1], program, f"RH{k}_")
+            half = spatial_add(half, child)
+            own = shift_inertia(frames[i + 1], P[-1], own, program, f"P{k}_")
+        H.append(_let_force(program, half, f"H{k}_"))
+        P.append(own)
+    H, P = H[::-1], P[::-1]
     C = sp.zeros(n, n)
     for j in reversed(range(n)):
         k = str(j + 1)
-        Ps = apply_inertia(sp.S.Zero, P[j][1], P[j][2], s[j])
-        sH = _cross_force(s[j], H[j])
-        Ipsi = apply_inertia(mass[j], hc[j], Ic[j], psi[j])
-        Y = _let_spatial(program, (v3.add(Ps[0], sH[0], Ipsi[0]), v3.add(Ps[1], sH[1], Ipsi[1])), f"Y{k}_")
-        A = _let_spatial(program, (v3.sub(Ps[0], sH[0]), v3.sub(Ps[1], sH[1])), f"A{k}_")
-        F = _let_spatial(program, apply_inertia(mass[j], hc[j], Ic[j], s[j]), f"F{k}_")
+        Ps = apply_inertia(P[j], s[j])
+        sH = cross_force(s[j], H[j])
+        Ipsi = apply_inertia(composites[j], psi[j])
+        # the three forces of column j, in frame j, then carried into frame i < j
+        Y = _let_force(program, spatial_add(Ps, sH, Ipsi), f"Y{k}_")
+        A = _let_force(program, spatial_sub(Ps, sH), f"A{k}_")
+        F = _let_force(program, apply_inertia(composites[j], s[j]), f"F{k}_")
         C[j, j] = program.let(project(s[j], Y), "C")
         for i in reversed(range(j)):
             frame = frames[i + 1]
             Y, A, F = (
-                _let_spatial(program, frame.force_to_parent(*vec, program, f"R{tag}{k}_"), f"{tag}{k}_")
-                for tag, vec in (("Y", Y), ("A", A), ("F", F))
+                _let_force(program, frame.force_to_parent(force, program, f"R{tag}{k}_"), f"{tag}{k}_")
+                for tag, force in (("Y", Y), ("A", A), ("F", F))
             )
             C[i, j] = program.let(project(s[i], Y), "C")
-            C[j, i] = program.let(v3._sum((project(s[i], A), project(psi[i], F))), "C")
+            C[j, i] = program.let(v3.sum_terms((project(s[i], A), project(psi[i], F))), "C")
     return C
-
-
-def _halved(I: v3.Mat) -> v3.Mat:
-    return tuple(tuple(v3._prod(_HALF, x) for x in row) for row in I)  # type: ignore[return-value]

@@ -21,58 +21,82 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import sympy as sp
 
 from ..model.robot import Robot
 from ..spatial import vectors as v3
+from ..spatial.motion import Force
 from ..spatial.transform import coordinate_axis
 from ..symbolic.program import Program
 
-__all__ = ["JointFrame", "joint_frames"]
+__all__ = ["AxisTurn", "JointFrame", "joint_frames"]
 
 #: the two axes spanning the plane of a rotation about x, y or z, in right-handed order
 _PLANES = {0: (1, 2), 1: (2, 0), 2: (0, 1)}
 
 
+class AxisTurn(NamedTuple):
+    """A rotation by q about coordinate axis k; (i, j, k) a right-handed order of the axes."""
+
+    i: int
+    j: int
+    k: int
+    cos: sp.Expr
+    sin: sp.Expr
+
+
 @dataclass(frozen=True)
 class JointFrame:
-    """Body frame i in its parent's: rotation R = B Rot(axis, q), origin p (parent axes)."""
+    """Body frame i in its parent's (frame i-1): R = parent_R_i = B Rot(axis, q_i), p = the
+    origin of frame i in frame i-1 (parent axes), B the constant rotation of the placement."""
 
     R: v3.Mat
     p: v3.Vec
     B: v3.Mat
-    #: (i, j, k, cos q, sin q) when the joint turns about coordinate axis k, else None
-    turn: tuple[int, int, int, sp.Expr, sp.Expr] | None = None
+    #: the joint's own rotation when it turns about a coordinate axis, else None
+    turn: AxisTurn | None = None
 
-    def rotate_symmetric(self, J: v3.Mat, program: Program, hint: str) -> list[list[sp.Expr]]:
-        """R J R^T for a symmetric J (entries of the result, not yet named)."""
+    def rotate_symmetric(
+        self, J: Sequence[Sequence[sp.Expr]], program: Program, hint: str
+    ) -> list[list[sp.Expr]]:
+        """R J R^T: a symmetric tensor J in frame i's axes turned into frame i-1's (Grupen,
+        "Dynamics" (2015), slide 10). Entries of the result, not yet named."""
         if self.turn is None:
             return _congruence(self.R, J)
         i, j, k, c, s = self.turn
-        e = v3._sum((J[i][i], -J[j][j]))
+        e = v3.sum_terms((J[i][i], -J[j][j]))
         out = [[sp.S.Zero] * 3 for _ in range(3)]
         out[i][i], out[j][j] = J[i][i], J[j][j]
         if e is not sp.S.Zero or J[i][j] is not sp.S.Zero:
             ss = program.let(s * s, f"{hint}ss_")
             cs = program.let(c * s, f"{hint}cs_")
             c2 = program.let(1 - 2 * ss, f"{hint}c2_")
-            t = program.let(v3._sum((v3._prod(e, ss), v3._prod(J[i][j], 2 * cs))), hint)
-            out[i][i] = v3._sum((J[i][i], -t))
-            out[j][j] = v3._sum((J[j][j], t))
-            out[i][j] = v3._sum((v3._prod(e, cs), v3._prod(J[i][j], c2)))
-        out[i][k] = v3._sum((v3._prod(c, J[i][k]), -v3._prod(s, J[j][k])))
-        out[j][k] = v3._sum((v3._prod(s, J[i][k]), v3._prod(c, J[j][k])))
+            t = program.let(v3.sum_terms((v3.product(e, ss), v3.product(J[i][j], 2 * cs))), hint)
+            out[i][i] = v3.sum_terms((J[i][i], -t))
+            out[j][j] = v3.sum_terms((J[j][j], t))
+            out[i][j] = v3.sum_terms((v3.product(e, cs), v3.product(J[i][j], c2)))
+        out[i][k] = v3.sum_terms((v3.product(c, J[i][k]), -v3.product(s, J[j][k])))
+        out[j][k] = v3.sum_terms((v3.product(s, J[i][k]), v3.product(c, J[j][k])))
         out[k][k] = J[k][k]
         for r, q in ((j, i), (k, i), (k, j)):
             out[r][q] = out[q][r]
         return _congruence(self.B, out)
 
-    def force_to_parent(self, n: v3.Vec, f: v3.Vec, program: Program, hint: str) -> tuple[v3.Vec, v3.Vec]:
-        """A force (moment n about the body origin, force f) carried into the parent frame:
-        (R n + p x R f, R f), with R f named (it appears in both)."""
+    def force_to_parent(self, force_i: Force, program: Program, hint: str) -> Force:
+        """A spatial force carried from frame i to frame i-1 (Featherstone 2008, sec. 2.8).
+
+        Args:
+            force_i: (moment n about frame i's origin, force f), frame i's axes.
+
+        Returns:
+            (R n + p x R f, R f): the moment about frame i-1's origin and the force, in frame
+            i-1's axes; R f is named (it appears in both).
+        """
+        n, f = force_i
         Rf = program.let_vector(v3.mul(self.R, f), hint)
-        return v3.add(v3.mul(self.R, n), v3.cross(self.p, Rf)), Rf  # type: ignore[return-value]
+        return Force(v3.add(v3.mul(self.R, n), v3.cross(self.p, Rf)), Rf)
 
 
 def _congruence(R: v3.Mat, J: Sequence[Sequence[sp.Expr]]) -> list[list[sp.Expr]]:
@@ -82,7 +106,16 @@ def _congruence(R: v3.Mat, J: Sequence[Sequence[sp.Expr]]) -> list[list[sp.Expr]
 
 
 def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
-    """R_i, p_i (and the factors of R_i) per link: body i in its parent's body frame."""
+    """R_i, p_i (and the factors of R_i) per link: body i in its parent's body frame.
+
+    Args:
+        robot: the model (symdyn.model.robot), n links.
+        q: n joint positions (symbols or numbers).
+
+    Returns:
+        n frames; frame i maps frame i's coordinates into frame i-1's (the base for i = 1).
+    """
+    assert len(q) == robot.n, (len(q), robot.n)
     out = []
     for link, qi in zip(robot.links, q, strict=True):
         T = link.joint_transform(qi)
@@ -91,6 +124,6 @@ def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
         if coord is not None:
             k, sign = coord
             angle = qi if sign == 1 else -qi
-            turn = (*_PLANES[k], k, sp.cos(angle), sp.sin(angle))
+            turn = AxisTurn(*_PLANES[k], k, sp.cos(angle), sp.sin(angle))
         out.append(JointFrame(v3.mat(T.R), v3.vec(T.p), v3.mat(link.placement.R), turn))
     return out

@@ -8,16 +8,22 @@ in the base frame:
     revolute j <= k:  Jv_j = z_j x (r - o_j),  Jw_j = z_j
     prismatic j <= k: Jv_j = z_j,              Jw_j = 0
 with z_j the joint axis and o_j the body origin of link j, in the base frame.
+
+References: Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 4.6
+(derivation of the Jacobian); Craig, Introduction to Robotics (3rd ed., 2005), ch. 3 (forward
+kinematics, frames composed link by link) and ch. 5 (Jacobians).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 import sympy as sp
 
+from ..errors import SymdynError
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
 from ..spatial.transform import Transform
@@ -42,17 +48,57 @@ def _named(T: Transform, program: Program | None, hint: str) -> Transform:
     return Transform(R, p)
 
 
+def _link_index(robot: Robot, link, where: str) -> int:
+    """`link` as a 0-based index into robot.links (negative counts from the end)."""
+    if isinstance(link, bool) or not isinstance(link, (int, np.integer)):
+        raise SymdynError(f"{where}: link must be an integer index, got {link!r}")
+    if not -robot.n <= link < robot.n:
+        raise SymdynError(
+            f"{where}: link {link} out of range: the robot has {robot.n} links (0 .. {robot.n - 1})"
+        )
+    return int(link) % robot.n
+
+
+def _point(point, where: str) -> tuple:
+    try:
+        out = tuple(sp.sympify(x) for x in point)
+    except (TypeError, sp.SympifyError):
+        raise SymdynError(f"{where}: point must be three numbers or expressions, got {point!r}") from None
+    if len(out) != 3:
+        raise SymdynError(f"{where}: point has {len(out)} entries, expected 3 (x, y, z in the link's frame)")
+    return out
+
+
 def link_transforms(robot: Robot, q: Sequence | None = None) -> list[Transform]:
-    """parent_T_i(q_i) for every link (symbolic q1..qn by default)."""
+    """parent_T_i(q_i) for every link (symbolic q1..qn by default).
+
+    Args:
+        robot: the model, n links.
+        q: n joint positions (symbols or numbers); None: the symbols q1..qn.
+
+    Returns:
+        n transforms, link i's body frame in link i-1's (the base for i = 1).
+    """
     if q is None:
         q = list(joint_symbols(robot.n)[0])
+    if len(q) != robot.n:
+        raise SymdynError(f"link_transforms: q has length {len(q)}, expected {robot.n} (one per joint)")
     return [link.joint_transform(qi) for link, qi in zip(robot.links, q, strict=True)]
 
 
 def forward_kinematics(
     robot: Robot, q: Sequence | None = None, program: Program | None = None
 ) -> list[Transform]:
-    """base_T_i for every link's body frame. With a `program`, entries are named intermediates."""
+    """base_T_i for every link's body frame (Craig (2005), ch. 3).
+
+    Args:
+        robot: the model, n links.
+        q: n joint positions; None: the symbols q1..qn.
+        program: if given, every entry becomes a named intermediate of it.
+
+    Returns:
+        n transforms, link i's body frame in the base frame.
+    """
     poses: list[Transform] = []
     T = Transform.identity()
     for i, Ti in enumerate(link_transforms(robot, q)):
@@ -62,7 +108,10 @@ def forward_kinematics(
 
 
 def frame_poses(robot: Robot, q: Sequence | None = None) -> list[Transform]:
-    """base_T of each convention frame (e.g. standard-DH frame i at the distal end)."""
+    """base_T of each convention frame (e.g. standard-DH frame i at the distal end).
+
+    Args and Returns as `forward_kinematics`, for the frames the robot file's convention names.
+    """
     return [T @ link.frame for T, link in zip(forward_kinematics(robot, q), robot.links, strict=True)]
 
 
@@ -73,12 +122,24 @@ def point_jacobian(
     q: Sequence | None = None,
     poses: list[Transform] | None = None,
 ) -> sp.Matrix:
-    """6 x n geometric Jacobian of `point` (body frame of link index `link`, 0-based), base frame."""
+    """The geometric Jacobian of a point fixed to a link (Spong et al. (2006), sec. 4.6).
+
+    Args:
+        robot: the model, n links.
+        link: 0-based link index (negative counts from the end).
+        point: the point in that link's body frame (3 entries).
+        q: n joint positions; None: the symbols q1..qn.
+        poses: `forward_kinematics(robot, q)`, to share it.
+
+    Returns:
+        J = [Jv; Jw] (6 x n): the point's linear velocity and the link's angular velocity
+        per unit joint rate, both in the base frame; columns after the link's joint are zero.
+    """
     n = robot.n
-    k = link % n
+    k = _link_index(robot, link, "point_jacobian")
     if poses is None:
         poses = forward_kinematics(robot, q)
-    r = poses[k].apply(point)
+    r = poses[k].apply(_point(point, "point_jacobian"))
     J = sp.zeros(6, n)
     for j in range(k + 1):
         z = poses[j].R * robot.links[j].axis
@@ -91,9 +152,24 @@ def point_jacobian(
 
 
 def end_effector_jacobian(robot: Robot, q: Sequence | None = None) -> sp.Matrix:
-    """Jacobian of the last convention frame's origin (the DH end-effector frame)."""
+    """Jacobian of the last convention frame's origin (the DH end-effector frame).
+
+    Args:
+        robot: the model, n links.
+        q: n joint positions; None: the symbols q1..qn.
+
+    Returns:
+        6 x n, base frame (see `point_jacobian`).
+    """
     last = robot.links[-1]
     return point_jacobian(robot, -1, list(last.frame.p), q)
+
+
+class PoseJacobian(NamedTuple):
+    """A link's pose (4x4, base frame) and the Jacobian (6 x n, base frame) of a point on it."""
+
+    pose: np.ndarray
+    jacobian: np.ndarray
 
 
 @lru_cache(maxsize=64)
@@ -101,26 +177,54 @@ def _pose_jacobian_function(robot: Robot, link: int, point: tuple):
     q = list(joint_symbols(robot.n)[0])
     r = robot.resolved()
     poses = forward_kinematics(r, q)
-    T = poses[link % r.n].matrix()
-    T[:3, 3] = poses[link % r.n].apply(point)
+    T = poses[link].matrix()
+    T[:3, 3] = poses[link].apply(point)
     J = point_jacobian(r, link, point, q, poses)
     return sp.lambdify([q, list(r.params)], [T, J], modules="numpy")
 
 
-def _pose_and_jacobian(robot, q, link, point, params):
-    values = robot.param_values(params) if robot.params else {}
+def _pose_and_jacobian(robot, q, link, point, params, where: str) -> PoseJacobian:
+    if not isinstance(robot, Robot):
+        raise SymdynError(f"{where}: robot must be a symdyn Robot, got {type(robot).__name__}")
+    k = _link_index(robot, link, where)
+    q = robot.joint_values(q, "q", where)
+    values = robot.param_values(params, where)
     # a point may name parameters the file gives values for (the frame origin [l2, 0, 0])
     known = robot.value_map
-    f = _pose_jacobian_function(robot, link, tuple(sp.sympify(x).xreplace(known) for x in point))
-    T, J = f(np.asarray(q, dtype=float), [values[p] for p in robot.params])
-    return np.asarray(T, dtype=float), np.asarray(J, dtype=float)
+    p = tuple(x.xreplace(known) for x in _point(point, where))
+    unknown = sorted({str(s) for x in p for s in x.free_symbols} - {str(s) for s in robot.params})
+    if unknown:
+        raise SymdynError(f"{where}: point names unknown symbol(s) {', '.join(unknown)}")
+    f = _pose_jacobian_function(robot, k, p)
+    T, J = f(q, [values[s] for s in robot.params])
+    return PoseJacobian(np.asarray(T, dtype=float), np.asarray(J, dtype=float))
 
 
 def numeric_pose(robot: Robot, q, link: int = -1, point=(0, 0, 0), params=None) -> np.ndarray:
-    """4x4 pose (rotation of link `link`, position of `point`) in the base frame, as numbers."""
-    return _pose_and_jacobian(robot, q, link, point, params)[0]
+    """The pose of a link with a point on it, in the base frame, as numbers.
+
+    Args:
+        robot: the model, n links.
+        q: n joint positions.
+        link: 0-based link index (negative counts from the end).
+        point: a point in that link's body frame (numbers, or expressions of the robot's
+            parameters).
+        params: values of the free parameters (a sequence in `robot.params` order or a
+            name -> number map); None when there are none.
+
+    Returns:
+        4x4: the link's orientation (base frame) and the point's position (base frame).
+
+    Raises:
+        SymdynError: a q without n numbers, a link out of range, a point without three
+            entries or naming unknown symbols, bad parameter values.
+    """
+    return _pose_and_jacobian(robot, q, link, point, params, "numeric_pose").pose
 
 
 def numeric_jacobian(robot: Robot, q, link: int = -1, point=(0, 0, 0), params=None) -> np.ndarray:
-    """6 x n geometric Jacobian of `point` on link `link`, base frame, as numbers."""
-    return _pose_and_jacobian(robot, q, link, point, params)[1]
+    """The 6 x n geometric Jacobian of a point on a link, base frame, as numbers.
+
+    Args and Raises as `numeric_pose`; Returns J = [Jv; Jw] (see `point_jacobian`).
+    """
+    return _pose_and_jacobian(robot, q, link, point, params, "numeric_jacobian").jacobian

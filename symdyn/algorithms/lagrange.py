@@ -11,6 +11,12 @@ centre of mass (body axes):
 
 Derivatives are taken by forward-mode differentiation through the program's
 named intermediates (symdyn.symbolic.program), never by expanding M.
+
+References: Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 7.2
+(kinetic and potential energy, M from the Jacobians) and sec. 7.3 (equations of motion,
+Christoffel symbols); Craig, Introduction to Robotics (3rd ed., 2005), sec. 6.9 (Lagrangian
+formulation). R. Grupen, "Dynamics" (2015) lists Lagrangian dynamics in its outline (slide 1)
+and gives the resulting form tau = M qdd + V + G + F on slide 16.
 """
 
 from __future__ import annotations
@@ -25,8 +31,19 @@ __all__ = ["lagrange"]
 
 
 def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dict[str, sp.Matrix]:
-    """M, C and G of the robot (rigid bodies plus motor inertia) over the program's intermediates."""
+    """M, C and G of the robot (rigid bodies plus motor inertia) by Lagrange's equations.
+
+    Args:
+        robot: the model, n links.
+        q, qd: the joint position and velocity symbols (n x 1); derivatives are taken by them.
+        program: receives the named intermediates.
+
+    Returns:
+        {"M": n x n, "C": n x n, "G": n x 1}, joint space, over the program's intermediates;
+        C is the Christoffel-symbol matrix (dM/dt - 2C skew-symmetric, Spong et al. sec. 7.5).
+    """
     n = robot.n
+    assert len(q) == len(qd) == n, (len(q), len(qd), n)
     poses = forward_kinematics(robot, list(q), program)
     M = sp.zeros(n, n)
     P = sp.S.Zero

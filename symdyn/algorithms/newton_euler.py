@@ -1,4 +1,4 @@
-"""Symbolic recursive Newton-Euler (slides 14-15), written into a straight-line program.
+"""Symbolic recursive Newton-Euler, written into a straight-line program.
 
 Every quantity of link i is expressed in link i's body frame. With
 R_i = parent_R_i(q_i) and p_i the origin of body i in its parent's frame
@@ -28,32 +28,37 @@ both the centre of mass and the next joint's origin. For links whose inertia
 tensor has products of inertia, N_i + c_i x F_i is formed about the body origin
 instead (h = m c, I_o = I_c + m (c^T c 1 - c c^T)): F = m vd + W h and
 N_o = I_o wd + w x I_o w + h x vd, which need neither vc nor c x F.
+
+References: R. Grupen, "Dynamics" (2015), slides 14-15 (the outward and inward iterations
+above); Craig, Introduction to Robotics (3rd ed., 2005), sec. 6.5 (iterative Newton-Euler
+dynamic formulation); Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 5.3 (the same
+recursion on spatial vectors, which symdyn.rnea implements numerically).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import sympy as sp
 
 from ..model.robot import Link, Robot
 from ..spatial import vectors as v3
+from ..spatial.inertia import body_inertia
+from ..spatial.motion import Force
 from ..symbolic.program import Program
 from .frames import JointFrame, joint_frames
 
-__all__ = ["newton_euler", "origin_inertia"]
+__all__ = ["newton_euler"]
 
 
-def origin_inertia(link: Link) -> v3.Mat:
-    """I_o = I_c + m (c^T c 1 - c c^T): the inertia about the body origin (parallel axis)."""
-    m = sp.sympify(link.mass)
-    c = v3.vec(link.com)
-    Ic = v3.mat(link.inertia)
-    cc = v3.dot(c, c)
-    return tuple(
-        tuple(Ic[r][s] + v3._prod(m, (cc if r == s else 0) - v3._prod(c[r], c[s])) for s in range(3))
-        for r in range(3)
-    )  # type: ignore[return-value]
+class LinkAcceleration(NamedTuple):
+    """Angular velocity w, angular acceleration wd and acceleration vd of a body's origin,
+    all of one body, in that body's frame."""
+
+    w: v3.Vec
+    wd: v3.Vec
+    vd: v3.Vec
 
 
 def _about_origin(link: Link) -> bool:
@@ -64,18 +69,16 @@ def _about_origin(link: Link) -> bool:
     return any(Ic[r, s] != 0 for r in range(3) for s in range(3) if r != s)
 
 
-def _body_wrench(
-    link: Link, W: v3.Mat, w: v3.Vec, wd: v3.Vec, vd: v3.Vec, program: Program, k: str
-) -> tuple[v3.Vec, v3.Vec]:
-    """Net force F and moment N about the body origin that accelerate the link (slide 15).
+def _body_wrench(link: Link, W: v3.Mat, motion: LinkAcceleration, program: Program, k: str) -> Force:
+    """The net wrench (N, F) about the body origin that accelerates the link (slide 15), body frame.
 
     Either about the centre of mass, F = m (W c + vd), N = I_c wd + w x I_c w + c x F,
     or about the origin with h = m c: F = m vd + W h, N = I_o wd + w x I_o w + h x vd."""
+    w, wd, vd = motion
     m = sp.sympify(link.mass)
     c = v3.vec(link.com)
     if _about_origin(link):
-        h = tuple(v3._prod(m, x) for x in c)
-        I = origin_inertia(link)
+        _, h, I = body_inertia(m, c, link.inertia)
         F = program.let_vector(v3.add(v3.scale(m, vd), v3.mul(W, h)), f"F{k}_")
         extra = v3.cross(h, vd)
     else:
@@ -85,17 +88,17 @@ def _body_wrench(
         extra = v3.cross(c, F)
     Iw = program.let_vector(v3.mul(I, w), f"Iw{k}_")
     N = program.let_vector(v3.add(v3.mul(I, wd), v3.cross(w, Iw), extra), f"N{k}_")
-    return F, N
+    return Force(N, F)
 
 
 def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
     """W = [wd x] + [w x]^2, so that wd x r + w x (w x r) = W r for any point r of the link."""
-    sq = [program.let(v3._prod(w[j], w[j]), f"ww{k}_") for j in range(3)]
-    xy, xz, yz = (program.let(v3._prod(w[a], w[b]), f"ww{k}_") for a, b in ((0, 1), (0, 2), (1, 2)))
+    sq = [program.let(v3.product(w[j], w[j]), f"ww{k}_") for j in range(3)]
+    xy, xz, yz = (program.let(v3.product(w[a], w[b]), f"ww{k}_") for a, b in ((0, 1), (0, 2), (1, 2)))
     W = (
-        (-v3._sum((sq[1], sq[2])), v3._sum((xy, -wd[2])), v3._sum((xz, wd[1]))),
-        (v3._sum((xy, wd[2])), -v3._sum((sq[0], sq[2])), v3._sum((yz, -wd[0]))),
-        (v3._sum((xz, -wd[1])), v3._sum((yz, wd[0])), -v3._sum((sq[0], sq[1]))),
+        (-v3.sum_terms((sq[1], sq[2])), v3.sum_terms((xy, -wd[2])), v3.sum_terms((xz, wd[1]))),
+        (v3.sum_terms((xy, wd[2])), -v3.sum_terms((sq[0], sq[2])), v3.sum_terms((yz, -wd[0]))),
+        (v3.sum_terms((xz, -wd[1])), v3.sum_terms((yz, wd[0])), -v3.sum_terms((sq[0], sq[1]))),
     )
     return tuple(program.let_vector(row, f"W{k}_") for row in W)  # type: ignore[return-value]
 
@@ -103,32 +106,30 @@ def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
 def _outward(
     link: Link,
     frame: JointFrame,
-    w: v3.Vec,
-    wd: v3.Vec,
-    vd: v3.Vec,
-    W: v3.Mat,
+    parent: LinkAcceleration,
+    W_parent: v3.Mat,
     qd,
     qdd,
     program: Program,
     k: str,
-) -> tuple[v3.Vec, v3.Vec, v3.Vec]:
-    """w_i, wd_i, vd_i of link i from those of its parent (slide 15, body frames).
+) -> LinkAcceleration:
+    """w_i, wd_i, vd_i of link i (frame i) from its parent's (frame i-1): slide 15.
 
     The parent's W = [wd x] + [w x]^2 gives wd x p + w x (w x p) = W p.
     """
     R, p = frame.R, frame.p
     a = v3.vec(link.axis)
-    vd_new = v3.mul_t(R, v3.add(v3.mul(W, p), vd))
-    w_par = program.let_vector(v3.mul_t(R, w), f"wp{k}_")
-    wd_par = v3.mul_t(R, wd)
+    vd_i = v3.mul_t(R, v3.add(v3.mul(W_parent, p), parent.vd))
+    w_parent_i = program.let_vector(v3.mul_t(R, parent.w), f"wp{k}_")  # the parent's w, frame i
+    wd_parent_i = v3.mul_t(R, parent.wd)
     if link.joint == "revolute":
-        w_new = program.let_vector(v3.add(w_par, v3.scale(qd, a)), f"w{k}_")
-        wd_new = v3.add(wd_par, v3.cross(w_par, v3.scale(qd, a)), v3.scale(qdd, a))
+        w_i = program.let_vector(v3.add(w_parent_i, v3.scale(qd, a)), f"w{k}_")
+        wd_i = v3.add(wd_parent_i, v3.cross(w_parent_i, v3.scale(qd, a)), v3.scale(qdd, a))
     else:
-        w_new = w_par
-        wd_new = wd_par
-        vd_new = v3.add(vd_new, v3.scale(2, v3.cross(w_new, v3.scale(qd, a))), v3.scale(qdd, a))
-    return w_new, program.let_vector(wd_new, f"wd{k}_"), program.let_vector(vd_new, f"vd{k}_")
+        w_i = w_parent_i
+        wd_i = wd_parent_i
+        vd_i = v3.add(vd_i, v3.scale(2, v3.cross(w_i, v3.scale(qd, a))), v3.scale(qdd, a))
+    return LinkAcceleration(w_i, program.let_vector(wd_i, f"wd{k}_"), program.let_vector(vd_i, f"vd{k}_"))
 
 
 def newton_euler(
@@ -142,41 +143,51 @@ def newton_euler(
     tag: str = "",
     rotations: list[JointFrame] | None = None,
 ) -> list[sp.Expr]:
-    """Rigid-body joint efforts (no friction, no motor inertia) for the given state.
+    """Rigid-body joint efforts (no friction, no motor inertia) by recursive Newton-Euler.
 
-    `q`, `qd`, `qdd` may hold symbols or numbers (zeros fold away). The result
-    is a list of expressions over the program's intermediates. `rotations`
-    (per link, from `symdyn.algorithms.frames.joint_frames`) may be passed in to share them.
+    Grupen (2015), slides 14-15; Craig (2005), sec. 6.5; Featherstone (2008), sec. 5.3.
+
+    Args:
+        robot: the model, n links.
+        q, qd, qdd: n joint positions, velocities and accelerations; symbols or numbers
+            (zeros fold away).
+        program: receives the named intermediates.
+        gravity: enter the robot's gravity (base frame) as the base acceleration vd_0 = -g.
+        tag: prefix of the intermediates' names, to tell passes apart.
+        rotations: `symdyn.algorithms.frames.joint_frames(robot, q)`, to share them.
+
+    Returns:
+        n joint efforts tau_i = a_i . n_i (revolute) or a_i . f_i (prismatic), with n_i, f_i
+        the wrench link i-1 exerts on link i in frame i; expressions over the program's
+        intermediates.
     """
     n = robot.n
+    assert len(q) == len(qd) == len(qdd) == n, (len(q), len(qd), len(qdd), n)
     frames = rotations if rotations is not None else joint_frames(robot, q)
-    zero: v3.Vec = (sp.S.Zero,) * 3  # type: ignore[assignment]
-    w, wd = zero, zero
-    W: v3.Mat = (zero, zero, zero)
-    vd = program.let_vector(v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
-    forces: list[v3.Vec] = []
-    moments: list[v3.Vec] = []
+    zero = v3.ZERO3
+    vd_0 = program.let_vector(v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
+    motion = LinkAcceleration(zero, zero, vd_0)  # of link i-1, in frame i-1
+    W: v3.Mat = v3.ZERO33
+    wrenches: list[Force] = []  # net wrench of link i about its origin, frame i
     for i, link in enumerate(robot.links):
         k = f"{tag}{i + 1}"
-        w, wd, vd = _outward(link, frames[i], w, wd, vd, W, qd[i], qdd[i], program, k)
-        W = _tilde(program, w, wd, k)
-        F, N = _body_wrench(link, W, w, wd, vd, program, k)
-        forces.append(F)
-        moments.append(N)
+        motion = _outward(link, frames[i], motion, W, qd[i], qdd[i], program, k)
+        W = _tilde(program, motion.w, motion.wd, k)
+        wrenches.append(_body_wrench(link, W, motion, program, k))
     tau: list[sp.Expr] = [sp.S.Zero] * n
-    f_next, n_next = zero, zero
+    f_child, n_child = zero, zero  # the wrench on link i+1, frame i+1
     for i in reversed(range(n)):
         link = robot.links[i]
         k = f"{tag}{i + 1}"
         if i + 1 < n:
-            n_par, f_par = frames[i + 1].force_to_parent(n_next, f_next, program, f"Rf{k}_")
-            n_new = v3.add(moments[i], n_par)
-            f_new = v3.add(f_par, forces[i])
+            n_child_i, f_child_i = frames[i + 1].force_to_parent(Force(n_child, f_child), program, f"Rf{k}_")
+            n_i = v3.add(wrenches[i].angular, n_child_i)
+            f_i = v3.add(f_child_i, wrenches[i].linear)
         else:
-            n_new = moments[i]
-            f_new = forces[i]
-        f_next = program.let_vector(f_new, f"f{k}_")
-        n_next = program.let_vector(n_new, f"n{k}_")
+            n_i = wrenches[i].angular
+            f_i = wrenches[i].linear
+        f_child = program.let_vector(f_i, f"f{k}_")
+        n_child = program.let_vector(n_i, f"n{k}_")
         a = v3.vec(link.axis)
-        tau[i] = v3.dot(a, n_next if link.joint == "revolute" else f_next)
+        tau[i] = v3.dot(a, n_child if link.joint == "revolute" else f_child)
     return tau

@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
+import numpy as np
 import sympy as sp
 
 from ..errors import SymdynError
@@ -94,6 +95,18 @@ class Link:
         )
 
 
+def _entries(k: int) -> str:
+    return f"{k} entry" if k == 1 else f"{k} entries"
+
+
+def _listed(values) -> list | None:
+    """The items of an iterable as a list; None for a non-iterable (a bare number)."""
+    try:
+        return list(values)
+    except TypeError:
+        return None
+
+
 @dataclass(frozen=True)
 class Robot:
     """An immutable serial manipulator.
@@ -128,23 +141,86 @@ class Robot:
             return self
         return self._substituted(self.value_map, values=())
 
-    def param_values(self, params=None) -> dict[sp.Symbol, float]:
-        """Numbers for the free parameters: a sequence in `params` order or a name/symbol map."""
-        if not self.params:
-            return {}
+    def param_values(self, params=None, where: str = "") -> dict[sp.Symbol, float]:
+        """Numbers for the free parameters: a sequence in `params` order or a name/symbol map.
+
+        Args:
+            params: None (only when the robot has no free parameters), a sequence of one
+                number per free parameter in `self.params` order, or a map from each free
+                parameter (name or symbol) to a number.
+            where: the public function asking, to start error messages with.
+
+        Returns:
+            free parameter symbol -> float (empty for a robot without free parameters).
+
+        Raises:
+            SymdynError: a missing, extra, unknown or non-numeric value.
+        """
+        prefix = f"{where}: " if where else ""
         if params is None:
-            names = ", ".join(str(p) for p in self.params)
-            raise SymdynError(f"robot '{self.name}' has free parameters ({names}); give their values")
+            if self.params:
+                raise SymdynError(
+                    f"{prefix}robot '{self.name}' has free parameters ({self._listing()}); give their values"
+                )
+            return {}
         if isinstance(params, Mapping):
             by_name = {str(k): v for k, v in params.items()}
-            missing = [str(p) for p in self.params if str(p) not in by_name]
+            names = [str(p) for p in self.params]
+            unknown = [k for k in by_name if k not in names]
+            if unknown:
+                raise SymdynError(
+                    f"{prefix}unknown parameter(s) {', '.join(unknown)} (free parameters of robot "
+                    f"'{self.name}': {self._listing()})"
+                )
+            missing = [k for k in names if k not in by_name]
             if missing:
-                raise SymdynError(f"no value for parameter(s) {', '.join(missing)}")
-            return {p: float(by_name[str(p)]) for p in self.params}
-        seq = list(params)
-        if len(seq) != len(self.params):
-            raise SymdynError(f"expected {len(self.params)} parameter values, got {len(seq)}")
-        return {p: float(v) for p, v in zip(self.params, seq, strict=True)}
+                raise SymdynError(f"{prefix}no value for parameter(s) {', '.join(missing)}")
+            given = [by_name[k] for k in names]
+        else:
+            given = None if isinstance(params, (str, bytes)) else _listed(params)
+            if given is None:
+                raise SymdynError(
+                    f"{prefix}params must be a sequence of numbers or a name -> number map, got {params!r}"
+                )
+            if len(given) != len(self.params):
+                raise SymdynError(
+                    f"{prefix}params has {len(given)} values, expected {len(self.params)} (one per free "
+                    f"parameter: {self._listing()})"
+                )
+        values = {}
+        for p, v in zip(self.params, given, strict=True):
+            try:
+                values[p] = float(v)
+            except (TypeError, ValueError):
+                raise SymdynError(f"{prefix}parameter {p} must be a number, got {v!r}") from None
+        return values
+
+    def _listing(self) -> str:
+        return ", ".join(str(p) for p in self.params) or "none"
+
+    def joint_values(self, values, name: str = "q", where: str = "") -> np.ndarray:
+        """One number per joint, as a float array of shape (n,).
+
+        Args:
+            values: n numbers (any sequence or array), or None for zeros.
+            name: what the vector is (q, qd, qdd, tau), for messages.
+            where: the public function asking, to start error messages with.
+
+        Raises:
+            SymdynError: not n numbers.
+        """
+        prefix = f"{where}: " if where else ""
+        if values is None:
+            return np.zeros(self.n)
+        try:
+            a = np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            raise SymdynError(f"{prefix}{name} must hold numbers, got {values!r}") from None
+        if a.ndim != 1:
+            raise SymdynError(f"{prefix}{name} has shape {a.shape}, expected ({self.n},) (one per joint)")
+        if a.size != self.n:
+            raise SymdynError(f"{prefix}{name} has {_entries(a.size)}, expected {self.n} (one per joint)")
+        return a
 
     def numeric(self, params=None) -> Robot:
         """A fully numeric copy (every parameter substituted), for the numeric algorithms."""

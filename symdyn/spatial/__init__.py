@@ -1,2 +1,3 @@
-"""Spatial algebra over SymPy expressions: homogeneous transforms, zero-aware 3-vectors,
-and spatial motions, forces and inertias (angular part first)."""
+"""Spatial algebra over SymPy expressions, the package's lowest floor (as Pinocchio's spatial/):
+rigid transforms (`transform`), zero-aware 3-vectors (`vectors`), spatial motions and forces,
+angular part first (`motion`), and spatial inertias (`inertia`)."""

@@ -13,14 +13,35 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-__all__ = ["Vec", "Mat", "vec", "mat", "add", "sub", "scale", "cross", "dot", "mul", "mul_t", "neg"]
+__all__ = [
+    "Vec",
+    "Mat",
+    "ZERO3",
+    "ZERO33",
+    "vec",
+    "mat",
+    "product",
+    "sum_terms",
+    "add",
+    "sub",
+    "scale",
+    "cross",
+    "dot",
+    "mul",
+    "mul_t",
+    "neg",
+]
 
 Vec = tuple[sp.Expr, sp.Expr, sp.Expr]
 Mat = tuple[Vec, Vec, Vec]
 ZERO = sp.S.Zero
+#: the zero 3-vector and the zero 3x3 matrix (SymPy's singleton zero in every entry)
+ZERO3: Vec = (ZERO, ZERO, ZERO)
+ZERO33: Mat = (ZERO3, ZERO3, ZERO3)
 
 
 def vec(v: Sequence) -> Vec:
+    """A 3-vector of SymPy expressions from any sequence of three numbers or expressions."""
     return tuple(sp.sympify(x) for x in v)  # type: ignore[return-value]
 
 
@@ -38,7 +59,8 @@ def _s(x) -> sp.Expr:
     return x if isinstance(x, sp.Basic) else sp.sympify(x)
 
 
-def _prod(a: sp.Expr, b: sp.Expr) -> sp.Expr:
+def product(a: sp.Expr, b: sp.Expr) -> sp.Expr:
+    """The scalar product a b, with 0 and +-1 factors folded before SymPy multiplies."""
     # SymPy's 0, 1 and -1 are singletons: identity tests avoid SymPy's (slow) comparisons
     a, b = _s(a), _s(b)
     if a is ZERO or b is ZERO:
@@ -54,7 +76,8 @@ def _prod(a: sp.Expr, b: sp.Expr) -> sp.Expr:
     return a * b
 
 
-def _sum(terms) -> sp.Expr:
+def sum_terms(terms) -> sp.Expr:
+    """The sum of scalar terms, zeros dropped before SymPy adds."""
     terms = [t for t in map(_s, terms) if t is not ZERO]
     if not terms:
         return ZERO
@@ -64,30 +87,36 @@ def _sum(terms) -> sp.Expr:
 
 
 def add(*vs: Vec) -> Vec:
-    return tuple(_sum(v[i] for v in vs) for i in range(3))  # type: ignore[return-value]
+    """The sum of 3-vectors."""
+    return tuple(sum_terms(v[i] for v in vs) for i in range(3))  # type: ignore[return-value]
 
 
 def sub(a: Vec, b: Vec) -> Vec:
-    return tuple(_sum((a[i], _prod(_MINUS_ONE, b[i]))) for i in range(3))  # type: ignore[return-value]
+    """a - b."""
+    return tuple(sum_terms((a[i], product(_MINUS_ONE, b[i]))) for i in range(3))  # type: ignore[return-value]
 
 
 def neg(a: Vec) -> Vec:
-    return tuple(_prod(_MINUS_ONE, x) for x in a)  # type: ignore[return-value]
+    """-a."""
+    return tuple(product(_MINUS_ONE, x) for x in a)  # type: ignore[return-value]
 
 
 def scale(k: sp.Expr, a: Vec) -> Vec:
-    return tuple(_prod(k, x) for x in a)  # type: ignore[return-value]
+    """k a for a scalar k."""
+    return tuple(product(k, x) for x in a)  # type: ignore[return-value]
 
 
 def dot(a: Sequence[sp.Expr], b: Sequence[sp.Expr]) -> sp.Expr:
-    return _sum(_prod(x, y) for x, y in zip(a, b, strict=True))
+    """a^T b (sequences of equal length)."""
+    return sum_terms(product(x, y) for x, y in zip(a, b, strict=True))
 
 
 def cross(a: Vec, b: Vec) -> Vec:
+    """a x b."""
     return (
-        _sum((_prod(a[1], b[2]), -_prod(a[2], b[1]))),
-        _sum((_prod(a[2], b[0]), -_prod(a[0], b[2]))),
-        _sum((_prod(a[0], b[1]), -_prod(a[1], b[0]))),
+        sum_terms((product(a[1], b[2]), -product(a[2], b[1]))),
+        sum_terms((product(a[2], b[0]), -product(a[0], b[2]))),
+        sum_terms((product(a[0], b[1]), -product(a[1], b[0]))),
     )
 
 

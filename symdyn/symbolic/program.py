@@ -8,6 +8,7 @@ nesting whole expressions, so the work stays linear in the number of links.
 
 Operations:
 - `let` names a non-trivial expression (atoms and numbers pass through);
+  `let_vector` and `let_symmetric` name vectors and symmetric 3x3 matrices entry by entry;
 - `diff` differentiates outputs by forward-mode propagation through the
   assignments (dt_k/dx = sum of partials times dt_j/dx);
 - `expand` substitutes the intermediates back, for closed forms;
@@ -140,6 +141,12 @@ class Program:
     def let_vector(self, v: Iterable, hint: str) -> tuple:
         """Name each component of a vector (see `let`): a tuple, as symdyn.spatial.vectors uses."""
         return tuple(self.let(x, hint) for x in v)
+
+    def let_symmetric(self, rows: Sequence[Sequence], hint: str) -> tuple:
+        """Name the 6 distinct entries of a symmetric 3x3 matrix (upper triangle, by rows);
+        rows of a tuple, each entry below the diagonal the name of its mirror image."""
+        e = {(r, c): self.let(rows[r][c], hint) for r in range(3) for c in range(r, 3)}
+        return tuple(tuple(e[(min(r, c), max(r, c))] for c in range(3)) for r in range(3))
 
     def _deps(self, expr: sp.Expr) -> set[sp.Symbol]:
         return {s for s in expr.free_symbols if s in self._index}

@@ -1,0 +1,170 @@
+"""The numeric oracle's inputs: a `Robot` as NumPy arrays, and the checked arguments.
+
+symdyn.rnea evaluates rigid-body dynamics with NumPy only; this module is its side that
+reads the model. `numeric_model` converts `robot.numeric(params)` to arrays once per robot
+and parameter values (cached), and `checked_inputs` checks what every public function of
+symdyn.rnea is given (the robot, the parameter values, the joint vectors) and says what it
+expected. Nothing here imports SymPy or the symbolic derivation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from .errors import SymdynError
+
+__all__ = ["NumericModel", "numeric_model", "checked_inputs", "skew"]
+
+
+@dataclass(frozen=True, eq=False)
+class NumericModel:
+    """A robot as NumPy arrays (n links): everything the numeric algorithms read.
+
+    `revolute` (n,) bool; `R0`, `p0` (n,3,3), (n,3) the constant placement;
+    `axis` (n,3) in the body frame; `mass` (n,); `com` (n,3) body frame;
+    `inertia` (n,3,3) about the centre of mass; `spatial_inertia` (n,6,6) about
+    the body origin; `viscous`, `coulomb`, `reflected` (n,) friction and
+    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame.
+    """
+
+    revolute: np.ndarray
+    R0: np.ndarray
+    p0: np.ndarray
+    axis: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    spatial_inertia: np.ndarray
+    viscous: np.ndarray
+    coulomb: np.ndarray
+    reflected: np.ndarray
+    gravity: np.ndarray
+
+    def __post_init__(self) -> None:
+        for value in vars(self).values():  # cached and shared: make every array read-only
+            value.flags.writeable = False
+
+    @property
+    def n(self) -> int:
+        return len(self.revolute)
+
+
+def skew(v: np.ndarray) -> np.ndarray:
+    """The cross-product matrix [v]x, with v of shape (..., 3) -> (..., 3, 3)."""
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    o = np.zeros_like(x)
+    return np.stack([np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2)
+
+
+def _floats(expr, shape, what: str) -> np.ndarray:
+    try:
+        return np.array(np.asarray(expr).tolist(), dtype=float).reshape(shape)
+    except (TypeError, ValueError) as exc:
+        raise SymdynError(f"{what} is not numeric after substitution: {expr}") from exc
+
+
+def _model(robot, params, where: str) -> NumericModel:
+    """The cached numeric model, after checking the robot and its parameter values."""
+    if not all(hasattr(robot, a) for a in ("links", "params", "param_values", "numeric")):
+        raise SymdynError(f"{where}: robot must be a symdyn Robot, got {type(robot).__name__}")
+    values = robot.param_values(params, where)  # names, count and numbers checked here
+    return _numeric_model(robot, tuple(values[p] for p in robot.params))
+
+
+def numeric_model(robot, params=None) -> NumericModel:
+    """Convert `robot.numeric(params)` to NumPy arrays, once per (robot, parameter values).
+
+    Args:
+        robot: a `symdyn.Robot`.
+        params: values of its free parameters (`robot.params`): a sequence in that order or a
+            name -> number map; None when it has none.
+
+    Raises:
+        SymdynError: missing, extra, unknown or non-numeric parameter values.
+    """
+    return _model(robot, params, "numeric_model")
+
+
+@lru_cache(maxsize=256)
+def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
+    r = robot.numeric(list(values) if values else None)
+    links = r.links
+    for k, lk in enumerate(links, 1):
+        if lk.joint not in ("revolute", "prismatic"):
+            raise SymdynError(f"unknown joint type {lk.joint!r}", link_index=k, link_name=lk.name)
+    R0 = np.array([_floats(lk.placement.R, (3, 3), f"{lk.name} placement") for lk in links])
+    p0 = np.array([_floats(lk.placement.p, (3,), f"{lk.name} placement") for lk in links])
+    axis = np.array([_floats(lk.axis, (3,), f"{lk.name} axis") for lk in links])
+    mass = np.array([_floats(lk.mass, (), f"{lk.name} mass") for lk in links])
+    com = np.array([_floats(lk.com, (3,), f"{lk.name} com") for lk in links])
+    inertia = np.array([_floats(lk.inertia, (3, 3), f"{lk.name} inertia") for lk in links])
+    n = len(links)
+    R0, inertia = R0.reshape(n, 3, 3), inertia.reshape(n, 3, 3)
+    p0, axis, com, mass = p0.reshape(n, 3), axis.reshape(n, 3), com.reshape(n, 3), mass.reshape(n)
+    # Spatial inertia about the body origin: [[Ic + m cx cx^T, m cx], [m cx^T, m 1]].
+    cx = skew(com)
+    m = mass[:, None, None]
+    spatial = np.zeros((n, 6, 6))
+    spatial[:, :3, :3] = inertia + m * cx @ np.swapaxes(cx, -1, -2)
+    spatial[:, :3, 3:] = m * cx
+    spatial[:, 3:, :3] = m * np.swapaxes(cx, -1, -2)
+    spatial[:, 3:, 3:] = m * np.eye(3)
+    fr = [(lk.friction.viscous, lk.friction.coulomb, lk.motor.reflected_inertia) for lk in links]
+    fr = np.array(
+        [[_floats(x, (), f"{lk.name} friction/motor") for x in t] for lk, t in zip(links, fr, strict=True)]
+    ).reshape(n, 3)
+    return NumericModel(
+        revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
+        R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
+        spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
+        gravity=_floats(r.gravity, (3,), "gravity"),
+    )  # fmt: skip
+
+
+def _states(where: str, n: int, *named: tuple[str, object]) -> tuple[list[np.ndarray], bool]:
+    """Joint vectors (name, value), each (n,) or (N, n) and all of one shape, as (N, n) arrays;
+    and whether they were single states."""
+    arrays = []
+    for name, x in named:
+        try:
+            a = np.asarray(x, dtype=float)
+        except (TypeError, ValueError):
+            raise SymdynError(f"{where}: {name} must hold numbers, got {x!r}") from None
+        if a.ndim == 1 and a.shape != (n,):
+            count = f"{a.size} entry" if a.size == 1 else f"{a.size} entries"
+            raise SymdynError(f"{where}: {name} has {count}, expected {n} (one per joint)")
+        if a.ndim not in (1, 2) or a.shape[-1] != n:
+            raise SymdynError(
+                f"{where}: {name} has shape {a.shape}, expected ({n},) or (N, {n}) (one column per joint)"
+            )
+        arrays.append(a)
+    if len({a.shape for a in arrays}) > 1:
+        shapes = ", ".join(f"{name} {a.shape}" for (name, _), a in zip(named, arrays, strict=True))
+        raise SymdynError(
+            f"{where}: the joint vectors differ in shape ({shapes}); give each one state or N states"
+        )
+    return [a.reshape(-1, n) for a in arrays], arrays[0].ndim == 1
+
+
+def checked_inputs(where: str, robot, params, *named: tuple[str, object]):
+    """The numeric model and the joint vectors of a public function of symdyn.rnea, checked.
+
+    Args:
+        where: the function's name, to start error messages with.
+        robot: a `symdyn.Robot` with n joints.
+        params: values of its free parameters (see `numeric_model`).
+        named: (name, value) of each joint vector, e.g. ("q", q): (n,) each, or (N, n) each.
+
+    Returns:
+        (model, the vectors as (N, n) arrays, whether they were single states).
+
+    Raises:
+        SymdynError: not a Robot, bad parameter values, a vector of the wrong shape or not
+            numeric, vectors of different shapes.
+    """
+    mdl = _model(robot, params, where)
+    arrays, single = _states(where, mdl.n, *named)
+    return mdl, arrays, single
