@@ -29,9 +29,6 @@ RANK = {
     "cli": 7,
     "regenerate": 8,
 }
-#: floors whose private helpers other floors still import (symdyn.apps.simulate's _format_of
-#: and _figure); they are not checked for private imports here
-PRIVATE_IMPORTS_PENDING = {"apps", "cli"}
 
 
 def _modules():
@@ -73,8 +70,6 @@ def test_floors_import_only_lower_floors(path, parts):
     "path,parts", list(_modules()), ids=lambda x: "/".join(x) if isinstance(x, tuple) else ""
 )
 def test_no_private_name_crosses_a_module(path, parts):
-    if _floor(parts) in PRIVATE_IMPORTS_PENDING:
-        pytest.skip("apps and cli are being reworked elsewhere")
     modules = set()  # names bound to symdyn modules here (`from ..spatial import vectors as v3`)
     for target, names in _imports(path, parts):
         private = [n for n in names if n.startswith("_") and n != "__version__"]
