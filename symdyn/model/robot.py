@@ -1,9 +1,10 @@
-"""The immutable robot model: a serial chain of links joined by general 1-DOF joints.
+"""The immutable robot model: a kinematic tree of links joined by general 1-DOF joints.
 
 Every loader (standard DH, modified DH, URDF) produces this model. Link i owns a
 *body frame* that moves with it. Its joint has a constant `placement`, the body
-frame of link i at q_i = 0 expressed in the body frame of link i-1 (the base
-frame for i = 1), and a unit `axis` in link i's own body frame:
+frame of link i at q_i = 0 expressed in the body frame of its parent link (the
+previous link unless `parent` says otherwise; the base frame for a link on the
+base), and a unit `axis` in link i's own body frame:
 
     parent_T_i(q_i) = placement @ Rot(axis, q_i)     (revolute)
     parent_T_i(q_i) = placement @ Trans(axis * q_i)  (prismatic)
@@ -13,11 +14,15 @@ inertia tensor (about the centre of mass) are expressed in the body frame.
 `frame` is the convention's frame i (e.g. the standard-DH frame at the distal
 end) relative to the body frame: it is used only to report kinematics in the
 frames the user wrote, never by the dynamics.
+
+Links come in depth-first order (a parent before its children; symdyn.model.topology).
+A link whose joint `mimic`s another's has no coordinate of its own, so the robot has
+`n` independent coordinates (degrees of freedom) and `nb` = len(links) bodies.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -25,8 +30,9 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from .topology import Coordinate, Mimic, check_parents, is_chain
 
-__all__ = ["Friction", "Motor", "Link", "Robot", "JOINT_TYPES", "DEFAULT_GRAVITY"]
+__all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "JOINT_TYPES", "DEFAULT_GRAVITY"]
 
 JOINT_TYPES = ("revolute", "prismatic")
 #: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
@@ -67,6 +73,10 @@ class Link:
     friction: Friction = field(default_factory=Friction)
     motor: Motor = field(default_factory=Motor)
     frame: Transform = field(default_factory=Transform.identity)
+    #: index of the parent link in Robot.links, -1 for the base; None: the previous link
+    parent: int | None = None
+    #: this joint follows another: q = multiplier * q_other + offset (no coordinate of its own)
+    mimic: Mimic | None = None
 
     def joint_transform(self, q) -> Transform:
         """parent_T_i(q): the body frame of this link in its parent's body frame."""
@@ -92,6 +102,13 @@ class Link:
                 sp.sympify(self.motor.gear_ratio).xreplace(x),
             ),
             frame=self.frame.subs(x),
+            mimic=None
+            if self.mimic is None
+            else Mimic(
+                self.mimic.joint,
+                sp.sympify(self.mimic.multiplier).xreplace(x),
+                sp.sympify(self.mimic.offset).xreplace(x),
+            ),
         )
 
 
@@ -109,7 +126,7 @@ def _listed(values) -> list | None:
 
 @dataclass(frozen=True)
 class Robot:
-    """An immutable serial manipulator.
+    """An immutable manipulator: a serial chain or a kinematic tree on a fixed base.
 
     `values` holds the parameters the file gave values for (symbol -> SymPy
     number or expression); `params` the free parameter symbols (no value), in
@@ -126,10 +143,75 @@ class Robot:
     source_sha256: str | None = None
     convention: str = "standard"
 
+    def __post_init__(self) -> None:
+        problem = check_parents(self.parents)
+        if problem:
+            raise SymdynError(f"robot '{self.name}': {problem}")
+        for i, link in enumerate(self.links):
+            m = link.mimic
+            if m is None:
+                continue
+            if not (0 <= m.joint < len(self.links)) or m.joint == i:
+                raise SymdynError(f"robot '{self.name}': link {i + 1} ({link.name}) mimics no other joint")
+            if self.links[m.joint].mimic is not None:
+                other = self.links[m.joint].name
+                raise SymdynError(
+                    f"robot '{self.name}': link {i + 1} ({link.name}) mimics {other}, which is a mimic "
+                    "joint itself (mimic the joint that it follows instead)"
+                )
+
     @property
     def n(self) -> int:
-        """Number of joints (degrees of freedom)."""
+        """Number of independent joint coordinates (degrees of freedom)."""
+        return sum(1 for link in self.links if link.mimic is None)
+
+    @property
+    def nb(self) -> int:
+        """Number of moving bodies (links with a joint, mimic joints included)."""
         return len(self.links)
+
+    @property
+    def parents(self) -> tuple[int, ...]:
+        """lambda(i) per link: the index of its parent link, -1 for the base."""
+        return tuple(i - 1 if link.parent is None else link.parent for i, link in enumerate(self.links))
+
+    @property
+    def is_chain(self) -> bool:
+        """A serial chain without mimic joints: every link carries the next."""
+        return self.n == self.nb and is_chain(self.parents)
+
+    @property
+    def coordinates(self) -> tuple[Coordinate, ...]:
+        """Per link, how its joint position follows from the independent coordinates."""
+        index = {}
+        for i, link in enumerate(self.links):
+            if link.mimic is None:
+                index[i] = len(index)
+        out = []
+        for i, link in enumerate(self.links):
+            m = link.mimic
+            out.append(
+                Coordinate(index[i]) if m is None else Coordinate(index[m.joint], m.multiplier, m.offset)
+            )
+        return tuple(out)
+
+    def selection(self) -> sp.ImmutableMatrix:
+        """S (nb x n): the body joint rates from the independent ones, qd_b = S qd."""
+        S = sp.zeros(self.nb, self.n)
+        for i, c in enumerate(self.coordinates):
+            S[i, c.index] = c.multiplier
+        return sp.ImmutableMatrix(S)
+
+    def body_positions(self, q: Sequence) -> list:
+        """q_b: each body's joint position from the n independent ones (symbols or numbers)."""
+        return [
+            q[c.index] if c.multiplier == 1 and c.offset == 0 else c.multiplier * q[c.index] + c.offset
+            for c in self.coordinates
+        ]
+
+    def body_rates(self, qd: Sequence) -> list:
+        """qd_b = S qd (or qdd_b = S qdd): each body's joint rate from the independent ones."""
+        return [qd[c.index] if c.multiplier == 1 else c.multiplier * qd[c.index] for c in self.coordinates]
 
     @property
     def value_map(self) -> dict[sp.Symbol, sp.Expr]:
