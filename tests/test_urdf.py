@@ -699,7 +699,9 @@ def test_cli_errors(tmp_path, capsys):
     assert err.startswith(f"symdyn: error: {DATA / 'bad_cycle.urdf'}: link 3 (b): field 'joint(ab).child': ")
     assert "Traceback" not in err
     assert main(["derive", str(DATA / "bad_floating.urdf")]) == 1
-    assert "floating bases are out of scope: load the robot below it with --base body" in capsys.readouterr().err
+    assert (
+        "floating bases are out of scope: load the robot below it with --base body" in capsys.readouterr().err
+    )
     out_dir = tmp_path / "out"
     assert main(["generate", str(DATA / "branch.urdf"), "--tip", "nope", "--out", str(out_dir)]) == 1
     assert "tip link 'nope' is not a link of the robot" in capsys.readouterr().err

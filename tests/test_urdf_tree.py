@@ -110,34 +110,42 @@ def test_tree_placements():
     assert sp.ImmutableMatrix([[1, 0, 0], [0, 0, -1], [0, 1, 0]]) == robot.links[2].placement.R
 
 
+#: The inertials of tree.urdf as written: link -> (mass, xyz, rpy, tensor) in the link frame.
+INERTIALS = {
+    "torso": (3, (0, 0, 0.2), (0, 0, 0), np.diag([0.05, 0.04, 0.02])),
+    "plate": (0.6, (0, 0, 0.01), (0, 0, 0), np.diag([0.002, 0.002, 0.003])),
+    "left_arm": (1.2, (0.15, 0, 0), (0, 0, 0), np.diag([0.001, 0.009, 0.009])),
+    "left_tool": (
+        0.4,
+        (0.02, 0, 0),
+        (0.1, 0, 0),
+        [[0.0004, 0.00002, 0], [0.00002, 0.0005, 0.00001], [0, 0.00001, 0.0006]],
+    ),
+    "left_slider": (0.2, (0.01, 0, 0.02), (0, 0, 0), np.diag([0.0001, 0.0002, 0.0002])),
+    "head": (0.8, (0, 0, 0.1), (0, 0, 0), np.diag([0.003, 0.003, 0.002])),
+    "wheel": (0.5, (0, 0, 0), (0, 0, 0), np.diag([0.001, 0.001, 0.002])),
+}
+#: Joint origins of tree.urdf (child frame in parent frame, joints at 0).
+PLATE_IN_TORSO = hom(rx(math.pi / 2), (0, -0.2, 0.3))
+LEFT_IN_TORSO = hom(rx(-math.pi / 2), (0, 0.2, 0.3))
+TOOL_IN_LEFT = hom(rz(0.5), (0.3, 0, 0))
+SLIDER_IN_TOOL = hom(ry(0.2), (0.05, 0, 0))
+
+
+def part(T: np.ndarray, name: str):
+    """(mass, com, tensor about the com) of link `name`'s inertial, its frame placed at T in the body."""
+    return placed(T, *INERTIALS[name])
+
+
 def test_tree_bodies_merge_fixed_subtrees_and_links_without_inertial_are_massless():
     robot = {lk.name: lk for lk in load_tree().links}
-    I_tool = [[0.0004, 0.00002, 0], [0.00002, 0.0005, 0.00001], [0, 0.00001, 0.0006]]
     want = {
         # the plate hangs from the torso by a fixed joint: merged into it
-        "torso": merged(
-            [
-                placed(np.eye(4), 3, (0, 0, 0.2), (0, 0, 0), np.diag([0.05, 0.04, 0.02])),
-                placed(
-                    hom(rx(math.pi / 2), (0, -0.2, 0.3)),
-                    0.6,
-                    (0, 0, 0.01),
-                    (0, 0, 0),
-                    np.diag([0.002, 0.002, 0.003]),
-                ),
-            ]
-        ),
+        "torso": merged([part(np.eye(4), "torso"), part(PLATE_IN_TORSO, "plate")]),
         # the tool is fixed to the left arm; the slider below it moves on its own
-        "left_arm": merged(
-            [
-                placed(np.eye(4), 1.2, (0.15, 0, 0), (0, 0, 0), np.diag([0.001, 0.009, 0.009])),
-                placed(hom(rz(0.5), (0.3, 0, 0)), 0.4, (0.02, 0, 0), (0.1, 0, 0), I_tool),
-            ]
-        ),
-        "wheel": (0.5, np.zeros(3), np.diag([0.001, 0.001, 0.002])),
-        "left_slider": (0.2, np.array([0.01, 0, 0.02]), np.diag([0.0001, 0.0002, 0.0002])),
+        "left_arm": merged([part(np.eye(4), "left_arm"), part(TOOL_IN_LEFT, "left_tool")]),
         # the camera (no <inertial>) adds nothing to the head
-        "head": (0.8, np.array([0, 0, 0.1]), np.diag([0.003, 0.003, 0.002])),
+        **{name: part(np.eye(4), name) for name in ("wheel", "left_slider", "head")},
     }
     for name, (m, c, J) in want.items():
         assert float(robot[name].mass) == pytest.approx(m, rel=1e-15), name
@@ -158,28 +166,14 @@ def test_a_tip_cuts_one_chain_out_of_the_tree():
     assert chain.parents == (-1, 0) and chain.is_chain
     for lk in chain.links:
         assert lk.placement == tree[lk.name].placement and lk.axis == tree[lk.name].axis
-    T_left = hom(rx(-math.pi / 2), (0, 0.2, 0.3))
-    T_tool = T_left @ hom(rz(0.5), (0.3, 0, 0))
-    I_tool = [[0.0004, 0.00002, 0], [0.00002, 0.0005, 0.00001], [0, 0.00001, 0.0006]]
+    T_tool = LEFT_IN_TORSO @ TOOL_IN_LEFT
     m, c, J = merged(
         [
-            placed(np.eye(4), 3, (0, 0, 0.2), (0, 0, 0), np.diag([0.05, 0.04, 0.02])),
-            placed(
-                hom(rx(math.pi / 2), (0, -0.2, 0.3)),
-                0.6,
-                (0, 0, 0.01),
-                (0, 0, 0),
-                np.diag([0.002, 0.002, 0.003]),
-            ),
-            placed(T_left, 1.2, (0.15, 0, 0), (0, 0, 0), np.diag([0.001, 0.009, 0.009])),
-            placed(T_tool, 0.4, (0.02, 0, 0), (0.1, 0, 0), I_tool),
-            placed(
-                T_tool @ hom(ry(0.2), (0.05, 0, 0)),
-                0.2,
-                (0.01, 0, 0.02),
-                (0, 0, 0),
-                np.diag([1e-4, 2e-4, 2e-4]),
-            ),
+            part(np.eye(4), "torso"),
+            part(PLATE_IN_TORSO, "plate"),
+            part(LEFT_IN_TORSO, "left_arm"),
+            part(T_tool, "left_tool"),
+            part(T_tool @ SLIDER_IN_TOOL, "left_slider"),
         ]
     )
     assert float(chain.links[0].mass) == pytest.approx(m, rel=1e-15)
