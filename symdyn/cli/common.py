@@ -16,5 +16,8 @@ def load_robot_argument(args: argparse.Namespace):
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("robot", help="robot file (YAML or JSON) or URDF file (.urdf)")
-    parser.add_argument("--base", help="URDF: the chain's base link (default: the root link)")
-    parser.add_argument("--tip", help="URDF: the chain's tip link (default: the single leaf)")
+    parser.add_argument("--base", help="URDF: the link the robot hangs from (default: the root link)")
+    parser.add_argument(
+        "--tip",
+        help="URDF: load only the chain from the base to this link (default: the whole tree)",
+    )

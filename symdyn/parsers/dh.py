@@ -9,10 +9,15 @@ standard (distal; Spong, Corke):
 modified (proximal; Craig, Khalil; the row holds alpha_{i-1}, a_{i-1}, d_i, theta_i):
     frame_i = frame_{i-1} Rx(alpha) Tx(a) Rz(theta) Tz(d)
     The body frame is DH frame i itself (link.frame = identity).
+    On a tree (W. Khalil and J. Kleinfinger, "A new geometric notation for open and
+    closed-loop robots", ICRA 1986) frame_{i-1} is the frame of link i's parent, and
+    two more parameters place the row when the parent's x axis is not the common
+    normal (the parent has several children):
+    frame_i = frame_parent Rz(gamma) Tz(b) Rx(alpha) Tx(a) Rz(theta) Tz(d).
 
 In both conventions the joint axis is z of the body frame, and `prev_frame` is
-the previous link's `frame` (DH frame i-1 in body frame i-1; identity for the
-first link), so a loader threads ``prev_frame = frame`` from link to link.
+the parent link's `frame` (its DH frame in its body frame; identity for a link on
+the base), so a loader threads ``prev_frame = frame`` from link to link.
 """
 
 from __future__ import annotations
@@ -46,14 +51,22 @@ def dh_link(
     d,
     theta,
     prev_frame: Transform | None = None,
+    gamma=0,
+    b=0,
 ) -> tuple[Transform, sp.ImmutableMatrix, Transform]:
     """One DH row -> (placement, axis, frame) of `symdyn.model.robot.Link`.
 
     `theta` is the offset for a revolute joint, `d` the offset for a prismatic one.
-    `prev_frame` is the previous link's `frame` (None or identity for the first link).
+    `prev_frame` is the parent link's `frame` (None or identity for a link on the base).
+    `gamma` and `b` (Khalil's tree parameters, modified convention only) turn and shift
+    along the parent's z axis before the row.
     """
-    a, alpha, d, theta = _exprs(a, alpha, d, theta)
+    a, alpha, d, theta, gamma, b = _exprs(a, alpha, d, theta, gamma, b)
     prev = Transform.identity() if prev_frame is None else prev_frame
+    if gamma != 0 or b != 0:
+        if convention != "modified":
+            raise ValueError("gamma and b belong to the modified convention")
+        prev = prev @ Transform.rz(gamma) @ Transform.tz(b)
     if joint not in ("revolute", "prismatic"):
         raise ValueError(f"joint must be 'revolute' or 'prismatic', not {joint!r}")
     if convention == "standard":

@@ -30,6 +30,7 @@ __all__ = [
     "INERTIA_KEYS",
     "FRICTION_KEYS",
     "MOTOR_KEYS",
+    "MIMIC_KEYS",
     "LinkData",
     "RobotFileReader",
 ]
@@ -37,7 +38,10 @@ __all__ = [
 TOP_KEYS = ("name", "convention", "gravity", "parameters", "links")
 LINK_KEYS = (
     "name",
+    "parent",
     "joint",
+    "gamma",
+    "b",
     "a",
     "alpha",
     "d",
@@ -47,21 +51,28 @@ LINK_KEYS = (
     "inertia",
     "friction",
     "motor",
+    "mimic",
 )
 INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 FRICTION_KEYS = ("viscous", "coulomb")
 MOTOR_KEYS = ("inertia", "gear_ratio")
+MIMIC_KEYS = ("joint", "multiplier", "offset")
 _AXES = ("x", "y", "z")
 _LINK_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*\Z")
 
 
 @dataclass
 class LinkData:
-    """One link entry as written: DH row, inertial data, friction and motor (defaults for omitted keys)."""
+    """One link entry as written: parent, DH row, inertial data, friction, motor and mimic (defaults
+    for omitted keys). `parent` is the name written (None: null); `parent_given` whether it was."""
 
     index: int
     name: str
+    parent: str | None = None
+    parent_given: bool = False
     joint: str = ""
+    gamma: sp.Expr = sp.S.Zero
+    b: sp.Expr = sp.S.Zero
     a: sp.Expr = sp.S.Zero
     alpha: sp.Expr = sp.S.Zero
     d: sp.Expr = sp.S.Zero
@@ -73,6 +84,7 @@ class LinkData:
     coulomb: sp.Expr = sp.S.Zero
     motor_inertia: sp.Expr = sp.S.Zero
     gear_ratio: sp.Expr = sp.S.One
+    mimic: tuple[str, sp.Expr, sp.Expr] | None = None  # (link name, multiplier, offset)
 
 
 class RobotFileReader:
@@ -257,9 +269,20 @@ class RobotFileReader:
                         field="joint",
                     )
                 link.joint = value
-            elif key in ("alpha", "theta"):
+            elif key == "parent":
+                if value is not None and not (isinstance(value, str) and _LINK_NAME.match(value)):
+                    raise self.error(
+                        f"parent must be the name of a link listed before this one, 'base' or null, "
+                        f"got {_kind(value)}",
+                        link=link,
+                        field="parent",
+                    )
+                link.parent, link.parent_given = value, True
+            elif key == "mimic":
+                self._read_mimic(value, link)
+            elif key in ("alpha", "theta", "gamma"):
                 setattr(link, key, self.angle(value, key, link))
-            elif key in ("a", "d", "mass"):
+            elif key in ("a", "d", "b", "mass"):
                 setattr(link, key, self.expr(value, key, link))
             elif key == "com":
                 link.com = self.vector(value, "com", link)
@@ -276,6 +299,28 @@ class RobotFileReader:
                     attr = "motor_inertia" if k == "inertia" else k
                     setattr(link, attr, self.expr(v, f"motor.{k}", link))
         return link
+
+    def _read_mimic(self, value: object, link: LinkData) -> None:
+        """mimic: {joint: LINK, multiplier: k, offset: o}, q_link = k q_LINK + o (null: none)."""
+        if value is None:
+            return
+        entries = self.mapping(value, MIMIC_KEYS, "mimic", link)
+        joint = entries.get("joint")
+        if "joint" not in entries:
+            raise self.error(
+                "missing required field (the name of the link whose joint is followed)",
+                link=link,
+                field="mimic.joint",
+            )
+        if not isinstance(joint, str):
+            raise self.error(
+                f"expected the name of a link, got {_kind(joint)}", link=link, field="mimic.joint"
+            )
+        factors = {"multiplier": sp.S.One, "offset": sp.S.Zero}
+        for k, v in entries.items():
+            if k != "joint":
+                factors[k] = self.expr(v, f"mimic.{k}", link)
+        link.mimic = (joint, factors["multiplier"], factors["offset"])
 
 
 def _kind(value: object) -> str:

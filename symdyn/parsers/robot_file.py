@@ -17,8 +17,10 @@ pi/2 are taken as that exact multiple; within 1e-3 rad of a nonzero multiple but
 not 1e-9 (1.5708) they are kept with a SymdynWarning (symdyn.model.angles).
 
 The text is parsed by symdyn.parsers.yaml_text, its fields read by
-symdyn.parsers.robot_fields; this module resolves parameter values, checks the
-numbers and builds the Robot with the DH rows of symdyn.parsers.dh.
+symdyn.parsers.robot_fields, its `parent:` and `mimic:` names resolved by
+symdyn.parsers.robot_tree; this module resolves parameter values, checks the
+numbers and builds the Robot with the DH rows of symdyn.parsers.dh, each row
+relative to the frame of the link's parent.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
 from .robot_fields import LinkData, RobotFileReader
+from .robot_tree import link_mimics, link_parents
 from .source import read_source
 from .yaml_text import parse_text
 
@@ -150,13 +153,17 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
     subs = {sp.Symbol(n): v for n, v in values.items()}
     params = tuple(sp.Symbol(n) for n in dict.fromkeys(reader.order) if n not in values)
 
+    parents, mimics = link_parents(reader), link_mimics(reader)
     links: list[Link] = []
-    prev = Transform.identity()
-    for ld in reader.links:
+    frames: list[Transform] = []  # each link's DH frame in its body frame
+    for i, ld in enumerate(reader.links):
         tensor = tensor_from_components(ld.inertia)
         _check_link_numbers(reader, ld, tensor, subs)
-        placement, axis, frame = dh_link(reader.convention, ld.joint, ld.a, ld.alpha, ld.d, ld.theta, prev)
-        prev = frame
+        prev = frames[parents[i]] if parents[i] >= 0 else Transform.identity()
+        placement, axis, frame = dh_link(
+            reader.convention, ld.joint, ld.a, ld.alpha, ld.d, ld.theta, prev, gamma=ld.gamma, b=ld.b
+        )
+        frames.append(frame)
         com, inertia = to_body(frame, ld.com, tensor)
         links.append(
             Link(
@@ -170,6 +177,8 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
                 friction=Friction(ld.viscous, ld.coulomb),
                 motor=Motor(ld.motor_inertia, ld.gear_ratio),
                 frame=frame,
+                parent=None if parents[i] == i - 1 else parents[i],
+                mimic=mimics[i],
             )
         )
 

@@ -1,20 +1,27 @@
-"""URDF -> `symdyn.model.robot.Robot`: one serial chain of a URDF tree, from a base link to a tip link.
+"""URDF -> `symdyn.model.robot.Robot`: the tree below a base link on a fixed base, or one chain of it.
 
 The URDF joint frame is the child link's frame, so each URDF link frame becomes
 a symdyn body frame unchanged (`Link.frame` is the identity):
 
-* a movable joint (revolute, continuous = revolute, prismatic) of the chain gives
-  one `Link`, named after its child link; its `placement` is the product of the
-  fixed-joint origins between the previous movable link (or the base) and the
-  joint, times the joint's own origin (xyz, rpy = Rz(yaw) Ry(pitch) Rx(roll));
-  its `axis` is the joint's <axis xyz> (default 1 0 0), normalised;
-* links joined to a chain link by fixed joints are merged into it, and so is
-  everything that hangs off the chain (side branches and whatever lies below
-  the tip), its joints locked at zero (a mimic joint at multiplier * 0 + offset):
-  masses add, centres of mass average, and each inertia tensor is rotated into
-  the body axes and moved to the common centre of mass by the parallel-axis
-  theorem (symdyn.inertia.rotate, parallel_axis). The inertial <origin> (xyz and
-  rpy) is honoured;
+* every movable joint (revolute, continuous = revolute, prismatic) below the base
+  gives one `Link`, named after its child link. Its parent is the link of the
+  nearest movable joint above it (-1, the base, when only fixed joints lie between
+  it and the base link). Its `placement` is the product of the fixed-joint origins
+  from that parent's link down to the joint, times the joint's own origin (xyz,
+  rpy = Rz(yaw) Ry(pitch) Rx(roll)); its `axis` is the joint's <axis xyz>
+  (default 1 0 0), normalised;
+* joint order: depth first from the base, the child joints of each link in the
+  order of their names: the order of urdfdom, and so of Pinocchio
+  (symdyn.parsers.urdf_tree);
+* links joined to a moving link by fixed joints are merged into it (a fixed
+  subtree carried by a movable link merges into that link): masses add, centres
+  of mass average, and each inertia tensor is rotated into the body axes and moved
+  to the common centre of mass by the parallel-axis theorem
+  (symdyn.parsers.urdf_merge). The inertial <origin> (xyz and rpy) is honoured; a
+  link without <inertial> is massless, as the URDF specification allows;
+* a <mimic joint= multiplier= offset=> makes the link's `mimic`: q = multiplier *
+  q_master + offset with master an independent loaded joint (a mimic of a mimic is
+  composed; symdyn.parsers.urdf_mimic). The master may come later in joint order;
 * the base link and everything rigidly fixed to it is the ground: its mass does
   not enter the dynamics; links that are not below the base are ignored. The whole
   file must be well formed (XML, numbers, one tree), but inertial data is checked
@@ -24,25 +31,31 @@ a symdyn body frame unchanged (`Link.frame` is the identity):
   limits, transmissions, visual and collision elements (and their meshes) are
   ignored: nothing is ever fetched, from disk or the network.
 
-Default base: the root link. Default tip: the single leaf below the base; leaves
-that hang by fixed joints only from another leaf's chain do not count (they give
-the same dynamics). Several different chains are an error naming the candidates.
+Default base: the root link. A tip cuts one chain out of the tree instead: the
+movable joints on the path from the base to the tip, in that order; everything
+that hangs off the chain (side branches, whatever lies below the tip) is merged
+into the chain link it hangs from, its joints locked at zero (a mimic joint at
+its offset, when its master is locked too).
 
-Floating and planar joints, and mimic joints that would have to move with the
-chain, are refused. Numbers are read as exact SymPy numbers: integers as
-Integer, others as Float of the written text; an rpy angle within 1e-9 rad of a
-multiple of pi/2 is taken as that exact multiple, so that its sine and cosine are
-exactly 0 or +-1 (the 1.5707963267948966 of xacro output), and one within 1e-3 rad
-of a nonzero multiple but not 1e-9 (1.5708) warns (symdyn.model.angles).
+Refused, naming the joint: floating and planar joints in the loaded part (a
+floating root joint, such as world -> base_link, with the hint to load the part
+below it with --base: floating bases are out of scope); a mimic of an unknown,
+fixed or unloaded joint, and mimic cycles; a locked joint that mimics a joint of
+the chain. Numbers are read as exact SymPy numbers: integers as Integer, others
+as Float of the written text; an rpy angle within 1e-9 rad of a multiple of pi/2
+is taken as that exact multiple, so that its sine and cosine are exactly 0 or +-1
+(the 1.5707963267948966 of xacro output), and one within 1e-3 rad of a nonzero
+multiple but not 1e-9 (1.5708) warns (symdyn.model.angles).
 
 The XML is read with the standard library's expat parser, hardened: a document
 type declaration (<!DOCTYPE ...>, which a URDF never needs) is refused, so no
 entity can be declared, expanded or fetched; parameter entities and external
 DTDs are never loaded either, and the file may be at most 64 MiB.
 
-The work is shared by four modules: symdyn.parsers.safe_xml (the XML),
+The work is shared by six modules: symdyn.parsers.safe_xml (the XML),
 symdyn.parsers.urdf_elements (links, joints, inertials), symdyn.parsers.urdf_tree
-(the tree, the chain, the merging) and this one (the assembly into a Robot).
+(the tree and its order), symdyn.parsers.urdf_merge (rigid parts merged),
+symdyn.parsers.urdf_mimic (mimic joints) and this one (the assembly into a Robot).
 """
 
 from __future__ import annotations
@@ -53,12 +66,13 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..model.inertia import check_inertia
-from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Robot
-from ..spatial.transform import Transform
+from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Mimic, Robot
 from .safe_xml import parse_xml
 from .source import MAX_BYTES, read_source
-from .urdf_elements import MOVABLE, UrdfReader, numeric, urdf_robot_name
-from .urdf_tree import UrdfTree, body_parts, default_tip, link_name, merge_inertials
+from .urdf_elements import MOVABLE, UrdfJoint, UrdfReader, numeric, urdf_robot_name
+from .urdf_merge import body_parts, merge_inertials
+from .urdf_mimic import mimic_error, resolve_mimic
+from .urdf_tree import UrdfTree, link_name
 
 __all__ = ["load_urdf", "urdf_robot_name", "MAX_BYTES"]
 
@@ -77,54 +91,86 @@ def _check_inertials(reader: UrdfReader, names: list[str]) -> None:
             )
 
 
+def _refuse_unmodelled(
+    reader: UrdfReader, tree: UrdfTree, joints: list[UrdfJoint], base: str, where: str
+) -> None:
+    """A floating or planar joint among `joints` (the loaded part) is refused, naming it."""
+    for j in joints:
+        if j.type not in ("floating", "planar"):
+            continue
+        if all(k.type == "fixed" for k in tree.path(base, j.parent)):  # the robot's own floating base
+            hint = f"{j.type} bases are out of scope: load the robot below it with --base {j.child}"
+        else:
+            hint = "choose a base below it (--base), or a tip (--tip) whose chain does not carry it"
+        raise reader.error(
+            f"joint '{j.name}' {where} is a {j.type} joint: symdyn handles revolute, continuous, "
+            f"prismatic and fixed joints only; {hint}",
+            link=reader.links[j.child],
+            field=f"joint({j.name}).type",
+            line=j.line,
+        )
+
+
+def _loaded(reader: UrdfReader, tree: UrdfTree, base: str, tip: str | None) -> tuple[list[UrdfJoint], str]:
+    """The movable joints that become links, in joint order, and where they lie (for messages)."""
+    if tip is None:
+        joints = tree.depth_first(base)
+        where = f"below the base '{base}'"
+        if not joints:
+            raise SymdynError(f"the base link '{base}' has no links below it", file=reader.file)
+        if not any(j.movable for j in joints):
+            raise SymdynError(f"no movable joint below the base link '{base}'", file=reader.file)
+    else:
+        tip = link_name(reader, tip, "tip")
+        if tip == base:
+            raise SymdynError(f"the tip link '{tip}' is the base link", file=reader.file)
+        joints = tree.path(base, tip)
+        if joints is None:
+            raise SymdynError(f"the tip link '{tip}' is not below the base link '{base}'", file=reader.file)
+        where = f"on the chain from '{base}' to '{tip}'"
+        if not any(j.movable for j in joints):
+            raise SymdynError(
+                f"no movable joint between the base '{base}' and the tip '{tip}'", file=reader.file
+            )
+    _refuse_unmodelled(reader, tree, joints, base, where)
+    return [j for j in joints if j.movable], where
+
+
+def _mimic(reader: UrdfReader, joint: UrdfJoint, index: dict[str, int], where: str) -> Mimic | None:
+    """The link's Mimic (the index of its independent master among the loaded links), or None."""
+    followed = resolve_mimic(reader, joint)
+    if followed is None:
+        return None
+    master, multiplier, offset = followed
+    if master.name not in index:
+        via = "" if joint.mimic[0] == master.name else f" (through '{joint.mimic[0]}')"
+        raise mimic_error(
+            reader,
+            joint,
+            f"follows joint '{master.name}'{via}, which is not loaded: it is not {where} "
+            "(cut away by --base or --tip; choose them so that both joints are loaded)",
+        )
+    return Mimic(index[master.name], multiplier, offset)
+
+
 def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -> Robot:
     tree = UrdfTree(reader)
     base = tree.root if base is None else link_name(reader, base, "base")
-    tip = default_tip(tree, base) if tip is None else link_name(reader, tip, "tip")
-    if tip == base:
-        raise SymdynError(f"the tip link '{tip}' is the base link", file=reader.file)
-    path = tree.path(base, tip)
-    if path is None:
-        raise SymdynError(f"the tip link '{tip}' is not below the base link '{base}'", file=reader.file)
-    movable = [j for j in path if j.movable]
-    if not movable:
-        raise SymdynError(f"no movable joint between the base '{base}' and the tip '{tip}'", file=reader.file)
-    for j in path:
-        if j.type in ("floating", "planar") or j.mimic is not None:
-            what = f"a {j.type} joint" if j.mimic is None else f"a mimic joint (of '{j.mimic[0]}')"
-            raise reader.error(
-                f"joint '{j.name}' on the chain from '{base}' to '{tip}' is {what}: symdyn handles "
-                "independent revolute, continuous, prismatic and fixed joints only",
-                link=reader.links[j.child],
-                field=f"joint({j.name}).{'type' if j.mimic is None else 'mimic'}",
-                line=j.line if j.mimic is None else j.mimic_line,
-            )
-    path_names = {j.name for j in path}
-    chain = {j.name for j in movable}
+    loaded, where = _loaded(reader, tree, base, tip)
+    index = {j.name: i for i, j in enumerate(loaded)}
 
     links: list[Link] = []
-    fixed = Transform.identity()  # previous body frame -> the current link on the path
-    for j in path:
-        if not j.movable:
-            fixed = fixed @ j.origin
-            continue
-        child = reader.links[j.child]
-        if child.inertial is None:
-            raise reader.error(
-                "missing <inertial>: a link moved by a joint of the chain needs mass and inertia "
-                "(write <inertial> with mass 0 and a zero tensor for a massless link)",
-                link=child,
-                field="inertial",
-                line=child.line,
-            )
-        parts = body_parts(tree, j.child, path_names, chain)
+    for i, j in enumerate(loaded):
+        carrier, fixed = tree.carrier(j, index, base)
+        parent = -1 if carrier is None else index[carrier.name]
+        parts = body_parts(tree, j.child, index)
         _check_inertials(reader, [name for name, _ in parts])
         mass, com, inertia = merge_inertials(
             [(reader.links[n].inertial, T) for n, T in parts if reader.links[n].inertial is not None]
         )
         links.append(
             Link(
-                name=child.name,
+                name=j.child,
                 joint=MOVABLE[j.type],
                 placement=fixed @ j.origin,
                 axis=j.axis,
@@ -132,9 +178,10 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
                 com=com.applyfunc(numeric),
                 inertia=inertia.applyfunc(numeric),
                 friction=Friction(j.damping, j.friction),
+                parent=None if parent == i - 1 else parent,
+                mimic=_mimic(reader, j, index, where),
             )
         )
-        fixed = Transform.identity()
     return Robot(
         name=reader.robot_name,
         links=tuple(links),
@@ -146,10 +193,10 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
 
 
 def load_urdf(path: str | os.PathLike, base: str | None = None, tip: str | None = None) -> Robot:
-    """Read a URDF file and return the serial chain from `base` to `tip` as a `Robot`.
+    """Read a URDF file and return the tree below `base`, or the chain from `base` to `tip`, as a `Robot`.
 
-    base: a link name (default: the root link); tip: a link below it (default: the
-    single leaf; see the module documentation). Raises SymdynError naming file,
+    base: a link name (default: the root link); tip: a link below it (default: none,
+    the whole tree; see the module documentation). Raises SymdynError naming file,
     link and field for bad input; warns with SymdynWarning for implausible inertial
     data of the links used. The robot's name is the URDF name made a C identifier.
     """

@@ -12,7 +12,7 @@ within 1e-9 rad of a multiple of pi/2 it is taken as that exact multiple, so tha
 its sine and cosine are exactly 0 or +-1 (the 1.5707963267948966 of xacro output);
 within 1e-3 rad of a nonzero multiple but not 1e-9 (1.5708) it is kept as written
 with a SymdynWarning naming the file, the link, the field and the line, whether or
-not that link ends up in the chain (the whole file is read).
+not that link ends up in the robot (the whole file is read).
 A joint's <axis xyz> (default 1 0 0) is normalised.
 """
 
