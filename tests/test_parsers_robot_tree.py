@@ -140,21 +140,30 @@ def with_fields(fields: dict[int, dict], convention: str = "modified") -> dict:
     return doc
 
 
-def test_mimic_of_a_mimic_is_composed_and_may_point_ahead():
+def test_a_mimic_may_point_ahead():
     robot = robot_from_data(
-        with_fields(
-            {
-                0: {"mimic": {"joint": "b", "multiplier": 2, "offset": 0.5}},
-                1: {"parent": "base", "mimic": {"joint": "c", "offset": "pi/4"}},
-                2: {"parent": "a"},
-            }
-        )
+        with_fields({1: {"parent": "base", "mimic": {"joint": "c", "offset": "pi/4"}}, 2: {"parent": "a"}})
+    )
+    assert robot.links[1].mimic == Mimic(2, 1, sp.pi / 4)
+    assert robot.parents == (-1, -1, 0) and robot.n == 2
+
+
+def test_a_mimic_of_a_mimic_is_refused_with_the_composed_relation():
+    data = with_fields(
+        {
+            0: {"mimic": {"joint": "b", "multiplier": 2, "offset": 0.5}},
+            1: {"parent": "base", "mimic": {"joint": "c", "offset": "pi/4"}},
+            2: {"parent": "a"},
+        }
     )
     # q_a = 2 q_b + 0.5 and q_b = q_c + pi/4, so q_a = 2 q_c + pi/2 + 0.5
-    assert robot.links[1].mimic == Mimic(2, 1, sp.pi / 4)
-    assert robot.links[0].mimic.joint == 2 and robot.links[0].mimic.multiplier == 2
-    assert sp.simplify(robot.links[0].mimic.offset - (sp.pi / 2 + sp.Rational(1, 2))) == 0
-    assert robot.parents == (-1, -1, 0) and robot.n == 1
+    with pytest.raises(SymdynError) as err:
+        robot_from_data(data)
+    message = str(err.value)
+    assert "link 1 (a): field 'mimic.joint': link 'b' is a mimic joint itself: follow 'c' directly" in message
+    relation = message.split("mimic: {joint: c, multiplier: ")[1].rstrip("}")
+    k, o = relation.split(", offset: ")
+    assert sp.sympify(k) == 2 and abs(float(sp.sympify(o)) - (float(sp.pi) / 2 + 0.5)) < 1e-12
 
 
 def test_parent_base_is_a_link_named_base_if_there_is_one():

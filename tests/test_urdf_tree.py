@@ -208,18 +208,19 @@ def test_a_tip_and_mimic_joints(tmp_path):
 # --------------------------------------------------------------------------- mimic joints
 
 
-def test_mimic_of_a_mimic_is_composed(tmp_path):
+def test_a_mimic_of_a_mimic_is_refused_with_the_composed_relation(tmp_path):
     """head follows right_arm, which follows left_arm: q_h = 2 (-q_l + 0.1) + 0.3 = -2 q_l + 0.5."""
     path = variant(
         tmp_path,
         ('<axis xyz="0 1 0"/>', '<axis xyz="0 1 0"/><mimic joint="c_right" multiplier="2" offset="0.3"/>'),
     )
-    robot = load_tree(path)
-    m = robot.links[5].mimic
-    assert m.joint == 3 and m.multiplier == -2
-    assert float(m.offset) == pytest.approx(0.5, rel=1e-15)
-    assert robot.links[2].mimic == Mimic(3, -1, sp.Float("0.1"))
-    assert (robot.n, robot.nb) == (4, 6)
+    with pytest.raises(SymdynError) as err:
+        load_tree(path)
+    message = str(err.value)
+    assert "mimics joint 'c_right', which is a mimic joint itself: follow 'b_left' directly" in message
+    k = message.split('multiplier="')[1].split('"')[0]
+    o = message.split('offset="')[1].split('"')[0]
+    assert float(k) == -2 and float(o) == pytest.approx(0.5, rel=1e-15)
 
 
 MIMIC_ERRORS = [
@@ -267,8 +268,8 @@ MIMIC_ERRORS = [
         "left_arm",
         "left_slide",
         "left_slider",
-        "follows joint 'b_left' (through 'c_right'), which is not loaded: it is not below the base "
-        "'left_arm'",
+        "mimics joint 'c_right', which is a mimic joint itself: follow 'b_left' directly, with "
+        '<mimic joint="b_left" multiplier="-1" offset="0.1"/>',
     ),
 ]
 

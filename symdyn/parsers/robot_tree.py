@@ -19,7 +19,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model.robot import Mimic
-from .mimic_chain import follow_mimics
+from .mimic_chain import follow_mimics, number_text
 from .robot_fields import LinkData, RobotFileReader
 from .source import did_you_mean
 
@@ -96,8 +96,16 @@ def link_mimics(reader: RobotFileReader) -> list[Mimic | None]:
             field="mimic.joint",
         )
 
+    def chain_error(name: str, master: str, end: str, k: sp.Expr, o: sp.Expr):
+        return reader.error(
+            f"link '{master}' is a mimic joint itself: follow '{end}' directly, with "
+            f"mimic: {{joint: {end}, multiplier: {number_text(k)}, offset: {number_text(o)}}}",
+            link=links[index[name]],
+            field="mimic.joint",
+        )
+
     out: list[Mimic | None] = []
     for ld in links:
-        followed = follow_mimics(ld.name, master_of, cycle_error)
+        followed = follow_mimics(ld.name, master_of, cycle_error, chain_error)
         out.append(None if followed is None else Mimic(index[followed[0]], *followed[1:]))
     return out

@@ -143,11 +143,10 @@ def _mimic(reader: UrdfReader, joint: UrdfJoint, index: dict[str, int], where: s
         return None
     master, multiplier, offset = followed
     if master.name not in index:
-        via = "" if joint.mimic[0] == master.name else f" (through '{joint.mimic[0]}')"
         raise mimic_error(
             reader,
             joint,
-            f"follows joint '{master.name}'{via}, which is not loaded: it is not {where} "
+            f"follows joint '{master.name}', which is not loaded: it is not {where} "
             "(cut away by --base or --tip; choose them so that both joints are loaded)",
         )
     return Mimic(index[master.name], multiplier, offset)

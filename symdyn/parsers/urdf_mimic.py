@@ -1,13 +1,12 @@
 """URDF mimic joints: q_follower = multiplier * q_master + offset, traced to an independent joint.
 
 A joint with `<mimic joint="m" multiplier="k" offset="o"/>` (k default 1, o default 0)
-has no coordinate of its own: q = k q_m + o. When the master is itself a mimic joint
-(a follows b, b follows c), the chain is composed into one relation with the
-independent joint at its end (symdyn.parsers.mimic_chain). Pinocchio refuses such
-chains; the composition is exact, so symdyn accepts them.
+has no coordinate of its own: q = k q_m + o.
 Refused, naming the file, the child link of the joint whose <mimic> is wrong and the
 field joint(NAME).mimic.joint: a master that does not exist, a master that is not a
-revolute, continuous or prismatic joint, and joints that follow each other in a cycle.
+revolute, continuous or prismatic joint, a master that is a mimic joint itself (a follows
+b, b follows c: the message gives the composed relation with c to write instead, as
+symdyn.parsers.mimic_chain computes it), and joints that follow each other in a cycle.
 A <mimic> on a fixed joint is ignored (the joint does not move; Talos' grippers have them).
 """
 
@@ -16,7 +15,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import SymdynError
-from .mimic_chain import follow_mimics
+from .mimic_chain import follow_mimics, number_text
 from .source import did_you_mean
 from .urdf_elements import UrdfJoint, UrdfReader
 
@@ -59,7 +58,15 @@ def resolve_mimic(reader: UrdfReader, joint: UrdfJoint) -> tuple[UrdfJoint, sp.E
             reader, reader.joints[name], f"mimic joints follow each other in a cycle: {' -> '.join(cycle)}"
         )
 
-    followed = follow_mimics(joint.name, master_of, cycle_error)
+    def chain_error(name: str, master: str, end: str, k: sp.Expr, o: sp.Expr) -> SymdynError:
+        return mimic_error(
+            reader,
+            reader.joints[name],
+            f"mimics joint '{master}', which is a mimic joint itself: follow '{end}' directly, "
+            f'with <mimic joint="{end}" multiplier="{number_text(k)}" offset="{number_text(o)}"/>',
+        )
+
+    followed = follow_mimics(joint.name, master_of, cycle_error, chain_error)
     if followed is None:
         return None
     master, multiplier, offset = followed
