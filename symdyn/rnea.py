@@ -263,7 +263,8 @@ def bias_torque(robot, q, qd, params=None) -> np.ndarray:
 
 
 def friction_torque(robot, qd, params=None) -> np.ndarray:
-    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0).
+    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0), per body at
+    qd_b = S qd and projected, S^T F_b, for mimic joints.
 
     Args:
         robot: a `symdyn.Robot` with n joints.
@@ -274,7 +275,8 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
         F, (n,) or (N, n).
     """
     mdl, (qd,), single = checked_inputs("friction_torque", robot, params, ("qd", qd))
-    return _out(mdl.viscous * qd + mdl.coulomb * np.sign(qd), single)
+    qd_b = body_rates(mdl, qd)
+    return _out(project(mdl, mdl.viscous * qd_b + mdl.coulomb * np.sign(qd_b)), single)
 
 
 def _check_invertible(mdl: NumericModel, M: np.ndarray, where: str) -> None:
