@@ -27,6 +27,7 @@ from symdyn.dynamics import derive
 from symdyn.errors import SymdynWarning
 from symdyn.model.robot import Friction, Link, Motor, Robot
 from symdyn.parsers.robot_file import load_robot, robot_from_data
+from symdyn.rnea import forward_kinematics as rnea_poses
 from symdyn.spatial.transform import Transform
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
@@ -108,6 +109,24 @@ def ev(dyn, name: str, q=None, qd=None, qdd=None, params=None) -> np.ndarray:
     """
     out = dyn.evaluate(name, q, qd, qdd, params)
     return out.reshape(dyn.n, dyn.n) if name in ("M", "C") else out
+
+
+def _vee(W: np.ndarray) -> np.ndarray:
+    return np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]]) / 2
+
+
+def fd_jacobian(robot, q, k, point, p, h=1e-6) -> np.ndarray:
+    """Jv by central differences of the point's position, Jw from dR/dq_j R^T (rnea poses),
+    over the robot's n independent coordinates."""
+    n = robot.n
+    R = rnea_poses(robot, q, p)[k][:3, :3]
+    J = np.zeros((6, n))
+    for j in range(n):
+        e = np.eye(n)[j] * h
+        Tp, Tm = rnea_poses(robot, q + e, p)[k], rnea_poses(robot, q - e, p)[k]
+        J[:3, j] = ((Tp[:3, :3] @ point + Tp[:3, 3]) - (Tm[:3, :3] @ point + Tm[:3, 3])) / (2 * h)
+        J[3:, j] = _vee((Tp[:3, :3] - Tm[:3, :3]) / (2 * h) @ R.T)
+    return J
 
 
 def assert_close(got, want, rtol: float = 1e-9, what: str = "") -> None:
@@ -483,6 +502,7 @@ def tree_parents(draw, min_bodies: int = 2, max_bodies: int = 7) -> tuple[int, .
 def branch_pairs(parents) -> list[tuple[int, int]]:
     """The pairs (i, j), i < j, of links on different branches: neither lies on the other's
     path to the base (computed from the parent array here, not by symdyn.model.topology)."""
+
     def path(i):
         out = set()
         while i >= 0:

@@ -13,11 +13,23 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
-from robots import ZERO3, Z, mat, roger_arm_robot, rotation, vec
+from robots import (
+    ZERO3,
+    Z,
+    branch_pairs,
+    mat,
+    roger_arm_robot,
+    rotation,
+    solo_robot,
+    tree_robot,
+    vec,
+    y_robot,
+)
 
 from symdyn import rnea as rn
 from symdyn.errors import SymdynError
 from symdyn.model.robot import Friction, Link, Motor, Robot
+from symdyn.model.topology import Mimic
 from symdyn.spatial.transform import Transform, rot_x, rot_y
 
 # --- Roger's eye and arm (slides 17-18) -------------------------------------------------
@@ -380,3 +392,88 @@ def test_oracle_is_independent_of_symbolic_derivation(module):
         "types",
     }
     assert "sympy" not in source
+
+
+# --- kinematic trees ---------------------------------------------------------------------
+
+
+def _tree(seed: int) -> Robot:
+    """The Y tree, the solo legs, or a random tree with a mimic joint (seed 2)."""
+    if seed == 0:
+        return y_robot()
+    if seed == 1:
+        return solo_robot()
+    parents = (-1, 0, 0, 2, -1, 4)
+    joints = ("revolute", "prismatic", "revolute", "revolute", "prismatic", "revolute")
+    return tree_robot("tree6", parents, joints, seed, mimic={3: Mimic(1, sp.Float(1.5), sp.Float(-0.2))})
+
+
+TREES = range(3)
+
+
+@pytest.mark.parametrize("seed", TREES)
+def test_tree_mass_matrix_is_rnea_columns_and_decouples_branches(seed):
+    """CRBA = RNEA with unit accelerations (two algorithms), SPD, exact zeros across branches."""
+    robot = _tree(seed)
+    q, _, _ = random_state(robot, seed)
+    M = rn.mass_matrix(robot, q)
+    np.testing.assert_allclose(M, M.T, atol=1e-12)
+    assert np.linalg.eigvalsh(M).min() > 0
+    zero = np.zeros(robot.n)
+    cols = [rn.rnea(robot, q, zero, e, gravity=False, friction=False) for e in np.eye(robot.n)]
+    np.testing.assert_allclose(np.array(cols).T, M, atol=1e-10)
+    if robot.n == robot.nb:
+        for i, j in branch_pairs(robot.parents):
+            assert M[i, j] == 0.0 and M[j, i] == 0.0
+
+
+@pytest.mark.parametrize("seed", TREES)
+def test_tree_energies_and_power(seed):
+    """T = 1/2 qd^T M qd; G = dU/dq; dT/dt = qd^T (tau - G) without friction."""
+    robot = _tree(seed)
+    q, qd, qdd = random_state(robot, seed)
+    assert rn.kinetic_energy(robot, q, qd) == pytest.approx(
+        0.5 * qd @ rn.mass_matrix(robot, q) @ qd, rel=1e-12
+    )
+    h = 1e-6
+    grad = [
+        (rn.potential_energy(robot, q + h * e) - rn.potential_energy(robot, q - h * e)) / (2 * h)
+        for e in np.eye(robot.n)
+    ]
+    np.testing.assert_allclose(rn.gravity_torque(robot, q), grad, atol=1e-7)
+
+    def T(t):
+        return rn.kinetic_energy(robot, q + qd * t + 0.5 * qdd * t**2, qd + qdd * t)
+
+    dT = (T(1e-5) - T(-1e-5)) / 2e-5
+    tau = rn.rnea(robot, q, qd, qdd, friction=False)
+    assert dT == pytest.approx(qd @ (tau - rn.gravity_torque(robot, q)), rel=1e-7, abs=1e-7)
+    np.testing.assert_allclose(rn.forward_dynamics(robot, q, qd, rn.rnea(robot, q, qd, qdd)), qdd, atol=1e-8)
+
+
+@pytest.mark.parametrize("seed", TREES)
+def test_tree_poses_compose_along_the_parents(seed):
+    """Poses are the model's own SymPy joint transforms multiplied along each link's path."""
+    robot = _tree(seed)
+    q, _, _ = random_state(robot, seed)
+    poses = rn.forward_kinematics(robot, q)
+    assert len(poses) == robot.nb
+    qb = robot.body_positions([sp.Float(x) for x in q])
+    for i, link in enumerate(robot.links):
+        T = np.array(link.joint_transform(qb[i]).matrix().evalf(), dtype=float)
+        p = robot.parents[i]
+        np.testing.assert_allclose(poses[i], T if p < 0 else poses[p] @ T, atol=1e-12)
+    coms = rn.link_com_positions(robot, q)
+    for i, link in enumerate(robot.links):
+        np.testing.assert_allclose(
+            coms[i], poses[i][:3, :3] @ np.array(link.com, dtype=float)[:, 0] + poses[i][:3, 3]
+        )
+
+
+def test_tree_batch_equals_loop():
+    robot = _tree(2)
+    q, qd, qdd = random_state(robot, 2, N=4)
+    tau = rn.rnea(robot, q, qd, qdd)
+    for k in range(4):
+        np.testing.assert_allclose(tau[k], rn.rnea(robot, q[k], qd[k], qdd[k]), atol=1e-12)
+        np.testing.assert_allclose(rn.mass_matrix(robot, q)[k], rn.mass_matrix(robot, q[k]))
