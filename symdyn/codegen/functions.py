@@ -8,7 +8,11 @@ CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
 forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
 unrolled symbolically (no square roots):
     D_j = M_jj - sum_{k<j} L_jk^2 D_k,  L_ij = (M_ij - sum_{k<j} L_ik L_jk D_k) / D_j,
-then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away.
+then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away. On a kinematic
+tree the coordinates are eliminated from the last to the first instead, M = L^T D L
+(Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 6.5): with parents numbered
+before their children this creates no fill-in, so L keeps the zeros of joints on
+different branches. A serial chain, whose M is dense, keeps the forward order.
 
 A generated function cannot raise, so forward_dynamics is not generated for a robot whose
 M is singular by construction: a joint that moves no mass or inertia (a massless subtree
@@ -150,7 +154,9 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
     if _solvable(dyn):
         fd = Program()
         b = [fd.let(tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
-        qdd_out = _ldlt_solve(sp.Matrix(c["M"]), b, fd)
+        order = list(range(n)) if dyn.robot.is_chain else list(reversed(range(n)))
+        solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+        qdd_out = [solved[order.index(i)] for i in range(n)]
         table.append(
             (
                 "forward_dynamics",
