@@ -90,9 +90,10 @@ def random_params(robot: Robot, rng: np.random.Generator) -> np.ndarray:
 
 
 def random_state(robot: Robot, rng: np.random.Generator):
-    """(q, qd, qdd): revolute angles over a full turn, prismatic offsets within +-0.5 m."""
+    """(q, qd, qdd): revolute angles over a full turn, prismatic offsets within +-0.5 m (one per
+    independent joint: mimic joints follow)."""
     n = robot.n
-    revolute = np.array([lk.joint == "revolute" for lk in robot.links])
+    revolute = np.array([lk.joint == "revolute" for lk in robot.links if lk.mimic is None])
     q = np.where(revolute, rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.5, 0.5, n))
     qd = rng.uniform(-2, 2, n)
     qd[np.abs(qd) < 1e-3] = 0.5  # keep sign(qd) away from its jump

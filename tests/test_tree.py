@@ -8,6 +8,7 @@ chains cut out of the tree (the force each branch carries into the torso adds up
 
 from __future__ import annotations
 
+import importlib.util
 import re
 import time
 import warnings
@@ -32,10 +33,12 @@ from robots import (
     y_robot,
 )
 
+from symdyn.codegen import render
 from symdyn.codegen.functions import FUNCTION_NAMES, build_functions
 from symdyn.dynamics import METHODS, derive
 from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.model.robot import Motor, Robot
+from symdyn.model.topology import Mimic
 from symdyn.rnea import (
     bias_torque,
     forward_dynamics,
@@ -295,3 +298,31 @@ def test_the_y_tree_is_what_its_name_says():
     assert robot.parents == Y_PARENTS
     assert tuple(lk.joint for lk in robot.links) == Y_JOINTS
     assert all(any(lk.inertia[r, c] != 0 for r in range(3) for c in range(3) if r != c) for lk in robot.links)
+
+
+# --------------------------------------------------------------------------- generated code of a tree
+
+
+@pytest.mark.parametrize("which", ["ytree", "solo", "mimic"])
+def test_generated_numpy_module_of_a_tree(which, tmp_path):
+    """The NumPy target of a tree (the LDL^T of forward_dynamics eliminating leaves first) and
+    of a tree with a mimic joint, against the oracle."""
+    if which == "mimic":
+        robot = tree_robot("gripmimic", (-1, 0, 1, 1), ("revolute",) * 2 + ("prismatic",) * 2, 7)
+        links = (*robot.links[:3], replace(robot.links[3], mimic=Mimic(2, sp.Float(-1), sp.Float(0.02))))
+        robot = replace(robot, links=links)
+    else:
+        robot = TREES[which]
+    ((name, text),) = render(robot, targets=("python",)).items()
+    path = tmp_path / name
+    path.write_text(text)
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rng = np.random.default_rng(21)
+    for _ in range(3):
+        q, qd, qdd = random_state(robot, rng)
+        tau = rnea(robot, q, qd, qdd)
+        assert_close(module.inverse_dynamics(q, qd, qdd), tau)
+        assert_close(module.mass_matrix(q).reshape(robot.n, robot.n), mass_matrix(robot, q))
+        assert_close(module.forward_dynamics(q, qd, tau), qdd, rtol=1e-8)
