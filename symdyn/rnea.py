@@ -22,7 +22,7 @@ or placement @ Trans(axis q_i) (prismatic, S_i = [0; axis]). Every public functi
 the n independent joint coordinates, as a single state (vectors of length n) or a batch
 (arrays of shape (N, n)). A mimic joint follows another, q_j = multiplier q_i + offset:
 the algorithms run on the nb bodies at q_b, qd_b = S qd, qdd_b = S qdd and the efforts come
-back as S^T tau_b (M = S^T M_b S), by virtual work (Featherstone 2008, sec. 8.2).
+back as S^T tau_b (M = S^T M_b S), by virtual work (Featherstone 2008, ch. 8: qd_b = S qd as a constraint).
 """
 
 from __future__ import annotations

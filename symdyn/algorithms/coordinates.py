@@ -8,7 +8,7 @@ independent coordinates are
 
     M = S^T M_b S,   C = S^T C_b S,   V = S^T V_b,   G = S^T G_b,   tau = S^T tau_b
 
-(Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 8.2, a joint-space constraint
+(Featherstone, Rigid Body Dynamics Algorithms (2008), ch. 8, a joint-space constraint
 qd_b = S qd with constant S). Each entry is formed directly as a sum over the nonzero
 entries of S, M[a, b] = sum m_i m_k M_b[i, k] over the bodies i of coordinate a and k of
 coordinate b, so exact zeros of M_b stay exact zeros; nothing multiplies dense matrices of

@@ -13,10 +13,6 @@ gives, with m = max(j, k) and every vector carried into one frame,
 
     2 C_jk = s_j^T (s_k x* h^c_m + 2 I^c_m psi_k + Idot^c_m s_k)
 
-On a kinematic tree (symdyn.model.topology) m is the deeper of j and k when one supports
-the other, and C_jk is an exact zero when neither does: qd_k then moves no body that
-joint j carries, and M_jk, M_ji and M_ki do not depend on the other joint.
-
 which is the Christoffel form C = 1/2 dV/dqd (Echeandia and Wensing 2021 reach
 the same result through their matrices B_i). With the half-quantities
 H = h^c / 2 and P = Idot^c / 2 this reads, for j >= k,
@@ -26,9 +22,14 @@ H = h^c / 2 and P = Idot^c / 2 this reads, for j >= k,
 
 (the lower triangle uses the symmetry of I^c and Idot^c and
 <a, b x* f> = -<b, a x* f>). Only the three forces Y_j, A_j and F_j travel
-inward along the support of j, n <- R n + p x R f, f <- R f; nothing with an inertia is formed per
-pair of joints, against one Newton-Euler tangent pass per column when C is
+inward along the support of j, n <- R n + p x R f, f <- R f; nothing with an inertia is
+formed per pair of joints, against one Newton-Euler tangent pass per column when C is
 computed as 1/2 dV/dqd.
+
+On a kinematic tree (symdyn.model.topology) m is the deeper of j and k when one supports
+the other. When neither does, C_jk = sum_i 1/2 (dM_jk/dq_i + dM_ji/dq_k - dM_ki/dq_j) qd_i
+is an exact zero: M_jk vanishes, M_ji does not depend on q_k, nor M_ki on q_j (an entry
+depends on the joints of the path between its two joints and of the deeper one's subtree).
 
 A zero-mass spatial inertia (h, I) carries P: for a body with first moment h
 and rotational inertia I about its origin moving with (w, u),

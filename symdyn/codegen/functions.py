@@ -8,11 +8,12 @@ CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
 forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
 unrolled symbolically (no square roots):
     D_j = M_jj - sum_{k<j} L_jk^2 D_k,  L_ij = (M_ij - sum_{k<j} L_ik L_jk D_k) / D_j,
-then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away. On a kinematic
-tree the coordinates are eliminated from the last to the first instead, M = L^T D L
-(Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 6.5): with parents numbered
-before their children this creates no fill-in, so L keeps the zeros of joints on
-different branches. A serial chain, whose M is dense, keeps the forward order.
+then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away. Unless the robot
+is a serial chain (Robot.is_chain) the coordinates are eliminated from the last to the
+first instead, M = L^T D L (Featherstone, Rigid Body Dynamics Algorithms (2008), ch. 6, the
+LTDL factorization that exploits branch-induced sparsity): on a tree numbered parents
+first this creates no fill-in, so L keeps the zeros of joints on different branches. A
+chain, whose M is dense, keeps the forward order.
 
 A generated function cannot raise, so forward_dynamics is not generated for a robot whose
 M is singular by construction: a joint that moves no mass or inertia (a massless subtree
