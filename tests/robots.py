@@ -27,6 +27,7 @@ from symdyn.dynamics import derive
 from symdyn.errors import SymdynWarning
 from symdyn.model.robot import Friction, Link, Motor, Robot
 from symdyn.parsers.robot_file import load_robot, robot_from_data
+from symdyn.rnea import forward_kinematics as rnea_poses
 from symdyn.spatial.transform import Transform
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
@@ -89,9 +90,10 @@ def random_params(robot: Robot, rng: np.random.Generator) -> np.ndarray:
 
 
 def random_state(robot: Robot, rng: np.random.Generator):
-    """(q, qd, qdd): revolute angles over a full turn, prismatic offsets within +-0.5 m."""
+    """(q, qd, qdd): revolute angles over a full turn, prismatic offsets within +-0.5 m (one per
+    independent joint: mimic joints follow)."""
     n = robot.n
-    revolute = np.array([lk.joint == "revolute" for lk in robot.links])
+    revolute = np.array([lk.joint == "revolute" for lk in robot.links if lk.mimic is None])
     q = np.where(revolute, rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.5, 0.5, n))
     qd = rng.uniform(-2, 2, n)
     qd[np.abs(qd) < 1e-3] = 0.5  # keep sign(qd) away from its jump
@@ -108,6 +110,24 @@ def ev(dyn, name: str, q=None, qd=None, qdd=None, params=None) -> np.ndarray:
     """
     out = dyn.evaluate(name, q, qd, qdd, params)
     return out.reshape(dyn.n, dyn.n) if name in ("M", "C") else out
+
+
+def _vee(W: np.ndarray) -> np.ndarray:
+    return np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]]) / 2
+
+
+def fd_jacobian(robot, q, k, point, p, h=1e-6) -> np.ndarray:
+    """Jv by central differences of the point's position, Jw from dR/dq_j R^T (rnea poses),
+    over the robot's n independent coordinates."""
+    n = robot.n
+    R = rnea_poses(robot, q, p)[k][:3, :3]
+    J = np.zeros((6, n))
+    for j in range(n):
+        e = np.eye(n)[j] * h
+        Tp, Tm = rnea_poses(robot, q + e, p)[k], rnea_poses(robot, q - e, p)[k]
+        J[:3, j] = ((Tp[:3, :3] @ point + Tp[:3, 3]) - (Tm[:3, :3] @ point + Tm[:3, 3])) / (2 * h)
+        J[3:, j] = _vee((Tp[:3, :3] - Tm[:3, :3]) / (2 * h) @ R.T)
+    return J
 
 
 def assert_close(got, want, rtol: float = 1e-9, what: str = "") -> None:
@@ -353,31 +373,40 @@ def random_dh_data(spec: RobotSpec) -> dict:
     }
 
 
+def random_axis(rng: np.random.Generator) -> np.ndarray:
+    """A unit joint axis: a signed coordinate axis 30% of the time, else a random direction."""
+    if rng.random() < 0.3:
+        axis = np.zeros(3)
+        axis[rng.integers(3)] = rng.choice([-1.0, 1.0])
+        return axis
+    axis = rng.normal(size=3)
+    return axis / np.linalg.norm(axis)
+
+
+def random_link(rng: np.random.Generator, name: str, joint: str, parent: int | None = None, **extra) -> Link:
+    """A link with a random rotated placement, unit axis, mass, centre of mass, full inertia
+    tensor, friction and motor (`extra` overrides fields, e.g. mimic=...)."""
+    axis = random_axis(rng)
+    mass = float(rng.uniform(0.2, 3.0))
+    link = Link(
+        name=name,
+        joint=joint,
+        placement=Transform(mat(rotation(rng)), mat(rng.uniform(-0.5, 0.5, (3, 1)))),
+        axis=mat(axis.reshape(3, 1)),
+        mass=sp.Float(mass),
+        com=mat(rng.uniform(-0.3, 0.3, (3, 1))),
+        inertia=mat(random_inertia(rng, mass)),
+        friction=Friction(*(sp.Float(v) for v in rng.uniform(0, 2, 2))),
+        motor=Motor(sp.Float(rng.uniform(0, 1e-3)), sp.Float(rng.uniform(1, 50))),
+        parent=parent,
+    )
+    return replace(link, **extra)
+
+
 def random_general_robot(spec: RobotSpec) -> Robot:
     """A chain of Link objects with random rotated placements and random unit joint axes."""
     rng = np.random.default_rng(spec.seed)
-    links = []
-    for i, joint in enumerate(spec.joints):
-        if rng.random() < 0.3:
-            axis = np.zeros(3)
-            axis[rng.integers(3)] = rng.choice([-1.0, 1.0])
-        else:
-            axis = rng.normal(size=3)
-            axis /= np.linalg.norm(axis)
-        mass = float(rng.uniform(0.2, 3.0))
-        links.append(
-            Link(
-                name=f"link{i + 1}",
-                joint=joint,
-                placement=Transform(mat(rotation(rng)), mat(rng.uniform(-0.5, 0.5, (3, 1)))),
-                axis=mat(axis.reshape(3, 1)),
-                mass=sp.Float(mass),
-                com=mat(rng.uniform(-0.3, 0.3, (3, 1))),
-                inertia=mat(random_inertia(rng, mass)),
-                friction=Friction(*(sp.Float(v) for v in rng.uniform(0, 2, 2))),
-                motor=Motor(sp.Float(rng.uniform(0, 1e-3)), sp.Float(rng.uniform(1, 50))),
-            )
-        )
+    links = [random_link(rng, f"link{i + 1}", joint) for i, joint in enumerate(spec.joints)]
     return Robot(f"random_general{spec.seed}", tuple(links), mat((rng.normal(size=3) * 5).reshape(3, 1)))
 
 
@@ -389,3 +418,97 @@ def build_robot(spec: RobotSpec) -> Robot:
 
 def without_motors(robot: Robot) -> Robot:
     return replace(robot, links=tuple(replace(lk, motor=Motor()) for lk in robot.links))
+
+
+# --------------------------------------------------------------------------- trees and mimic joints
+
+
+def tree_robot(name: str, parents, joints, seed: int, mimic: dict | None = None) -> Robot:
+    """Random links (random_link) joined as the tree `parents` (lambda(i), -1: the base).
+
+    mimic: {link index: Mimic(...)} for the links whose joint follows another.
+    """
+    rng = np.random.default_rng(seed)
+    mimic = mimic or {}
+    links = []
+    for i, (p, joint) in enumerate(zip(parents, joints, strict=True)):
+        links.append(random_link(rng, f"{name}{i + 1}", joint, parent=p, mimic=mimic.get(i)))
+    return Robot(name, tuple(links), mat((rng.normal(size=3) * 5).reshape(3, 1)))
+
+
+#: the Y-shaped robot: a torso on the base carrying two 2-joint arms
+Y_PARENTS = (-1, 0, 1, 0, 3)
+Y_JOINTS = ("revolute", "revolute", "prismatic", "prismatic", "revolute")
+
+
+def y_robot() -> Robot:
+    """A torso (revolute) with a left arm (revolute, prismatic) and a right arm (prismatic,
+    revolute): general axes and placements, full inertia tensors, friction and motors."""
+    return tree_robot("ytree", Y_PARENTS, Y_JOINTS, seed=2015)
+
+
+#: four legs of three joints each on a fixed base, depth first: leg k is links 3k, 3k+1, 3k+2
+SOLO_PARENTS = tuple(p for k in range(4) for p in (-1, 3 * k, 3 * k + 1))
+
+
+def solo_robot() -> Robot:
+    """A quadruped on a fixed base (a "solo"-like test robot): per leg a hip abduction about x,
+    a hip flexion and a knee about y, thigh and shank of 0.16 m along -z, full inertia tensors."""
+    rng = np.random.default_rng(12)
+    links = []
+    x_axis, y_axis = mat([[1], [0], [0]]), mat([[0], [1], [0]])
+    for k, (sx, sy) in enumerate(((1, 1), (1, -1), (-1, 1), (-1, -1))):
+        hip = Transform(mat(np.eye(3)), mat([[0.2 * sx], [0.08 * sy], [0]]))
+        flexion = Transform(mat(np.eye(3)), mat([[0], [0.06 * sy], [0]]))
+        knee = Transform(mat(np.eye(3)), mat([[0], [0], [-0.16]]))
+        for j, (placement, axis, mass, com) in enumerate(
+            (
+                (hip, x_axis, 0.15, [0.02 * sx, 0.01 * sy, 0]),
+                (flexion, y_axis, 0.15, [0, 0.01 * sy, -0.08]),
+                (knee, y_axis, 0.03, [0, 0, -0.08]),
+            )
+        ):
+            links.append(
+                Link(
+                    name=f"leg{k + 1}_{('abduction', 'flexion', 'knee')[j]}",
+                    joint="revolute",
+                    placement=placement,
+                    axis=axis,
+                    mass=sp.Float(mass),
+                    com=mat(np.reshape(com, (3, 1))),
+                    inertia=mat(random_inertia(rng, mass)),
+                    motor=Motor(sp.Float(5e-6), sp.Float(9)),
+                    parent=SOLO_PARENTS[3 * k + j],
+                )
+            )
+    return Robot("solo", tuple(links), mat([[0], [0], [-9.81]]))
+
+
+@st.composite
+def tree_parents(draw, min_bodies: int = 2, max_bodies: int = 7) -> tuple[int, ...]:
+    """A random parent array in depth-first order: each link hangs from the base or from a link
+    on the path from the base to the previous link (so every subtree is numbered contiguously)."""
+    nb = draw(st.integers(min_bodies, max_bodies))
+    parents: list[int] = []
+    for i in range(nb):
+        path = [-1]
+        k = i - 1
+        while k >= 0:
+            path.append(k)
+            k = parents[k]
+        parents.append(draw(st.sampled_from(sorted(path))))
+    return tuple(parents)
+
+
+def branch_pairs(parents) -> list[tuple[int, int]]:
+    """The pairs (i, j), i < j, of links on different branches: neither lies on the other's
+    path to the base (computed from the parent array here, not by symdyn.model.topology)."""
+
+    def path(i):
+        out = set()
+        while i >= 0:
+            out.add(i)
+            i = parents[i]
+        return out
+
+    return [(i, j) for j in range(len(parents)) for i in range(j) if i not in path(j)]

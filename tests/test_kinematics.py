@@ -14,12 +14,15 @@ from robots import (
     assert_close,
     assert_matrix_zero,
     example,
+    fd_jacobian,
     random_general_robot,
     random_params,
     random_state,
     raw_example,
     raw_value,
+    solo_robot,
     sym3_data,
+    y_robot,
 )
 
 from symdyn.algorithms.kinematics import (
@@ -148,23 +151,6 @@ def test_poses_symbolic(data):
 
 
 # --------------------------------------------------------------------------- Jacobians
-
-
-def _vee(W: np.ndarray) -> np.ndarray:
-    return np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]]) / 2
-
-
-def fd_jacobian(robot, q, k, point, p, h=1e-6) -> np.ndarray:
-    """Jv by central differences of the point's position, Jw from dR/dq_j R^T (rnea poses)."""
-    n = robot.n
-    R = rnea_poses(robot, q, p)[k][:3, :3]
-    J = np.zeros((6, n))
-    for j in range(n):
-        e = np.eye(n)[j] * h
-        Tp, Tm = rnea_poses(robot, q + e, p)[k], rnea_poses(robot, q - e, p)[k]
-        J[:3, j] = ((Tp[:3, :3] @ point + Tp[:3, 3]) - (Tm[:3, :3] @ point + Tm[:3, 3])) / (2 * h)
-        J[3:, j] = _vee((Tp[:3, :3] - Tm[:3, :3]) / (2 * h) @ R.T)
-    return J
 
 
 @pytest.mark.parametrize("name", EXAMPLE_NAMES)
@@ -317,3 +303,27 @@ def test_general_joint_axes(seed):
     assert_close(J, fd_jacobian(robot, q, robot.n - 1, np.array(point), None), rtol=1e-6)
     assert_close(J, numeric_jacobian(robot, q, link=robot.n - 1, point=point))
     assert_close(numeric_pose(robot, q, point=point), numeric_pose(robot, q, link=robot.n - 1, point=point))
+
+
+# --------------------------------------------------------------------------- trees
+
+
+@pytest.mark.parametrize("make", [y_robot, solo_robot], ids=["ytree", "solo"])
+def test_tree_poses_and_jacobians(make):
+    """Poses against the oracle's; Jacobians against differences of the oracle's poses, with
+    exact zeros in the columns of the joints off the link's path to the base."""
+    robot = make()
+    rng = np.random.default_rng(8)
+    q, _, _ = random_state(robot, rng)
+    oracle = rnea_poses(robot, q)
+    for k, T in enumerate(forward_kinematics(robot, list(q))):
+        assert_close(_floats(T), oracle[k])
+    symbolic = point_jacobian(robot, robot.nb - 1, (0.1, 0, -0.05))
+    path = {robot.nb - 1}
+    while robot.parents[min(path)] >= 0:
+        path.add(robot.parents[min(path)])
+    assert all((symbolic[:, j] == sp.zeros(6, 1)) == (j not in path) for j in range(robot.n))
+    for k in range(robot.nb):
+        point = rng.uniform(-0.3, 0.3, 3)
+        J = numeric_jacobian(robot, q, link=k, point=tuple(point))
+        assert_close(J, fd_jacobian(robot, q, k, point, None), rtol=1e-6)

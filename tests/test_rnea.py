@@ -13,11 +13,23 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
-from robots import ZERO3, Z, mat, roger_arm_robot, rotation, vec
+from robots import (
+    ZERO3,
+    Z,
+    branch_pairs,
+    mat,
+    roger_arm_robot,
+    rotation,
+    solo_robot,
+    tree_robot,
+    vec,
+    y_robot,
+)
 
 from symdyn import rnea as rn
 from symdyn.errors import SymdynError
 from symdyn.model.robot import Friction, Link, Motor, Robot
+from symdyn.model.topology import Mimic
 from symdyn.spatial.transform import Transform, rot_x, rot_y
 
 # --- Roger's eye and arm (slides 17-18) -------------------------------------------------
@@ -161,9 +173,28 @@ def random_state(robot: Robot, seed: int, N: int | None = None):
 SEEDS = range(12)
 
 
-@pytest.mark.parametrize("seed", SEEDS)
+def any_robot(seed: int) -> Robot:
+    """A random chain (SEEDS) or a tree (TREES): the Y tree, the solo legs, or a tree of two
+    branches on the base whose first branch forks, link 4 mimicking link 2 across the fork."""
+    if seed not in TREES:
+        return random_robot(seed)
+    if seed == TREES[0]:
+        return y_robot()
+    if seed == TREES[1]:
+        return solo_robot()
+    parents = (-1, 0, 0, 2, -1, 4)
+    joints = ("revolute", "prismatic", "revolute", "revolute", "prismatic", "revolute")
+    return tree_robot("tree6", parents, joints, seed, mimic={3: Mimic(1, sp.Float(1.5), sp.Float(-0.2))})
+
+
+#: the trees among the robots of the oracle's identities (seeds of any_robot)
+TREES = (100, 101, 102)
+ROBOTS = [*SEEDS, *TREES]
+
+
+@pytest.mark.parametrize("seed", ROBOTS)
 def test_mass_matrix_spd_and_equals_unit_acceleration_columns(seed):
-    robot = random_robot(seed)
+    robot = any_robot(seed)
     q, _, _ = random_state(robot, seed)
     M = rn.mass_matrix(robot, q)
     np.testing.assert_allclose(M, M.T, atol=1e-12)
@@ -171,11 +202,13 @@ def test_mass_matrix_spd_and_equals_unit_acceleration_columns(seed):
     zero = np.zeros(robot.n)
     cols = [rn.rnea(robot, q, zero, e, gravity=False, friction=False) for e in np.eye(robot.n)]
     np.testing.assert_allclose(np.array(cols).T, M, atol=1e-10)
+    if robot.n == robot.nb:  # joints on different branches: exact zeros
+        assert all(M[i, j] == M[j, i] == 0.0 for i, j in branch_pairs(robot.parents))
 
 
-@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("seed", ROBOTS)
 def test_gravity_is_gradient_of_potential(seed):
-    robot = random_robot(seed)
+    robot = any_robot(seed)
     q, _, _ = random_state(robot, seed)
     h = 1e-6
     grad = [
@@ -185,18 +218,18 @@ def test_gravity_is_gradient_of_potential(seed):
     np.testing.assert_allclose(rn.gravity_torque(robot, q), grad, atol=1e-7)
 
 
-@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("seed", ROBOTS)
 def test_kinetic_energy_is_quadratic_form_of_mass_matrix(seed):
-    robot = random_robot(seed)
+    robot = any_robot(seed)
     q, qd, _ = random_state(robot, seed)
     expect = 0.5 * qd @ rn.mass_matrix(robot, q) @ qd
     assert rn.kinetic_energy(robot, q, qd) == pytest.approx(expect, rel=1e-12, abs=1e-12)
 
 
-@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("seed", ROBOTS)
 def test_power_identity_along_trajectory(seed):
     """d/dt T = qd^T (tau - G) with friction off: T differentiated along q(t) by differences."""
-    robot = random_robot(seed)
+    robot = any_robot(seed)
     q, qd, qdd = random_state(robot, seed)
     h = 1e-5
 
@@ -208,10 +241,10 @@ def test_power_identity_along_trajectory(seed):
     assert dT == pytest.approx(qd @ (tau - rn.gravity_torque(robot, q)), rel=1e-7, abs=1e-7)
 
 
-@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("seed", ROBOTS)
 def test_bias_equals_christoffel_form_of_mass_matrix(seed):
     """Lagrange: V_i = sum_jk (dM_ij/dq_k - 1/2 dM_jk/dq_i) qd_j qd_k, dM by differences."""
-    robot = random_robot(seed)
+    robot = any_robot(seed)
     q, qd, _ = random_state(robot, seed)
     h = 1e-6
     dM = np.array(
@@ -224,9 +257,9 @@ def test_bias_equals_christoffel_form_of_mass_matrix(seed):
     np.testing.assert_allclose(rn.bias_torque(robot, q, qd), V, atol=1e-6)
 
 
-@pytest.mark.parametrize("seed", SEEDS)
+@pytest.mark.parametrize("seed", ROBOTS)
 def test_forward_dynamics_inverts_rnea(seed):
-    robot = random_robot(seed)
+    robot = any_robot(seed)
     q, qd, qdd = random_state(robot, seed)
     tau = rn.rnea(robot, q, qd, qdd)
     np.testing.assert_allclose(rn.forward_dynamics(robot, q, qd, tau), qdd, atol=1e-8)
@@ -380,3 +413,34 @@ def test_oracle_is_independent_of_symbolic_derivation(module):
         "types",
     }
     assert "sympy" not in source
+
+
+# --- kinematic trees ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", TREES)
+def test_tree_poses_compose_along_the_parents(seed):
+    """Poses are the model's own SymPy joint transforms multiplied along each link's path."""
+    robot = any_robot(seed)
+    q, _, _ = random_state(robot, seed)
+    poses = rn.forward_kinematics(robot, q)
+    assert len(poses) == robot.nb
+    qb = robot.body_positions([sp.Float(x) for x in q])
+    for i, link in enumerate(robot.links):
+        T = np.array(link.joint_transform(qb[i]).matrix().evalf(), dtype=float)
+        p = robot.parents[i]
+        np.testing.assert_allclose(poses[i], T if p < 0 else poses[p] @ T, atol=1e-12)
+    coms = rn.link_com_positions(robot, q)
+    for i, link in enumerate(robot.links):
+        np.testing.assert_allclose(
+            coms[i], poses[i][:3, :3] @ np.array(link.com, dtype=float)[:, 0] + poses[i][:3, 3]
+        )
+
+
+def test_tree_batch_equals_loop():
+    robot = any_robot(TREES[2])
+    q, qd, qdd = random_state(robot, 2, N=4)
+    tau = rn.rnea(robot, q, qd, qdd)
+    for k in range(4):
+        np.testing.assert_allclose(tau[k], rn.rnea(robot, q[k], qd[k], qdd[k]), atol=1e-12)
+        np.testing.assert_allclose(rn.mass_matrix(robot, q)[k], rn.mass_matrix(robot, q[k]))
