@@ -10,6 +10,13 @@ Two independent routes fill the same `Dynamics`:
 - "lagrange" (symdyn.algorithms.lagrange): M from the link Jacobians, C from the
   Christoffel symbols of M, G from the potential energy, V = C qd.
 
+On a kinematic tree both routes run over the nb links (symdyn.model.topology). With
+mimic joints the Newton-Euler route runs on the nb bodies with q_b = Robot.body_positions(q),
+qd_b = S qd and qdd_b = S qdd over the n independent symbols, and projects
+(symdyn.algorithms.coordinates): M = S^T M_b S, C = S^T C_b S, V = S^T V_b, G = S^T G_b,
+F = S^T F_b(qd_b), tau = S^T tau_b, a mimic joint's reflected rotor inertia on M_b's
+diagonal; the Lagrange route differentiates by the independent coordinates directly.
+
 Both keep their results as expressions over named intermediates
 (symdyn.symbolic.program); `Dynamics.M` etc. give closed forms over q, qd, qdd and the
 free parameters, simplified with trigonometric identities when requested
@@ -28,18 +35,20 @@ and 6.2; Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
+from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
-from .errors import SymdynError
+from .errors import SymdynError, SymdynWarning
 from .model.robot import Robot
 from .model.symbols import joint_symbols
 from .symbolic.program import Program
@@ -64,8 +73,11 @@ def _check_quantity(name, where: str) -> str:
 def friction_vector(robot: Robot, qd) -> sp.Matrix:
     """F_i = viscous_i qd_i + coulomb_i sign(qd_i) (Grupen (2015), slide 16).
 
+    Per body at its joint rate qd_b = S qd; a mimic joint's friction is projected onto
+    the coordinate it follows, F = S^T F_b(qd_b).
+
     Args:
-        robot: the model, n links.
+        robot: the model, n independent joints.
         qd: n joint velocities (symbols or numbers).
 
     Returns:
@@ -73,12 +85,17 @@ def friction_vector(robot: Robot, qd) -> sp.Matrix:
     """
     if len(qd) != robot.n:
         raise SymdynError(f"friction_vector: qd has length {len(qd)}, expected {robot.n} (one per joint)")
-    return sp.Matrix(
-        [
-            link.friction.viscous * qd[i] + link.friction.coulomb * sp.sign(qd[i])
-            for i, link in enumerate(robot.links)
-        ]
-    )
+    rates = robot.body_rates(list(qd))
+    F_b = [
+        link.friction.viscous * rate + link.friction.coulomb * sp.sign(rate)
+        for link, rate in zip(robot.links, rates, strict=True)
+    ]
+    if robot.n == robot.nb:
+        return sp.Matrix(F_b)
+    F = [sp.S.Zero] * robot.n
+    for f, c in zip(F_b, robot.coordinates, strict=True):
+        F[c.index] += c.multiplier * f
+    return sp.Matrix(F)
 
 
 def simplify_entry(expr: sp.Expr) -> sp.Expr:
@@ -223,21 +240,45 @@ class Dynamics:
 
 
 def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:
-    """M, C, V, G, tau and the rigid-body bias by Newton-Euler and the composite bodies."""
-    n = robot.n
-    rot = joint_frames(robot, q)
-    zeros = [0] * n
+    """M, C, V, G, tau and the rigid-body bias by Newton-Euler and the composite bodies.
+
+    The recursions run on the nb bodies at q_b, qd_b = S qd, qdd_b = S qdd; the results are
+    projected onto the n independent coordinates (the identity without mimic joints)."""
+    q_b, qd_b, qdd_b = robot.body_positions(list(q)), robot.body_rates(list(qd)), robot.body_rates(list(qdd))
+    rot = joint_frames(robot, q_b)
+    zeros = [0] * robot.nb
     with distribute(True):  # numbers times sums fold into the coefficients of the composites
         composites = composite_inertias(robot, rot, program)
-        G = sp.Matrix(gravity_composite(robot, rot, composites, program))
+        G = gravity_composite(robot, rot, composites, program)
         M = mass_matrix_crba(robot, rot, composites, program)
-        C = coriolis_matrix_composite(robot, rot, composites, list(qd), program)
-    V = sp.Matrix(newton_euler(robot, q, list(qd), zeros, program, gravity=False, tag="V", rotations=rot))
+        C = coriolis_matrix_composite(robot, rot, composites, qd_b, program)
+    V = newton_euler(robot, q_b, qd_b, zeros, program, gravity=False, tag="V", rotations=rot)
     Vn = [program.let(v, "V") for v in V]
-    bias = newton_euler(robot, q, list(qd), zeros, program, gravity=True, tag="B", rotations=rot)
-    body = newton_euler(robot, q, list(qd), list(qdd), program, gravity=True, tag="T", rotations=rot)
-    tau = sp.Matrix([body[i] + link.motor.reflected_inertia * qdd[i] for i, link in enumerate(robot.links)])
-    return {"M": M, "C": C, "V": sp.Matrix(Vn), "G": G, "tau": tau, "bias": sp.Matrix(bias)}
+    bias = newton_euler(robot, q_b, qd_b, zeros, program, gravity=True, tag="B", rotations=rot)
+    body = newton_euler(robot, q_b, qd_b, qdd_b, program, gravity=True, tag="T", rotations=rot)
+    tau = [body[i] + link.motor.reflected_inertia * qdd_b[i] for i, link in enumerate(robot.links)]
+    return {
+        "M": project_matrix(robot, M, program, "M"),
+        "C": project_matrix(robot, C, program, "C"),
+        "V": sp.Matrix(project_vector(robot, Vn, program, "V")),
+        "G": sp.Matrix(project_vector(robot, G, program, "G")),
+        "tau": sp.Matrix(project_vector(robot, tau, program, "tau")),
+        "bias": sp.Matrix(project_vector(robot, bias, program, "bias")),
+    }
+
+
+def _warn_idle_joints(robot: Robot) -> None:
+    """A SymdynWarning naming the joints that move nothing with inertia (M singular)."""
+    idle = robot.idle_joints()
+    if idle:
+        names = ", ".join(f"'{robot.links[i].name}' (link {i + 1})" for i in idle)
+        warnings.warn(
+            f"robot '{robot.name}': joint(s) {names} move no mass or inertia (their subtrees have "
+            "zero mass and inertia and they have no rotor inertia), so M(q) is singular and "
+            "forward dynamics is undefined",
+            SymdynWarning,
+            stacklevel=3,
+        )
 
 
 def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = None) -> Dynamics:
@@ -259,6 +300,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
 
     Raises:
         SymdynError: not a Robot, an unknown method or a simplify that is not True, False or None.
+
+    Warns:
+        SymdynWarning: a joint moves nothing with mass or inertia (Robot.idle_joints), so M is
+            singular. Decided on numbers only: with a symbolic mass it cannot be.
     """
     if not isinstance(robot, Robot):
         raise SymdynError(
@@ -269,6 +314,7 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
     if simplify is not None and not isinstance(simplify, bool):
         raise SymdynError(f"derive: simplify must be True, False or None, got {simplify!r}")
     r = robot.resolved()
+    _warn_idle_joints(r)
     q, qd, qdd = joint_symbols(r.n)
     program = Program()
     with distribute(False):

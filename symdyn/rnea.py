@@ -15,10 +15,14 @@ taken at the body-frame origin O and expressed in body-frame axes):
 * mass matrix: the composite-rigid-body algorithm (CRBA);
 * energies and kinematics: poses composed in the base frame.
 
-Body i moves relative to body i-1 by parent_T_i(q_i) = placement @ Rot(axis, q_i)
-(revolute, motion subspace S_i = [axis; 0]) or placement @ Trans(axis q_i)
-(prismatic, S_i = [0; axis]). Every public function accepts a single state
-(vectors of length n) or a batch (arrays of shape (N, n)).
+The links form a kinematic tree: body i moves relative to its parent lambda(i) (the base
+for lambda(i) = -1; Featherstone's parent array, sec. 4.1.2) by
+parent_T_i(q_i) = placement @ Rot(axis, q_i) (revolute, motion subspace S_i = [axis; 0])
+or placement @ Trans(axis q_i) (prismatic, S_i = [0; axis]). Every public function takes
+the n independent joint coordinates, as a single state (vectors of length n) or a batch
+(arrays of shape (N, n)). A mimic joint follows another, q_j = multiplier q_i + offset:
+the algorithms run on the nb bodies at q_b, qd_b = S qd, qdd_b = S qdd and the efforts come
+back as S^T tau_b (M = S^T M_b S), by virtual work (Featherstone 2008, sec. 8.2).
 """
 
 from __future__ import annotations
@@ -28,7 +32,16 @@ import types
 
 import numpy as np
 
-from .rnea_inputs import NumericModel, checked_inputs, numeric_model, skew
+from .errors import SymdynError
+from .rnea_inputs import (
+    NumericModel,
+    body_positions,
+    body_rates,
+    checked_inputs,
+    numeric_model,
+    project,
+    skew,
+)
 
 __all__ = [
     "NumericModel",
@@ -51,9 +64,10 @@ def _out(a: np.ndarray, single: bool) -> np.ndarray:
 
 
 def _joint_poses(mdl: NumericModel, q: np.ndarray):
-    """Per joint i: (E, r) with E = parent_R_i (N,3,3) and r = origin of body i in parent (N,3)."""
+    """Per body i: (E, r) with E = parent_R_i (N,3,3) and r = origin of body i in its parent
+    (N,3), for the bodies' joint positions q (N, nb)."""
     out = []
-    for i in range(mdl.n):
+    for i in range(mdl.nb):
         qi = q[:, i]
         if mdl.revolute[i]:
             k = mdl.axis[i]
@@ -68,7 +82,7 @@ def _joint_poses(mdl: NumericModel, q: np.ndarray):
 
 
 def _motion_transforms(poses) -> list[np.ndarray]:
-    """i_X_{i-1} = [[E^T, 0], [-E^T [r]x, E^T]]: parent motion vectors into body i coordinates."""
+    """i_X_lambda(i) = [[E^T, 0], [-E^T [r]x, E^T]]: parent motion vectors into body i coordinates."""
     xs = []
     for E, r in poses:
         Et = np.swapaxes(E, -1, -2)
@@ -81,8 +95,8 @@ def _motion_transforms(poses) -> list[np.ndarray]:
 
 
 def _subspaces(mdl: NumericModel) -> np.ndarray:
-    """Motion subspaces S_i (n,6) in body coordinates: [axis; 0] revolute, [0; axis] prismatic."""
-    S = np.zeros((mdl.n, 6))
+    """Motion subspaces S_i (nb,6) in body coordinates: [axis; 0] revolute, [0; axis] prismatic."""
+    S = np.zeros((mdl.nb, 6))
     S[mdl.revolute, :3] = mdl.axis[mdl.revolute]
     S[~mdl.revolute, 3:] = mdl.axis[~mdl.revolute]
     return S
@@ -102,32 +116,47 @@ def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.einsum("...ij,...j->...i", A, x)
 
 
-def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
-    """Spatial RNEA on a batch (all arguments (N, n)); see `rnea`."""
-    N, n = q.shape
+def _body_rnea(mdl: NumericModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, g_on: bool) -> np.ndarray:
+    """Rigid-body efforts of the bodies' joints (N, nb) by the spatial RNEA on the tree, for the
+    bodies' joint positions, velocities and accelerations (N, nb) each; see `rnea`."""
+    N = len(q)
     X = _motion_transforms(_joint_poses(mdl, q))
     S = _subspaces(mdl)
-    v = np.zeros((N, 6))
-    a = np.zeros((N, 6))
+    base_v = np.zeros((N, 6))
+    base_a = np.zeros((N, 6))
     if g_on:
-        a[:, 3:] = -mdl.gravity  # fictitious base acceleration a_0 = [0; -g]
+        base_a[:, 3:] = -mdl.gravity  # fictitious base acceleration a_0 = [0; -g]
+    vs: list[np.ndarray] = []
+    accs: list[np.ndarray] = []
     forces = []
-    for i in range(n):
-        v = _mv(X[i], v) + S[i] * qd[:, i, None]
+    for i in range(mdl.nb):
+        p = mdl.parent[i]
+        v_p, a_p = (base_v, base_a) if p < 0 else (vs[p], accs[p])
+        v = _mv(X[i], v_p) + S[i] * qd[:, i, None]
         vx = _crm(v)
-        a = _mv(X[i], a) + S[i] * qdd[:, i, None] + _mv(vx, S[i]) * qd[:, i, None]
+        a = _mv(X[i], a_p) + S[i] * qdd[:, i, None] + _mv(vx, S[i]) * qd[:, i, None]
+        vs.append(v)
+        accs.append(a)
         Iv = _mv(mdl.spatial_inertia[i], v)
         # f = I a + v x* (I v), with v x* = -(v x)^T the force cross product.
         forces.append(_mv(mdl.spatial_inertia[i], a) - _mv(np.swapaxes(vx, -1, -2), Iv))
-    tau = np.zeros((N, n))
-    for i in reversed(range(n)):
+    tau = np.zeros((N, mdl.nb))
+    for i in reversed(range(mdl.nb)):  # every child's force is in by now: children come later
         tau[:, i] = forces[i] @ S[i]
-        if i > 0:
-            forces[i - 1] = forces[i - 1] + _mv(np.swapaxes(X[i], -1, -2), forces[i])
-    tau += mdl.reflected * qdd
-    if f_on:
-        tau += mdl.viscous * qd + mdl.coulomb * np.sign(qd)
+        p = mdl.parent[i]
+        if p >= 0:
+            forces[p] = forces[p] + _mv(np.swapaxes(X[i], -1, -2), forces[i])
     return tau
+
+
+def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
+    """tau (N, n) for independent q, qd, qdd (N, n): the bodies' efforts, with rotor inertia and
+    friction at the bodies' rates, projected by S^T; see `rnea`."""
+    q_b, qd_b, qdd_b = body_positions(mdl, q), body_rates(mdl, qd), body_rates(mdl, qdd)
+    tau = _body_rnea(mdl, q_b, qd_b, qdd_b, g_on) + mdl.reflected * qdd_b
+    if f_on:
+        tau += mdl.viscous * qd_b + mdl.coulomb * np.sign(qd_b)
+    return project(mdl, tau)
 
 
 def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.ndarray:
@@ -135,14 +164,15 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
 
     Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 5.3; the lecture's 3-vector form
     is R. Grupen, "Dynamics" (2015), slides 14-15 (symdyn.algorithms.newton_euler).
-    Body frames, spatial vectors at each body origin. Outward: v_i = X_i v_{i-1} + S_i qd_i,
-    a_i = X_i a_{i-1} + S_i qdd_i + v_i x S_i qd_i, from v_0 = 0 and a_0 = [0; -g] (gravity
-    in the base frame; a_0 = 0 with gravity=False); body force f_i = I_i a_i + v_i x* I_i v_i.
-    Inward: tau_i = S_i^T f_i, f_{i-1} += X_i^T f_i. Then tau_i += gear_ratio^2 J_m qdd_i
-    (reflected rotor inertia) and, unless friction=False, viscous qd_i + coulomb sign(qd_i).
+    Body frames, spatial vectors at each body origin, p = lambda(i) the parent (v_p = 0 and
+    a_p = [0; -g] for the base: gravity in the base frame; a_p = 0 with gravity=False).
+    Outward: v_i = X_i v_p + S_i qd_i, a_i = X_i a_p + S_i qdd_i + v_i x S_i qd_i; body force
+    f_i = I_i a_i + v_i x* I_i v_i. Inward: tau_i = S_i^T f_i, f_p += X_i^T f_i. Then
+    tau_i += gear_ratio^2 J_m qdd_i (reflected rotor inertia) and, unless friction=False,
+    viscous qd_i + coulomb sign(qd_i); all per body at q_b, qd_b, qdd_b, then tau = S^T tau_b.
 
     Args:
-        robot: a `symdyn.Robot` with n joints.
+        robot: a `symdyn.Robot` with n independent joints.
         q, qd, qdd: joint positions, velocities, accelerations: (n,) each, or (N, n) each for
             N states.
         params: the free parameters' values (see `numeric_model`).
@@ -159,29 +189,33 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
 
 
 def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
-    """M for a batch q (N, n) -> (N, n, n); see `mass_matrix`."""
-    N, n = q.shape
-    X = _motion_transforms(_joint_poses(mdl, q))
+    """M for a batch of independent q (N, n) -> (N, n, n); see `mass_matrix`."""
+    N = len(q)
+    X = _motion_transforms(_joint_poses(mdl, body_positions(mdl, q)))
     S = _subspaces(mdl)
-    Ic = [np.broadcast_to(mdl.spatial_inertia[i], (N, 6, 6)).copy() for i in range(n)]
-    M = np.zeros((N, n, n))
-    for i in reversed(range(n)):
-        if i > 0:
-            Ic[i - 1] += np.swapaxes(X[i], -1, -2) @ Ic[i] @ X[i]
+    Ic = [np.broadcast_to(mdl.spatial_inertia[i], (N, 6, 6)).copy() for i in range(mdl.nb)]
+    M = np.zeros((N, mdl.nb, mdl.nb))
+    for i in reversed(range(mdl.nb)):  # Ic[i] is complete: its children come after it
+        if mdl.parent[i] >= 0:
+            Ic[mdl.parent[i]] += np.swapaxes(X[i], -1, -2) @ Ic[i] @ X[i]
         F = Ic[i] @ S[i]
         M[:, i, i] = F @ S[i] + mdl.reflected[i]
-        for j in range(i, 0, -1):
+        j = i
+        while mdl.parent[j] >= 0:
             F = _mv(np.swapaxes(X[j], -1, -2), F)
-            M[:, i, j - 1] = M[:, j - 1, i] = F @ S[j - 1]
-    return M
+            j = mdl.parent[j]
+            M[:, i, j] = M[:, j, i] = F @ S[j]
+    return mdl.selection.T @ M @ mdl.selection
 
 
 def mass_matrix(robot, q, params=None) -> np.ndarray:
     """Joint-space inertia M(q) by the composite-rigid-body algorithm (body frames).
 
-    Featherstone (2008), sec. 6.2. Composite inertias Ic_{i-1} += X_i^T Ic_i X_i (inward);
-    F = Ic_i S_i, M_ii = S_i^T F, and for j < i, M_ij = M_ji = S_j^T (X_{j+1}^T ... X_i^T F).
-    The diagonal also gets the reflected rotor inertia gear_ratio^2 J_m.
+    Featherstone (2008), sec. 6.2. Composite inertias Ic_lambda(i) += X_i^T Ic_i X_i (inward);
+    F = Ic_i S_i, M_ii = S_i^T F, and for each ancestor j of i, M_ij = M_ji = S_j^T F with F
+    carried down the path, F <- X_k^T F; the other entries are zero (joints on different
+    branches). The diagonal also gets the reflected rotor inertia gear_ratio^2 J_m; with
+    mimic joints this is M_b of the bodies and M = S^T M_b S.
 
     Args:
         robot: a `symdyn.Robot` with n joints.
@@ -243,6 +277,22 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
     return _out(mdl.viscous * qd + mdl.coulomb * np.sign(qd), single)
 
 
+def _check_invertible(mdl: NumericModel, M: np.ndarray, where: str) -> None:
+    """Raise when a diagonal entry of M (N, n, n) is exactly zero: that joint moves no mass or
+    inertia (M positive semi-definite, so its whole row is zero) and M cannot be inverted."""
+    idle = np.flatnonzero(np.any(np.diagonal(M, axis1=-2, axis2=-1) == 0.0, axis=0))
+    if idle.size:
+        names = ", ".join(
+            f"'{mdl.names[i]}' (link {i + 1})"
+            for i in range(mdl.nb)
+            if mdl.coordinate[i] in set(idle.tolist())
+        )
+        raise SymdynError(
+            f"{where}: robot '{mdl.name}': M(q) is singular: joint(s) {names} move no mass or inertia "
+            "(their subtrees have zero mass and inertia and they have no rotor inertia)"
+        )
+
+
 def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
     """qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (numpy.linalg.solve, joint space).
 
@@ -255,12 +305,17 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
 
     Returns:
         qdd, (n,) or (N, n).
+
+    Raises:
+        SymdynError: bad arguments (see `rnea`), or M(q) singular because a joint moves no
+            mass or inertia (named in the message).
     """
     mdl, (q, qd, tau), single = checked_inputs(
         "forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau)
     )
     h = _rnea(mdl, q, qd, np.zeros_like(q), True, True)
     M = _mass_matrix(mdl, q)
+    _check_invertible(mdl, M, "forward_dynamics")
     return _out(np.linalg.solve(M, (tau - h)[..., None])[..., 0], single)
 
 
@@ -279,31 +334,34 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
         T, a float or (N,).
     """
     mdl, (q, qd), single = checked_inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
-    X = _motion_transforms(_joint_poses(mdl, q))
+    X = _motion_transforms(_joint_poses(mdl, body_positions(mdl, q)))
     S = _subspaces(mdl)
-    v = np.zeros((len(q), 6))
-    T = 0.5 * (mdl.reflected * qd**2).sum(axis=1)
-    for i in range(mdl.n):
-        v = _mv(X[i], v) + S[i] * qd[:, i, None]
+    qd_b = body_rates(mdl, qd)
+    T = 0.5 * (mdl.reflected * qd_b**2).sum(axis=1)
+    vs: list[np.ndarray] = []
+    for i in range(mdl.nb):
+        p = mdl.parent[i]
+        v = (_mv(X[i], vs[p]) if p >= 0 else 0.0) + S[i] * qd_b[:, i, None]
+        vs.append(v)
         T = T + 0.5 * np.einsum("ni,ij,nj->n", v, mdl.spatial_inertia[i], v)
     return float(T[0]) if single else T
 
 
 def _poses(mdl: NumericModel, q: np.ndarray) -> list[np.ndarray]:
-    """Base-frame poses base_T_i (N,4,4), composed from the joint transforms."""
+    """Base-frame poses base_T_i (N,4,4) for independent q (N, n), composed along the tree."""
     N = len(q)
-    T = np.broadcast_to(np.eye(4), (N, 4, 4))
-    out = []
-    for E, r in _joint_poses(mdl, q):
+    base = np.broadcast_to(np.eye(4), (N, 4, 4))
+    out: list[np.ndarray] = []
+    for i, (E, r) in enumerate(_joint_poses(mdl, body_positions(mdl, q))):
         J = np.zeros((N, 4, 4))
         J[:, :3, :3], J[:, :3, 3], J[:, 3, 3] = E, r, 1.0
-        T = T @ J
-        out.append(T)
+        p = mdl.parent[i]
+        out.append((out[p] if p >= 0 else base) @ J)
     return out
 
 
 def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
-    """The 4x4 pose base_T_i = prod_k parent_T_k(q_k) of every body frame, in the base frame.
+    """The 4x4 pose base_T_i = base_T_lambda(i) parent_T_i(q_i) of every body frame, base frame.
 
     Args:
         robot: a `symdyn.Robot` with n joints.
@@ -311,14 +369,14 @@ def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
         params: the free parameters' values (see `numeric_model`).
 
     Returns:
-        A list of n arrays (4, 4), or (N, 4, 4) for a batch.
+        A list of nb arrays (4, 4), or (N, 4, 4) for a batch, one per link.
     """
     mdl, (q,), single = checked_inputs("forward_kinematics", robot, params, ("q", q))
     return [_out(T, single) for T in _poses(mdl, q)]
 
 
 def _com_positions(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
-    """Centres of mass in the base frame for a batch q (N, n) -> (N, n, 3)."""
+    """Centres of mass in the base frame for a batch q (N, n) -> (N, nb, 3)."""
     Ts = _poses(mdl, q)
     return np.stack([_mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
 
@@ -332,7 +390,7 @@ def link_com_positions(robot, q, params=None) -> np.ndarray:
         params: the free parameters' values (see `numeric_model`).
 
     Returns:
-        (n, 3), or (N, n, 3) for a batch.
+        (nb, 3), or (N, nb, 3) for a batch, one row per link.
     """
     mdl, (q,), single = checked_inputs("link_com_positions", robot, params, ("q", q))
     return _out(_com_positions(mdl, q), single)

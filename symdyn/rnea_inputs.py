@@ -4,7 +4,9 @@ symdyn.rnea evaluates rigid-body dynamics with NumPy only; this module is its si
 reads the model. `numeric_model` converts `robot.numeric(params)` to arrays once per robot
 and parameter values (cached), and `checked_inputs` checks what every public function of
 symdyn.rnea is given (the robot, the parameter values, the joint vectors) and says what it
-expected. Nothing here imports SymPy or the symbolic derivation.
+expected. `body_positions` and `body_rates` expand the n independent joint vectors to the
+nb bodies (a mimic joint follows q_j = multiplier q_i + offset), and `project` takes body
+efforts back, S^T tau_b. Nothing here imports SymPy or the symbolic derivation.
 """
 
 from __future__ import annotations
@@ -16,18 +18,31 @@ import numpy as np
 
 from .errors import SymdynError
 
-__all__ = ["NumericModel", "numeric_model", "checked_inputs", "skew"]
+__all__ = [
+    "NumericModel",
+    "numeric_model",
+    "checked_inputs",
+    "skew",
+    "body_positions",
+    "body_rates",
+    "project",
+]
 
 
 @dataclass(frozen=True, eq=False)
 class NumericModel:
-    """A robot as NumPy arrays (n links): everything the numeric algorithms read.
+    """A robot as NumPy arrays (nb links, n independent joints): everything the numeric
+    algorithms read.
 
-    `revolute` (n,) bool; `R0`, `p0` (n,3,3), (n,3) the constant placement;
-    `axis` (n,3) in the body frame; `mass` (n,); `com` (n,3) body frame;
-    `inertia` (n,3,3) about the centre of mass; `spatial_inertia` (n,6,6) about
-    the body origin; `viscous`, `coulomb`, `reflected` (n,) friction and
-    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame.
+    `revolute` (nb,) bool; `R0`, `p0` (nb,3,3), (nb,3) the constant placement;
+    `axis` (nb,3) in the body frame; `mass` (nb,); `com` (nb,3) body frame;
+    `inertia` (nb,3,3) about the centre of mass; `spatial_inertia` (nb,6,6) about
+    the body origin; `viscous`, `coulomb`, `reflected` (nb,) friction and
+    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame; `parent` (nb,) int,
+    lambda(i) with -1 for the base (parents before children); `coordinate` (nb,) int, the
+    independent coordinate each body's joint follows, with `multiplier` and `offset` (nb,)
+    (q_i = multiplier_i q[coordinate_i] + offset_i); `selection` (nb, n) the matrix S of
+    qd_b = S qd; `names` the links' names and `name` the robot's, for messages.
     """
 
     revolute: np.ndarray
@@ -42,13 +57,27 @@ class NumericModel:
     coulomb: np.ndarray
     reflected: np.ndarray
     gravity: np.ndarray
+    parent: np.ndarray
+    coordinate: np.ndarray
+    multiplier: np.ndarray
+    offset: np.ndarray
+    selection: np.ndarray
+    names: tuple[str, ...]
+    name: str
 
     def __post_init__(self) -> None:
         for value in vars(self).values():  # cached and shared: make every array read-only
-            value.flags.writeable = False
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
 
     @property
     def n(self) -> int:
+        """Number of independent joint coordinates (the length of q, qd, qdd, tau)."""
+        return self.selection.shape[1]
+
+    @property
+    def nb(self) -> int:
+        """Number of bodies (links)."""
         return len(self.revolute)
 
 
@@ -116,11 +145,23 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
     fr = np.array(
         [[_floats(x, (), f"{lk.name} friction/motor") for x in t] for lk, t in zip(links, fr, strict=True)]
     ).reshape(n, 3)
+    coords = r.coordinates
+    coordinate = np.array([c.index for c in coords], dtype=int).reshape(n)
+    multiplier = np.array(
+        [_floats(c.multiplier, (), f"{lk.name} mimic") for lk, c in zip(links, coords, strict=True)]
+    )
+    offset = np.array(
+        [_floats(c.offset, (), f"{lk.name} mimic") for lk, c in zip(links, coords, strict=True)]
+    )
+    selection = np.zeros((n, r.n))
+    selection[np.arange(n), coordinate] = multiplier
     return NumericModel(
         revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
         R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
         spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
-        gravity=_floats(r.gravity, (3,), "gravity"),
+        gravity=_floats(r.gravity, (3,), "gravity"), parent=np.array(r.parents, dtype=int).reshape(n),
+        coordinate=coordinate, multiplier=multiplier.reshape(n), offset=offset.reshape(n),
+        selection=selection, names=tuple(lk.name for lk in links), name=r.name,
     )  # fmt: skip
 
 
@@ -168,3 +209,18 @@ def checked_inputs(where: str, robot, params, *named: tuple[str, object]):
     mdl = _model(robot, params, where)
     arrays, single = _states(where, mdl.n, *named)
     return mdl, arrays, single
+
+
+def body_positions(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
+    """q_b (N, nb): each body's joint position, multiplier q[coordinate] + offset, from q (N, n)."""
+    return q[:, mdl.coordinate] * mdl.multiplier + mdl.offset
+
+
+def body_rates(mdl: NumericModel, qd: np.ndarray) -> np.ndarray:
+    """qd_b = S qd (N, nb) from qd (N, n); the same for accelerations."""
+    return qd[:, mdl.coordinate] * mdl.multiplier
+
+
+def project(mdl: NumericModel, tau_b: np.ndarray) -> np.ndarray:
+    """S^T tau_b (N, n): body efforts (N, nb) on the independent coordinates (virtual work)."""
+    return tau_b @ mdl.selection

@@ -13,6 +13,10 @@ gives, with m = max(j, k) and every vector carried into one frame,
 
     2 C_jk = s_j^T (s_k x* h^c_m + 2 I^c_m psi_k + Idot^c_m s_k)
 
+On a kinematic tree (symdyn.model.topology) m is the deeper of j and k when one supports
+the other, and C_jk is an exact zero when neither does: qd_k then moves no body that
+joint j carries, and M_jk, M_ji and M_ki do not depend on the other joint.
+
 which is the Christoffel form C = 1/2 dV/dqd (Echeandia and Wensing 2021 reach
 the same result through their matrices B_i). With the half-quantities
 H = h^c / 2 and P = Idot^c / 2 this reads, for j >= k,
@@ -22,7 +26,7 @@ H = h^c / 2 and P = Idot^c / 2 this reads, for j >= k,
 
 (the lower triangle uses the symmetry of I^c and Idot^c and
 <a, b x* f> = -<b, a x* f>). Only the three forces Y_j, A_j and F_j travel
-inward, n <- R n + p x R f, f <- R f; nothing with an inertia is formed per
+inward along the support of j, n <- R n + p x R f, f <- R f; nothing with an inertia is formed per
 pair of joints, against one Newton-Euler tangent pass per column when C is
 computed as 1/2 dV/dqd.
 
@@ -44,6 +48,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model.robot import Robot
+from ..model.topology import children
 from ..spatial import vectors as v3
 from ..spatial.inertia import SpatialInertia, apply_inertia, inertia_rate, scaled_inertia
 from ..spatial.motion import Force, Motion, cross_force, cross_motion, project, spatial_add, spatial_sub
@@ -81,58 +86,59 @@ def coriolis_matrix_composite(
     See the module docstring for the recursion.
 
     Args:
-        robot: the model, n links.
+        robot: the model, nb links in a tree.
         frames: `symdyn.algorithms.frames.joint_frames(robot, q)`.
         composites: `symdyn.algorithms.crba.composite_inertias(robot, frames, program)`,
             subtree inertias about each body origin, body axes.
-        qd: n joint velocities (symbols).
+        qd: nb joint velocities of the bodies (symbols or expressions).
         program: receives the named intermediates.
 
     Returns:
-        The n x n matrix C over the program's intermediates (joint space).
+        The nb x nb matrix C over the program's intermediates (the bodies' joint space);
+        C_jk is SymPy's zero unless j supports k or k supports j.
     """
-    n = robot.n
-    assert len(qd) == n and len(composites) == n, (len(qd), len(composites), n)
+    nb = robot.nb
+    assert len(qd) == nb and len(composites) == nb, (len(qd), len(composites), nb)
+    parents = robot.parents
     s = [link_subspace(link) for link in robot.links]  # s[i] in frame i
     # outward: body velocities v_i (frame i) and psi_k = v_k x s_k (frame k)
     vel: list[Motion] = []
-    w, u = v3.ZERO3, v3.ZERO3  # velocity of body i-1 in frame i-1, then of body i in frame i
-    for i in range(n):
+    for i in range(nb):
         R, p = frames[i].R, frames[i].p
+        w, u = vel[parents[i]] if parents[i] >= 0 else (v3.ZERO3, v3.ZERO3)  # the parent's, its frame
         u = v3.mul_t(R, v3.add(u, v3.cross(w, p)))
         w = v3.mul_t(R, w)
         w = program.let_vector(v3.add(w, v3.scale(qd[i], s[i].angular)), f"w{i + 1}_")
         u = program.let_vector(v3.add(u, v3.scale(qd[i], s[i].linear)), f"u{i + 1}_")
         vel.append(Motion(w, u))
-    psi = [_let_motion(program, cross_motion(vel[k], s[k]), f"psi{k + 1}_") for k in range(n)]
+    psi = [_let_motion(program, cross_motion(vel[k], s[k]), f"psi{k + 1}_") for k in range(nb)]
     # inward: half momentum H and half inertia rate P of every subtree (frame i)
-    H: list[Force] = []
-    P: list[SpatialInertia] = []
-    for i in reversed(range(n)):
+    H: list[Force] = [Force(v3.ZERO3, v3.ZERO3)] * nb
+    P: list[SpatialInertia] = [scaled_inertia(_HALF, link_inertia(link)) for link in robot.links]
+    for i in reversed(range(nb)):
         k = str(i + 1)
-        half_body = scaled_inertia(_HALF, link_inertia(robot.links[i]))
+        half_body = P[i]
         half = apply_inertia(half_body, vel[i])
         own = _named_rate(half_body, vel[i], program, k)
-        if i + 1 < n:
-            child = frames[i + 1].force_to_parent(H[-1], program, f"RH{k}_")
-            half = spatial_add(half, child)
-            own = shift_inertia(frames[i + 1], P[-1], own, program, f"P{k}_")
-        H.append(_let_force(program, half, f"H{k}_"))
-        P.append(own)
-    H, P = H[::-1], P[::-1]
-    C = sp.zeros(n, n)
-    for j in reversed(range(n)):
+        for child in children(parents, i):
+            half = spatial_add(half, frames[child].force_to_parent(H[child], program, f"RH{k}_"))
+            own = shift_inertia(frames[child], P[child], own, program, f"P{k}_")
+        H[i] = _let_force(program, half, f"H{k}_")
+        P[i] = own
+    C = sp.zeros(nb, nb)
+    for j in reversed(range(nb)):
         k = str(j + 1)
         Ps = apply_inertia(P[j], s[j])
         sH = cross_force(s[j], H[j])
         Ipsi = apply_inertia(composites[j], psi[j])
-        # the three forces of column j, in frame j, then carried into frame i < j
+        # the three forces of column j, in frame j, then carried down the support of j
         Y = _let_force(program, spatial_add(Ps, sH, Ipsi), f"Y{k}_")
         A = _let_force(program, spatial_sub(Ps, sH), f"A{k}_")
         F = _let_force(program, apply_inertia(composites[j], s[j]), f"F{k}_")
         C[j, j] = program.let(project(s[j], Y), "C")
-        for i in reversed(range(j)):
-            frame = frames[i + 1]
+        i = j
+        while parents[i] >= 0:
+            frame, i = frames[i], parents[i]
             Y, A, F = (
                 _let_force(program, frame.force_to_parent(force, program, f"R{tag}{k}_"), f"{tag}{k}_")
                 for tag, force in (("Y", Y), ("A", A), ("F", F))

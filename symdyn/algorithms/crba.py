@@ -2,18 +2,20 @@
 
 Each body i carries, about its body-frame origin, its spatial inertia (m_i, h_i, I_i):
 mass, first moment h_i = m_i c_i and rotational inertia I_i = I_ci + m_i (c_i^T c_i 1 - c_i c_i^T)
-(symdyn.spatial.inertia). The composite body of the subtree rooted at i adds its children,
-moved into frame i (R, p: child frame in parent frame, h' = R h):
+(symdyn.spatial.inertia). The composite body of the subtree rooted at i (a kinematic tree,
+symdyn.model.topology) adds the composites of its children j, each moved into frame i
+(R, p: child frame in parent frame, h' = R h):
 
     m += m_j,   h += R h_j + m_j p,
     I += R I_j R^T - [h' x][p x] - [p x][h' x] - m_j [p x]^2
 
 A unit acceleration of joint j makes the composite j exert the spatial force
 (moment n about the origin, force f) = (I^c a, a x h^c) for a revolute joint
-with axis a, or (h^c x a, m^c a) for a prismatic one. Carried inward,
-n <- R n + p x R f, f <- R f, and projected on each joint i <= j, it gives
-M_ij = a_i . n (revolute) or a_i . f (prismatic). O(n^2), against n
-Newton-Euler passes.
+with axis a, or (h^c x a, m^c a) for a prismatic one. Carried inward from each link to
+its parent, n <- R n + p x R f, f <- R f, and projected on each joint i of the support of
+j (j and its ancestors), it gives M_ij = a_i . n (revolute) or a_i . f (prismatic). Joints
+on different branches move disjoint subtrees, so M_ij is an exact zero for them. O(nb d),
+d the depth of the tree, against nb Newton-Euler passes.
 
 References: Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 6.2 (the
 composite-rigid-body algorithm); R. Grupen, "Dynamics" (2015), slide 16 (M in
@@ -25,6 +27,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model.robot import Link, Robot
+from ..model.topology import children
 from ..spatial import vectors as v3
 from ..spatial.inertia import SpatialInertia, apply_inertia, body_inertia, shifted_rotational_inertia
 from ..spatial.motion import Force, Motion, motion_subspace, project
@@ -94,25 +97,26 @@ def composite_inertias(robot: Robot, frames: list[JointFrame], program: Program)
     """The spatial inertia of the subtree rooted at each link (the link and everything outboard).
 
     Args:
-        robot: the model, n links.
+        robot: the model, nb links in a tree.
         frames: `symdyn.algorithms.frames.joint_frames(robot, q)`.
         program: receives the named intermediates.
 
     Returns:
-        n composites (m^c_i, h^c_i, I^c_i), each about body i's origin, in body i's axes
+        nb composites (m^c_i, h^c_i, I^c_i), each about body i's origin, in body i's axes
         (Featherstone 2008, sec. 6.2).
     """
-    n = robot.n
-    composites: list[SpatialInertia] = []
-    for j in reversed(range(n)):
-        body = link_inertia(robot.links[j])
+    nb = robot.nb
+    parents = robot.parents
+    composites: list[SpatialInertia] = [link_inertia(link) for link in robot.links]
+    for j in reversed(range(nb)):
+        body = composites[j]
         own = SpatialInertia(
             body.mass, program.let_vector(body.first_moment, "h"), program.let_symmetric(body.inertia, "Io")
         )
-        if j + 1 < n:
-            own = shift_inertia(frames[j + 1], composites[-1], own, program, "c")
-        composites.append(own)
-    return composites[::-1]
+        for child in children(parents, j):  # complete: children come after their parent
+            own = shift_inertia(frames[child], composites[child], own, program, "c")
+        composites[j] = own
+    return composites
 
 
 def mass_matrix_crba(
@@ -122,27 +126,32 @@ def mass_matrix_crba(
     reflected motor inertia gear_ratio^2 J_m on the diagonal (Grupen (2015), slide 16).
 
     Args:
-        robot: the model, n links.
+        robot: the model, nb links in a tree.
         frames: `joint_frames(robot, q)`.
         composites: `composite_inertias(robot, frames, program)` (body frames).
         program: receives the named intermediates.
 
     Returns:
-        The symmetric n x n joint-space inertia matrix over the program's intermediates.
+        The symmetric nb x nb inertia matrix of the bodies' joints over the program's
+        intermediates; M_ij is SymPy's zero unless i supports j or j supports i.
     """
-    n = robot.n
-    M = sp.zeros(n, n)
-    for j in range(n):
+    nb = robot.nb
+    parents = robot.parents
+    M = sp.zeros(nb, nb)
+    for j in range(nb):
         force = apply_inertia(composites[j], link_subspace(robot.links[j]))  # frame j
         force = Force(program.let_vector(force.angular, "Fn"), program.let_vector(force.linear, "Ff"))
-        for i in range(j, -1, -1):  # force is in frame i from here on
-            if i < j:
-                force = frames[i + 1].force_to_parent(force, program, "Ff")
-                force = force._replace(angular=program.let_vector(force.angular, "Fn"))
+        i = j
+        while True:  # force is in frame i, i = j and then down its support
             entry = project(link_subspace(robot.links[i]), force)
             if i == j:
                 entry = entry + robot.links[j].motor.reflected_inertia
             M[i, j] = M[j, i] = program.let(entry, "M")
+            if parents[i] < 0:
+                break
+            force = frames[i].force_to_parent(force, program, "Ff")
+            force = force._replace(angular=program.let_vector(force.angular, "Fn"))
+            i = parents[i]
     return M
 
 
@@ -151,9 +160,9 @@ def gravity_composite(
 ) -> list[sp.Expr]:
     """G(q) from the composite bodies (Grupen (2015), slide 16: the G of tau = M qdd + V + G + F).
 
-    With g_k the gravitational acceleration in frame k (g_k = R_k^T g_{k-1}, g_0 the robot's
-    gravity in the base frame) and m^c_k, h^c_k the subtree's mass and first moment about
-    origin k,
+    With g_k the gravitational acceleration in frame k (g_k = R_k^T g_lambda(k), the robot's
+    gravity in the base frame for a link on the base) and m^c_k, h^c_k the subtree's mass and
+    first moment about origin k,
 
         G_k = a_k . (g_k x h^c_k)   (revolute: minus gravity's torque about joint k)
         G_k = -m^c_k (a_k . g_k)    (prismatic: minus gravity's force along joint k)
@@ -163,18 +172,21 @@ def gravity_composite(
     recursion, against a Newton-Euler pass with qd = qdd = 0.
 
     Args:
-        robot: the model, n links (gravity in the base frame).
+        robot: the model, nb links in a tree (gravity in the base frame).
         frames: `joint_frames(robot, q)`.
         composites: `composite_inertias(robot, frames, program)` (body frames).
         program: receives the named intermediates (the g_k).
 
     Returns:
-        n expressions over the program's intermediates.
+        nb expressions (the bodies' joints) over the program's intermediates.
     """
-    g_k = v3.vec(robot.gravity)  # base frame; frame k after step k
+    g_base = v3.vec(robot.gravity)
+    g: list[v3.Vec] = []  # g_k, frame k
     G: list[sp.Expr] = []
     for k, link in enumerate(robot.links):
-        g_k = program.let_vector(v3.mul_t(frames[k].R, g_k), f"gk{k + 1}_")  # type: ignore[assignment]
+        p = robot.parents[k]
+        g_k = program.let_vector(v3.mul_t(frames[k].R, g_base if p < 0 else g[p]), f"gk{k + 1}_")
+        g.append(g_k)  # type: ignore[arg-type]
         a = v3.vec(link.axis)
         c = composites[k]
         if link.joint == "revolute":

@@ -1,6 +1,7 @@
 """Joint frames for the symbolic recursions, and rotations of inertia tensors between them.
 
-Link i's body frame sits in its parent's at p_i with orientation
+Link i's body frame sits in its parent's (link lambda(i), or the base: a kinematic tree,
+symdyn.model.topology) at p_i with orientation
 R_i = B_i Rot(a_i, q_i) (revolute) or R_i = B_i (prismatic), B_i the constant
 rotation of the joint's placement (symdyn.model.robot). The composite-body
 recursions move symmetric 3x3 tensors (rotational inertias and their rates of
@@ -49,8 +50,9 @@ class AxisTurn(NamedTuple):
 
 @dataclass(frozen=True)
 class JointFrame:
-    """Body frame i in its parent's (frame i-1): R = parent_R_i = B Rot(axis, q_i), p = the
-    origin of frame i in frame i-1 (parent axes), B the constant rotation of the placement."""
+    """Body frame i in its parent's (frame lambda(i), written i-1 below as in a chain):
+    R = parent_R_i = B Rot(axis, q_i), p = the origin of frame i in the parent frame (parent
+    axes), B the constant rotation of the placement."""
 
     R: v3.Mat
     p: v3.Vec
@@ -109,13 +111,15 @@ def joint_frames(robot: Robot, q: Sequence) -> list[JointFrame]:
     """R_i, p_i (and the factors of R_i) per link: body i in its parent's body frame.
 
     Args:
-        robot: the model (symdyn.model.robot), n links.
-        q: n joint positions (symbols or numbers).
+        robot: the model (symdyn.model.robot), nb links (bodies).
+        q: nb joint positions of the bodies (symbols, numbers or, for mimic joints,
+            expressions of the independent coordinates: Robot.body_positions).
 
     Returns:
-        n frames; frame i maps frame i's coordinates into frame i-1's (the base for i = 1).
+        nb frames; frame i maps frame i's coordinates into its parent's (robot.parents[i];
+        the base frame for a link on the base).
     """
-    assert len(q) == robot.n, (len(q), robot.n)
+    assert len(q) == robot.nb, (len(q), robot.nb)
     out = []
     for link, qi in zip(robot.links, q, strict=True):
         T = link.joint_transform(qi)

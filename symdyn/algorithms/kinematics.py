@@ -1,13 +1,17 @@
 """Forward kinematics and geometric Jacobians, symbolic (SymPy) and numeric.
 
-All poses are body frames of the links expressed in the base frame:
-base_T_i = parent_T_1(q_1) @ ... @ parent_T_i(q_i) (see `symdyn.model.robot`). The
+All poses are body frames of the links expressed in the base frame, composed along
+the path from the base: base_T_i = base_T_lambda(i) @ parent_T_i(q_i) (see
+`symdyn.model.robot`; a chain gives parent_T_1(q_1) @ ... @ parent_T_i(q_i)). The
 geometric Jacobian J = [Jv; Jw] (6 x n) of a point r fixed to link k maps joint
 velocities to the point's linear velocity and the link's angular velocity, both
-in the base frame:
-    revolute j <= k:  Jv_j = z_j x (r - o_j),  Jw_j = z_j
-    prismatic j <= k: Jv_j = z_j,              Jw_j = 0
-with z_j the joint axis and o_j the body origin of link j, in the base frame.
+in the base frame. Per link j of the support of k (k and its ancestors):
+    revolute j:  Jv_j = z_j x (r - o_j),  Jw_j = z_j
+    prismatic j: Jv_j = z_j,              Jw_j = 0
+with z_j the joint axis and o_j the body origin of link j, in the base frame; the other
+links' columns are zero. Every function takes the n independent joint positions; a mimic
+joint's position is q_j = multiplier q_i + offset (Robot.body_positions), and its column
+adds to its coordinate's with the multiplier (J = J_b S).
 
 References: Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 4.6
 (derivation of the Jacobian); Craig, Introduction to Robotics (3rd ed., 2005), ch. 3 (forward
@@ -26,6 +30,7 @@ import sympy as sp
 from ..errors import SymdynError
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
+from ..model.topology import support
 from ..spatial.transform import Transform
 from ..symbolic.program import Program
 
@@ -52,11 +57,11 @@ def _link_index(robot: Robot, link, where: str) -> int:
     """`link` as a 0-based index into robot.links (negative counts from the end)."""
     if isinstance(link, bool) or not isinstance(link, (int, np.integer)):
         raise SymdynError(f"{where}: link must be an integer index, got {link!r}")
-    if not -robot.n <= link < robot.n:
+    if not -robot.nb <= link < robot.nb:
         raise SymdynError(
-            f"{where}: link {link} out of range: the robot has {robot.n} links (0 .. {robot.n - 1})"
+            f"{where}: link {link} out of range: the robot has {robot.nb} links (0 .. {robot.nb - 1})"
         )
-    return int(link) % robot.n
+    return int(link) % robot.nb
 
 
 def _point(point, where: str) -> tuple:
@@ -73,37 +78,37 @@ def link_transforms(robot: Robot, q: Sequence | None = None) -> list[Transform]:
     """parent_T_i(q_i) for every link (symbolic q1..qn by default).
 
     Args:
-        robot: the model, n links.
+        robot: the model, nb links and n independent joints.
         q: n joint positions (symbols or numbers); None: the symbols q1..qn.
 
     Returns:
-        n transforms, link i's body frame in link i-1's (the base for i = 1).
+        nb transforms, link i's body frame in its parent's (the base for a link on the base).
     """
     if q is None:
         q = list(joint_symbols(robot.n)[0])
     if len(q) != robot.n:
         raise SymdynError(f"link_transforms: q has length {len(q)}, expected {robot.n} (one per joint)")
-    return [link.joint_transform(qi) for link, qi in zip(robot.links, q, strict=True)]
+    return [link.joint_transform(qi) for link, qi in zip(robot.links, robot.body_positions(q), strict=True)]
 
 
 def forward_kinematics(
     robot: Robot, q: Sequence | None = None, program: Program | None = None
 ) -> list[Transform]:
-    """base_T_i for every link's body frame (Craig (2005), ch. 3).
+    """base_T_i for every link's body frame (Craig (2005), ch. 3), composed along the tree.
 
     Args:
-        robot: the model, n links.
+        robot: the model, nb links and n independent joints.
         q: n joint positions; None: the symbols q1..qn.
         program: if given, every entry becomes a named intermediate of it.
 
     Returns:
-        n transforms, link i's body frame in the base frame.
+        nb transforms, link i's body frame in the base frame.
     """
     poses: list[Transform] = []
-    T = Transform.identity()
+    base = Transform.identity()
     for i, Ti in enumerate(link_transforms(robot, q)):
-        T = _named(T @ Ti, program, f"T{i + 1}")
-        poses.append(T)
+        p = robot.parents[i]
+        poses.append(_named((base if p < 0 else poses[p]) @ Ti, program, f"T{i + 1}"))
     return poses
 
 
@@ -125,7 +130,7 @@ def point_jacobian(
     """The geometric Jacobian of a point fixed to a link (Spong et al. (2006), sec. 4.6).
 
     Args:
-        robot: the model, n links.
+        robot: the model, nb links and n independent joints.
         link: 0-based link index (negative counts from the end).
         point: the point in that link's body frame (3 entries).
         q: n joint positions; None: the symbols q1..qn.
@@ -133,21 +138,29 @@ def point_jacobian(
 
     Returns:
         J = [Jv; Jw] (6 x n): the point's linear velocity and the link's angular velocity
-        per unit joint rate, both in the base frame; columns after the link's joint are zero.
+        per unit joint rate, both in the base frame; only the columns of the joints that
+        support the link (the link and its ancestors) are nonzero.
     """
-    n = robot.n
     k = _link_index(robot, link, "point_jacobian")
     if poses is None:
         poses = forward_kinematics(robot, q)
     r = poses[k].apply(_point(point, "point_jacobian"))
-    J = sp.zeros(6, n)
-    for j in range(k + 1):
+    J = sp.zeros(6, robot.n)
+    coordinates = robot.coordinates
+    filled: set[int] = set()
+    for j in reversed(support(robot.parents, k)):  # from the base out, as j = 1 .. k of a chain
         z = poses[j].R * robot.links[j].axis
-        if robot.links[j].joint == "revolute":
-            J[:3, j] = z.cross(r - poses[j].p)
-            J[3:, j] = z
+        revolute = robot.links[j].joint == "revolute"
+        column = sp.Matrix.vstack(
+            z.cross(r - poses[j].p) if revolute else z, z if revolute else sp.zeros(3, 1)
+        )
+        c = coordinates[j]
+        if c.index in filled or c.multiplier != 1:  # a mimic joint adds to its coordinate: J = J_b S
+            column = column * c.multiplier
+            J[:, c.index] += column
         else:
-            J[:3, j] = z
+            J[:, c.index] = column
+        filled.add(c.index)
     return J
 
 

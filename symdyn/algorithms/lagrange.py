@@ -2,9 +2,11 @@
 
 In the base frame, with Jv_i the Jacobian of link i's centre of mass, Jw_i its
 angular-velocity Jacobian, R_i its orientation and I_i its inertia about the
-centre of mass (body axes):
+centre of mass (body axes), summed over the nb links of the tree and taken over the n
+independent coordinates (a column is nonzero only for the joints that support link i; a
+mimic joint q_j = s q_k + o adds s times its column to q_k's, symdyn.algorithms.kinematics):
 
-    M = sum_i m_i Jv_i^T Jv_i + Jw_i^T (R_i I_i R_i^T) Jw_i  (+ reflected motor inertia)
+    M = sum_i m_i Jv_i^T Jv_i + Jw_i^T (R_i I_i R_i^T) Jw_i  (+ reflected motor inertia s^2 J)
     P = -sum_i m_i g^T p_ci                   (g: gravitational acceleration)
     G_k = dP/dq_k
     C_kj = sum_i 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) qd_i
@@ -34,8 +36,9 @@ def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dic
     """M, C and G of the robot (rigid bodies plus motor inertia) by Lagrange's equations.
 
     Args:
-        robot: the model, n links.
-        q, qd: the joint position and velocity symbols (n x 1); derivatives are taken by them.
+        robot: the model, nb links in a tree, n independent joints.
+        q, qd: the independent joint position and velocity symbols (n x 1); derivatives are
+            taken by them.
         program: receives the named intermediates.
 
     Returns:
@@ -57,8 +60,8 @@ def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dic
         M += link.mass * (Jv.T * Jv) + Jw.T * I_base * Jw
         pc = poses[i].apply(list(link.com))
         P -= link.mass * (g.T * sp.Matrix(pc))[0]
-    for i, link in enumerate(robot.links):
-        M[i, i] += link.motor.reflected_inertia
+    for link, c in zip(robot.links, robot.coordinates, strict=True):
+        M[c.index, c.index] += c.multiplier**2 * link.motor.reflected_inertia
     for i in range(n):
         for j in range(i, n):
             M[i, j] = program.let(M[i, j], "M")

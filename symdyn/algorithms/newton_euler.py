@@ -3,7 +3,8 @@
 Every quantity of link i is expressed in link i's body frame. With
 R_i = parent_R_i(q_i) and p_i the origin of body i in its parent's frame
 (symdyn.model.robot), the outward recursion from a base at rest, gravity entered as
-a base acceleration vd_0 = -g, is
+a base acceleration vd_0 = -g, is (i-1 standing for the parent lambda(i) of a tree,
+symdyn.model.topology)
 
     revolute:  w_i  = R_i^T w_{i-1} + a_i qd_i
                wd_i = R_i^T wd_{i-1} + (R_i^T w_{i-1}) x a_i qd_i + a_i qdd_i
@@ -13,10 +14,11 @@ a base acceleration vd_0 = -g, is
     vc_i = wd_i x c_i + w_i x (w_i x c_i) + vd_i
     F_i = m_i vc_i,   N_i = I_i wd_i + w_i x I_i w_i   (about the centre of mass)
 
-and the inward one, i = n .. 1,
+and the inward one, i = nb .. 1, summing over the children j of link i (the next link
+j = i+1 of a chain; no term for a leaf),
 
-    f_i = R_{i+1} f_{i+1} + F_i
-    n_i = N_i + c_i x F_i + R_{i+1} n_{i+1} + p_{i+1} x R_{i+1} f_{i+1}
+    f_i = F_i + sum_j R_j f_j
+    n_i = N_i + c_i x F_i + sum_j (R_j n_j + p_j x R_j f_j)
     tau_i = a_i . n_i (revolute) or a_i . f_i (prismatic)
 
 where a_i is the joint axis (z for DH robots) and c_i the centre of mass.
@@ -43,6 +45,7 @@ from typing import NamedTuple
 import sympy as sp
 
 from ..model.robot import Link, Robot
+from ..model.topology import children
 from ..spatial import vectors as v3
 from ..spatial.inertia import body_inertia
 from ..spatial.motion import Force
@@ -113,7 +116,7 @@ def _outward(
     program: Program,
     k: str,
 ) -> LinkAcceleration:
-    """w_i, wd_i, vd_i of link i (frame i) from its parent's (frame i-1): slide 15.
+    """w_i, wd_i, vd_i of link i (frame i) from its parent's (frame lambda(i)): slide 15.
 
     The parent's W = [wd x] + [w x]^2 gives wd x p + w x (w x p) = W p.
     """
@@ -145,49 +148,54 @@ def newton_euler(
 ) -> list[sp.Expr]:
     """Rigid-body joint efforts (no friction, no motor inertia) by recursive Newton-Euler.
 
-    Grupen (2015), slides 14-15; Craig (2005), sec. 6.5; Featherstone (2008), sec. 5.3.
+    Grupen (2015), slides 14-15; Craig (2005), sec. 6.5; Featherstone (2008), sec. 5.3
+    (on a kinematic tree: outward from each link's parent, inward summing the children).
 
     Args:
-        robot: the model, n links.
-        q, qd, qdd: n joint positions, velocities and accelerations; symbols or numbers
-            (zeros fold away).
+        robot: the model, nb links (bodies) in a tree.
+        q, qd, qdd: nb joint positions, velocities and accelerations of the bodies; symbols,
+            numbers or expressions (zeros fold away).
         program: receives the named intermediates.
         gravity: enter the robot's gravity (base frame) as the base acceleration vd_0 = -g.
         tag: prefix of the intermediates' names, to tell passes apart.
         rotations: `symdyn.algorithms.frames.joint_frames(robot, q)`, to share them.
 
     Returns:
-        n joint efforts tau_i = a_i . n_i (revolute) or a_i . f_i (prismatic), with n_i, f_i
-        the wrench link i-1 exerts on link i in frame i; expressions over the program's
-        intermediates.
+        nb joint efforts tau_i = a_i . n_i (revolute) or a_i . f_i (prismatic), with n_i, f_i
+        the wrench the parent exerts on link i in frame i; expressions over the program's
+        intermediates (body joint space).
     """
-    n = robot.n
-    assert len(q) == len(qd) == len(qdd) == n, (len(q), len(qd), len(qdd), n)
+    nb = robot.nb
+    assert len(q) == len(qd) == len(qdd) == nb, (len(q), len(qd), len(qdd), nb)
+    parents = robot.parents
     frames = rotations if rotations is not None else joint_frames(robot, q)
     zero = v3.ZERO3
     vd_0 = program.let_vector(v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
-    motion = LinkAcceleration(zero, zero, vd_0)  # of link i-1, in frame i-1
-    W: v3.Mat = v3.ZERO33
+    base = LinkAcceleration(zero, zero, vd_0)
+    motions: list[LinkAcceleration] = []  # of link i, in frame i
+    Ws: list[v3.Mat] = []
     wrenches: list[Force] = []  # net wrench of link i about its origin, frame i
     for i, link in enumerate(robot.links):
         k = f"{tag}{i + 1}"
-        motion = _outward(link, frames[i], motion, W, qd[i], qdd[i], program, k)
+        p = parents[i]
+        parent, W_parent = (base, v3.ZERO33) if p < 0 else (motions[p], Ws[p])
+        motion = _outward(link, frames[i], parent, W_parent, qd[i], qdd[i], program, k)
         W = _tilde(program, motion.w, motion.wd, k)
+        motions.append(motion)
+        Ws.append(W)
         wrenches.append(_body_wrench(link, W, motion, program, k))
-    tau: list[sp.Expr] = [sp.S.Zero] * n
-    f_child, n_child = zero, zero  # the wrench on link i+1, frame i+1
-    for i in reversed(range(n)):
+    tau: list[sp.Expr] = [sp.S.Zero] * nb
+    transmitted: list[Force] = [Force(zero, zero)] * nb  # the wrench on link i from its parent, frame i
+    for i in reversed(range(nb)):
         link = robot.links[i]
         k = f"{tag}{i + 1}"
-        if i + 1 < n:
-            n_child_i, f_child_i = frames[i + 1].force_to_parent(Force(n_child, f_child), program, f"Rf{k}_")
-            n_i = v3.add(wrenches[i].angular, n_child_i)
-            f_i = v3.add(f_child_i, wrenches[i].linear)
-        else:
-            n_i = wrenches[i].angular
-            f_i = wrenches[i].linear
-        f_child = program.let_vector(f_i, f"f{k}_")
-        n_child = program.let_vector(n_i, f"n{k}_")
+        carried = [
+            frames[j].force_to_parent(transmitted[j], program, f"Rf{k}_") for j in children(parents, i)
+        ]
+        n_i = v3.add(wrenches[i].angular, *(c.angular for c in carried))
+        f_i = v3.add(*(c.linear for c in carried), wrenches[i].linear)
+        f = program.let_vector(f_i, f"f{k}_")
+        transmitted[i] = Force(program.let_vector(n_i, f"n{k}_"), f)
         a = v3.vec(link.axis)
-        tau[i] = v3.dot(a, n_child if link.joint == "revolute" else f_child)
+        tau[i] = v3.dot(a, transmitted[i].angular if link.joint == "revolute" else f)
     return tau

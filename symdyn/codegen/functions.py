@@ -9,15 +9,24 @@ forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
 unrolled symbolically (no square roots):
     D_j = M_jj - sum_{k<j} L_jk^2 D_k,  L_ij = (M_ij - sum_{k<j} L_ik L_jk D_k) / D_j,
 then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away.
+
+A generated function cannot raise, so forward_dynamics is not generated for a robot whose
+M is singular by construction: a joint that moves no mass or inertia (a massless subtree
+and no rotor inertia, symdyn.model.robot.Robot.idle_joints) would make some D_j an exact
+zero. `build_functions` then leaves it out with a SymdynWarning naming the joints, and the
+other six functions are generated as usual. This is decided on numbers only: with symbolic
+masses M cannot be known to be singular, and forward_dynamics is generated.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import sympy as sp
 
 from ..dynamics import QUANTITIES, Dynamics
+from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import Eliminated, OpCount, eliminate_many
 
@@ -94,8 +103,27 @@ def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
     return x
 
 
+def _solvable(dyn: Dynamics) -> bool:
+    """Whether M can be inverted as far as the numbers tell; warn naming the joints if not."""
+    robot = dyn.robot
+    idle = robot.idle_joints()
+    if idle:
+        names = ", ".join(f"'{robot.links[i].name}' (link {i + 1})" for i in idle)
+        warnings.warn(
+            f"robot '{robot.name}': forward_dynamics is not generated: joint(s) {names} move no mass "
+            "or inertia, so M(q) is singular; the other functions are",
+            SymdynWarning,
+            stacklevel=3,
+        )
+    return not idle
+
+
 def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
-    """The seven generated functions for a derived robot, with CSE applied per function."""
+    """The generated functions for a derived robot, with CSE applied per function.
+
+    All seven, or the six without forward_dynamics (and a SymdynWarning) when a joint moves
+    no mass or inertia (see the module docstring).
+    """
     n = dyn.n
     q = Input("q", tuple(dyn.q))
     qd = Input("qd", tuple(dyn.qd))
@@ -103,10 +131,6 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
     tau = Input("tau", tuple(sp.Symbol(f"tau{i + 1}") for i in range(n)))
     p = Input("p", tuple(dyn.params))
     c = dyn.compact
-
-    fd = Program()
-    b = [fd.let(tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
-    qdd_out = _ldlt_solve(sp.Matrix(c["M"]), b, fd)
     table = [
         ("inverse_dynamics", "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)", (q, qd, qdd, p), "tau", c["tau"]),
         ("mass_matrix", "M(q), row-major n x n", (q, p), "M", c["M"]),
@@ -120,17 +144,24 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
         ("coriolis", "V(q, qd) = C(q, qd) qd", (q, qd, p), "V", c["V"]),
         ("gravity", "G(q)", (q, p), "G", c["G"]),
         ("friction", "F(qd) = viscous qd + coulomb sign(qd)", (qd, p), "F", c["F"]),
-        (
-            "forward_dynamics",
-            "qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T)",
-            (q, qd, tau, p),
-            "qdd",
-            sp.Matrix(qdd_out),
-        ),
     ]
-    outputs = {name: list(exprs) for name, _, _, _, exprs in table}
     program_outputs = [e for name in QUANTITIES for e in c[name]] + list(c["bias"])
-    steps = dyn.program.needed(program_outputs) + fd.needed(qdd_out)
+    steps = dyn.program.needed(program_outputs)
+    if _solvable(dyn):
+        fd = Program()
+        b = [fd.let(tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
+        qdd_out = _ldlt_solve(sp.Matrix(c["M"]), b, fd)
+        table.append(
+            (
+                "forward_dynamics",
+                "qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T)",
+                (q, qd, tau, p),
+                "qdd",
+                sp.Matrix(qdd_out),
+            )
+        )
+        steps += fd.needed(qdd_out)
+    outputs = {name: list(exprs) for name, _, _, _, exprs in table}
     inputs = (*q.symbols, *qd.symbols, *qdd.symbols, *tau.symbols, *p.symbols)
     code = eliminate_many(steps, outputs, reserved=inputs)
     return [

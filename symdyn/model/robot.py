@@ -30,7 +30,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
-from .topology import Coordinate, Mimic, check_parents, is_chain
+from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
 __all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "JOINT_TYPES", "DEFAULT_GRAVITY"]
 
@@ -114,6 +114,11 @@ class Link:
 
 def _entries(k: int) -> str:
     return f"{k} entry" if k == 1 else f"{k} entries"
+
+
+def _is_zero(x) -> bool:
+    """Whether a number or expression is exactly zero (a free symbol may be anything: False)."""
+    return sp.sympify(x).is_zero is True
 
 
 def _listed(values) -> list | None:
@@ -212,6 +217,31 @@ class Robot:
     def body_rates(self, qd: Sequence) -> list:
         """qd_b = S qd (or qdd_b = S qdd): each body's joint rate from the independent ones."""
         return [qd[c.index] if c.multiplier == 1 else c.multiplier * qd[c.index] for c in self.coordinates]
+
+    def idle_joints(self) -> tuple[int, ...]:
+        """The links whose joint moves nothing with mass or inertia: M(q) is singular.
+
+        Joint i is idle when it has no rotor inertia and its subtree has zero mass and zero
+        rotational inertia (zero mass for a prismatic joint): M has a zero row for it
+        (symdyn.model.topology.idle_joints). A coordinate that drives several links (mimic
+        joints) is idle only when all of them are. Decided on the numbers of the robot with
+        its valued parameters substituted: a free parameter may take any value, so a mass
+        or inertia that names one counts as non-zero.
+
+        Returns:
+            The indices of the idle links in self.links, in increasing order.
+        """
+        links = self.resolved().links
+        weightless = [_is_zero(lk.mass) for lk in links]
+        massless = [
+            w and all(_is_zero(x) for x in lk.inertia) for w, lk in zip(weightless, links, strict=True)
+        ]
+        turns = [lk.joint == "revolute" for lk in links]
+        geared = [not _is_zero(lk.motor.reflected_inertia) for lk in links]
+        idle = set(idle_joints(self.parents, massless, weightless, turns, geared))
+        coordinates = self.coordinates
+        busy = {c.index for i, c in enumerate(coordinates) if i not in idle}
+        return tuple(i for i in sorted(idle) if coordinates[i].index not in busy)
 
     @property
     def value_map(self) -> dict[sp.Symbol, sp.Expr]:

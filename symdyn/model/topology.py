@@ -21,7 +21,16 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-__all__ = ["Mimic", "Coordinate", "check_parents", "children", "support", "subtree", "is_chain"]
+__all__ = [
+    "Mimic",
+    "Coordinate",
+    "check_parents",
+    "children",
+    "support",
+    "subtree",
+    "is_chain",
+    "idle_joints",
+]
 
 
 @dataclass(frozen=True)
@@ -77,3 +86,37 @@ def subtree(parents: Sequence[int], i: int) -> list[int]:
 def is_chain(parents: Sequence[int]) -> bool:
     """Whether the tree is a serial chain 0 <- 1 <- 2 ... in link order."""
     return all(p == i - 1 for i, p in enumerate(parents))
+
+
+def idle_joints(
+    parents: Sequence[int],
+    massless: Sequence[bool],
+    weightless: Sequence[bool],
+    turns: Sequence[bool],
+    geared: Sequence[bool],
+) -> list[int]:
+    """The links whose joint moves nothing that has inertia: a zero row and column of M.
+
+    A unit rate of joint i moves the subtree of link i and nothing else, so M[i, i] =
+    s_i^T I^c_i s_i + gear_ratio_i^2 J_m,i. It is zero, and with it the whole row (M is
+    positive semi-definite), when joint i has no rotor inertia and its subtree has zero
+    mass and zero rotational inertia; for a prismatic joint (which turns nothing) zero mass
+    is enough. The rotors of the joints further out only add to their own diagonal entries.
+
+    Args:
+        parents: lambda(i) per link (-1: the base), parents before children.
+        massless: per link, whether it has zero mass and zero rotational inertia.
+        weightless: per link, whether it has zero mass (true wherever `massless` is).
+        turns: per link, whether its joint is revolute.
+        geared: per link, whether its joint may have rotor inertia.
+
+    Returns:
+        The indices of the idle joints, in increasing order.
+    """
+    empty, light = list(massless), list(weightless)
+    for i in reversed(range(len(parents))):  # every child comes after its parent
+        p = parents[i]
+        if p >= 0:
+            empty[p] = empty[p] and empty[i]
+            light[p] = light[p] and light[i]
+    return [i for i in range(len(parents)) if not geared[i] and (empty[i] or (light[i] and not turns[i]))]
