@@ -1,7 +1,9 @@
 """Rewrite generated/ from the example robots: `python -m symdyn.regenerate [--check]`.
 
 Run from the repository root. generated/<robot>/ receives every target's
-files for roger_arm, puma560 and panda, and generated/TOOLCHAIN the versions
+files for roger_arm, puma560 and panda (examples/*.yaml) and for solo12, the legs of
+the Solo-12 quadruped on a fixed base (a kinematic tree of 4 x 3 joints, from the URDF that
+the example-robot-data package of the test extra ships), and generated/TOOLCHAIN the versions
 of symdyn and of the tools the bytes depend on (one "tool version" a line, in a
 fixed order). With --check nothing is written and the exit status says whether
 generated/ is up to date here (tests/test_generated.py does the same
@@ -13,17 +15,23 @@ depends on).
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import importlib.metadata
 import sys
 import warnings
 from pathlib import Path
 
 from .codegen import TARGETS, file_tools, render
 from .codegen.output import write_files
-from .parsers import load_robot
+from .errors import SymdynError
+from .model.robot import Robot
+from .parsers import load_robot, load_urdf
 
 __all__ = ["EXAMPLES", "render_all", "main", "versions", "toolchain", "read_toolchain", "changed_tools"]
 
-EXAMPLES = ("roger_arm", "puma560", "panda")
+EXAMPLES = ("roger_arm", "puma560", "panda", "solo12")
+#: examples that are URDF files of the example-robot-data package: name -> path in its robots/
+URDF_EXAMPLES = {"solo12": "solo_description/robots/solo12.urdf"}
 TOOLCHAIN_FILE = "TOOLCHAIN"
 
 
@@ -63,14 +71,27 @@ def changed_tools(
     ]
 
 
+def example_robot(root: Path, name: str) -> Robot:
+    """The example robot `name`: examples/NAME.yaml, or a URDF of example-robot-data named NAME."""
+    if name not in URDF_EXAMPLES:
+        return load_robot(root / "examples" / f"{name}.yaml")
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        raise SymdynError(
+            f"the example {name} is a URDF of the example-robot-data package: install the test extra"
+        ) from None
+    path = Path(dist.locate_file(f"cmeel.prefix/share/example-robot-data/robots/{URDF_EXAMPLES[name]}"))
+    return dataclasses.replace(load_urdf(path), name=name)
+
+
 def render_all(root: Path) -> dict[str, dict[str, str | bytes]]:
     """robot name -> {file name: content} for every example robot and target."""
     out = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for name in EXAMPLES:
-            robot = load_robot(root / "examples" / f"{name}.yaml")
-            out[name] = render(robot, targets=tuple(TARGETS))
+            out[name] = render(example_robot(root, name), targets=tuple(TARGETS))
     return out
 
 
@@ -92,7 +113,12 @@ def main(argv=None) -> int:
         stale.append(f"{stamp} ({', '.join(changes) or 'format'})")
         if not args.check:
             write_files(stamp.parent, {TOOLCHAIN_FILE: text}, force=True)
-    for name, files in render_all(root).items():
+    try:
+        rendered = render_all(root)
+    except SymdynError as exc:
+        print(f"symdyn: error: {exc}", file=sys.stderr)
+        return 1
+    for name, files in rendered.items():
         folder = root / "generated" / name
         for fname, content in files.items():
             data = content.encode() if isinstance(content, str) else content
