@@ -24,6 +24,12 @@ The robot is read from the same `symdyn.model.robot.Robot` the generated C comes
 `robot.numeric()` gives SymPy numbers, converted to floats here; joint i moves
 by parent_T_i(q_i) = placement @ Rot(axis, q_i) (revolute) or placement @
 Trans(axis q_i) (prismatic), as `symdyn.model.robot.Link.joint_transform` defines.
+The robot may be a kinematic tree (`Robot.parents`, Featherstone's lambda(i), -1 for
+the base, parents before children): the RNEA goes outward from each body's parent and
+inward into it, the CRBA adds composite inertias into the parent and fills M only along
+each body's path to the base. Mimic joints are handled as symdyn.rnea does: the algorithms
+run on the nb bodies at q_b = multiplier q[c] + offset (rates multiplier qd[c]) and
+project, tau = S^T tau_b, M = S^T M_b S (S the selection matrix, `Robot.selection()`).
 
     fns = casadi_functions(robot)              # {"inverse_dynamics": casadi.Function, ...}
     flops(fns["inverse_dynamics"])             # OpCount-like dict of the SX algorithm
@@ -48,7 +54,7 @@ FUNCTIONS = ("inverse_dynamics", "mass_matrix", "gravity")
 
 @dataclass(frozen=True)
 class RobotArrays:
-    """The numeric robot as plain floats (what a URDF parser would hand to the RNEA)."""
+    """The numeric robot as plain floats (what a URDF parser would hand to the RNEA), per body."""
 
     revolute: tuple[bool, ...]
     R0: np.ndarray  # (n, 3, 3) placement rotation
@@ -61,10 +67,24 @@ class RobotArrays:
     coulomb: np.ndarray  # (n,)
     reflected: np.ndarray  # (n,) gear_ratio^2 * rotor inertia
     gravity: np.ndarray  # (3,) base frame
+    parent: tuple[int, ...]  # lambda(i): the parent body, -1 for the base
+    coordinate: tuple[int, ...]  # the independent coordinate that drives the body's joint
+    multiplier: np.ndarray  # (nb,) q_b = multiplier q[coordinate] + offset (1 and 0 unless mimic)
+    offset: np.ndarray  # (nb,)
+
+    @property
+    def nb(self) -> int:
+        """Number of bodies (joints, mimic joints included)."""
+        return len(self.revolute)
 
     @property
     def n(self) -> int:
-        return len(self.revolute)
+        """Number of independent coordinates."""
+        return max(self.coordinate, default=-1) + 1
+
+    @property
+    def has_mimic(self) -> bool:
+        return self.n != self.nb
 
 
 def _f(x) -> np.ndarray:
@@ -75,6 +95,7 @@ def robot_arrays(robot, params=None) -> RobotArrays:
     """Floats for every quantity of `robot.numeric(params)`."""
     r = robot.numeric(params)
     links = r.links
+    coords = r.coordinates
     return RobotArrays(
         revolute=tuple(lk.joint == "revolute" for lk in links),
         R0=np.array([_f(lk.placement.R).reshape(3, 3) for lk in links]),
@@ -87,6 +108,10 @@ def robot_arrays(robot, params=None) -> RobotArrays:
         coulomb=np.array([float(lk.friction.coulomb) for lk in links]),
         reflected=np.array([float(lk.motor.reflected_inertia) for lk in links]),
         gravity=_f(r.gravity).reshape(3),
+        parent=tuple(r.parents),
+        coordinate=tuple(c.index for c in coords),
+        multiplier=np.array([float(c.multiplier) for c in coords]),
+        offset=np.array([float(c.offset) for c in coords]),
     )
 
 
@@ -142,9 +167,23 @@ def joint_subspace(revolute: bool, axis: np.ndarray) -> cs.DM:
     return cs.DM(s)
 
 
+def _body_values(m: RobotArrays, x, offset: bool) -> list:
+    """Per body: multiplier x[c] (+ offset): the bodies' joint positions (offset) or rates."""
+    out = []
+    for i in range(m.nb):
+        xi = x[m.coordinate[i]]
+        if m.multiplier[i] != 1.0:
+            xi = m.multiplier[i] * xi
+        if offset and m.offset[i] != 0.0:
+            xi = xi + m.offset[i]
+        out.append(xi)
+    return out
+
+
 def _transforms(m: RobotArrays, q):
+    """i_X_lambda(i) per body, for the bodies' joint positions q (list of nb)."""
     xs = []
-    for i in range(m.n):
+    for i in range(m.nb):
         R0, p0 = cs.DM(m.R0[i]), cs.DM(m.p0[i])
         if m.revolute[i]:
             E, r = R0 @ rodrigues(m.axis[i], q[i]), p0
@@ -158,43 +197,67 @@ def _transforms(m: RobotArrays, q):
 
 
 def rnea(m: RobotArrays, q, qd, qdd, gravity: bool = True, friction: bool = True):
-    """Featherstone's RNEA over SX: tau (n x 1)."""
+    """Featherstone's RNEA over SX on the tree: tau (n x 1), body frames, p = lambda(i).
+
+    Outward: v_i = X_i v_p + S_i qd_i, a_i = X_i a_p + S_i qdd_i + v_i x S_i qd_i (v_p = 0,
+    a_p = [0; -g] for the base), f_i = I_i a_i + v_i x* I_i v_i. Inward: tau_i = S_i^T f_i,
+    f_p += X_i^T f_i. Per body at q_b, qd_b, qdd_b, then tau = S^T tau_b.
+    """
+    q, qd, qdd = _body_values(m, q, True), _body_values(m, qd, False), _body_values(m, qdd, False)
     X = _transforms(m, q)
-    S = [joint_subspace(m.revolute[i], m.axis[i]) for i in range(m.n)]
-    Ii = [spatial_inertia(m.mass[i], m.com[i], m.inertia[i]) for i in range(m.n)]
-    v = cs.SX.zeros(6, 1)
-    a = cs.vertcat(cs.SX.zeros(3, 1), -cs.DM(m.gravity)) if gravity else cs.SX.zeros(6, 1)
-    f = []
-    for i in range(m.n):
-        v = X[i] @ v + S[i] * qd[i]
-        a = X[i] @ a + S[i] * qdd[i] + motion_cross(v) @ S[i] * qd[i]
-        f.append(Ii[i] @ a + force_cross(v) @ (Ii[i] @ v))
-    tau = [None] * m.n
-    for i in reversed(range(m.n)):
+    S = [joint_subspace(m.revolute[i], m.axis[i]) for i in range(m.nb)]
+    Ii = [spatial_inertia(m.mass[i], m.com[i], m.inertia[i]) for i in range(m.nb)]
+    base_v = cs.SX.zeros(6, 1)
+    base_a = cs.vertcat(cs.SX.zeros(3, 1), -cs.DM(m.gravity)) if gravity else cs.SX.zeros(6, 1)
+    v, a, f = [], [], []
+    for i in range(m.nb):
+        p = m.parent[i]
+        v_p, a_p = (base_v, base_a) if p < 0 else (v[p], a[p])
+        v.append(X[i] @ v_p + S[i] * qd[i])
+        a.append(X[i] @ a_p + S[i] * qdd[i] + motion_cross(v[i]) @ S[i] * qd[i])
+        f.append(Ii[i] @ a[i] + force_cross(v[i]) @ (Ii[i] @ v[i]))
+    tau = [None] * m.nb
+    for i in reversed(range(m.nb)):  # children come after their parent: f[i] is complete
         tau[i] = S[i].T @ f[i] + m.reflected[i] * qdd[i]
         if friction:
             tau[i] += m.viscous[i] * qd[i] + m.coulomb[i] * cs.sign(qd[i])
-        if i > 0:
-            f[i - 1] = f[i - 1] + X[i].T @ f[i]
-    return cs.vertcat(*tau)
+        if m.parent[i] >= 0:
+            f[m.parent[i]] = f[m.parent[i]] + X[i].T @ f[i]
+    if not m.has_mimic:
+        return cs.vertcat(*tau)
+    out = [cs.SX(0)] * m.n  # S^T tau_b
+    for i in range(m.nb):
+        out[m.coordinate[i]] = out[m.coordinate[i]] + m.multiplier[i] * tau[i]
+    return cs.vertcat(*out)
 
 
 def crba(m: RobotArrays, q):
-    """The composite-rigid-body algorithm over SX: dense M (n x n), both triangles."""
-    X = _transforms(m, q)
-    S = [joint_subspace(m.revolute[i], m.axis[i]) for i in range(m.n)]
-    Ic = [cs.SX(spatial_inertia(m.mass[i], m.com[i], m.inertia[i])) for i in range(m.n)]
-    M = cs.SX.zeros(m.n, m.n)
-    for i in reversed(range(m.n)):
-        if i > 0:
-            Ic[i - 1] = Ic[i - 1] + X[i].T @ Ic[i] @ X[i]
+    """The composite-rigid-body algorithm over SX on the tree: dense M (n x n), both triangles.
+
+    Ic_p += X_i^T Ic_i X_i (inward); F = Ic_i S_i, M_ii = S_i^T F, and for each ancestor j of
+    i, M_ij = M_ji = S_j^T F with F carried down the path, F <- X_k^T F; entries of joints on
+    different branches stay zero. With mimic joints this is M_b and M = S^T M_b S.
+    """
+    X = _transforms(m, _body_values(m, q, True))
+    S = [joint_subspace(m.revolute[i], m.axis[i]) for i in range(m.nb)]
+    Ic = [cs.SX(spatial_inertia(m.mass[i], m.com[i], m.inertia[i])) for i in range(m.nb)]
+    M = cs.SX.zeros(m.nb, m.nb)
+    for i in reversed(range(m.nb)):  # Ic[i] is complete: its children come after it
+        if m.parent[i] >= 0:
+            Ic[m.parent[i]] = Ic[m.parent[i]] + X[i].T @ Ic[i] @ X[i]
         F = Ic[i] @ S[i]
         M[i, i] = S[i].T @ F + m.reflected[i]
-        for j in range(i, 0, -1):
+        j = i
+        while m.parent[j] >= 0:
             F = X[j].T @ F
-            M[i, j - 1] = S[j - 1].T @ F
-            M[j - 1, i] = M[i, j - 1]
-    return M
+            j = m.parent[j]
+            M[i, j] = S[j].T @ F
+            M[j, i] = M[i, j]
+    if not m.has_mimic:
+        return M
+    sel = np.zeros((m.nb, m.n))
+    sel[np.arange(m.nb), m.coordinate] = m.multiplier
+    return cs.DM(sel).T @ M @ cs.DM(sel)
 
 
 def casadi_functions(robot, params=None, prefix: str = "cr") -> dict[str, cs.Function]:

@@ -1,9 +1,12 @@
 """The Pinocchio side of bench/run.py: find its headers, compile the harness, check and time it.
 
 bench/pinocchio_harness.cpp builds the robot as a pinocchio::Model from the numbers of
-`pinocchio_model_text` (placements, axes, body inertias about the centre of mass in the
-body frame, armature = gear_ratio^2 J_m), checks rnea, crba, computeGeneralizedGravity,
-computeCoriolisMatrix and aba against symdyn.rnea's numbers, then times them. It is
+`pinocchio_model_text` (each joint's parent, placements, axes, body inertias about the centre
+of mass in the body frame, armature = gear_ratio^2 J_m): a chain or a kinematic tree on a fixed
+base, in symdyn's depth-first link order. Robots with mimic joints are not modelled (the
+harness adds one independent joint per link; `check_pinocchio` leaves them out with a note).
+It checks rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix and aba against
+symdyn.rnea's numbers, then times them. It is
 compiled header-only with g++ against the `pin` wheel's headers (cmeel.prefix/include) and
 Eigen's (the `cmeel-eigen` wheel, or the system's as `pkg-config eigen3` reports them);
 the build is cached. Notes name the headers by package, never by absolute path.
@@ -25,7 +28,12 @@ from machine import BENCH, CXX_COMPILER, CXX_EXTRA, FLAGS, compiler_version, log
 from row import Row
 from states import CHECK_TOL, NCHECK, NSTATES
 
-__all__ = ["prepare", "check_pinocchio", "pinocchio_model_text"]
+__all__ = ["prepare", "check_pinocchio", "pinocchio_model_text", "MIMIC_NOTE"]
+
+MIMIC_NOTE = (
+    "mimic joints: Pinocchio not run (bench/pinocchio_harness.cpp gives every link an independent "
+    "joint; a mimic joint would need Pinocchio's JointModelMimic)"
+)
 
 PIN_DEFINES = (  # what pinocchio's CMake target pinocchio_headers adds
     "-DBOOST_MPL_LIMIT_LIST_SIZE=30",
@@ -117,6 +125,7 @@ def prepare(build_dir: Path) -> tuple[Path | None, str]:
 def pinocchio_model_text(robot, states, refs: list[dict]) -> str:
     """The MODEL.txt of bench/pinocchio_harness.cpp, with symdyn.rnea's reference numbers `refs`."""
     m = casadi_route.robot_arrays(robot)
+    assert not m.has_mimic, "the Pinocchio harness models independent joints only"
     lines = [f"n {m.n}", "gravity " + " ".join(repr(float(x)) for x in m.gravity)]
     for i in range(m.n):
         I = m.inertia[i]
@@ -134,7 +143,8 @@ def pinocchio_model_text(robot, states, refs: list[dict]) -> str:
             I[2, 2],
             m.reflected[i],
         ]
-        lines.append(f"joint {'R' if m.revolute[i] else 'P'} " + " ".join(repr(float(v)) for v in vals))
+        kind = "R" if m.revolute[i] else "P"
+        lines.append(f"joint {kind} {m.parent[i]} " + " ".join(repr(float(v)) for v in vals))
     lines.append(f"nstates {NSTATES}")
     for k in range(NSTATES):
         vec = np.concatenate([states[x][k] for x in ("q", "qd", "qdd", "tau")])
@@ -155,8 +165,14 @@ def pinocchio_model_text(robot, states, refs: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def check_pinocchio(row: Row, robot, exe: Path, work: Path, states, refs: list[dict]) -> list:
-    """Write MODEL.txt, run the harness once (it checks, then times briefly); the command to time."""
+def check_pinocchio(row: Row, robot, exe: Path, work: Path, states, refs: list[dict]) -> list | None:
+    """Write MODEL.txt, run the harness once (it checks, then times briefly); the command to time.
+
+    None (and MIMIC_NOTE in the row's notes) for a robot with mimic joints.
+    """
+    if robot.n != robot.nb:
+        row.notes.append(MIMIC_NOTE)
+        return None
     model = work / f"pinocchio_{row.name}.txt"
     model.write_text(pinocchio_model_text(robot, states, refs))
     checks, _ = parse_harness(run([exe, model, 1, 0.1]).stdout)

@@ -1,4 +1,5 @@
-// Pinocchio side of bench/run.py: build a symdyn Robot as a pinocchio::Model, check it against
+// Pinocchio side of bench/run.py: build a symdyn Robot (a chain or a kinematic tree on a fixed base,
+// without mimic joints) as a pinocchio::Model, check it against
 // symdyn.rnea's numbers, and time rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix
 // and aba on the same pre-generated states as the C harness.
 //
@@ -7,10 +8,13 @@
 // MODEL.txt (whitespace separated, written by bench/run.py):
 //   n N
 //   gravity gx gy gz
-//   N lines: joint R|P  ax ay az  R00 R01 R02 R10 R11 R12 R20 R21 R22  px py pz
+//   N lines: joint R|P PARENT  ax ay az  R00 R01 R02 R10 R11 R12 R20 R21 R22  px py pz
 //                    mass cx cy cz  Ixx Ixy Ixz Iyy Iyz Izz  armature
-//     (placement (R, p) of the body frame in the parent body frame at q = 0; the axis in the
-//      body frame; inertia about the centre of mass, body axes; armature = gear_ratio^2 J_m)
+//     (PARENT: the 0-based line of the parent joint, -1 for the base; parents come before their
+//      children (depth-first order), so joint line i becomes Pinocchio's joint i + 1 and
+//      PARENT its parent joint PARENT + 1, 0 being Pinocchio's universe; placement (R, p) of the
+//      body frame in the parent body frame at q = 0; the axis in the body frame; inertia about
+//      the centre of mass, body axes; armature = gear_ratio^2 J_m)
 //   nstates K           then K lines: q(N) qd(N) qdd(N) tau(N)
 //   ncheck C            then C lines: k  tau(N) M(N*N, row-major) G(N) V(N) qdd(N)
 //     (symdyn.rnea's numbers for state k: rnea without friction, the CRBA, gravity, the
@@ -98,11 +102,14 @@ static Model build_model(std::istream & in, int & n)
   for (int j = 0; j < 3; ++j)
     g[j] = read<double>(in, "gravity");
   std::vector<double> armature(n);
-  pinocchio::JointIndex parent = 0;
   for (int i = 0; i < n; ++i)
   {
     expect(in, "joint");
     const std::string type = read<std::string>(in, "joint type");
+    const int parent_line = read<int>(in, "parent");
+    if (parent_line < -1 || parent_line >= i)
+      fail("joint " + std::to_string(i + 1) + ": the parent must be -1 (base) or an earlier joint");
+    const pinocchio::JointIndex parent = pinocchio::JointIndex(parent_line + 1);
     Eigen::Vector3d axis, p, com;
     Eigen::Matrix3d R;
     for (int j = 0; j < 3; ++j)
@@ -148,8 +155,9 @@ static Model build_model(std::istream & in, int & n)
     else
       fail("joint type must be R or P, not " + type);
     const pinocchio::Symmetric3 Ic(I[0], I[1], I[3], I[2], I[4], I[5]);  // xx xy yy xz yz zz
+    if (id != pinocchio::JointIndex(i + 1))
+      fail("joint " + std::to_string(i + 1) + " got Pinocchio index " + std::to_string(id));
     model.appendBodyToJoint(id, pinocchio::Inertia(mass, com, Ic), pinocchio::SE3::Identity());
-    parent = id;
   }
   if (model.nv != n)
     fail("model has nv != n");

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from machine import C_COMPILER, CXX_COMPILER, CXX_EXTRA, FLAGS, RESULTS, compiler_version, machine
-from robots import ARMS
+from robots import ARMS, TREES
 from row import CASADI_FUNCTIONS, FUNCTIONS, PINOCCHIO, PINOCCHIO_NAMES, SHORT, Row
 from states import CHECK_TOL, NCHECK, NSTATES
 
@@ -136,10 +136,23 @@ def verdict(ok: bool | None) -> str:
     return "SKIP" if ok is None else ("PASS" if ok else "FAIL")
 
 
+def _against_pinocchio(r: Row, fn: str, alg: str, goal: float, have_pin: bool) -> str:
+    """The target line `fn` <= goal x Pinocchio's `alg` of robot `r` (SKIP without Pinocchio's time)."""
+    what = f"{r.name} {fn} <= {goal:g}x Pinocchio's {PINOCCHIO_NAMES[alg]}"
+    c, p = r.c_ns.get(fn), r.pin_ns.get(alg)
+    if not have_pin or p is None:
+        why = "no Pinocchio" if not have_pin else "Pinocchio not run for this robot (see its notes)"
+        return f"SKIP  {what}: {why}"
+    best = min(r.samples[fn]) / min(r.samples["pin_" + alg])
+    ok = verdict(c <= goal * p)
+    return f"{ok}  {what}: {c:.1f} ns vs {p:.1f} ns = {c / p:.2f}x (fastest repetitions {best:.2f}x)"
+
+
 def targets(rows: dict[str, Row], sym: Row | None, have_pin: bool) -> list[str]:
-    """One PASS/FAIL/SKIP line per target of the issue, with its numbers (medians; ARMS only)."""
+    """One PASS/FAIL/SKIP line per target, with its numbers (medians; ARMS and TREES only)."""
     lines = []
     arms = [rows[a] for a in ARMS if a in rows]
+    trees = [rows[t] for t in TREES if t in rows]
     for fn in CASADI_FUNCTIONS:
         for r in arms:
             c, cr = r.c_ns.get(fn), r.cr_c_ns.get(fn)
@@ -157,20 +170,18 @@ def targets(rows: dict[str, Row], sym: Row | None, have_pin: bool) -> list[str]:
                 f"{ops} ops vs {cro} = {ops / cro:.2f}x"
             )
     for fn, alg in (("coriolis_matrix", "coriolis_matrix"), ("forward_dynamics", "aba")):
-        for r in arms:
-            c, p = r.c_ns.get(fn), r.pin_ns.get(alg)
-            if not have_pin or p is None:
-                lines.append(f"SKIP  {r.name} {fn} <= 0.5x Pinocchio's {PINOCCHIO_NAMES[alg]}: no Pinocchio")
-                continue
-            best = min(r.samples[fn]) / min(r.samples["pin_" + alg])
-            lines.append(
-                f"{verdict(c <= 0.5 * p)}  {r.name} {fn} <= 0.5x Pinocchio's {PINOCCHIO_NAMES[alg]}: "
-                f"{c:.1f} ns vs {p:.1f} ns = {c / p:.2f}x (fastest repetitions {best:.2f}x)"
-            )
+        lines += [_against_pinocchio(r, fn, alg, 0.5, have_pin) for r in arms]
+    for fn in ("inverse_dynamics", "mass_matrix", "gravity"):
+        lines += [_against_pinocchio(r, fn, PINOCCHIO[fn], 0.25, have_pin) for r in trees]
     for r in arms:
         lines.append(
             f"{verdict(r.gen_wall < 3.0)}  {r.name}: symdyn generate --target c (7 functions) < 3 s: "
             f"{r.gen_wall:.2f} s wall ({r.gen_cpu:.2f} s CPU)"
+        )
+    for r in trees:
+        lines.append(
+            f"{verdict(r.gen_wall < 30.0)}  {r.name} (tree, {r.n} joints): symdyn generate --target c "
+            f"(7 functions) < 30 s: {r.gen_wall:.2f} s wall ({r.gen_cpu:.2f} s CPU)"
         )
     if sym is not None:
         lines.append(
@@ -232,6 +243,13 @@ def _notes(rows: list[Row], info: RunInfo) -> list[str]:
         "puma560_symbolic: bench/chains/puma560_symbolic.yaml (examples/puma560.yaml with all 60 inertial "
         "parameters free, no motor inertia, no friction); generated, not timed",
     ]
+    trees = [r.name for r in rows if r.name in TREES]
+    if trees:
+        notes.append(
+            f"{', '.join(trees)}: whole URDF trees of example-robot-data on a fixed base, loaded without a "
+            "tip (joint order = Pinocchio's); no mimic joints (n = nb); Pinocchio's model gets each "
+            "joint's parent, the CasADi route runs its RNEA and CRBA on the same parents"
+        )
     if any(r.name == "puma560_float" for r in rows):
         notes.append(
             "puma560_float: bench/chains/puma560_float.yaml, examples/puma560.yaml with every twist pi/2 "

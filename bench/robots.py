@@ -16,7 +16,11 @@ For bench/derive.py (built in memory as symdyn Robots):
 For bench/run.py (robot files, as `symdyn generate` reads them):
 
 * `ROBOTS`: name -> robot file; `QUICK_ROBOTS`, `ARMS` (the arms the targets judge),
-  `URDF_TIPS` (URDF file -> tip link) and `load(path)`.
+  `TREES` (the kinematic trees the targets judge), `URDF_TIPS` (URDF file -> tip link)
+  and `load(path)`. The URDF robots come from example-robot-data when it is installed:
+  `panda_urdf` (a chain cut out by its tip), and the whole trees on a fixed base
+  `talos_reduced` (32 joints: two legs, torso, two arms with grippers, head) and
+  `solo12` (12 joints, four legs), loaded without a tip.
 * `puma560_float_text()`: examples/puma560.yaml with every twist pi/2 written as the
   float 1.5707963267948966 (the robot `puma560_float`, file bench/chains/puma560_float.yaml,
   written by `write_robot_files()` with the chains of bench/chains.py).
@@ -47,6 +51,7 @@ __all__ = [
     "QUICK_ROBOTS",
     "ARMS",
     "URDF_TIPS",
+    "TREES",
 ]
 
 PUMA_FILE = chains.PUMA_FILE
@@ -193,8 +198,8 @@ def puma560_float_text(path: Path = PUMA_FILE) -> str:
     return header + text
 
 
-def _panda_urdf() -> Path | None:
-    """The Franka Panda URDF that example-robot-data (the test extra) ships, if installed."""
+def _example_robot(inside: str) -> Path | None:
+    """A URDF that example-robot-data (the test extra) ships under robots/, if installed."""
     try:
         from importlib.metadata import PackageNotFoundError, distribution
 
@@ -202,7 +207,7 @@ def _panda_urdf() -> Path | None:
         robots = distribution("example-robot-data").locate_file(share)
     except (ImportError, PackageNotFoundError):
         return None
-    path = Path(str(robots)) / "panda_description" / "urdf" / "panda.urdf"
+    path = Path(str(robots)) / inside
     return path if path.is_file() else None
 
 
@@ -216,11 +221,19 @@ ROBOTS = {  # name -> robot file (chains are written by bench/chains.py)
     "chain_12": chains.chain_file(12),
 }
 URDF_TIPS: dict[Path, str] = {}  # URDF file -> the tip link of its chain
-if (_urdf := _panda_urdf()) is not None:  # the same arm as panda.yaml, through the URDF loader
-    ROBOTS["panda_urdf"] = _urdf
+if (_urdf := _example_robot("panda_description/urdf/panda.urdf")) is not None:
+    ROBOTS["panda_urdf"] = _urdf  # the same arm as panda.yaml, through the URDF loader
     URDF_TIPS[_urdf] = "panda_hand"
+_TREE_FILES = {  # whole URDF trees on a fixed base (no tip); joint order = Pinocchio's
+    "talos_reduced": "talos_data/robots/talos_reduced.urdf",
+    "solo12": "solo_description/robots/solo12.urdf",
+}
+for _name, _inside in _TREE_FILES.items():
+    if (_urdf := _example_robot(_inside)) is not None:
+        ROBOTS[_name] = _urdf
 QUICK_ROBOTS = ("roger_arm_values", "puma560", "panda")
 ARMS = ("puma560", "stanford", "panda")  # the issue's "6-7 joint arms with numeric parameters"
+TREES = tuple(_TREE_FILES)  # the kinematic trees judged against Pinocchio (when installed)
 
 
 def write_robot_files() -> dict[str, Path]:

@@ -11,9 +11,11 @@ ns per call of symdyn's C (all seven functions), the CasADi route (an RNEA/CRBA
 traced in casadi.SX, bench/casadi_route.py: its casadi.Function called from
 Python, and its CodeGenerator C), the NumPy RNEA (symdyn.rnea), and Pinocchio's
 C++ (bench/pinocchio_harness.cpp, when the `pin` and `cmeel-eigen` wheels are
-installed), with ratio columns. Under the table: notes, the correctness checks
-(every timed function is first compared with symdyn.rnea at random states; a
-mismatch stops the run) and one PASS/FAIL line per target of the issue.
+installed), with ratio columns. The robots are chains and, when example-robot-data is
+installed, whole URDF trees on a fixed base (talos_reduced, solo12; bench/robots.py).
+Under the table: notes, the correctness checks (every timed function is first compared
+with symdyn.rnea at random states; a mismatch stops the run) and one PASS/FAIL line per
+target of the issue.
 Progress goes to stderr; the table, notes and verdicts go to stdout and to
 bench/results/run.txt (or run.md with --markdown); every number to
 bench/results/run.json. See bench/README_run.md.
