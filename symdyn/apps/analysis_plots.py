@@ -156,7 +156,7 @@ def plot_workspace(
     arms, hands = [], []
     for a in analyses:
         pts = [np.zeros(2)]
-        for k in range(robot.n):
+        for k in range(robot.nb):  # every body, mimic joints included
             T = numeric_pose(robot, a.q, link=k, point=list(frames[k]), params=params)
             pts.append(T[rows, 3])
         arms.append(np.array(pts))
