@@ -27,7 +27,16 @@ from .errors import SymdynError
 from .model.robot import Robot
 from .parsers import load_robot, load_urdf
 
-__all__ = ["EXAMPLES", "render_all", "main", "versions", "toolchain", "read_toolchain", "changed_tools"]
+__all__ = [
+    "EXAMPLES",
+    "example_robot_data_folder",
+    "render_all",
+    "main",
+    "versions",
+    "toolchain",
+    "read_toolchain",
+    "changed_tools",
+]
 
 EXAMPLES = ("roger_arm", "puma560", "panda", "solo12")
 #: examples that are URDF files of the example-robot-data package: name -> path in its robots/
@@ -71,18 +80,26 @@ def changed_tools(
     ]
 
 
+def example_robot_data_folder() -> Path | None:
+    """The robots/ folder of the example-robot-data package (the test extra), or None."""
+    try:
+        dist = importlib.metadata.distribution("example-robot-data")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    path = Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
+    return path if path.is_dir() else None
+
+
 def example_robot(root: Path, name: str) -> Robot:
     """The example robot `name`: examples/NAME.yaml, or a URDF of example-robot-data named NAME."""
     if name not in URDF_EXAMPLES:
         return load_robot(root / "examples" / f"{name}.yaml")
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
+    folder = example_robot_data_folder()
+    if folder is None:
         raise SymdynError(
             f"the example {name} is a URDF of the example-robot-data package: install the test extra"
-        ) from None
-    path = Path(dist.locate_file(f"cmeel.prefix/share/example-robot-data/robots/{URDF_EXAMPLES[name]}"))
-    return dataclasses.replace(load_urdf(path), name=name)
+        )
+    return dataclasses.replace(load_urdf(folder / URDF_EXAMPLES[name]), name=name)
 
 
 def render_all(root: Path) -> dict[str, dict[str, str | bytes]]:

@@ -12,7 +12,6 @@ symbolic derivation.
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 import importlib.util
 import shutil
 import subprocess
@@ -25,6 +24,7 @@ from cbuild import SANITIZE_FLAGS, STRICT_FLAGS, build_dynamics, compile_program
 
 import symdyn
 from symdyn.codegen import render
+from symdyn.regenerate import example_robot_data_folder
 
 rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 
@@ -37,8 +37,10 @@ TOL = 1e-9
 
 
 def _robot(name: str):
-    dist = importlib.metadata.distribution("example-robot-data")
-    path = dist.locate_file(f"cmeel.prefix/share/example-robot-data/robots/{FILES[name]}")
+    folder = example_robot_data_folder()
+    if folder is None:
+        pytest.skip("example-robot-data is not installed")
+    path = folder / FILES[name]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         robot = symdyn.load_urdf(path)
@@ -48,10 +50,7 @@ def _robot(name: str):
 @pytest.fixture(scope="module", params=sorted(FILES))
 def generated(request, tmp_path_factory):
     pytest.importorskip("casadi")
-    try:
-        robot = _robot(request.param)
-    except importlib.metadata.PackageNotFoundError:
-        pytest.skip("example-robot-data is not installed")
+    robot = _robot(request.param)
     out = tmp_path_factory.mktemp(request.param)
     files = render(robot, targets=("c", "casadi", "python", "latex"))
     write_files(files, out)

@@ -15,7 +15,6 @@ those tests skip if it is not installed.
 from __future__ import annotations
 
 import hashlib
-import importlib.metadata
 import math
 import warnings
 import xml.etree.ElementTree as ET
@@ -37,6 +36,7 @@ from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.model.robot import Friction, Link, Robot
 from symdyn.parsers import robot_from_data
 from symdyn.parsers.urdf import load_urdf, urdf_robot_name
+from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import forward_kinematics, gravity_torque, mass_matrix, rnea
 from symdyn.spatial.transform import Transform
 
@@ -711,16 +711,7 @@ def test_cli_errors(tmp_path, capsys):
 # --------------------------------------------------------------------------- real robots
 
 
-def _erd_robots() -> Path | None:
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    path = Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
-    return path if path.is_dir() else None
-
-
-ERD = _erd_robots()
+ERD = example_robot_data_folder()
 needs_erd = pytest.mark.skipif(ERD is None, reason="example-robot-data is not installed")
 
 #: name -> (file under the package's robots/ folder, load_urdf keywords, links merged into the last)

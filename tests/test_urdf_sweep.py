@@ -18,7 +18,6 @@ The table of the sweep prints with `pytest -s tests/test_urdf_sweep.py`.
 
 from __future__ import annotations
 
-import importlib.metadata
 import xml.etree.ElementTree as ET
 import zlib
 from pathlib import Path
@@ -28,21 +27,13 @@ import pytest
 
 import symdyn
 from symdyn import SymdynError
+from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import gravity_torque, mass_matrix
 
 pin = pytest.importorskip("pinocchio", reason="the test extra installs pin (Pinocchio)")
 
 
-def _robots_folder() -> Path | None:
-    try:
-        dist = importlib.metadata.distribution("example-robot-data")
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    path = Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
-    return path if path.is_dir() else None
-
-
-ROBOTS = _robots_folder()
+ROBOTS = example_robot_data_folder()
 FILES = sorted(ROBOTS.rglob("*.urdf")) if ROBOTS else []
 
 #: files symdyn refuses, with the documented reason (a fragment of its message)
