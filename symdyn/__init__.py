@@ -21,6 +21,7 @@ from .codegen import generate  # noqa: E402
 from .dynamics import Dynamics, derive  # noqa: E402
 from .errors import SymdynError, SymdynWarning  # noqa: E402
 from .model import inertia  # noqa: E402
+from .model.parameters import standard_parameters  # noqa: E402
 from .model.robot import Link, Robot  # noqa: E402
 from .parsers import load_robot, load_urdf, robot_from_data  # noqa: E402
 
@@ -43,4 +44,5 @@ __all__ = [
     "load_urdf",
     "rnea",
     "robot_from_data",
+    "standard_parameters",
 ]

@@ -50,7 +50,7 @@ def _imports(path: Path, parts: tuple[str, ...]):
 
 
 def _floor(parts: tuple[str, ...]) -> str:
-    return "rnea" if parts[0] == "rnea_inputs" else parts[0]  # the oracle's input side
+    return "rnea" if parts[0] in ("rnea_inputs", "rnea_regressor") else parts[0]  # the oracle's other modules
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,70 @@
+"""The standard dynamic parameters of a robot: 13 per body, in Pinocchio's order.
+
+Per link i (body frame i), the 10 inertial parameters of `pinocchio.Inertia.toDynamicParameters`
+
+    m_i, m_i c_x, m_i c_y, m_i c_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz
+
+with c the centre of mass in body frame i and I the inertia tensor about the ORIGIN of body
+frame i, I = I_c + m (c^T c 1 - c c^T) (parallel-axis theorem; I_c about the centre of mass,
+`Link.inertia`; off-diagonal entries are the tensor's, minus the product-of-inertia integrals);
+then the joint's 3: Ia_i = gear_ratio^2 J_m (reflected rotor inertia), fv_i (viscous friction),
+fc_i (Coulomb friction). The equations of motion are linear in this vector,
+tau = Y(q, qd, qdd) pi (symdyn.rnea_regressor; Atkeson, An and Hollerbach 1986).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+__all__ = ["INERTIAL_NAMES", "JOINT_NAMES", "PER_BODY", "standard_parameters", "numeric_parameters"]
+
+#: the 10 inertial parameters of a body, Pinocchio's order (toDynamicParameters)
+INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+#: the 3 parameters of a body's joint: reflected rotor inertia, viscous and Coulomb friction
+JOINT_NAMES = ("Ia", "fv", "fc")
+#: parameters per body
+PER_BODY = len(INERTIAL_NAMES) + len(JOINT_NAMES)
+
+
+def _body_parameters(link) -> list[sp.Expr]:
+    """[m, m c, I_O (6 entries), Ia, fv, fc] of one link, all in its body frame."""
+    m = sp.sympify(link.mass)
+    c = sp.Matrix(link.com)
+    I_origin = sp.Matrix(link.inertia) + m * ((c.T * c)[0, 0] * sp.eye(3) - c * c.T)
+    inertial = [m, *(m * c), *(I_origin[i, j] for i, j in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)))]
+    joint = [link.motor.reflected_inertia, link.friction.viscous, link.friction.coulomb]
+    return [sp.sympify(x) for x in (*inertial, *joint)]
+
+
+def standard_parameters(robot) -> tuple[tuple[str, ...], tuple[sp.Expr, ...]]:
+    """The standard parameter vector pi of a robot: 13 per body, link 1 first.
+
+    Per body i (1-based, every link including mimic joints' bodies): m_i, m_i c_i (body frame i),
+    the inertia tensor about body frame i's origin (I_xx, I_xy, I_yy, I_xz, I_yz, I_zz: Pinocchio's
+    `Inertia.toDynamicParameters` order), then Ia_i = gear_ratio^2 J_m, fv_i, fc_i.
+
+    Args:
+        robot: a `symdyn.Robot`; its valued parameters are substituted (`Robot.resolved`).
+
+    Returns:
+        (names, values): names such as "m1", "mx1", ..., "fc1", "m2", ...; values SymPy
+        expressions in which only the robot's free parameters stay symbols.
+    """
+    links = robot.resolved().links
+    names = tuple(f"{p}{i}" for i in range(1, len(links) + 1) for p in (*INERTIAL_NAMES, *JOINT_NAMES))
+    values = tuple(x for link in links for x in _body_parameters(link))
+    return names, values
+
+
+def numeric_parameters(robot, params=None) -> np.ndarray:
+    """The standard parameter vector pi (13 nb,) as floats, with the free parameters' values.
+
+    Args:
+        robot: a `symdyn.Robot`.
+        params: values of its free parameters (`Robot.param_values`); None when it has none.
+
+    Raises:
+        SymdynError: missing, extra or non-numeric parameter values.
+    """
+    return np.array([float(x) for x in standard_parameters(robot.numeric(params))[1]])

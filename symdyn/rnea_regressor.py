@@ -1,0 +1,147 @@
+"""The numeric regressor of the oracle: tau = Y(q, qd, qdd) pi, with NumPy only.
+
+The Newton-Euler equations are linear in each body's 10 inertial parameters (Atkeson, An and
+Hollerbach, "Estimation of inertial parameters of manipulator loads and links", 1986): in
+Featherstone's spatial form (body frame i, vectors at its origin, motion v = [omega; v_O],
+force f = [n_O; f]) the spatial inertia of body i is
+
+    I_i(pi_i) = [[I_O, [h]x], [[h]x^T, m 1]],   h = m c,  I_O the tensor about the origin,
+
+so its wrench f_i = I_i a_i + v_i x* I_i v_i = A(v_i, a_i) pi_i with A the 6 x 10 matrix whose
+column k is B_k a_i + v_i x* B_k v_i for the basis inertia B_k = dI_i/dpi_k. Joint j's effort
+collects the wrenches of its subtree, tau_j = S_j^T sum_{i in subtree(j)} j_X_i^* f_i, so row j
+of Y holds S_j^T j_X_i^* A(v_i, a_i) in the columns of each body i that joint j supports; the
+rotor and friction columns are qdd_j, qd_j and sign(qd_j) on joint j's own row. The parameter
+order is symdyn.model.parameters (Pinocchio's `toDynamicParameters`, then Ia, fv, fc).
+
+As symdyn.rnea, this runs on the nb bodies at q_b = S q + o, qd_b = S qd, qdd_b = S qdd and
+projects the rows with S^T (mimic joints), gravity entering as the base acceleration [0; -g].
+It shares no code with the symbolic derivation: poses come from `symdyn.rnea.forward_kinematics`
+and the model from `symdyn.rnea_inputs`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .rnea import forward_kinematics
+from .rnea_inputs import NumericModel, body_rates, checked_inputs, project, skew
+
+__all__ = ["regressor", "PER_BODY"]
+
+#: columns per body: 10 inertial parameters, then Ia, fv, fc (symdyn.model.parameters)
+PER_BODY = 13
+
+
+def _basis() -> np.ndarray:
+    """B_k (10, 6, 6) = dI/dpi_k: spatial inertia [[I_O, [h]x], [[h]x^T, m 1]] per parameter
+    m, h_x, h_y, h_z, I_xx, I_xy, I_yy, I_xz, I_yz, I_zz."""
+    B = np.zeros((10, 6, 6))
+    B[0, 3:, 3:] = np.eye(3)
+    for k in range(3):
+        h = skew(np.eye(3)[k])
+        B[1 + k, :3, 3:] = h
+        B[1 + k, 3:, :3] = h.T
+    for k, (i, j) in enumerate(((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2))):
+        B[4 + k, :3, :3][i, j] = B[4 + k, :3, :3][j, i] = 1.0
+    return B
+
+
+_BASIS = _basis()
+
+
+def _force_cross(v: np.ndarray) -> np.ndarray:
+    """v x* = [[omega x, v_O x], [0, omega x]] (N, 6, 6): the spatial force cross product."""
+    W, V = skew(v[:, :3]), skew(v[:, 3:])
+    out = np.zeros((len(v), 6, 6))
+    out[:, :3, :3] = W
+    out[:, 3:, 3:] = W
+    out[:, :3, 3:] = V
+    return out
+
+
+def _motion_cross(v: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """v x m = [omega x m_w; omega x m_v + v_O x m_w] (N, 6): the spatial motion cross product."""
+    w, vo = v[:, :3], v[:, 3:]
+    return np.concatenate([np.cross(w, m[:, :3]), np.cross(w, m[:, 3:]) + np.cross(vo, m[:, :3])], 1)
+
+
+def _parent_transforms(mdl: NumericModel, poses: list[np.ndarray]) -> list[np.ndarray]:
+    """i_X_lambda(i) (N, 6, 6): motion vectors from the parent's body coordinates to body i's,
+    from base_T_i: with parent_T_i = (E, r), X = [[E^T, 0], [-E^T [r]x, E^T]]."""
+    out = []
+    for i, T in enumerate(poses):
+        p = mdl.parent[i]
+        if p < 0:
+            E, r = T[:, :3, :3], T[:, :3, 3]
+        else:  # parent_T_i = base_T_p^-1 base_T_i, with the rigid inverse (R^T, -R^T p)
+            Rp_t = np.swapaxes(poses[p][:, :3, :3], -1, -2)
+            E, r = Rp_t @ T[:, :3, :3], np.einsum("nij,nj->ni", Rp_t, T[:, :3, 3] - poses[p][:, :3, 3])
+        Et = np.swapaxes(E, -1, -2)
+        X = np.zeros((len(T), 6, 6))
+        X[:, :3, :3] = X[:, 3:, 3:] = Et
+        X[:, 3:, :3] = -Et @ skew(r)
+        out.append(X)
+    return out
+
+
+def _body_regressor(
+    mdl: NumericModel, X: list[np.ndarray], qd_b: np.ndarray, qdd_b: np.ndarray
+) -> np.ndarray:
+    """Y_b (N, nb, 13 nb): the bodies' joint efforts tau_b = Y_b pi, in body coordinates."""
+    N, nb = qd_b.shape
+    S = np.zeros((nb, 6))
+    S[mdl.revolute, :3] = mdl.axis[mdl.revolute]
+    S[~mdl.revolute, 3:] = mdl.axis[~mdl.revolute]
+    Y = np.zeros((N, nb, PER_BODY * nb))
+    v, a = [], []
+    for i in range(nb):
+        p = mdl.parent[i]
+        v_p = np.zeros((N, 6)) if p < 0 else v[p]
+        a_p = np.concatenate([np.zeros((N, 3)), np.broadcast_to(-mdl.gravity, (N, 3))], 1) if p < 0 else a[p]
+        vi = np.einsum("nij,nj->ni", X[i], v_p) + S[i] * qd_b[:, i, None]
+        ai = np.einsum("nij,nj->ni", X[i], a_p) + S[i] * qdd_b[:, i, None]
+        ai += _motion_cross(vi, S[i] * qd_b[:, i, None])  # + v_i x S_i qd_i
+        v.append(vi)
+        a.append(ai)
+        # A (N, 6, 10): column k = B_k a + v x* B_k v
+        A = np.einsum("kij,nj->nik", _BASIS, ai) + np.einsum("nij,kjl,nl->nik", _force_cross(vi), _BASIS, vi)
+        cols = slice(PER_BODY * i, PER_BODY * i + 10)
+        j = i
+        while True:  # carry body i's wrench down its support, S_j^T on every joint j it passes
+            Y[:, j, cols] = np.einsum("i,nik->nk", S[j], A)
+            if mdl.parent[j] < 0:
+                break
+            A = np.swapaxes(X[j], -1, -2) @ A
+            j = mdl.parent[j]
+        Y[:, i, PER_BODY * i + 10] = qdd_b[:, i]
+        Y[:, i, PER_BODY * i + 11] = qd_b[:, i]
+        Y[:, i, PER_BODY * i + 12] = np.sign(qd_b[:, i])
+    return Y
+
+
+def regressor(robot, q, qd, qdd, params=None) -> np.ndarray:
+    """The regressor Y(q, qd, qdd) with tau = Y pi (joint space, with friction and rotor inertia).
+
+    pi is the standard parameter vector of `symdyn.standard_parameters` (13 per body: m, m c,
+    the inertia about the body origin, Ia, fv, fc), so Y @ pi equals symdyn.rnea(robot, q, qd,
+    qdd, params). Computed on the bodies (body frames, spatial vectors at each origin) and
+    projected, Y = S^T Y_b, for mimic joints; see the module docstring for the recursion.
+
+    Args:
+        robot: a `symdyn.Robot` with n independent joints and nb bodies.
+        q, qd, qdd: (n,) each, or (N, n) each for N states.
+        params: the free parameters' values (only the kinematics need them: Y does not depend
+            on the inertial and joint parameters).
+
+    Returns:
+        Y, (n, 13 nb) or (N, n, 13 nb).
+
+    Raises:
+        SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
+    """
+    mdl, (q, qd, qdd), single = checked_inputs("regressor", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
+    X = _parent_transforms(mdl, forward_kinematics(robot, q, params))
+    Y_b = _body_regressor(mdl, X, body_rates(mdl, qd), body_rates(mdl, qdd))
+    Y = np.swapaxes(project(mdl, np.swapaxes(Y_b, 1, 2)), 1, 2)  # S^T Y_b, row by row
+    return Y[0] if single else Y
