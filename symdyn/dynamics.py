@@ -35,6 +35,7 @@ and 6.2; Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 
 
 from __future__ import annotations
 
+import re
 import warnings
 from dataclasses import dataclass, field
 
@@ -237,6 +238,39 @@ class Dynamics:
         shape = self.compact[name].shape
         out = np.asarray(self._numeric(name)(*vec, p), dtype=float).reshape(shape)
         return out[:, 0] if name not in ("M", "C") else out
+
+    def __repr__(self) -> str:
+        """One line: robot, joints, method and free parameters (the robot's table: `table()`)."""
+        k, r = len(self.params), self.robot
+        joints = f"{r.n} joint{'s' * (r.n != 1)}" + (f" ({r.nb} bodies)" if r.nb != r.n else "")
+        listed = f" ({', '.join(map(str, self.params))})" if 0 < k <= 6 else ""
+        return f"<Dynamics of {r.name}: {joints}, {self.method}, {k} free parameter{'s' * (k != 1)}{listed}>"
+
+    def table(self) -> str:
+        """The robot's table, one row per link (symdyn.model.table)."""
+        return repr(self.robot)
+
+    def latex(self, name: str) -> str:
+        """Closed form of quantity `name` (ALL_QUANTITIES) in LaTeX, joint space, with q_{i},
+        \\dot{q}_{i}, \\ddot{q}_{i} for the joint symbols (as in docs/generated-code.md)."""
+        _check_quantity(name, "Dynamics.latex")
+        names = {}
+        for head, v in (("q", self.q), ("\\dot{q}", self.qd), ("\\ddot{q}", self.qdd)):
+            names.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})
+        return sp.latex(self.closed_form(name), symbol_names=names)
+
+    def _repr_latex_(self) -> str:
+        """tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (slide 16) for notebooks, with the closed
+        forms of M, V and G for robots of up to AUTO_SIMPLIFY_MAX_JOINTS joints."""
+        n, name = self.n, re.sub(r"([_#%&{}$])", r"\\\1", self.robot.name)
+        q = ", ".join(f"q_{{{i}}}" for i in (range(1, n + 1) if n <= 3 else (1, "\\dots", n)))
+        lines = [
+            f"\\text{{{name}}}:\\ \\tau = M(q)\\,\\ddot{{q}} + V(q, \\dot{{q}}) + G(q) + F(\\dot{{q}})",
+            f"q = ({q}),\\quad M \\in \\mathbb{{R}}^{{{n} \\times {n}}}",
+        ]
+        if n <= AUTO_SIMPLIFY_MAX_JOINTS:
+            lines += [f"{k} = {self.latex(k)}" for k in ("M", "V", "G")]
+        return "$$\\begin{aligned}" + " \\\\ ".join(f"& {line}" for line in lines) + "\\end{aligned}$$"
 
 
 def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:

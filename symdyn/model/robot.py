@@ -30,6 +30,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
 __all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "JOINT_TYPES", "DEFAULT_GRAVITY"]
@@ -164,6 +165,12 @@ class Robot:
                     f"robot '{self.name}': link {i + 1} ({link.name}) mimics {other}, which is a mimic "
                     "joint itself (mimic the joint that it follows instead)"
                 )
+
+    def __repr__(self) -> str:
+        """A header line and one row per link (symdyn.model.table), instead of every matrix."""
+        return robot_table(self)
+
+    __str__ = __repr__
 
     @property
     def n(self) -> int:
