@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["SymdynError", "SymdynWarning", "location"]
+__all__ = ["SymdynError", "SymdynWarning", "location", "link_fields"]
 
 
 def location(
@@ -20,6 +20,14 @@ def location(
     if field:
         parts.append(f"field '{field}'")
     return ": ".join(parts)
+
+
+def link_fields(link) -> dict:
+    """link_index and link_name of a loader's link record (anything with .index and .name), or
+    None for both when the message concerns no link: keyword arguments for SymdynError."""
+    if link is None:
+        return {"link_index": None, "link_name": None}
+    return {"link_index": link.index, "link_name": link.name}
 
 
 class SymdynError(ValueError):

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..errors import SymdynError
+from ..errors import SymdynError, link_fields
 from ..model.angles import snap_angle
 from ..model.expressions import check_parameter_name, is_c_identifier, parse_expression_names
 from ..model.robot import JOINT_TYPES
@@ -105,8 +105,7 @@ class RobotFileReader:
         return SymdynError(
             message,
             file=self.file,
-            link_index=None if link is None else link.index,
-            link_name=None if link is None else link.name,
+            **link_fields(link),
             field=field,
         )
 
@@ -114,8 +113,7 @@ class RobotFileReader:
         expr, names = parse_expression_names(
             value,
             file=self.file,
-            link_index=None if link is None else link.index,
-            link_name=None if link is None else link.name,
+            **link_fields(link),
             field=field,
         )
         self.order.extend(names)

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..errors import SymdynError
+from ..errors import SymdynError, link_fields
 from ..model.angles import snap_angle
 from ..model.expressions import C_KEYWORDS
 from ..model.inertia import tensor_from_components
@@ -121,8 +121,7 @@ class UrdfReader:
         return SymdynError(
             message,
             file=self.file,
-            link_index=None if link is None else link.index,
-            link_name=None if link is None else link.name,
+            **link_fields(link),
             field=field,
         )
 
@@ -168,8 +167,7 @@ class UrdfReader:
             snap_angle(
                 a,
                 file=self.file,
-                link_index=None if link is None else link.index,
-                link_name=None if link is None else link.name,
+                **link_fields(link),
                 field=prefix + "origin.rpy",
                 angle=name,
                 line=el.line,
