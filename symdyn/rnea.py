@@ -40,8 +40,8 @@ from .rnea_inputs import (
     checked_inputs,
     numeric_model,
     project,
-    skew,
 )
+from .rnea_spatial import crm, joint_poses, motion_transforms, mv, subspaces
 
 __all__ = [
     "NumericModel",
@@ -63,65 +63,12 @@ def _out(a: np.ndarray, single: bool) -> np.ndarray:
     return a[0] if single else a
 
 
-def _joint_poses(mdl: NumericModel, q: np.ndarray):
-    """Per body i: (E, r) with E = parent_R_i (N,3,3) and r = origin of body i in its parent
-    (N,3), for the bodies' joint positions q (N, nb)."""
-    out = []
-    for i in range(mdl.nb):
-        qi = q[:, i]
-        if mdl.revolute[i]:
-            k = mdl.axis[i]
-            K = skew(k)
-            c, s = np.cos(qi)[:, None, None], np.sin(qi)[:, None, None]
-            rot = c * np.eye(3) + s * K + (1.0 - c) * np.outer(k, k)  # Rodrigues
-            out.append((mdl.R0[i] @ rot, np.broadcast_to(mdl.p0[i], (len(qi), 3))))
-        else:
-            E = np.broadcast_to(mdl.R0[i], (len(qi), 3, 3))
-            out.append((E, mdl.p0[i] + qi[:, None] * (mdl.R0[i] @ mdl.axis[i])))
-    return out
-
-
-def _motion_transforms(poses) -> list[np.ndarray]:
-    """i_X_lambda(i) = [[E^T, 0], [-E^T [r]x, E^T]]: parent motion vectors into body i coordinates."""
-    xs = []
-    for E, r in poses:
-        Et = np.swapaxes(E, -1, -2)
-        X = np.zeros((len(E), 6, 6))
-        X[:, :3, :3] = Et
-        X[:, 3:, 3:] = Et
-        X[:, 3:, :3] = -Et @ skew(r)
-        xs.append(X)
-    return xs
-
-
-def _subspaces(mdl: NumericModel) -> np.ndarray:
-    """Motion subspaces S_i (nb,6) in body coordinates: [axis; 0] revolute, [0; axis] prismatic."""
-    S = np.zeros((mdl.nb, 6))
-    S[mdl.revolute, :3] = mdl.axis[mdl.revolute]
-    S[~mdl.revolute, 3:] = mdl.axis[~mdl.revolute]
-    return S
-
-
-def _crm(v: np.ndarray) -> np.ndarray:
-    """Spatial motion cross product matrix v x = [[w x, 0], [v_O x, w x]] for v (N,6)."""
-    W, V = skew(v[:, :3]), skew(v[:, 3:])
-    out = np.zeros((len(v), 6, 6))
-    out[:, :3, :3] = W
-    out[:, 3:, 3:] = W
-    out[:, 3:, :3] = V
-    return out
-
-
-def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return np.einsum("...ij,...j->...i", A, x)
-
-
 def _body_rnea(mdl: NumericModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, g_on: bool) -> np.ndarray:
     """Rigid-body efforts of the bodies' joints (N, nb) by the spatial RNEA on the tree, for the
     bodies' joint positions, velocities and accelerations (N, nb) each; see `rnea`."""
     N = len(q)
-    X = _motion_transforms(_joint_poses(mdl, q))
-    S = _subspaces(mdl)
+    X = motion_transforms(joint_poses(mdl, q))
+    S = subspaces(mdl)
     base_v = np.zeros((N, 6))
     base_a = np.zeros((N, 6))
     if g_on:
@@ -132,20 +79,20 @@ def _body_rnea(mdl: NumericModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
     for i in range(mdl.nb):
         p = mdl.parent[i]
         v_p, a_p = (base_v, base_a) if p < 0 else (vs[p], accs[p])
-        v = _mv(X[i], v_p) + S[i] * qd[:, i, None]
-        vx = _crm(v)
-        a = _mv(X[i], a_p) + S[i] * qdd[:, i, None] + _mv(vx, S[i]) * qd[:, i, None]
+        v = mv(X[i], v_p) + S[i] * qd[:, i, None]
+        vx = crm(v)
+        a = mv(X[i], a_p) + S[i] * qdd[:, i, None] + mv(vx, S[i]) * qd[:, i, None]
         vs.append(v)
         accs.append(a)
-        Iv = _mv(mdl.spatial_inertia[i], v)
+        Iv = mv(mdl.spatial_inertia[i], v)
         # f = I a + v x* (I v), with v x* = -(v x)^T the force cross product.
-        forces.append(_mv(mdl.spatial_inertia[i], a) - _mv(np.swapaxes(vx, -1, -2), Iv))
+        forces.append(mv(mdl.spatial_inertia[i], a) - mv(np.swapaxes(vx, -1, -2), Iv))
     tau = np.zeros((N, mdl.nb))
     for i in reversed(range(mdl.nb)):  # every child's force is in by now: children come later
         tau[:, i] = forces[i] @ S[i]
         p = mdl.parent[i]
         if p >= 0:
-            forces[p] = forces[p] + _mv(np.swapaxes(X[i], -1, -2), forces[i])
+            forces[p] = forces[p] + mv(np.swapaxes(X[i], -1, -2), forces[i])
     return tau
 
 
@@ -191,8 +138,8 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
 def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
     """M for a batch of independent q (N, n) -> (N, n, n); see `mass_matrix`."""
     N = len(q)
-    X = _motion_transforms(_joint_poses(mdl, body_positions(mdl, q)))
-    S = _subspaces(mdl)
+    X = motion_transforms(joint_poses(mdl, body_positions(mdl, q)))
+    S = subspaces(mdl)
     Ic = [np.broadcast_to(mdl.spatial_inertia[i], (N, 6, 6)).copy() for i in range(mdl.nb)]
     M = np.zeros((N, mdl.nb, mdl.nb))
     for i in reversed(range(mdl.nb)):  # Ic[i] is complete: its children come after it
@@ -202,7 +149,7 @@ def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
         M[:, i, i] = F @ S[i] + mdl.reflected[i]
         j = i
         while mdl.parent[j] >= 0:
-            F = _mv(np.swapaxes(X[j], -1, -2), F)
+            F = mv(np.swapaxes(X[j], -1, -2), F)
             j = mdl.parent[j]
             M[:, i, j] = M[:, j, i] = F @ S[j]
     return mdl.selection.T @ M @ mdl.selection
@@ -336,14 +283,14 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
         T, a float or (N,).
     """
     mdl, (q, qd), single = checked_inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
-    X = _motion_transforms(_joint_poses(mdl, body_positions(mdl, q)))
-    S = _subspaces(mdl)
+    X = motion_transforms(joint_poses(mdl, body_positions(mdl, q)))
+    S = subspaces(mdl)
     qd_b = body_rates(mdl, qd)
     T = 0.5 * (mdl.reflected * qd_b**2).sum(axis=1)
     vs: list[np.ndarray] = []
     for i in range(mdl.nb):
         p = mdl.parent[i]
-        v = (_mv(X[i], vs[p]) if p >= 0 else 0.0) + S[i] * qd_b[:, i, None]
+        v = (mv(X[i], vs[p]) if p >= 0 else 0.0) + S[i] * qd_b[:, i, None]
         vs.append(v)
         T = T + 0.5 * np.einsum("ni,ij,nj->n", v, mdl.spatial_inertia[i], v)
     return float(T[0]) if single else T
@@ -354,7 +301,7 @@ def _poses(mdl: NumericModel, q: np.ndarray) -> list[np.ndarray]:
     N = len(q)
     base = np.broadcast_to(np.eye(4), (N, 4, 4))
     out: list[np.ndarray] = []
-    for i, (E, r) in enumerate(_joint_poses(mdl, body_positions(mdl, q))):
+    for i, (E, r) in enumerate(joint_poses(mdl, body_positions(mdl, q))):
         J = np.zeros((N, 4, 4))
         J[:, :3, :3], J[:, :3, 3], J[:, 3, 3] = E, r, 1.0
         p = mdl.parent[i]
@@ -380,7 +327,7 @@ def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
 def _com_positions(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
     """Centres of mass in the base frame for a batch q (N, n) -> (N, nb, 3)."""
     Ts = _poses(mdl, q)
-    return np.stack([_mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
+    return np.stack([mv(T[:, :3, :3], mdl.com[i]) + T[:, :3, 3] for i, T in enumerate(Ts)], 1)
 
 
 def link_com_positions(robot, q, params=None) -> np.ndarray:

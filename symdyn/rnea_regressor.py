@@ -16,16 +16,16 @@ order is symdyn.model.parameters (Pinocchio's `toDynamicParameters`, then Ia, fv
 
 As symdyn.rnea, this runs on the nb bodies at q_b = S q + o, qd_b = S qd, qdd_b = S qdd and
 projects the rows with S^T (mimic joints), gravity entering as the base acceleration [0; -g].
-It shares no code with the symbolic derivation: poses come from `symdyn.rnea.forward_kinematics`
-and the model from `symdyn.rnea_inputs`.
+It shares no code with the symbolic derivation: the spatial kinematics are the oracle's own
+(symdyn.rnea_spatial) and the model comes from `symdyn.rnea_inputs`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .rnea import forward_kinematics
-from .rnea_inputs import NumericModel, body_rates, checked_inputs, project, skew
+from .rnea_inputs import NumericModel, body_positions, body_rates, checked_inputs, project, skew
+from .rnea_spatial import crm, joint_poses, motion_transforms, mv, subspaces
 
 __all__ = ["regressor", "PER_BODY"]
 
@@ -50,62 +50,26 @@ def _basis() -> np.ndarray:
 _BASIS = _basis()
 
 
-def _force_cross(v: np.ndarray) -> np.ndarray:
-    """v x* = [[omega x, v_O x], [0, omega x]] (N, 6, 6): the spatial force cross product."""
-    W, V = skew(v[:, :3]), skew(v[:, 3:])
-    out = np.zeros((len(v), 6, 6))
-    out[:, :3, :3] = W
-    out[:, 3:, 3:] = W
-    out[:, :3, 3:] = V
-    return out
-
-
-def _motion_cross(v: np.ndarray, m: np.ndarray) -> np.ndarray:
-    """v x m = [omega x m_w; omega x m_v + v_O x m_w] (N, 6): the spatial motion cross product."""
-    w, vo = v[:, :3], v[:, 3:]
-    return np.concatenate([np.cross(w, m[:, :3]), np.cross(w, m[:, 3:]) + np.cross(vo, m[:, :3])], 1)
-
-
-def _parent_transforms(mdl: NumericModel, poses: list[np.ndarray]) -> list[np.ndarray]:
-    """i_X_lambda(i) (N, 6, 6): motion vectors from the parent's body coordinates to body i's,
-    from base_T_i: with parent_T_i = (E, r), X = [[E^T, 0], [-E^T [r]x, E^T]]."""
-    out = []
-    for i, T in enumerate(poses):
-        p = mdl.parent[i]
-        if p < 0:
-            E, r = T[:, :3, :3], T[:, :3, 3]
-        else:  # parent_T_i = base_T_p^-1 base_T_i, with the rigid inverse (R^T, -R^T p)
-            Rp_t = np.swapaxes(poses[p][:, :3, :3], -1, -2)
-            E, r = Rp_t @ T[:, :3, :3], np.einsum("nij,nj->ni", Rp_t, T[:, :3, 3] - poses[p][:, :3, 3])
-        Et = np.swapaxes(E, -1, -2)
-        X = np.zeros((len(T), 6, 6))
-        X[:, :3, :3] = X[:, 3:, 3:] = Et
-        X[:, 3:, :3] = -Et @ skew(r)
-        out.append(X)
-    return out
-
-
 def _body_regressor(
     mdl: NumericModel, X: list[np.ndarray], qd_b: np.ndarray, qdd_b: np.ndarray
 ) -> np.ndarray:
     """Y_b (N, nb, 13 nb): the bodies' joint efforts tau_b = Y_b pi, in body coordinates."""
     N, nb = qd_b.shape
-    S = np.zeros((nb, 6))
-    S[mdl.revolute, :3] = mdl.axis[mdl.revolute]
-    S[~mdl.revolute, 3:] = mdl.axis[~mdl.revolute]
+    S = subspaces(mdl)
     Y = np.zeros((N, nb, PER_BODY * nb))
     v, a = [], []
     for i in range(nb):
         p = mdl.parent[i]
         v_p = np.zeros((N, 6)) if p < 0 else v[p]
         a_p = np.concatenate([np.zeros((N, 3)), np.broadcast_to(-mdl.gravity, (N, 3))], 1) if p < 0 else a[p]
-        vi = np.einsum("nij,nj->ni", X[i], v_p) + S[i] * qd_b[:, i, None]
-        ai = np.einsum("nij,nj->ni", X[i], a_p) + S[i] * qdd_b[:, i, None]
-        ai += _motion_cross(vi, S[i] * qd_b[:, i, None])  # + v_i x S_i qd_i
+        vi = mv(X[i], v_p) + S[i] * qd_b[:, i, None]
+        cross = crm(vi)
+        ai = mv(X[i], a_p) + S[i] * qdd_b[:, i, None] + mv(cross, S[i] * qd_b[:, i, None])  # + v_i x S_i qd_i
         v.append(vi)
         a.append(ai)
-        # A (N, 6, 10): column k = B_k a + v x* B_k v
-        A = np.einsum("kij,nj->nik", _BASIS, ai) + np.einsum("nij,kjl,nl->nik", _force_cross(vi), _BASIS, vi)
+        # A (N, 6, 10): column k = B_k a + v x* B_k v, with v x* = -(v x)^T
+        force_cross = -np.swapaxes(cross, -1, -2)
+        A = np.einsum("kij,nj->nik", _BASIS, ai) + np.einsum("nij,kjl,nl->nik", force_cross, _BASIS, vi)
         cols = slice(PER_BODY * i, PER_BODY * i + 10)
         j = i
         while True:  # carry body i's wrench down its support, S_j^T on every joint j it passes
@@ -141,7 +105,7 @@ def regressor(robot, q, qd, qdd, params=None) -> np.ndarray:
         SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
     """
     mdl, (q, qd, qdd), single = checked_inputs("regressor", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
-    X = _parent_transforms(mdl, forward_kinematics(robot, q, params))
+    X = motion_transforms(joint_poses(mdl, body_positions(mdl, q)))
     Y_b = _body_regressor(mdl, X, body_rates(mdl, qd), body_rates(mdl, qdd))
     Y = np.swapaxes(project(mdl, np.swapaxes(Y_b, 1, 2)), 1, 2)  # S^T Y_b, row by row
     return Y[0] if single else Y

@@ -50,7 +50,7 @@ def _imports(path: Path, parts: tuple[str, ...]):
 
 
 def _floor(parts: tuple[str, ...]) -> str:
-    return "rnea" if parts[0] in ("rnea_inputs", "rnea_regressor") else parts[0]  # the oracle's other modules
+    return "rnea" if parts[0] in ("rnea_inputs", "rnea_spatial", "rnea_regressor") else parts[0]  # the oracle
 
 
 @pytest.mark.parametrize(

@@ -390,10 +390,11 @@ def test_every_public_function_checks_its_arguments(name):
         assert np.shape(call(robot, batch, P_ARM))[0] == 3  # one result per state
 
 
-@pytest.mark.parametrize("module", ["rnea", "rnea_inputs"])
+@pytest.mark.parametrize("module", ["rnea", "rnea_inputs", "rnea_spatial"])
 def test_oracle_is_independent_of_symbolic_derivation(module):
-    """The oracle (rnea.py and its input side rnea_inputs.py) imports NumPy, the error type and
-    itself only: no SymPy, no symbolic derivation."""
+    """The oracle (rnea.py, its input side rnea_inputs.py and its spatial kinematics
+    rnea_spatial.py) imports NumPy, the error type and itself only: no SymPy, no symbolic
+    derivation."""
     source = (Path(rn.__file__).parent / f"{module}.py").read_text()
     imported = set()
     for node in ast.walk(ast.parse(source)):
@@ -409,6 +410,7 @@ def test_oracle_is_independent_of_symbolic_derivation(module):
         "numpy",
         "errors",
         "rnea_inputs",
+        "rnea_spatial",
         "sys",  # the callable-module hook that makes symdyn.rnea(...) a function too
         "types",
     }

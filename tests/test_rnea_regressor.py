@@ -146,7 +146,7 @@ def test_regressor_is_independent_of_the_symbolic_code():
     nodes = list(ast.walk(ast.parse(source)))
     modules = {n.module for n in nodes if isinstance(n, ast.ImportFrom)}
     modules |= {a.name for n in nodes if isinstance(n, ast.Import) for a in n.names}
-    assert modules <= {"__future__", "numpy", "rnea", "rnea_inputs"}
+    assert modules <= {"__future__", "numpy", "rnea_inputs", "rnea_spatial"}
     assert "sympy" not in source
 
 
