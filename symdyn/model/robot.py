@@ -24,6 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 import sympy as sp
@@ -172,7 +173,7 @@ class Robot:
 
     __str__ = __repr__
 
-    @property
+    @cached_property
     def n(self) -> int:
         """Number of independent joint coordinates (degrees of freedom)."""
         return sum(1 for link in self.links if link.mimic is None)
@@ -182,7 +183,7 @@ class Robot:
         """Number of moving bodies (links with a joint, mimic joints included)."""
         return len(self.links)
 
-    @property
+    @cached_property
     def parents(self) -> tuple[int, ...]:
         """lambda(i) per link: the index of its parent link, -1 for the base."""
         return tuple(i - 1 if link.parent is None else link.parent for i, link in enumerate(self.links))
@@ -192,7 +193,7 @@ class Robot:
         """A serial chain without mimic joints: every link carries the next."""
         return self.n == self.nb and is_chain(self.parents)
 
-    @property
+    @cached_property
     def coordinates(self) -> tuple[Coordinate, ...]:
         """Per link, how its joint position follows from the independent coordinates."""
         index = {}
