@@ -194,21 +194,33 @@ class Dynamics:
         """V + G + F = tau at qdd = 0, closed form."""
         return self.closed_form("bias")
 
-    def linear_compact(self) -> tuple[sp.Matrix, BaseParameters]:
+    def regressor_compact(self) -> sp.Matrix:
         """The regressor Y (n x 13 nb) over the intermediates of `program`, tau = Y pi with pi the
-        standard parameters (symdyn.standard_parameters), and the base parameters found from it
-        (symdyn.algorithms.regressor, symdyn.algorithms.base_parameters); computed on first use."""
-        if not self._linear:
-            Y = regressor_matrix(self.robot, self.q, self.qd, self.qdd, self.program)
+        standard parameters (symdyn.standard_parameters; symdyn.algorithms.regressor)."""
+        if "Y" not in self._linear:
+            self._linear["Y"] = regressor_matrix(self.robot, self.q, self.qd, self.qdd, self.program)
+        return self._linear["Y"]  # type: ignore[return-value]
+
+    def linear_compact(self) -> tuple[sp.Matrix, BaseParameters]:
+        """`regressor_compact()` and the base parameters found from it
+        (symdyn.algorithms.base_parameters); computed on first use.
+
+        Raises:
+            SymdynError: the base parameters depend on free parameters and some angle enters other
+                than as sin(q) and cos(q) (a mimic joint's multiplier, a joint offset).
+        """
+        Y = self.regressor_compact()
+        if "base" not in self._linear:
             names = standard_parameters(self.robot)[0]
-            base = find_base_parameters(self.robot, Y, self.program, self.q, self.qd, self.qdd, names)
-            self._linear.update(Y=Y, base=base)
-        return self._linear["Y"], self._linear["base"]  # type: ignore[return-value]
+            self._linear["base"] = find_base_parameters(
+                self.robot, Y, self.program, self.q, self.qd, self.qdd, names
+            )
+        return Y, self._linear["base"]  # type: ignore[return-value]
 
     @property
     def regressor(self) -> sp.Matrix:
         """Y(q, qd, qdd), n x 13 nb, closed form: tau = Y pi (pi: symdyn.standard_parameters)."""
-        return self._expanded("regressor", self.linear_compact()[0])
+        return self._expanded("regressor", self.regressor_compact())
 
     @property
     def base_parameters(self) -> tuple[tuple[str, sp.Expr], ...]:

@@ -16,6 +16,8 @@ import sympy as sp
 from robots import EXAMPLE_NAMES, assert_close, derived, derived_robot, random_params, random_state, y_robot
 
 import symdyn
+import symdyn.codegen
+from symdyn.errors import SymdynError
 from symdyn.model.parameters import numeric_parameters
 from symdyn.rnea_regressor import regressor as oracle_regressor
 
@@ -73,3 +75,34 @@ def test_base_regressor_is_the_kept_columns():
     Yb = dyn.base_regressor
     assert Yb.shape == (4, len(base.names))
     assert Yb == dyn.regressor.extract(list(range(4)), list(base.columns))
+
+
+def test_mimic_joint_with_a_symbolic_length_is_refused_clearly():
+    """q2 = 1.5 q1 and a free length a: the coefficients depend on a, and sin(1.5 q1) has no exact
+    rational evaluation, so one SymdynError asks for a value of a; with a value the base
+    parameters are found and agree with the oracle. The generated code leaves out base_regressor
+    with a SymdynWarning and keeps regressor."""
+    robot = symdyn.robot_from_data(MIMIC_SYM, source="test")
+    dyn = symdyn.derive(robot, simplify=False)
+    with pytest.raises(SymdynError, match="not as cos\\(1.5\\*q1\\).*give the free parameters values"):
+        dyn.linear_compact()
+    with pytest.warns(symdyn.SymdynWarning, match="base_regressor is not generated"):
+        files = symdyn.codegen.render(robot, targets=("python",))
+    assert (
+        "def regressor(" in files["mimic_sym_numpy.py"]
+        and "def base_regressor(" not in files["mimic_sym_numpy.py"]
+    )
+    valued = symdyn.robot_from_data({**MIMIC_SYM, "parameters": {"a": 0.4}}, source="test")
+    check(symdyn.derive(valued, simplify=False), seed=9)
+
+
+_BODY = {"mass": 1, "com": [0.1, 0.02, 0], "inertia": {"ixx": 0.1, "iyy": 0.2, "izz": 0.3}}
+MIMIC_SYM = {
+    "name": "mimic_sym",
+    "parameters": {"a": None},
+    "links": [
+        {"name": "l1", "joint": "revolute", "a": "a", "alpha": "pi/2", **_BODY},
+        {"name": "l2", "joint": "revolute", "a": "a", **_BODY, "mimic": {"joint": "l1", "multiplier": 1.5}},
+        {"name": "l3", "joint": "revolute", "a": 0.3, **_BODY},
+    ],
+}

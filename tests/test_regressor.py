@@ -43,7 +43,7 @@ RTOL = 1e-10
 
 def compact_function(dyn):
     """Y(q, qd, qdd, p) as NumPy over the compact form (the program's intermediates)."""
-    Y = dyn.linear_compact()[0]
+    Y = dyn.regressor_compact()
     steps = dyn.program.needed(list(Y))
     args = [list(dyn.q), list(dyn.qd), list(dyn.qdd), list(dyn.params)]
     return sp.lambdify(args, Y, modules="numpy", cse=lambda exprs: (steps, exprs))

@@ -23,13 +23,15 @@ RANK_TOL |R_00|. The kept columns are then chosen in the order of the standard p
 kept before it exceeds RANK_TOL, so parameters of later bodies regroup into earlier ones. Both
 counts must agree. beta solves W_1 beta = W_2 in the least-squares sense.
 
-Coefficients: for a robot with free parameters (symbolic lengths, masses) beta is found exactly.
-The closed forms of the columns involved are evaluated at states whose sines and cosines are
+Coefficients: when beta depends on the robot's free parameters (symbolic lengths: beta differs at
+two random values of them) it is found exactly.
+The closed forms of the columns involved (where every angle must enter as sin(q) and cos(q):
+else a SymdynError asks for the parameters' values) are evaluated at states whose sines and cosines are
 rational points of the unit circle ((1 - t^2) / (1 + t^2), 2 t / (1 + t^2)) with the numbers of
 the model made rational, and r independent rows solve W_1 beta = W_2 over the rational functions
-of the parameters; the result is checked against the numeric beta. For a robot whose parameters
-are all numbers each coefficient is the numeric beta: an integer or a fraction with a denominator
-up to 1000 when it is one to 1e-10, else the number to 12 significant digits, and 0 when its
+of the parameters; the result is checked against the numeric beta. Otherwise each coefficient is
+the numeric beta: an integer or a fraction with a denominator
+up to 12 when it is one to 1e-10, else the number to 12 significant digits, and 0 when its
 contribution is below 1e-9 of the column's.
 """
 
@@ -46,7 +48,7 @@ from ..errors import SymdynError
 from ..model.robot import Robot
 from ..symbolic.program import Program
 
-__all__ = ["BaseParameters", "find_base_parameters", "RANK_TOL", "ZERO_TOL", "STATES_PER_COLUMN"]
+__all__ = ["BaseParameters", "find_base_parameters", "evaluate", "RANK_TOL", "ZERO_TOL", "STATES_PER_COLUMN"]
 
 #: |R_kk| / |R_00| below this (unit-norm columns) counts as rank-deficient
 RANK_TOL = 1e-8
@@ -96,6 +98,52 @@ def _states(robot: Robot, rng: np.random.Generator, count: int):
     return q, qd, rng.uniform(-2, 2, (count, robot.n))
 
 
+def _value(e: sp.Expr, values: dict, memo: dict, count: int):
+    """e at `count` states: a NumPy array, or a float when it is a constant."""
+    if e.is_Symbol:
+        return values[e]
+    if e.is_Number:
+        return float(e)
+    hit = memo.get(e)
+    if hit is not None:
+        return hit
+    args = [_value(a, values, memo, count) for a in e.args]
+    if e.is_Add:
+        out = sum(args[1:], args[0])
+    elif e.is_Mul:
+        out = args[0]
+        for a in args[1:]:
+            out = out * a
+    elif e.is_Pow:
+        out = args[0] ** args[1]
+    elif isinstance(e, sp.sin):
+        out = np.sin(args[0])
+    elif isinstance(e, sp.cos):
+        out = np.cos(args[0])
+    elif isinstance(e, sp.sign):
+        out = np.sign(args[0])
+    else:
+        out = (
+            float(e)
+            if not e.free_symbols
+            else np.asarray(
+                sp.lambdify(list(e.free_symbols), e)(*(values[s] for s in e.free_symbols)), dtype=float
+            )
+        )
+    memo[e] = out
+    return out
+
+
+def evaluate(program: Program, outputs: list[sp.Expr], values: dict, count: int) -> np.ndarray:
+    """The outputs (over the program's intermediates) at `count` states, (len(outputs), count):
+    a direct NumPy walk of the needed assignments (the inputs' arrays in `values`)."""
+    values = dict(values)
+    memo: dict = {}
+    for sym, expr in program.needed(outputs):
+        values[sym] = _value(expr, values, memo, count)
+    return np.array([np.broadcast_to(_value(sp.sympify(e), values, memo, count), (count,)) for e in outputs])
+
+
 def _pivoted_rank(A: np.ndarray) -> int:
     """Rank of A (unit-norm columns) by Householder QR with column pivoting: |R_kk| > RANK_TOL |R_00|."""
     A = A.copy()
@@ -137,7 +185,7 @@ def _number(c: float, scale: float) -> sp.Expr:
     """A numeric coefficient as an integer, a small fraction or a 12-digit number (see the module)."""
     if abs(c) * scale < 1e-9:
         return sp.S.Zero
-    f = Fraction(c).limit_denominator(1000)
+    f = Fraction(c).limit_denominator(12)
     if abs(float(f) - c) <= 1e-10 * max(1.0, abs(c)):
         return sp.Rational(f.numerator, f.denominator)
     return sp.Float(float(f"{c:.12g}"), 15)
@@ -146,6 +194,14 @@ def _number(c: float, scale: float) -> sp.Expr:
 def _rational_trig(robot: Robot, q, qd, qdd, rng: np.random.Generator, program: Program, Y, cols, count):
     """Exact rows of Y[:, cols] at `count` states with rational sines and cosines (module docstring)."""
     exprs = program.expand([Y[r, c] for r in range(Y.rows) for c in cols])
+    joints = set(q) | {-x for x in q}
+    other = sorted({str(f) for e in exprs for f in e.atoms(sp.sin, sp.cos) if f.args[0] not in joints})
+    if other:
+        raise SymdynError(
+            f"robot '{robot.name}': the base parameters depend on its free parameters, and are found "
+            f"exactly only when the joint angles enter as sin(q) and cos(q), not as {other[0]} (a mimic "
+            "joint's multiplier or a joint offset): give the free parameters values"
+        )
     rows = []
     for _ in range(count):
         subs = {}
@@ -159,11 +215,7 @@ def _rational_trig(robot: Robot, q, qd, qdd, rng: np.random.Generator, program: 
         vals = []
         for e in exprs:
             e = e.xreplace({f: sp.Rational(str(f)) for f in e.atoms(sp.Float)}).xreplace(subs)
-            if set(e.free_symbols) - set(robot.params):
-                raise SymdynError(
-                    f"robot '{robot.name}': symbolic base parameters need joint angles that enter only "
-                    "as sin(q) and cos(q) (not with mimic multipliers); give the free parameters values"
-                )
+            assert e.free_symbols <= set(robot.params), e.free_symbols
             vals.append(sp.expand(e))
         rows += [vals[r * len(cols) : (r + 1) * len(cols)] for r in range(Y.rows)]
     return sp.Matrix(rows)
@@ -193,6 +245,17 @@ def _exact_beta(robot, q, qd, qdd, program, Y, kept, dependent, rng, beta_num, p
     return beta
 
 
+def _stacked(program: Program, Y: sp.Matrix, joints, states, p: dict) -> np.ndarray:
+    """Y at the states (q, qd, qdd arrays of shape (count, n)) stacked row block by row block,
+    with the free parameters' values p."""
+    count = len(states[0])
+    values: dict = {s: np.full(count, v) for s, v in p.items()}
+    for symbols, x in zip(joints, states, strict=True):
+        values.update({s: x[:, i] for i, s in enumerate(symbols)})
+    Ys = evaluate(program, list(Y), values, count)  # (entries, count)
+    return np.concatenate([Ys[r * Y.cols : (r + 1) * Y.cols].T for r in range(Y.rows)], axis=0)
+
+
 def find_base_parameters(
     robot: Robot, Y: sp.Matrix, program: Program, q, qd, qdd, names: tuple[str, ...]
 ) -> BaseParameters:
@@ -206,17 +269,11 @@ def find_base_parameters(
         names: the standard parameters' names (symdyn.standard_parameters), one per column.
     """
     rng = np.random.default_rng(_SEED)
-    steps = program.needed(list(Y))
     params = list(robot.params)
-    f = sp.lambdify([list(q), list(qd), list(qdd), params], Y, modules="numpy", cse=lambda e: (steps, e))
     p0 = {s: float(v) for s, v in zip(params, rng.uniform(0.5, 2.0, len(params)), strict=True)}
     count = -(-STATES_PER_COLUMN * Y.cols // robot.n) + 10
-    W = np.vstack(
-        [
-            np.asarray(f(*x, list(p0.values())), dtype=float)
-            for x in zip(*_states(robot, rng, count), strict=True)
-        ]
-    )
+    states = _states(robot, rng, count)
+    W = _stacked(program, Y, (q, qd, qdd), states, p0)
     norms = np.linalg.norm(W, axis=0)
     nonzero = [c for c in range(W.shape[1]) if norms[c] > ZERO_TOL * norms.max()]
     A = W[:, nonzero] / norms[nonzero]
@@ -230,7 +287,13 @@ def find_base_parameters(
     dependent = [c for c in nonzero if c not in kept]
     beta = np.linalg.lstsq(W[:, kept], W[:, dependent], rcond=None)[0] if dependent else np.zeros((rank, 0))
     assert np.allclose(W[:, kept] @ beta, W[:, dependent], atol=1e-8 * norms.max())
+    exact = False
     if params and dependent:
+        p1 = {s: float(v) for s, v in zip(params, rng.uniform(0.5, 2.0, len(params)), strict=True)}
+        W1 = _stacked(program, Y, (q, qd, qdd), states, p1)
+        beta1 = np.linalg.lstsq(W1[:, kept], W1[:, dependent], rcond=None)[0]
+        exact = not np.allclose(beta, beta1, rtol=1e-9, atol=1e-12 * np.abs(beta).max())
+    if exact:  # the coefficients depend on the free parameters
         coeffs = _exact_beta(robot, q, qd, qdd, program, Y, kept, dependent, rng, beta, p0)
     else:
         coeffs = sp.Matrix(
