@@ -20,6 +20,7 @@ from ..dynamics import METHODS, derive
 from ..errors import SymdynError, SymdynWarning
 from .apps import register
 from .common import add_robot_argument, load_robot_argument
+from .identification import register as register_identification
 
 __all__ = ["main"]
 
@@ -135,6 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
     g.set_defaults(func=cmd_generate)
     register(sub)  # simulate, analyze, check (the lecture's applications)
+    register_identification(sub)  # identify, excite
     return parser
 
 
