@@ -23,7 +23,7 @@ from .errors import SymdynError, SymdynWarning  # noqa: E402
 from .model import inertia  # noqa: E402
 from .model.parameters import standard_parameters  # noqa: E402
 from .model.robot import Link, Robot  # noqa: E402
-from .parsers import load_robot, load_urdf, robot_from_data  # noqa: E402
+from .parsers import load_robot, load_urdf, robot_from_data, robot_from_poe  # noqa: E402
 
 # `symdyn.inertia` and `symdyn.kinematics` are public modules: keep `import symdyn.inertia` working.
 _sys.modules[__name__ + ".inertia"] = inertia
@@ -44,5 +44,6 @@ __all__ = [
     "load_urdf",
     "rnea",
     "robot_from_data",
+    "robot_from_poe",
     "standard_parameters",
 ]
