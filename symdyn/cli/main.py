@@ -75,6 +75,10 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    if args.steps or args.at:
+        from .steps import cmd_derive_steps
+
+        return cmd_derive_steps(args)
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
@@ -119,6 +123,10 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         help="trigonometric simplification of the closed forms (auto: up to 3 joints)",
     )
+    d.add_argument(
+        "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"
+    )
+    d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
     d.set_defaults(func=cmd_derive)
 
     g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
