@@ -134,7 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument(
         "--target",
         action="append",
-        choices=("c", "casadi", "python", "latex"),
+        choices=("c", "casadi", "python", "latex", "matlab"),
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")
