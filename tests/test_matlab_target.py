@@ -68,6 +68,7 @@ def octave(tmp_path_factory):
                 "qdd": qdd,
                 "tau": rng.uniform(-5, 5, robot.n),
                 "p": random_params(robot, rng),
+                "F": rng.normal(size=6),  # the end-effector wrench of tip_wrench_torque (PoE robots)
             }
             for spec in _context(name).functions:
                 args = [values[i.name] for i in spec.inputs]

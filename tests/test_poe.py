@@ -9,6 +9,7 @@ from the numeric oracle symdyn.rnea. The lists of a robot file are read with yam
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import itertools
 import tempfile
 from functools import cache
@@ -22,6 +23,7 @@ import yaml
 from robots import assert_close
 
 import symdyn
+import symdyn.codegen
 from symdyn.algorithms.kinematics import frame_poses
 from symdyn.algorithms.tip_wrench import body_jacobian
 from symdyn.errors import SymdynError
@@ -349,3 +351,34 @@ def test_frames_and_jacobian_match_modern_robotics_kinematics():
     assert_close(np.array(frames[5].matrix(), dtype=float), T)
     Jb = np.array(body_jacobian(robot, list(q)), dtype=float)
     assert_close(mr.Adjoint(T) @ Jb, mr.JacobianSpace(Slist, q))
+
+
+def test_generated_tip_wrench_torque_matches_modern_robotics(tmp_path):
+    """tip_wrench_torque(q, F, p) of the generated NumPy and CasADi code (PoE robots only)."""
+    import casadi
+
+    robot = symdyn.load_robot(EXAMPLES / "mr_ur5.yaml")
+    Mlist, Glist, Slist = lists_from_file(EXAMPLES / "mr_ur5.yaml")
+    files = symdyn.codegen.render(robot, targets=("python", "casadi"))
+    for name, content in files.items():
+        (tmp_path / name).write_bytes(content.encode() if isinstance(content, str) else content)
+    module = _import(tmp_path / "mr_ur5_numpy.py")
+    function = casadi.Function.load(str(tmp_path / "mr_ur5_tip_wrench_torque.casadi"))
+    rng = np.random.default_rng(9)
+    q, F = rng.uniform(-np.pi, np.pi, (4, 6)), rng.normal(size=(4, 6))
+    want = np.array([mr.EndEffectorForces(q[k], F[k], Mlist, Glist, Slist) for k in range(4)])
+    assert_close(module.tip_wrench_torque(q, F), want, 1e-12)
+    assert_close(np.array(function(q[0], F[0], [])).ravel(), want[0], 1e-12)
+    assert (
+        "tip_wrench_torque"
+        not in symdyn.codegen.render(symdyn.load_robot(EXAMPLES / "roger_arm.yaml"), ("c",))[
+            "roger_arm_dynamics.h"
+        ]
+    )
+
+
+def _import(path: Path):
+    spec = importlib.util.spec_from_file_location(path.stem + "_poe_test", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
