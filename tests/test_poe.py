@@ -26,6 +26,7 @@ import symdyn
 import symdyn.codegen
 from symdyn.algorithms.kinematics import frame_poses
 from symdyn.algorithms.tip_wrench import body_jacobian
+from symdyn.apps.check import check_answers
 from symdyn.errors import SymdynError
 from symdyn.parsers import load_urdf, robot_from_data
 from symdyn.parsers.poe import robot_from_poe
@@ -382,3 +383,28 @@ def _import(path: Path):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def test_ur5_answers_are_modern_robotics_numbers_and_check_confirms_them():
+    """examples/answers/mr_ur5_answers.yaml holds modern_robotics' own numbers (recomputed here)
+    at the state it names, and `symdyn check` matches them; a changed digit is caught."""
+    answers = EXAMPLES / "answers" / "mr_ur5_answers.yaml"
+    data = yaml.safe_load(answers.read_text())
+    Mlist, Glist, Slist = lists_from_file(EXAMPLES / "mr_ur5.yaml")
+    q, qd, qdd = (np.array(data["at"][k]) for k in ("q", "qd", "qdd"))
+    g = [0, 0, -9.81]
+    assert_close(q, [0, np.pi / 6, np.pi / 4, np.pi / 3, np.pi / 2, 2 * np.pi / 3], 1e-15)
+    assert_close(np.array(data["M"]), mr.MassMatrix(q, Mlist, Glist, Slist), 1e-11)
+    assert_close(data["V"], mr.VelQuadraticForces(q, qd, Mlist, Glist, Slist), 1e-11)
+    assert_close(data["G"], mr.GravityForces(q, g, Mlist, Glist, Slist), 1e-11)
+    assert_close(data["tau"], mr.InverseDynamics(q, qd, qdd, g, np.zeros(6), Mlist, Glist, Slist), 1e-11)
+    robot = symdyn.load_robot(EXAMPLES / "mr_ur5.yaml")
+    report = check_answers(robot, answers)
+    assert report.ok and len(report.results) == 54
+    data["tau"][1] = -41.0704
+    report = check_answers(robot, data)
+    assert [r.label for r in report.differing] == ["tau[2]"]
+    with pytest.raises(SymdynError, match="unknown name"):
+        check_answers(robot, {**data, "at": {**data["at"], "m9": 1.0}})
+    with pytest.raises(SymdynError, match="checked symbolically"):
+        check_answers(robot, {**data, "steps": {1: {"omega": [0, 0, "qd1"]}}})

@@ -38,6 +38,7 @@ from ..errors import SymdynError
 from ..model.expressions import parse_expression
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
+from .check_state import AT_KEY, TOLERANCE_KEY, compare_at_state
 from .check_steps import check_steps
 
 __all__ = [
@@ -76,10 +77,11 @@ def parse_answers(data: object, robot: Robot, file: str | None = None) -> dict[s
     if not isinstance(data, Mapping):
         kind = "empty file" if data is None else type(data).__name__
         raise SymdynError(f"expected a mapping of M, C, V, G, F, tau to answers, got {kind}", file=file)
-    unknown = [str(k) for k in data if k not in (*QUANTITIES, STEPS_KEY)]
+    unknown = [str(k) for k in data if k not in (*QUANTITIES, STEPS_KEY, AT_KEY, TOLERANCE_KEY)]
     if unknown:
         raise SymdynError(
-            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)} and {STEPS_KEY})",
+            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)} and {STEPS_KEY}, "
+            f"or numbers {AT_KEY} a state with a {TOLERANCE_KEY})",
             file=file,
         )
     if not data:
@@ -160,7 +162,8 @@ class EntryResult:
     """One compared entry: 1-based `index`, symdyn's `expected` and the answer's `got`.
 
     status: "symbolic" (the difference simplifies to 0), "numeric" (equal at every
-    random point, simplification inconclusive) or "differs".
+    random point, simplification inconclusive), "at the state" (numbers at the state of an
+    `at:` key, symdyn.apps.check_state) or "differs".
     """
 
     quantity: str
@@ -205,6 +208,8 @@ class CheckReport:
         names = ", ".join([f"{steps} step{'s' * (steps != 1)}"] * bool(steps) + finals)
         if self.ok:
             numeric = sum(r.status == "numeric" for r in self.results)
+            if any(r.status == "at the state" for r in self.results):
+                return f"{self.robot}: all {total} entries of {names} match at the given state"
             how = (
                 "all symbolically"
                 if not numeric
@@ -299,6 +304,12 @@ def check_answers(
         ]
     )
     report = CheckReport(robot.name, method, samples)
+    if AT_KEY in data:
+        if STEPS_KEY in data:
+            raise SymdynError(f"{STEPS_KEY} are checked symbolically: leave out {AT_KEY}", file=file)
+        at = compare_at_state(dyn, parsed, data[AT_KEY], data.get(TOLERANCE_KEY), file)
+        report.results = [EntryResult(*r) for r in at]
+        return report
     if STEPS_KEY in data:
         steps, report.first_step = check_steps(
             robot,
