@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ...errors import SymdynError
+from ..printing import free_name
 from ..render import RenderContext
 
 __all__ = ["MatlabNames", "matlab_names", "MATLAB_RESERVED", "TEMPORARY", "NAME_LENGTH_MAX"]
@@ -87,11 +88,6 @@ def matlab_names(ctx: RenderContext) -> MatlabNames:
     for p in ctx.dynamics.params:
         if p in locals_:
             raise SymdynError(f"robot '{name}': parameter name {p} clashes with a joint symbol")
-        base = candidate = str(p)
-        k = 0
-        while candidate in reserved or candidate in used or TEMPORARY.match(candidate):
-            candidate = f"{base}_" if k == 0 else f"{base}_{k}"
-            k += 1
-        locals_[p] = candidate
-        used.add(candidate)
+        locals_[p] = free_name(str(p), reserved | used, TEMPORARY)
+        used.add(locals_[p])
     return MatlabNames(functions, locals_)
