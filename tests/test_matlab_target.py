@@ -5,7 +5,8 @@ a product-of-exponentials robot) are written to a temporary folder, and one octa
 for the whole module calls every generated function at random states, printing the outputs
 to 17 significant digits. The seven functions must equal the C target's (compiled with the
 strict flags, tests/cbuild.py) and every function (other families included) the NumPy
-target's, to a relative 1e-12. Then: the header and the operation counts are those of the other
+target's, to a relative 1e-12; the same run leaves p out for a robot without parameters and
+passes wrong input sizes. Then: the header and the operation counts are those of the other
 targets, p may be left out for a robot without parameters, a wrong input size is one error,
 and names MATLAB cannot take are refused.
 """
@@ -79,6 +80,7 @@ def octave(tmp_path_factory):
                     lines.append(
                         f"fprintf('@ {name} {spec.name} {s} {k}'); fprintf(' %.17g', o{k}.'); fprintf('\\n');"
                     )
+    lines.append(EXTRA_CALLS)  # p left out, wrong sizes: in the same Octave run
     script = root / "run_all.m"
     script.write_text("\n".join(lines) + "\n")
     done = subprocess.run(
@@ -95,7 +97,8 @@ def octave(tmp_path_factory):
             _, robot, fname, s, k, *nums = line.split()
             results.setdefault((robot, fname, int(s)), {})[int(k)] = np.array([float(x) for x in nums])
     assert len(results) == len(calls), done.stderr[-2000:]
-    return root, results, calls
+    extra = [line[2:] for line in done.stdout.splitlines() if line.startswith("# ")]
+    return root, results, calls, extra
 
 
 @cache
@@ -117,7 +120,7 @@ def _numpy_module(name: str, folder: Path):
 @pytest.mark.skipif(not compilers(), reason="no C compiler")
 @pytest.mark.parametrize("name", ROBOTS)
 def test_octave_equals_the_c_and_numpy_targets(octave, name, tmp_path):
-    root, results, calls = octave
+    root, results, calls, _ = octave
     lib = _c_library(name, str(tmp_path))
     module = _numpy_module(name, tmp_path)
     for (robot, fname, s), (spec, values) in calls.items():
@@ -149,25 +152,30 @@ def test_header_op_counts_and_one_file_per_function():
     assert "p: the 0 free parameters, or [] (or left out): the robot has none" in files["puma560_gravity.m"]
 
 
+#: Octave statements run after the comparisons: p left out for a robot without parameters, and
+#: wrong input sizes; each prints one line starting with "# ".
+EXTRA_CALLS = """
+g = puma560_gravity(zeros(1, 6)); fprintf('# %d\\n', numel(g));
+try
+  puma560_gravity([1 2 3]);
+catch err
+  fprintf('# %s\\n', err.message);
+end
+try
+  roger_arm_gravity([0 0], [1 2]);
+catch err
+  fprintf('# %s\\n', err.message);
+end
+"""
+
+
 def test_p_left_out_and_wrong_sizes(octave):
-    root, _, _ = octave
-    script = (
-        "addpath('puma560'); g = puma560_gravity(zeros(1, 6)); fprintf('%d\\n', numel(g));\n"
-        "try\n  puma560_gravity([1 2 3]);\ncatch err\n  disp(err.message);\nend\n"
-        "addpath('roger_arm');\n"
-        "try\n  roger_arm_gravity([0 0], [1 2]);\ncatch err\n  disp(err.message);\nend\n"
-    )
-    done = subprocess.run(
-        [OCTAVE, "--no-gui", "--quiet", "--norc", "--no-history", "--eval", script],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        cwd=root,
-    )
-    out = done.stdout.splitlines()
-    assert out[0] == "6"
-    assert out[1] == "puma560_gravity: q must have 6 entries, got 3"
-    assert out[2] == "roger_arm_gravity: p must have 5 entries, got 2"
+    *_, extra = octave
+    assert extra == [
+        "6",
+        "puma560_gravity: q must have 6 entries, got 3",
+        "roger_arm_gravity: p must have 5 entries, got 2",
+    ]
 
 
 def test_printer_spells_matlab():
