@@ -167,9 +167,10 @@ def test_files_signatures_and_module_text(name, generated):
             assert f.name() == spec.name
             assert f.name_in() == [inp.name for inp in spec.inputs]
             assert [f.size_in(i) for i in range(f.n_in())] == [(sizes[x], 1) for x in f.name_in()]
-            assert f.name_out() == [spec.output]
-            assert f.size_out(0) == spec.shape
-            assert f.sparsity_out(0).is_dense()
+            assert f.name_out() == [r.name for r in spec.results]
+            for i, r in enumerate(spec.results):
+                assert f.size_out(i) == (r.rows, r.cols)
+                assert f.sparsity_out(i).is_dense()
         assert g.functions[spec.name].serialize() == g.loaded[spec.name].serialize()
 
 

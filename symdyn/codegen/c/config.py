@@ -97,6 +97,7 @@ class CNames:
     functions: dict[str, str]  # spec name -> C function name
     locals: dict[sp.Symbol, str]  # input symbol -> C local name
     param_macro: dict[sp.Symbol, str]  # parameter symbol -> its index macro
+    dims: dict[str, str]  # size name of an output (symdyn.codegen.functions.DIMS) -> C expression
 
 
 def _aliases(written: list[str], taken: set[str]) -> tuple[tuple[str, str], ...]:
@@ -144,7 +145,10 @@ def c_names(ctx: RenderContext) -> CNames:
             f"robot '{name}': parameter name(s) {', '.join(clash)} clash with the joint or effort "
             "symbols of the generated functions"
         )
-    reserved = C_RESERVED | taken | {a for a, _ in aliases}
+    arguments = {r.name for f in ctx.functions for r in f.results} | {
+        inp.name for f in ctx.functions for inp in f.inputs
+    }
+    reserved = C_RESERVED | taken | {a for a, _ in aliases} | arguments
     used = {str(s) for s in joint_symbols}
     local_names: dict[sp.Symbol, str] = {s: str(s) for s in joint_symbols}
     for s in joint_symbols:
@@ -171,4 +175,5 @@ def c_names(ctx: RenderContext) -> CNames:
         functions=functions,
         locals=local_names,
         param_macro=param_macro,
+        dims={"1": "1", "n": ndof, "2n": f"(2*{ndof})"},
     )

@@ -48,21 +48,33 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         for s in used:
             index = names.param_macro[s] if inp.name == "p" else str(inp.symbols.index(s))
             reads.append((names.locals[s], inp.name, index))
-    rows, cols = spec.shape
-    assert len(spec.outputs) == rows * cols and cols in (1, ctx.robot.n), f"{spec.name}: shape {spec.shape}"
+    outputs = []
+    for result in spec.results:
+        rows, cols = (names.dims[d] for d in result.dims)
+        if result.matrix:
+            size = f"{rows}*{cols} values, row-major: {result.name}[i*{cols} + j] is row i, column j"
+        else:
+            size = f"{rows} values"
+        entries = spec.entries(result)
+        outputs.append(
+            {
+                "name": result.name,
+                "doc": result.doc,
+                "size": size,
+                "stores": [(k, printer.doprint(e)) for k, e in enumerate(entries)],
+            }
+        )
     return {
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
         "ops": spec.ops.summary(),
         "inputs": inputs,
-        "output": spec.output,
-        "matrix": cols > 1,
-        "width": max(len(a) for a in [*(inp.name for inp in spec.inputs), spec.output]),
+        "outputs": outputs,
+        "width": max(len(a) for a in [*(inp.name for inp in spec.inputs), *(r.name for r in spec.results)]),
         "unused": unused,
         "reads": reads,
         "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in spec.temporaries],
-        "stores": [(k, printer.doprint(e)) for k, e in enumerate(spec.outputs)],
     }
 
 

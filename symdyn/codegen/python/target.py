@@ -25,9 +25,6 @@ __all__ = ["render", "file_name", "TOOLS"]
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_numpy.py": ("sympy",)}
 
-#: Outputs that stay matrices even for one joint (shape (1, 1)); the others are vectors.
-_MATRICES = ("M", "C")
-
 
 def file_name(name: str) -> str:
     return f"{name}_numpy.py"
@@ -36,7 +33,6 @@ def file_name(name: str) -> str:
 def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
     """One function as data: arguments, the input elements it reads, temporaries, output entries."""
     free = spec.free_symbols
-    rows, cols = spec.shape
     return {
         "name": spec.name,
         "doc": spec.doc,
@@ -50,9 +46,14 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
             if s in free
         ],
         "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in spec.temporaries],
-        "output": spec.output,
-        "shape": [rows, cols] if spec.output in _MATRICES else [rows],
-        "entries": [printer.doprint(e) for e in spec.outputs],
+        "outputs": [
+            {
+                "name": r.name,
+                "shape": [r.rows, r.cols] if r.matrix else [r.rows],
+                "entries": [printer.doprint(e) for e in spec.entries(r)],
+            }
+            for r in spec.results
+        ],
     }
 
 
