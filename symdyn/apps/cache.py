@@ -24,6 +24,7 @@ import shutil
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 from .. import __version__
@@ -51,9 +52,25 @@ def cache_dir() -> Path:
     return Path(platformdirs.user_cache_dir("symdyn", appauthor=False))
 
 
+@lru_cache(maxsize=1)
+def code_fingerprint() -> str:
+    """SHA-256 over the name, size and modification time of symdyn's modules and templates.
+
+    Part of every key, so that an edited checkout (same version number) never reuses
+    artefacts of other code; it costs a stat per file, not a read.
+    """
+    package = Path(__file__).resolve().parents[1]
+    files = sorted(
+        [*package.rglob("*.py"), *package.parent.glob("templates/*/*.j2"), *package.glob("templates/*/*.j2")]
+    )
+    stamp = [(str(f.relative_to(f.parents[1])), f.stat().st_size, f.stat().st_mtime_ns) for f in files]
+    return hashlib.sha256(json.dumps(stamp).encode()).hexdigest()
+
+
 def entry_key(**parts) -> str:
-    """A SHA-256 (hex) over symdyn's version, the cache format and `parts` (JSON-serialisable)."""
-    text = json.dumps({"symdyn": __version__, "format": FORMAT, **parts}, sort_keys=True)
+    """A SHA-256 (hex) over symdyn's version and code, the cache format and `parts` (JSON-ready)."""
+    head = {"symdyn": __version__, "code": code_fingerprint(), "format": FORMAT}
+    text = json.dumps({**head, **parts}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()
 
 

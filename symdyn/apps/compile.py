@@ -14,10 +14,11 @@ are not square. One state (vectors of their size) runs one C call; a batch (lead
 axes, e.g. (B, n)) runs one call of NAME_batch, whose loop is in C. Joint quantities are
 in joint space (rad or m), the base frame fixes gravity, as in docs/generated-code.md.
 
-The binding is cffi's ABI mode: measured on this machine, a 7-joint function called with
+The methods bind through cffi's ABI mode: measured on this machine, a 7-joint function called with
 NumPy arrays costs about 2.7 us through cffi (ffi.from_buffer) against 5.8-6.3 us through
-ctypes (docs/speed.md). Without a C compiler the methods are the generated NumPy
-module's, with one warning.
+ctypes (docs/speed.md). cffi parses the declarations when a method is first used (about
+0.1 s), so the stepping loop, called once per run, goes through ctypes instead. Without a C
+compiler the methods are the generated NumPy module's, with one warning.
 """
 
 from __future__ import annotations
@@ -56,7 +57,9 @@ def _canonical(value):
     """A deterministic, content-only description of a robot (dataclasses, tuples, SymPy objects)."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return [type(value).__name__] + [
-            [f.name, _canonical(getattr(value, f.name))] for f in dataclasses.fields(value) if f.name != "source"
+            [f.name, _canonical(getattr(value, f.name))]
+            for f in dataclasses.fields(value)
+            if f.name != "source"
         ]
     if isinstance(value, (tuple, list)):
         return [_canonical(v) for v in value]
@@ -76,7 +79,7 @@ def robot_digest(robot) -> str:
 
 
 def _options(method: str, precision: str = "double") -> dict:
-    from ..codegen.c.build import COMPILE_FLAGS, find_compiler
+    from .build import COMPILE_FLAGS, find_compiler
 
     compiler = find_compiler()
     return {
@@ -91,11 +94,11 @@ def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
     """build(folder): derive, generate (C, NumPy, runtime), compile; return the entry's metadata."""
 
     def build(folder: Path) -> dict:
-        from ..codegen import context
         from ..codegen import c as c_target
+        from ..codegen import context
         from ..codegen import python as numpy_target
-        from ..codegen.c.build import compile_library, library_suffix
         from ..codegen.c.runtime import function_table, render_runtime
+        from .build import compile_library, library_suffix
 
         ctx = context(robot, options["precision"], method)
         files = {**c_target.render(ctx), **render_runtime(ctx), **numpy_target.render(ctx)}
@@ -104,7 +107,11 @@ def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
         library = None
         if options["compiler"]:
             library = f"lib{ctx.name}{library_suffix()}"
-            compile_library(options["compiler"], {k: v for k, v in files.items() if k.endswith((".c", ".h"))}, folder / library)
+            compile_library(
+                options["compiler"],
+                {k: v for k, v in files.items() if k.endswith((".c", ".h"))},
+                folder / library,
+            )
         return {
             "robot": {"name": ctx.name, "n": ctx.robot.n, "params": [str(s) for s in ctx.dynamics.params]},
             "functions": function_table(ctx),
@@ -131,7 +138,7 @@ def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: 
     return CompiledDynamics._from_entry(entry, robot, params)
 
 
-def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamics:  # noqa: A001
+def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamics:
     """The robot's generated functions compiled to C, with its free parameters bound to `params`.
 
     params: None (no free parameters), a map name -> value, or one value per free parameter
@@ -142,7 +149,12 @@ def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamic
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
-    return cached_dynamics({"robot": robot_digest(robot)}, lambda: robot, params, method)
+    from ..codegen.functions import FAMILIES
+
+    families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
+    return cached_dynamics(
+        {"robot": robot_digest(robot), "families": families}, lambda: robot, params, method
+    )
 
 
 def _bind(names: list[str], robot, params) -> np.ndarray | None:
@@ -164,7 +176,9 @@ def _bind(names: list[str], robot, params) -> np.ndarray | None:
     else:
         given = [float(v) for v in params]
         if len(given) != len(names):
-            raise SymdynError(f"parameters: expected {len(names)} values ({', '.join(names)}), got {len(given)}")
+            raise SymdynError(
+                f"parameters: expected {len(names)} values ({', '.join(names)}), got {len(given)}"
+            )
         by_name = dict(zip(names, given, strict=True))
     return np.array([float(by_name[n]) for n in names], dtype=np.float64) if names else None
 
@@ -192,20 +206,39 @@ class CompiledDynamics:
         self._entry = entry
         self._module = None
         self.functions = tuple(f["name"] for f in meta["functions"])
-        lib = _load_library(entry.file(meta["library"]), meta["functions"]) if meta["library"] else None
-        if lib is None:
+        self._library = entry.file(meta["library"]) if meta["library"] else None
+        self.backend = "c" if self._library is not None else "numpy"
+        if self._library is None:
             _warn_fallback()
-            self.backend = "numpy"
             for f in meta["functions"]:
                 setattr(self, f["name"], _numpy_method(self, f["name"]))
-        else:
-            self.backend = "c"
-            self.ffi, self.lib = lib
-            p_ptr = self.ffi.NULL if self.p is None else self.ffi.from_buffer("double[]", self.p)
-            self._p_ptr = p_ptr
-            for f in meta["functions"]:
-                setattr(self, f["name"], _c_method(self.ffi, self.lib, f, p_ptr))
         return self
+
+    def __getattr__(self, name: str):
+        """The C methods, bound on first use (cffi parses the declarations then: ~0.1 s)."""
+        entry = self.__dict__.get("_entry")
+        if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
+            raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
+        ffi, lib = _load_library(self._library, entry.meta["functions"])
+        p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
+        for f in entry.meta["functions"]:
+            setattr(self, f["name"], _c_method(ffi, lib, f, p_ptr))
+        return self.__dict__[name]
+
+    @property
+    def cdll(self):
+        """The library through ctypes (loads in microseconds; symdyn.apps.stepping calls it once per run)."""
+        assert self.backend == "c"
+        import ctypes
+
+        return _CDLLS.setdefault(str(self._library), ctypes.CDLL(str(self._library)))
+
+    def pointer(self, name: str) -> int:
+        """The address of the C function `name` (for the stepping loop's function pointers)."""
+        import ctypes
+
+        c_name = next(f["c_name"] for f in self._entry.meta["functions"] if f["name"] == name)
+        return ctypes.cast(getattr(self.cdll, c_name), ctypes.c_void_p).value
 
     @property
     def n(self) -> int:
@@ -223,14 +256,9 @@ class CompiledDynamics:
             self._module = module
         return self._module
 
-    def pointer(self, name: str):
-        """The C function `name` of the library (for symdyn_simulate), or NULL with the NumPy backend."""
-        assert self.backend == "c"
-        c_name = next(f["c_name"] for f in self._entry.meta["functions"] if f["name"] == name)
-        return self.ffi.addressof(self.lib, c_name)
-
     def __repr__(self) -> str:
-        return f"<CompiledDynamics {self.robot.name}: {self.n} joints, {self.backend}, {', '.join(self.functions)}>"
+        names = ", ".join(self.functions)
+        return f"<CompiledDynamics {self.robot.name}: {self.n} joints, {self.backend}, {names}>"
 
 
 def compile_source(path: Path):
@@ -244,7 +272,11 @@ def _warn_fallback() -> None:
     global _warned
     if not _warned:
         _warned = True
-        warnings.warn(f"no C compiler found: using the generated NumPy module, {_FALLBACK_NOTE}", SymdynWarning, stacklevel=4)
+        warnings.warn(
+            f"no C compiler found: using the generated NumPy module, {_FALLBACK_NOTE}",
+            SymdynWarning,
+            stacklevel=4,
+        )
 
 
 def _numpy_method(owner: CompiledDynamics, name: str) -> Callable:
@@ -256,23 +288,18 @@ def _numpy_method(owner: CompiledDynamics, name: str) -> Callable:
 
 
 def _declarations(functions: list[dict]) -> str:
-    """The cdef of every generated function, its batch wrapper and the stepping loop."""
+    """The cdef of every generated function and its batch wrapper."""
     lines = []
     for f in functions:
         ins = ", ".join(f"const double {name}[]" for name, _ in f["inputs"])
         outs = ", ".join(f"double {name}[]" for name, *_ in f["outputs"])
         lines.append(f"void {f['c_name']}({ins}, {outs});")
         lines.append(f"void {f['c_name']}_batch(long count, {ins}, {outs});")
-    lines.append(
-        "long symdyn_simulate(int n, int scheme, long k0, long k1, const double h[], void *forward, "
-        "const double p[], const double *torque, void *inverse, void *friction, const double pm[], "
-        "const double *reference, const double Kp[], const double Kd[], double Q[], double QD[], "
-        "double U[], double work[]);"
-    )
     return "\n".join(lines)
 
 
 _LIBRARIES: dict[str, tuple] = {}
+_CDLLS: dict = {}
 
 
 def _load_library(path: Path, functions: list[dict]):
@@ -321,7 +348,10 @@ def _batch_call(batch, buf, arrays, sizes, names, p_args, shapes, one, name):
             raise ValueError(f"{name}: {n} must have shape ({s},) or (..., {s}); got {a.shape}")
     lead = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
     count = int(np.prod(lead, dtype=np.int64))
-    flat = [np.ascontiguousarray(np.broadcast_to(a, (*lead, s))).reshape(count, s) for a, s in zip(arrays, sizes, strict=True)]
+    flat = [
+        np.ascontiguousarray(np.broadcast_to(a, (*lead, s))).reshape(count, s)
+        for a, s in zip(arrays, sizes, strict=True)
+    ]
     outs = [np.empty((*lead, *shape)) for shape in shapes]
     if count:
         batch(count, *[buf("double[]", a) for a in flat], *p_args, *[buf("double[]", o) for o in outs])

@@ -12,12 +12,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import replace
-
-import sympy as sp
+from typing import TYPE_CHECKING
 
 from ..errors import SymdynError
-from ..model.robot import Robot
 from .compile import CompiledDynamics
+
+if TYPE_CHECKING:
+    from ..model.robot import Robot
 
 __all__ = ["CompiledDynamics", "compiled_dynamics", "with_parameters"]
 
@@ -28,6 +29,8 @@ def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
     The result has those parameters as values (no longer free). A value the file
     wrote as an expression of another parameter keeps the number it had.
     """
+    import sympy as sp
+
     if not values:
         return robot
     known = {str(s): s for s in (*robot.params, *(s for s, _ in robot.values))}
@@ -48,11 +51,11 @@ def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
 def compiled_dynamics(robot: Robot | CompiledDynamics, params=None) -> CompiledDynamics:
     """A CompiledDynamics for a Robot (or the given one unchanged when params is None)."""
     if isinstance(robot, CompiledDynamics):
-        if params is not None:
-            if not isinstance(robot.robot, Robot):
-                raise SymdynError("new parameter values need the Robot, not a cached CompiledDynamics")
-            return CompiledDynamics(robot.robot, params)
-        return robot
+        if params is None:
+            return robot
+        robot = robot.robot
+    from ..model.robot import Robot
+
     if not isinstance(robot, Robot):
         raise SymdynError(f"expected a Robot, not {type(robot).__name__}")
     return CompiledDynamics(robot, params)

@@ -146,8 +146,10 @@ def track(
     integrator: str = "rk4",
     params=None,
     progress: bool | None = None,
+    rtol: float = 1e-6,
+    atol: float = 1e-9,
 ) -> Trajectory:
-    """Simulate the plant under `controller` tracking `reference`.
+    """Simulate the plant under `controller` tracking `reference` (rtol, atol: rk45 and dop853 only).
 
     q0, qd0 default to the reference's initial position and velocity. The result
     carries q_ref and qd_ref at the sample times.
@@ -163,6 +165,8 @@ def track(
         integrator=integrator,
         params=params,
         progress=progress,
+        rtol=rtol,
+        atol=atol,
     )
     q_ref, qd_ref, _ = reference(traj.t)
     if traj.q.ndim == 3:

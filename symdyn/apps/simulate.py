@@ -35,18 +35,21 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-import sympy as sp
 
 from ..errors import SymdynError
-from ..model.expressions import parse_expression
-from ..model.robot import Robot
 from . import stepping
 from .compiled import CompiledDynamics, compiled_dynamics, with_parameters
 from .output import write_atomic
-from .stepping import sample_times, torque_rows
+from .stepping import ADAPTIVE, INTEGRATORS, sample_times, torque_rows
 from .trajectory import Trajectory, plot_trajectory
+
+if TYPE_CHECKING:
+    import sympy as sp
+
+    from ..model.robot import Robot
 
 __all__ = [
     "INTEGRATORS",
@@ -61,15 +64,19 @@ __all__ = [
     "simulate",
     "write_atomic",
     "plot_trajectory",
-    "TIME",
+    "TIME",  # noqa: F822 (module __getattr__)
 ]
 
-#: The integrators; "lecture" is another name for "euler" (the scheme of slide 19).
-INTEGRATORS = ("rk4", "euler", "lecture", "semi-implicit", "rk45", "dop853")
-#: The adaptive ones (scipy's solve_ivp with error control); the others take fixed steps.
-ADAPTIVE = ("rk45", "dop853")
-#: The time symbol of torque and reference expressions.
-TIME = sp.Symbol("t")
+
+def __getattr__(name: str):
+    """TIME, the time symbol of torque and reference expressions (SymPy is imported on first use)."""
+    if name == "TIME":
+        import sympy as sp
+
+        return sp.Symbol("t")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 #: Runs of at least this many steps show a progress bar by default (when stderr is a terminal).
 PROGRESS_MIN_STEPS = 2000
 
@@ -82,6 +89,11 @@ def time_expressions(values: Sequence, n: int, what: str = "tau", broadcast: boo
 
     With `broadcast`, a single value applies to every joint.
     """
+    import sympy as sp
+
+    from ..model.expressions import parse_expression
+
+    time = sp.Symbol("t")
     values = list(values)
     if broadcast and len(values) == 1 and n > 1:
         values = values * n
@@ -90,7 +102,7 @@ def time_expressions(values: Sequence, n: int, what: str = "tau", broadcast: boo
     exprs = []
     for i, v in enumerate(values, 1):
         e = v if isinstance(v, sp.Basic) else parse_expression(v, field=f"{what}[{i}]")
-        extra = sorted(str(s) for s in e.free_symbols if s != TIME)
+        extra = sorted(str(s) for s in e.free_symbols if s != time)
         if extra:
             raise SymdynError(f"{what}[{i}]: unknown name(s) {', '.join(extra)}: only t (time, s) may appear")
         exprs.append(e)
@@ -99,12 +111,29 @@ def time_expressions(values: Sequence, n: int, what: str = "tau", broadcast: boo
 
 def lambdify_time(exprs: Sequence[sp.Expr]) -> Callable[[float], np.ndarray]:
     """A function t -> array (n,) (or (n, len(t)) for an array t) of the parsed expressions."""
-    funcs = [sp.lambdify(TIME, e, modules="numpy") for e in exprs]
+    import sympy as sp
+
+    funcs = [sp.lambdify(sp.Symbol("t"), e, modules="numpy") for e in exprs]
 
     def f(t):
         return np.array([np.broadcast_to(np.asarray(g(t), dtype=float), np.shape(t)) for g in funcs])
 
     return f
+
+
+def _constants(tau, n: int) -> np.ndarray | None:
+    """n torques given as plain numbers (one: every joint), without parsing; else None."""
+    values = [tau] if isinstance(tau, (int, float)) else tau
+    if not isinstance(values, (list, tuple, np.ndarray)) or isinstance(tau, bool):
+        return None
+    if not all(isinstance(v, (int, float, np.floating)) and not isinstance(v, bool) for v in values):
+        return None
+    values = [float(v) for v in values]
+    if len(values) == 1 and n > 1:
+        values = values * n
+    if len(values) != n:
+        raise SymdynError(f"tau: expected {n} values (one per joint), got {len(values)}")
+    return np.array(values)
 
 
 def torque_function(tau, n: int) -> Callable:
@@ -114,6 +143,9 @@ def torque_function(tau, n: int) -> Callable:
         return lambda t, q, qd: zero
     if callable(tau):
         return tau
+    const = _constants(tau, n)
+    if const is not None:
+        return lambda t, q, qd: const
     if isinstance(tau, str):
         tau = [tau]
     exprs = time_expressions(tau, n, "tau")
@@ -173,6 +205,9 @@ def _torque_table(tau, n: int, rows: np.ndarray) -> np.ndarray | None:
         return None
     if tau is None:
         return np.zeros((len(rows), n))
+    const = _constants(tau, n)
+    if const is not None:
+        return np.tile(const, (len(rows), 1))
     exprs = time_expressions([tau] if isinstance(tau, str) else tau, n, "tau")
     if all(not e.free_symbols for e in exprs):
         return np.tile(np.array([float(e) for e in exprs]), (len(rows), 1))
@@ -309,7 +344,9 @@ def simulate(
     if steps > 10_000_000:
         raise SymdynError(f"{steps} steps is too many (at most 10000000); increase dt")
     if "forward_dynamics" not in plant.functions:
-        raise SymdynError(f"robot '{plant.robot.name}': no forward dynamics (M(q) is singular), cannot simulate")
+        raise SymdynError(
+            f"robot '{plant.robot.name}': no forward dynamics (M(q) is singular), cannot simulate"
+        )
     q = _state(q0, n, "q0")
     qd = np.zeros_like(q) if qd0 is None else _state(qd0, n, "qd0")
     q, qd = np.broadcast_arrays(q, qd)

@@ -26,8 +26,12 @@ import numpy as np
 from ..errors import SymdynError
 from .compile import CompiledDynamics
 
-__all__ = ["SCHEMES", "sample_times", "torque_rows", "run"]
+__all__ = ["INTEGRATORS", "ADAPTIVE", "SCHEMES", "sample_times", "torque_rows", "run"]
 
+#: The integrators of symdyn.apps.simulate; "lecture" is another name for "euler" (slide 19).
+INTEGRATORS = ("rk4", "euler", "lecture", "semi-implicit", "rk45", "dop853")
+#: The adaptive ones (scipy's solve_ivp with error control); the others take fixed steps.
+ADAPTIVE = ("rk45", "dop853")
 #: The fixed-step schemes, by their number in step.c.j2.
 SCHEMES = {"rk4": 0, "euler": 1, "semi-implicit": 2}
 
@@ -52,17 +56,35 @@ def torque_rows(t: np.ndarray, h: np.ndarray) -> np.ndarray:
     return rows
 
 
-def _controller_args(plant: CompiledDynamics, controller, reference_table: np.ndarray):
-    """The C arguments of the computed-torque law (model pointers, gains, reference)."""
+def _address(a: np.ndarray) -> int:
+    return a.ctypes.data
+
+
+def _controller_args(controller, reference_table: np.ndarray):
+    """The C arguments of the computed-torque law (model pointers, gains, reference), or None."""
     model = controller.model
     if model.backend != "c" or "inverse_dynamics" not in model.functions:
         return None
-    ffi = plant.ffi
-    friction = ffi.NULL if controller.friction else model.pointer("friction")
-    keep = [np.ascontiguousarray(controller.Kp, dtype=float), np.ascontiguousarray(controller.Kd, dtype=float)]
-    keep.append(np.ascontiguousarray(reference_table, dtype=float))
-    pm = ffi.NULL if model.p is None else ffi.from_buffer("double[]", model.p)
-    return keep, (model.pointer("inverse_dynamics"), friction, pm)
+    keep = [np.ascontiguousarray(x, dtype=float) for x in (controller.Kp, controller.Kd, reference_table)]
+    friction = None if controller.friction else model.pointer("friction")
+    pm = None if model.p is None else _address(model.p)
+    keep.append(model)
+    return keep, [
+        model.pointer("inverse_dynamics"),
+        friction,
+        pm,
+        _address(keep[2]),
+        *map(_address, keep[:2]),
+    ]
+
+
+def _simulate_function(plant: CompiledDynamics):
+    import ctypes
+
+    f = plant.cdll.symdyn_simulate
+    f.restype = ctypes.c_long
+    f.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_long, ctypes.c_long, *[ctypes.c_void_p] * 14]
+    return f
 
 
 def run(
@@ -85,32 +107,28 @@ def run(
     """
     if plant.backend != "c" or "forward_dynamics" not in plant.functions:
         return None
-    ffi, lib = plant.ffi, plant.lib
     n, steps = plant.n, len(h)
-    buf = ffi.from_buffer
-    keep: list = []
     if torque is not None:
-        keep.append(np.ascontiguousarray(torque, dtype=float))
-        table, inverse, friction, pm, ref, Kp, Kd = buf("double[]", keep[0]), *([ffi.NULL] * 6)
+        keep: list = [np.ascontiguousarray(torque, dtype=float)]
+        law = [_address(keep[0]), None, None, None, None, None, None]
     else:
-        args = _controller_args(plant, controller, reference)
+        args = _controller_args(controller, reference)
         if args is None:
             return None
-        keep, (inverse, friction, pm) = args
-        table, Kp, Kd, ref = ffi.NULL, buf("double[]", keep[0]), buf("double[]", keep[1]), buf("double[]", keep[2])
+        keep, (inverse, friction, pm, ref, Kp, Kd) = args
+        law = [None, inverse, friction, pm, ref, Kp, Kd]
     Q, QD, U = np.empty((steps + 1, n)), np.empty((steps + 1, n)), np.empty((steps + 1, n))
     Q[0], QD[0] = q0, qd0
     work = np.empty(12 * n)
     h = np.ascontiguousarray(h, dtype=float)
-    p = ffi.NULL if plant.p is None else buf("double[]", plant.p)
-    forward = plant.pointer("forward_dynamics")
+    p = None if plant.p is None else _address(plant.p)
+    simulate = _simulate_function(plant)
+    head = [_address(h), plant.pointer("forward_dynamics"), p]
+    tail = [_address(Q), _address(QD), _address(U), _address(work)]
     chunk = max(steps // 100, 1) if bar is not None and bar.enabled else steps
     for k0 in range(0, steps, chunk):
         k1 = min(k0 + chunk, steps)
-        bad = lib.symdyn_simulate(
-            n, SCHEMES[scheme], k0, k1, buf("double[]", h), forward, p, table, inverse, friction, pm, ref,
-            Kp, Kd, buf("double[]", Q), buf("double[]", QD), buf("double[]", U), buf("double[]", work),
-        )  # fmt: skip
+        bad = simulate(n, SCHEMES[scheme], k0, k1, *head, *law, *tail)
         if bad >= 0:
             raise SymdynError(
                 f"the simulation diverged at t = {t[bad]:.6g} s (the state is no longer finite); "
@@ -118,4 +136,5 @@ def run(
             )
         if bar is not None:
             bar.update(k1, t[k1])
+    del keep
     return Q, QD, U

@@ -11,30 +11,13 @@ Every C statement is spelled in templates/c/batch.c.j2 and templates/c/step.c.j2
 
 from __future__ import annotations
 
-from ..functions import FunctionSpec
 from ..render import RenderContext, environment, header_lines
 from .config import CConfig, c_names
 
-__all__ = ["function_table", "render_runtime", "results", "STEP_SOURCE"]
+__all__ = ["function_table", "render_runtime", "STEP_SOURCE"]
 
 #: The stepping loop's file name (symdyn_simulate, robot-independent).
 STEP_SOURCE = "symdyn_step.c"
-
-#: Outputs that are matrices even when they have one column (M and C of a one-joint robot).
-_MATRICES = ("M", "C")
-
-
-def results(spec: FunctionSpec) -> list[tuple[str, int, int, bool]]:
-    """The outputs of `spec` in argument order: (name, rows, cols, is a matrix).
-
-    Works with one output (spec.output, spec.shape) and with several (spec.results,
-    each with rows, cols and the size names dims; a matrix has a second size other than "1").
-    """
-    several = getattr(spec, "results", None)
-    if several is not None:
-        return [(o.name, o.rows, o.cols, o.dims[1] != "1" or o.name in _MATRICES) for o in several]
-    rows, cols = spec.shape
-    return [(spec.output, rows, cols, cols > 1 or spec.output in _MATRICES)]
 
 
 def function_table(ctx: RenderContext) -> list[dict]:
@@ -46,7 +29,7 @@ def function_table(ctx: RenderContext) -> list[dict]:
             "c_name": names.functions[spec.name],
             "doc": spec.doc,
             "inputs": [[inp.name, len(inp.symbols)] for inp in spec.inputs],
-            "outputs": [[name, rows, cols, matrix] for name, rows, cols, matrix in results(spec)],
+            "outputs": [[r.name, r.rows, r.cols, r.matrix] for r in spec.results],
         }
         for spec in ctx.functions
     ]

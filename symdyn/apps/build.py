@@ -1,4 +1,4 @@
-"""Compiling generated C into a shared library with the system's C compiler.
+"""Compiling generated C into a shared library with the system's C compiler (symdyn.compile).
 
 The compiler is $CC when set (it may carry flags: "clang -m64"), else the first of
 cc, gcc and clang on PATH. The flags are COMPILE_FLAGS: optimised (-O2) but with the
@@ -17,7 +17,7 @@ import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
-from ...errors import SymdynError
+from ..errors import SymdynError
 
 __all__ = ["COMPILE_FLAGS", "find_compiler", "compile_library", "library_suffix"]
 
