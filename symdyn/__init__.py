@@ -15,8 +15,20 @@ __version__ = "0.1.0"
 
 import importlib as _importlib
 import sys as _sys
+from typing import TYPE_CHECKING
 
 from .errors import SymdynError, SymdynWarning  # noqa: E402
+
+if TYPE_CHECKING:  # what the names below are, for type checkers and the API reference
+    from . import rnea
+    from .algorithms import kinematics
+    from .apps.compile import compile
+    from .codegen import generate
+    from .dynamics import Dynamics, derive
+    from .model import inertia
+    from .model.parameters import standard_parameters
+    from .model.robot import Link, Robot
+    from .parsers import load_robot, load_urdf, robot_from_data
 
 # Every other public name is imported on first use (PEP 562), so that `import symdyn` and a
 # cached `symdyn simulate` start without SymPy: name -> (module, attribute or None for the module).
