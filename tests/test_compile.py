@@ -210,3 +210,21 @@ def test_the_parser_methods_are_the_derivations():
     from symdyn.dynamics import METHODS as DERIVED
 
     assert METHODS == DERIVED
+
+
+def test_analyze_on_the_cached_plant_equals_the_robot_route():
+    """analyze on a CompiledDynamics (its kinematics read back from the cache) is analyze on the Robot."""
+    from symdyn.apps.analysis import analyze
+    from symdyn.apps.compile import cached_dynamics
+
+    robot = example("puma560")
+    q, qd = np.linspace(0.1, 0.6, 6), np.linspace(-0.3, 0.2, 6)
+    want = analyze(robot, q, qd, torque_limits=50)
+    for _ in range(2):  # built, then read back from the cache without the Robot
+        plant = cached_dynamics({"name": "puma"}, lambda: robot)
+        got = analyze(plant, q, qd, torque_limits=50)
+        np.testing.assert_allclose(got.J, want.J, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(got.Jdot_qd, want.Jdot_qd, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(got.polytope.vertices, want.polytope.vertices, rtol=1e-10, atol=1e-10)
+        assert got.axes == want.axes
+    assert not isinstance(plant.robot, type(robot))

@@ -135,7 +135,9 @@ def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: 
     if entry is None:
         robot = make_robot()
         entry = cache.get_or_build(key, _build(robot, method, options))
-    return CompiledDynamics._from_entry(entry, robot, params)
+    self = CompiledDynamics._from_entry(entry, robot, params)
+    self._source = ({**key_parts, "method": method}, make_robot)
+    return self
 
 
 def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamics:
@@ -255,6 +257,20 @@ class CompiledDynamics:
             exec(compile_source(path), module.__dict__)
             self._module = module
         return self._module
+
+    def derived_entry(self, kind: str, build: Callable) -> cache.Entry:
+        """A further cache entry of this robot, e.g. its task-space kinematics (symdyn.apps.task_space).
+
+        Keyed like the robot's own entry plus `kind`; on a miss build(robot, folder) writes its
+        files and returns its metadata, the Robot loaded only then when it came from the cache.
+        """
+        parts, make_robot = self._source
+        key = cache.entry_key(**parts, kind=kind)
+        entry = cache.lookup(key)
+        if entry is None:
+            robot = self.robot if not isinstance(self.robot, RobotInfo) else make_robot()
+            entry = cache.get_or_build(key, lambda folder: build(robot, folder))
+        return entry
 
     def __repr__(self) -> str:
         names = ", ".join(self.functions)

@@ -254,12 +254,13 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     axes = parse_axes(args.axes)
     if args.plot and axes is not None and len(axes) != 2:
         raise SymdynError(f"--plot draws a 2-D task space: give two --axes (got {args.axes})")
-    robot = _with_params(load_robot_argument(args), _assignments(args.params, "--params"))
-    n = robot.n
+    params = _assignments(args.params, "--params")
+    plant = _plant(args, params)
+    n = plant.n
     q = _vector(args.q, n, "--q")
     qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
     limits = _numbers(args.torque_limits, "--torque-limits")
-    result = analyze(robot, q, qd, torque_limits=limits, axes=axes)
+    result = analyze(plant, q, qd, torque_limits=limits, axes=axes)
     image = None
     if args.plot:
         if len(result.axes) != 2:
@@ -267,6 +268,11 @@ def cmd_analyze(args: argparse.Namespace) -> int:
                 "--plot draws a 2-D task space: give two --axes "
                 f"(the default here is {','.join(result.axes)})"
             )
+        from ..apps.compile import RobotInfo
+
+        robot = plant.robot
+        if isinstance(robot, RobotInfo):  # the plant came from the cache: the picture needs the Robot
+            robot = _with_params(load_robot_argument(args), params)
         image = plot_analysis(result, robot=robot)
     sys.stdout.write(result.to_json() if args.format == "json" else result.to_text())
     if image is not None:
