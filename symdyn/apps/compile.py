@@ -341,16 +341,24 @@ def _c_method(ffi, lib, f: dict, p_ptr) -> Callable:
     one = len(shapes) == 1
     buf = ffi.from_buffer
     p_args = (p_ptr,) if with_p else ()
-    f64 = np.float64
+    f64, ndarray = np.dtype(np.float64), np.ndarray
+    one_state = [(size,) for size in sizes]
 
     def call(*args):
         if len(args) != len(sizes):
             raise TypeError(f"{f['name']}({', '.join(names)}) takes {len(sizes)} arguments, got {len(args)}")
-        arrays = [np.ascontiguousarray(a, dtype=f64) for a in args]
-        if all(a.shape == (s,) for a, s in zip(arrays, sizes, strict=True)):
+        pointers = []
+        for a, shape in zip(args, one_state, strict=True):  # the fast path: one state, float64 arrays
+            if a.__class__ is not ndarray or a.dtype != f64 or a.shape != shape or not a.flags.c_contiguous:
+                break
+            pointers.append(buf("double[]", a))
+        else:
             outs = [np.empty(shape) for shape in shapes]
-            single(*[buf("double[]", a) for a in arrays], *p_args, *[buf("double[]", o) for o in outs])
+            single(*pointers, *p_args, *[buf("double[]", o) for o in outs])
             return outs[0] if one else tuple(outs)
+        arrays = [np.ascontiguousarray(a, dtype=f64) for a in args]
+        if all(a.shape == shape for a, shape in zip(arrays, one_state, strict=True)):
+            return call(*arrays)
         return _batch_call(batch, buf, arrays, sizes, names, p_args, shapes, one, f["name"])
 
     call.__name__ = f["name"]
