@@ -11,6 +11,7 @@ a corrupt or foreign entry and never trust it. Every test uses a temporary cache
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,13 +28,23 @@ from symdyn.codegen import functions as fn
 from symdyn.errors import SymdynWarning
 from symdyn.rnea import forward_dynamics as oracle_forward
 
+PLANAR = Path(__file__).resolve().parent.parent / "examples" / "planar_3r.yaml"
 pytestmark = pytest.mark.skipif(not compilers(), reason="needs a C compiler")
 
 
-@pytest.fixture(autouse=True)
+@pytest.fixture(autouse=True, scope="module")
+def module_cache(tmp_path_factory):
+    """One temporary cache for the module's tests (each robot is built once)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(cache.CACHE_ENV, str(tmp_path_factory.mktemp("cache")))
+        mp.delenv("CC", raising=False)
+        yield
+
+
+@pytest.fixture
 def temporary_cache(tmp_path, monkeypatch):
+    """An empty cache of its own, for the tests of the cache itself."""
     monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "cache"))
-    monkeypatch.delenv("CC", raising=False)
     return tmp_path / "cache"
 
 
@@ -97,7 +108,7 @@ def test_simulation_in_c_equals_the_numpy_path(name, integrator, monkeypatch):
 
 def test_energy_along_a_swing_equals_the_numpy_path(monkeypatch):
     """The kinetic energy 1/2 qd^T M(q) qd along a free swing (its drift) is the NumPy path's."""
-    robot = symdyn.load_robot("examples/planar_3r.yaml")
+    robot = symdyn.load_robot(PLANAR)
     fast, slow = compile(robot), _numpy_backend(robot, monkeypatch)
     drift = []
     for plant in (fast, slow):
@@ -109,7 +120,7 @@ def test_energy_along_a_swing_equals_the_numpy_path(monkeypatch):
 
 
 def test_tracking_in_c_equals_the_python_callback(monkeypatch):
-    robot = symdyn.load_robot("examples/planar_3r.yaml")
+    robot = symdyn.load_robot(PLANAR)
     plant = compile(robot)
     reference = Reference(["0.3*sin(2*t)", "0.2*cos(t)", "t/4"])
     controller = ComputedTorque(plant, 100, 20)
@@ -127,7 +138,7 @@ def test_tracking_in_c_equals_the_python_callback(monkeypatch):
 
 @pytest.mark.parametrize("method", ["rk45", "dop853"])
 def test_adaptive_integrators_agree_with_fine_rk4(method):
-    robot = symdyn.load_robot("examples/planar_3r.yaml")
+    robot = symdyn.load_robot(PLANAR)
     a = simulate(robot, [0.1, 0.2, 0.3], duration=0.5, dt=1e-2, integrator=method, rtol=1e-10, atol=1e-12)
     b = simulate(robot, [0.1, 0.2, 0.3], duration=0.5, dt=1e-4)
     np.testing.assert_allclose(a.q[-1], b.q[-1], atol=1e-8)
@@ -149,7 +160,7 @@ def _family(dyn, x):
 def test_any_generated_function_becomes_a_method(monkeypatch):
     """Several outputs (a tuple) and a non-square output, one state and a batch."""
     monkeypatch.setattr(fn, "FAMILIES", (*fn.FAMILIES, _family))
-    robot = symdyn.load_robot("examples/planar_3r.yaml")
+    robot = symdyn.load_robot(PLANAR)
     c = compile(robot)
     q = np.array([[0.1, 0.2, 0.3], [-0.4, 0.5, 0.6]])
     M, G = c.mass_and_gravity(q)
@@ -161,7 +172,7 @@ def test_any_generated_function_becomes_a_method(monkeypatch):
 
 
 def test_cache_hit_corrupt_and_foreign_entries(temporary_cache):
-    robot = symdyn.load_robot("examples/planar_3r.yaml")
+    robot = symdyn.load_robot(PLANAR)
     first = compile(robot)
     folder = first._entry.path
     assert compile(robot)._entry.path == folder
@@ -191,9 +202,9 @@ def test_parameters_bound_by_name_or_vector():
     np.testing.assert_array_equal(a.mass_matrix(q), b.mass_matrix(q))
 
 
-def test_cli_cache_and_a_warm_simulate(tmp_path, capsys):
+def test_cli_cache_and_a_warm_simulate(tmp_path, capsys, temporary_cache):
     out = tmp_path / "a.csv"
-    argv = ["simulate", "examples/planar_3r.yaml", "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
+    argv = ["simulate", str(PLANAR), "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
     assert main(argv) == 0
     cold = out.read_text()
     assert main(argv) == 0 and out.read_text() == cold
@@ -228,3 +239,18 @@ def test_analyze_on_the_cached_plant_equals_the_robot_route():
         np.testing.assert_allclose(got.polytope.vertices, want.polytope.vertices, rtol=1e-10, atol=1e-10)
         assert got.axes == want.axes
     assert not isinstance(plant.robot, type(robot))
+
+
+def test_two_processes_building_one_entry(temporary_cache):
+    """Concurrent builds of the same robot both succeed and leave one verified entry."""
+    import subprocess
+    import sys
+
+    code = f"import symdyn; c = symdyn.compile(symdyn.load_robot({str(PLANAR)!r})); print(c.backend)"
+    procs = [
+        subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True) for _ in range(2)
+    ]
+    assert [p.communicate(timeout=300)[0].strip() for p in procs] == ["c", "c"]
+    assert all(p.returncode == 0 for p in procs)
+    root, count, _ = cache.usage()
+    assert count == 1 and not list((root / "v1").glob(".build-*"))

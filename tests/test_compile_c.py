@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -69,7 +70,7 @@ int main(void)
 
 @pytest.fixture(scope="module")
 def files():
-    robot = symdyn.load_robot("examples/planar_3r.yaml")
+    robot = symdyn.load_robot(Path(__file__).resolve().parent.parent / "examples" / "planar_3r.yaml")
     ctx = context(robot)
     return robot, {**c_target.render(ctx), **render_runtime(ctx)}
 
