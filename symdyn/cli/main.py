@@ -13,13 +13,10 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-import sympy as sp
-
 from .. import __version__
-from ..dynamics import METHODS, derive
 from ..errors import SymdynError, SymdynWarning
 from .apps import register
-from .common import add_robot_argument, load_robot_argument
+from .common import METHODS, add_robot_argument, load_robot_argument
 
 __all__ = ["main"]
 
@@ -35,6 +32,8 @@ def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
 
 
 def _derive_text(dyn) -> str:
+    import sympy as sp
+
     lines = [
         f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
@@ -50,6 +49,8 @@ def _derive_text(dyn) -> str:
 
 
 def _derive_json(dyn) -> str:
+    import sympy as sp
+
     doc: dict = {
         "robot": dyn.robot.name,
         "method": dyn.method,
@@ -79,6 +80,8 @@ def cmd_derive(args: argparse.Namespace) -> int:
         from .steps import cmd_derive_steps
 
         return cmd_derive_steps(args)
+    from ..dynamics import derive
+
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
