@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # what the names below are, for type checkers and the API ref
     from .model import inertia
     from .model.parameters import standard_parameters
     from .model.robot import Link, Robot
-    from .parsers import load_robot, load_urdf, robot_from_data
+    from .parsers import load_robot, load_urdf, robot_from_data, robot_from_poe
 
 # Every other public name is imported on first use (PEP 562), so that `import symdyn` and a
 # cached `symdyn simulate` start without SymPy: name -> (module, attribute or None for the module).
@@ -46,6 +46,7 @@ _LAZY = {
     "load_robot": (".parsers", "load_robot"),
     "load_urdf": (".parsers", "load_urdf"),
     "robot_from_data": (".parsers", "robot_from_data"),
+    "robot_from_poe": (".parsers", "robot_from_poe"),
 }
 #: `symdyn.inertia` and `symdyn.kinematics` are public modules: `import symdyn.inertia` works too.
 _ALIASES = {"inertia": ".model.inertia", "kinematics": ".algorithms.kinematics"}
@@ -97,5 +98,6 @@ __all__ = [
     "load_urdf",
     "rnea",
     "robot_from_data",
+    "robot_from_poe",
     "standard_parameters",
 ]

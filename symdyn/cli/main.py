@@ -76,6 +76,10 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    if args.steps or args.at:
+        from .steps import cmd_derive_steps
+
+        return cmd_derive_steps(args)
     from ..dynamics import derive
 
     robot = load_robot_argument(args)
@@ -122,6 +126,10 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         help="trigonometric simplification of the closed forms (auto: up to 3 joints)",
     )
+    d.add_argument(
+        "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"
+    )
+    d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
     d.set_defaults(func=cmd_derive)
 
     g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
@@ -129,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument(
         "--target",
         action="append",
-        choices=("c", "casadi", "python", "latex"),
+        choices=("c", "casadi", "python", "latex", "matlab"),
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")
