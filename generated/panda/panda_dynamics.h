@@ -284,7 +284,7 @@ void panda_forward_dynamics(const double q[], const double qd[], const double ta
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), panda_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), panda_NDOF values
  * @param[in]  p    free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
- * @param[out] Y    regressor of the standard parameters, columns below, panda_NDOF*panda_NSTD values, row-major: Y[i*panda_NSTD + j] is row i, column j
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), panda_NDOF*panda_NSTD values, row-major: Y[i*panda_NSTD + j] is row i, column j
  *
  * Cost per call: 1743 operations: 1020 multiplications, 704 additions, 0 divisions, 12 trigonometric calls, 7 other calls.
  */
@@ -297,7 +297,7 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), panda_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), panda_NDOF values
  * @param[in]  p    free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
- * @param[out] Yb   regressor of the base parameters, columns below, panda_NDOF*panda_NBASE values, row-major: Yb[i*panda_NBASE + j] is row i, column j
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), panda_NDOF*panda_NBASE values, row-major: Yb[i*panda_NBASE + j] is row i, column j
  *
  * Cost per call: 1429 operations: 841 multiplications, 569 additions, 0 divisions, 12 trigonometric calls, 7 other calls.
  */

@@ -261,7 +261,7 @@ void puma560_forward_dynamics(const double q[], const double qd[], const double 
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), puma560_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), puma560_NDOF values
  * @param[in]  p    free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
- * @param[out] Y    regressor of the standard parameters, columns below, puma560_NDOF*puma560_NSTD values, row-major: Y[i*puma560_NSTD + j] is row i, column j
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), puma560_NDOF*puma560_NSTD values, row-major: Y[i*puma560_NSTD + j] is row i, column j
  *
  * Cost per call: 1007 operations: 574 multiplications, 417 additions, 0 divisions, 10 trigonometric calls, 6 other calls.
  */
@@ -274,7 +274,7 @@ void puma560_regressor(const double q[], const double qd[], const double qdd[], 
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), puma560_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), puma560_NDOF values
  * @param[in]  p    free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
- * @param[out] Yb   regressor of the base parameters, columns below, puma560_NDOF*puma560_NBASE values, row-major: Yb[i*puma560_NBASE + j] is row i, column j
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), puma560_NDOF*puma560_NBASE values, row-major: Yb[i*puma560_NBASE + j] is row i, column j
  *
  * Cost per call: 819 operations: 472 multiplications, 331 additions, 0 divisions, 10 trigonometric calls, 6 other calls.
  */

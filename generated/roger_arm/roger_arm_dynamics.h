@@ -180,7 +180,7 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), roger_arm_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), roger_arm_NDOF values
  * @param[in]  p    free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
- * @param[out] Y    regressor of the standard parameters, columns below, roger_arm_NDOF*roger_arm_NSTD values, row-major: Y[i*roger_arm_NSTD + j] is row i, column j
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), roger_arm_NDOF*roger_arm_NSTD values, row-major: Y[i*roger_arm_NSTD + j] is row i, column j
  *
  * Cost per call: 35 operations: 18 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 2 other calls.
  */
@@ -193,7 +193,7 @@ void roger_arm_regressor(const double q[], const double qd[], const double qdd[]
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), roger_arm_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), roger_arm_NDOF values
  * @param[in]  p    free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
- * @param[out] Yb   regressor of the base parameters, columns below, roger_arm_NDOF*roger_arm_NBASE values, row-major: Yb[i*roger_arm_NBASE + j] is row i, column j
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), roger_arm_NDOF*roger_arm_NBASE values, row-major: Yb[i*roger_arm_NBASE + j] is row i, column j
  *
  * Cost per call: 32 operations: 16 multiplications, 10 additions, 0 divisions, 4 trigonometric calls, 2 other calls.
  */

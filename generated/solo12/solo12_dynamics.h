@@ -383,7 +383,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), solo12_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), solo12_NDOF values
  * @param[in]  p    free parameters: none (solo12_NPARAM is 0), so p may be NULL; not read by this function
- * @param[out] Y    regressor of the standard parameters, columns below, solo12_NDOF*solo12_NSTD values, row-major: Y[i*solo12_NSTD + j] is row i, column j
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), solo12_NDOF*solo12_NSTD values, row-major: Y[i*solo12_NSTD + j] is row i, column j
  *
  * Cost per call: 928 operations: 512 multiplications, 380 additions, 0 divisions, 24 trigonometric calls, 12 other calls.
  */
@@ -396,7 +396,7 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
  * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), solo12_NDOF values
  * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), solo12_NDOF values
  * @param[in]  p    free parameters: none (solo12_NPARAM is 0), so p may be NULL; not read by this function
- * @param[out] Yb   regressor of the base parameters, columns below, solo12_NDOF*solo12_NBASE values, row-major: Yb[i*solo12_NBASE + j] is row i, column j
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), solo12_NDOF*solo12_NBASE values, row-major: Yb[i*solo12_NBASE + j] is row i, column j
  *
  * Cost per call: 772 operations: 424 multiplications, 312 additions, 0 divisions, 24 trigonometric calls, 12 other calls.
  */

@@ -46,7 +46,15 @@ def regressor_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             "regressor",
             "Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body)",
             state,
-            (Output("Y", n, Y.cols, "regressor of the standard parameters, columns below", ("n", "nstd")),),
+            (
+                Output(
+                    "Y",
+                    n,
+                    Y.cols,
+                    "regressor of the standard parameters (symdyn.standard_parameters order)",
+                    ("n", "nstd"),
+                ),
+            ),
             tuple(Y),
         )
     ]
@@ -61,7 +69,15 @@ def regressor_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             "base_regressor",
             "Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters",
             state,
-            (Output("Yb", n, Yb.cols, "regressor of the base parameters, columns below", ("n", "nbase")),),
+            (
+                Output(
+                    "Yb",
+                    n,
+                    Yb.cols,
+                    "regressor of the base parameters (Dynamics.base_parameters order)",
+                    ("n", "nbase"),
+                ),
+            ),
             tuple(Yb),
         )
     )
