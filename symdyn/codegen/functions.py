@@ -316,8 +316,8 @@ def regressor_family(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
 FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     dynamics_rows,
     forward_dynamics_rows,
-    tip_wrench_rows,
     regressor_family,
+    tip_wrench_rows,
 )
 
 
