@@ -43,14 +43,17 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
+from .algorithms.base_parameters import BaseParameters, find_base_parameters
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
+from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
+from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
 from .symbolic.program import Program
@@ -132,6 +135,7 @@ class Dynamics:
     simplified: bool
     _closed: dict[str, sp.Matrix] = field(default_factory=dict, repr=False)
     _compiled: dict[str, object] = field(default_factory=dict, repr=False)
+    _linear: dict[str, object] = field(default_factory=dict, repr=False)
 
     @property
     def n(self) -> int:
@@ -151,8 +155,11 @@ class Dynamics:
             SymdynError: an unknown name.
         """
         _check_quantity(name, "Dynamics.closed_form")
+        return self._expanded(name, self.compact[name])
+
+    def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
+        """The closed form of compact matrix m, cached under `name`."""
         if name not in self._closed:
-            m = self.compact[name]
             entries = self.program.expand(list(m))
             if self.simplified:
                 entries = [simplify_entry(e) for e in entries]
@@ -187,6 +194,47 @@ class Dynamics:
     def bias(self) -> sp.Matrix:
         """V + G + F = tau at qdd = 0, closed form."""
         return self.closed_form("bias")
+
+    def regressor_compact(self) -> sp.Matrix:
+        """The regressor Y (n x 13 nb) over the intermediates of `program`, tau = Y pi with pi the
+        standard parameters (symdyn.standard_parameters; symdyn.algorithms.regressor)."""
+        if "Y" not in self._linear:
+            self._linear["Y"] = regressor_matrix(self.robot, self.q, self.qd, self.qdd, self.program)
+        return self._linear["Y"]  # type: ignore[return-value]
+
+    def linear_compact(self) -> tuple[sp.Matrix, BaseParameters]:
+        """`regressor_compact()` and the base parameters found from it
+        (symdyn.algorithms.base_parameters); computed on first use.
+
+        Raises:
+            SymdynError: the base parameters depend on free parameters and some angle enters other
+                than as sin(q) and cos(q) (a mimic joint's multiplier, a joint offset).
+        """
+        Y = self.regressor_compact()
+        if "base" not in self._linear:
+            names = standard_parameters(self.robot)[0]
+            self._linear["base"] = find_base_parameters(
+                self.robot, Y, self.program, self.q, self.qd, self.qdd, names
+            )
+        return Y, self._linear["base"]  # type: ignore[return-value]
+
+    @property
+    def regressor(self) -> sp.Matrix:
+        """Y(q, qd, qdd), n x 13 nb, closed form: tau = Y pi (pi: symdyn.standard_parameters)."""
+        return self._expanded("regressor", self.regressor_compact())
+
+    @property
+    def base_parameters(self) -> tuple[tuple[str, sp.Expr], ...]:
+        """(name, expression) per base parameter: exact linear combinations of the standard
+        parameters' symbols (m1, mx1, ...), in the order of `base_regressor`'s columns."""
+        base = self.linear_compact()[1]
+        return tuple(zip(base.names, base.expressions, strict=True))
+
+    @property
+    def base_regressor(self) -> sp.Matrix:
+        """Y_b(q, qd, qdd), n x (number of base parameters), closed form: tau = Y_b pi_b."""
+        Y, base = self.linear_compact()
+        return self._expanded("base_regressor", Y.extract(list(range(Y.rows)), list(base.columns)))
 
     def assignments(self, names=QUANTITIES) -> list[tuple[sp.Symbol, sp.Expr]]:
         """The intermediates the given quantities need, in evaluation order.

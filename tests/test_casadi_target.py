@@ -30,7 +30,15 @@ from types import ModuleType
 import casadi as ca
 import numpy as np
 import pytest
-from robots import EXAMPLE_NAMES, assert_close, derived, example, random_params, random_state
+from robots import (
+    EXAMPLE_NAMES,
+    assert_close,
+    derived,
+    example,
+    random_params,
+    random_state,
+    regressor_oracle,
+)
 
 from symdyn.codegen import FUNCTION_NAMES
 from symdyn.codegen import casadi as casadi_backend
@@ -117,10 +125,10 @@ def _oracle(robot, params, q, qd, qdd, tau) -> dict[str, np.ndarray]:
 
 
 def _call(f: ca.Function, values: dict[str, np.ndarray]) -> np.ndarray:
-    """Call f with its inputs by name; vectors come back flat, M and C as n x n."""
+    """Call f with its inputs by name; vectors come back flat, M and C as n x n, Y and Yb as matrices."""
     out = f.call({f.name_in(i): values[f.name_in(i)] for i in range(f.n_in())})[f.name_out(0)]
     out = np.asarray(out.full())
-    return out if f.name_out(0) in ("M", "C") else out[:, 0]
+    return out if f.name_out(0) in ("M", "C", "Y", "Yb") else out[:, 0]
 
 
 # --------------------------------------------------------------------------- the files
@@ -190,7 +198,7 @@ def test_matches_rnea_module_and_loaded_files(name, generated):
         q, qd, qdd = random_state(robot, rng)
         tau = rng.uniform(-5, 5, robot.n)
         values = {"q": q, "qd": qd, "qdd": qdd, "tau": tau, "p": p}
-        want = _oracle(robot, params, q, qd, qdd, tau)
+        want = _oracle(robot, params, q, qd, qdd, tau) | regressor_oracle(dyn, q, qd, qdd, params)
         for f in FUNCTION_NAMES:
             got = _call(g.functions[f], values)
             assert_close(got, want[f], RTOL, what=f"{name}.{f}")

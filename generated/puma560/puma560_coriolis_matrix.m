@@ -17,6 +17,8 @@ function C = puma560_coriolis_matrix(q, qd, p)
 %   gravity              43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
 %   friction             24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
 %   forward_dynamics    749 ops: 419 mul, 308 add, 6 div, 10 trig, 6 other
+%   regressor          1007 ops: 574 mul, 417 add, 0 div, 10 trig, 6 other
+%   base_regressor      819 ops: 472 mul, 331 add, 0 div, 10 trig, 6 other
 if numel(q) ~= 6
     error('puma560_coriolis_matrix: q must have 6 entries, got %d', numel(q));
 end

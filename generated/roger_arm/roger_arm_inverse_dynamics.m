@@ -18,6 +18,8 @@ function tau = roger_arm_inverse_dynamics(q, qd, qdd, p)
 %   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 %   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
 %   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
+%   regressor            35 ops: 18 mul, 11 add, 0 div, 4 trig, 2 other
+%   base_regressor       32 ops: 16 mul, 10 add, 0 div, 4 trig, 2 other
 if numel(q) ~= 2
     error('roger_arm_inverse_dynamics: q must have 2 entries, got %d', numel(q));
 end

@@ -17,6 +17,7 @@ from .. import __version__
 from ..errors import SymdynError, SymdynWarning
 from .apps import register
 from .common import METHODS, add_robot_argument, load_robot_argument
+from .identification import register as register_identification
 
 __all__ = ["main"]
 
@@ -146,6 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
     g.set_defaults(func=cmd_generate)
     register(sub)  # simulate, analyze, check (the lecture's applications)
+    register_identification(sub)  # identify, excite
     return parser
 
 

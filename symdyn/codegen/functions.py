@@ -47,6 +47,7 @@ __all__ = [
     "Output",
     "DIMS",
     "FAMILIES",
+    "OWN_CSE",
     "build_functions",
     "vector_output",
     "joint_matrix_output",
@@ -61,6 +62,8 @@ FUNCTION_NAMES = (
     "gravity",
     "friction",
     "forward_dynamics",
+    "regressor",
+    "base_regressor",
 )
 
 
@@ -75,7 +78,7 @@ class Input:
 #: Size names of the outputs (Output.dims): "1" for a vector's columns, "n" for the joints, "2n"
 #: for the state x = (q, qd); a target spells each as its own expression (C: a macro), and a
 #: family of functions that needs another size adds the name and every target's spelling.
-DIMS = ("1", "n", "2n")
+DIMS = ("1", "n", "2n", "nstd", "nbase")
 
 
 @dataclass(frozen=True)
@@ -300,29 +303,56 @@ _OUTPUT_DOCS = {
     "qdd": "joint accelerations",
 }
 
+
 #: The families of generated functions, in the order of the generated files: each maps a derived
 #: robot and the input vectors to its FunctionRows (a new family is one module and one entry here).
+def regressor_family(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """regressor and base_regressor (symdyn.codegen.regressor_functions, which builds on this module)."""
+    from .regressor_functions import regressor_rows
+
+    return regressor_rows(dyn, x)
+
+
 FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     dynamics_rows,
     forward_dynamics_rows,
+    regressor_family,
     tip_wrench_rows,
 )
 
 
+#: Families eliminated in a CSE pass of their own: they add intermediates to `dyn.program`, and a
+#: joint pass would let those change the other functions' temporaries.
+OWN_CSE: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (regressor_family,)
+
+
+def _eliminated(
+    dyn: Dynamics, rows: list[FunctionRow], x: Inputs, base: list[sp.Expr]
+) -> dict[str, Eliminated]:
+    """One CSE pass over `rows` (their outputs, extra steps and the `base` needs)."""
+    needs = [e for row in rows for e in row.exprs] + [e for row in rows for _, e in row.steps] + base
+    steps = dyn.program.needed(needs) + [s for row in rows for s in row.steps]
+    return eliminate_many(steps, {row.name: list(row.exprs) for row in rows}, reserved=x.symbols)
+
+
 def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
-    """The generated functions of a derived robot, one CSE pass over all of them.
+    """The generated functions of a derived robot, one CSE pass over all of them (and one more
+    per family of OWN_CSE).
 
     All of FAMILIES' rows: the seven of docs/generated-code.md, or six without forward_dynamics
-    (and a SymdynWarning) when a joint moves no mass or inertia (see the module docstring).
+    (and a SymdynWarning) when a joint moves no mass or inertia (see the module docstring), then
+    regressor and base_regressor (symdyn.codegen.regressor_functions).
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
     x = Inputs.of(dyn)
-    rows = [row for family in FAMILIES for row in family(dyn, x)]
+    groups = [(family in OWN_CSE, family(dyn, x)) for family in FAMILIES]
+    rows = [row for _, group in groups for row in group]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
-    needs = [e for row in rows for e in row.exprs] + [e for row in rows for _, e in row.steps]
-    needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
-    steps = dyn.program.needed(needs) + [s for row in rows for s in row.steps]
-    code = eliminate_many(steps, {row.name: list(row.exprs) for row in rows}, reserved=x.symbols)
+    base = [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
+    code = _eliminated(dyn, [row for own, group in groups if not own for row in group], x, base)
+    for own, group in groups:
+        if own and group:
+            code.update(_eliminated(dyn, group, x, []))
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

@@ -135,7 +135,12 @@ def c_names(ctx: RenderContext) -> CNames:
     param_macros = tuple((f"{name}_P_{p}", k) for k, p in enumerate(params))
     functions = {f.name: f"{name}_{f.name}" for f in ctx.functions}
     guard = f"{name.upper()}_DYNAMICS_H"
-    written = [ndof, nparam] + [m for m, _ in param_macros]
+    column_dims = {r.dims[1] for f in ctx.functions for r in f.results} & {"nstd", "nbase"}
+    written = (
+        [ndof, nparam]
+        + [m for m, _ in param_macros]
+        + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
+    )
     taken = set(written) | set(functions.values()) | {guard}
     aliases = _aliases(written, taken)
 
@@ -170,5 +175,5 @@ def c_names(ctx: RenderContext) -> CNames:
         functions=functions,
         locals=local_names,
         param_macro=param_macro,
-        dims={"1": "1", "n": ndof, "2n": f"(2*{ndof})"},
+        dims={"1": "1", "n": ndof, "2n": f"(2*{ndof})", "nstd": f"{name}_NSTD", "nbase": f"{name}_NBASE"},
     )

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from ...errors import SymdynError
 from ..functions import FunctionSpec
+from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .printer import CPrinter
@@ -100,7 +101,27 @@ def render_context(ctx: RenderContext) -> dict:
         "param_macros": list(names.param_macros),
         "aliases": list(names.aliases),
         "functions": [_function_view(ctx, names, spec) for spec in ctx.functions],
+        "column_sizes": _column_sizes(ctx, names),
     }
+
+
+def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
+    """The column counts of the regressor outputs (size names nstd, nbase): macro, count and the
+    table naming every column (symdyn.codegen.regressor_functions.columns)."""
+    sizes = {}
+    for spec in ctx.functions:
+        for r in spec.results:
+            if r.dims[1] in ("nstd", "nbase") and r.dims[1] not in sizes:
+                table = columns(ctx.dynamics, r.dims[1])
+                assert len(table) == r.cols and not any("*/" in t for _, t in table)
+                sizes[r.dims[1]] = {
+                    "macro": names.dims[r.dims[1]],
+                    "count": r.cols,
+                    "output": r.name,
+                    "columns": table,
+                    "width": max(len(c) for c, _ in table),
+                }
+    return list(sizes.values())
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
