@@ -2,7 +2,7 @@
 
 tau = Y_b(q, qd, qdd) pi_b (symdyn.algorithms.base_parameters), so N samples stacked give the
 overdetermined linear system  y = W pi_b  with W (N n x nbase) the base regressor at every sample
-(evaluated by the generated NumPy module in one batch, `base_regressor_samples`) and y the
+(evaluated by the compiled C base_regressor in one batch, `base_regressor_samples`) and y the
 measured torques. Following Gautier ("Dynamic identification of robots with power model", 1997):
 
 1. ordinary least squares, pi_0 = argmin |y - W pi|, and per joint j the residual variance
@@ -216,12 +216,14 @@ def differentiate(t: np.ndarray, q: np.ndarray, where: str = "differentiate", wi
 
 
 def base_regressor_samples(robot: Robot, q, qd, qdd) -> np.ndarray:
-    """Y_b at N samples, (N, n, nbase), by the generated NumPy module (symdyn.apps.compiled) in one
-    batch; the robot's parameters must all have values."""
+    """Y_b at N samples, (N, n, nbase): one batch call of the compiled C base_regressor
+    (symdyn.compile, cached; its loop over the samples is in C, or the generated NumPy module
+    without a C compiler); the robot's parameters must all have values."""
     from .compiled import compiled_dynamics
 
     cd = compiled_dynamics(robot)
-    return np.asarray(cd.module.base_regressor(q, qd, qdd, cd.p), dtype=float).reshape(len(q), robot.n, -1)
+    Yb = cd.base_regressor(np.asarray(q, dtype=float), np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float))
+    return np.asarray(Yb, dtype=float).reshape(len(q), robot.n, -1)
 
 
 def identify(robot: Robot, data: Measurements, base: tuple[tuple[str, object], ...]) -> Identification:
