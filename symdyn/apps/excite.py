@@ -10,8 +10,9 @@ excitation and identification", IEEE Trans. Robotics and Automation 13(5), 1997)
 
 The coefficients a, b (n x L) are chosen to minimise the condition number of the base regressor
 stacked at `samples` times over one period (symdyn.apps.identify evaluates it with the compiled
-C base_regressor, one batch call per trial), with scipy.optimize.minimize (Powell's method, from the best of a few random
-starts), stopped after `evaluations` evaluations of the condition number (the best one is kept).
+C base_regressor, one batch call per trial), with scipy.optimize.minimize (Powell's method, from
+the best of a few random starts), stopped after `evaluations` evaluations of the condition
+number (the best one is kept).
 The limits |q_i - q0_i| <= q_range_i, |qd_i| <= qd_max_i, |qdd_i| <= qdd_max_i hold on the
 sampled period because every trial is scaled into them: q - q0, qd and qdd are all linear in
 (a, b), so the factor that brings the tightest of them to its limit is exact; the optimiser works

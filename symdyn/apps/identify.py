@@ -138,11 +138,11 @@ class Identification:
         return "\n".join(lines) + "\n"
 
 
-def _columns(header: list[str], n: int, where: str) -> dict[str, list[int]]:
-    """Indices of t, q, qd, qdd, tau in the header (qd and qdd may be missing)."""
+def _columns(header: list[str], n: int, where: str, torques: bool = True) -> dict[str, list[int]]:
+    """Indices of t, q, qd, qdd (and tau when `torques`) in the header (qd and qdd may be missing)."""
     index = {name.strip(): k for k, name in enumerate(header)}
     out: dict[str, list[int]] = {}
-    for head in ("t", "q", "qd", "qdd", "tau"):
+    for head in ("t", "q", "qd", "qdd", "tau") if torques else ("t", "q", "qd", "qdd"):
         names = ["t"] if head == "t" else [f"{head}{i}" for i in range(1, n + 1)]
         present = [c for c in names if c in index]
         if head in ("qd", "qdd") and not present:
@@ -158,8 +158,11 @@ def _columns(header: list[str], n: int, where: str) -> dict[str, list[int]]:
     return out
 
 
-def read_measurements(path: str | os.PathLike, n: int) -> Measurements:
+def read_measurements(path: str | os.PathLike, n: int, torques: bool = True) -> Measurements:
     """Measurements of an n-joint robot from a CSV file (see the module docstring).
+
+    With torques=False the tau columns are not required (a reference trajectory, e.g. the file
+    `symdyn excite` writes, for `symdyn simulate --track FILE.csv`); `tau` is then empty.
 
     Raises:
         SymdynError: no such file, a missing column, a value that is not a finite number,
@@ -173,7 +176,7 @@ def read_measurements(path: str | os.PathLike, n: int) -> Measurements:
     rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
     if not rows:
         raise SymdynError(f"{where}: empty file (expected a header t,q1..,tau1..)")
-    cols = _columns(rows[0], n, where)
+    cols = _columns(rows[0], n, where, torques)
     data = np.empty((len(rows) - 1, len(rows[0])))
     for k, row in enumerate(rows[1:], start=2):
         if len(row) != len(rows[0]):
@@ -186,7 +189,8 @@ def read_measurements(path: str | os.PathLike, n: int) -> Measurements:
         raise SymdynError(f"{where}: values must be finite numbers")
     if len(data) < 2:
         raise SymdynError(f"{where}: too few samples ({len(data)})")
-    t, q, tau = data[:, cols["t"][0]], data[:, cols["q"]], data[:, cols["tau"]]
+    t, q = data[:, cols["t"][0]], data[:, cols["q"]]
+    tau = data[:, cols["tau"]] if torques else np.empty((len(data), 0))
     if "qd" in cols:
         return Measurements(t, q, data[:, cols["qd"]], data[:, cols["qdd"]], tau)
     q, qd, qdd = differentiate(t, q, where)
@@ -222,7 +226,9 @@ def base_regressor_samples(robot: Robot, q, qd, qdd) -> np.ndarray:
     from .compiled import compiled_dynamics
 
     cd = compiled_dynamics(robot)
-    Yb = cd.base_regressor(np.asarray(q, dtype=float), np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float))
+    Yb = cd.base_regressor(
+        np.asarray(q, dtype=float), np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float)
+    )
     return np.asarray(Yb, dtype=float).reshape(len(q), robot.n, -1)
 
 

@@ -184,9 +184,19 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     n = plant.n
     tolerances = {"rtol": args.rtol, "atol": args.atol}
     if args.track is not None:
-        from ..apps.control import ComputedTorque, Reference, track
+        from ..apps.control import ComputedTorque, Reference, SampledReference, track
 
-        reference = Reference(_words(args.track, "--track"), n)
+        words = _words(args.track, "--track")
+        if len(words) == 1 and words[0].lower().endswith(".csv"):
+            reference = SampledReference.from_csv(words[0], n)
+            start, end = reference.span
+            if start > 0.0 or end < args.duration:
+                raise SymdynError(
+                    f"{words[0]}: the reference covers t in [{start:g}, {end:g}] s, "
+                    f"the simulation [0, {args.duration:g}] s"
+                )
+        else:
+            reference = Reference(words, n)
         r0, rd0, _ = reference(0.0)
         q0 = _vector(args.q0, n, "--q0", default=r0)
         qd0 = _vector(args.qd0, n, "--qd0", default=rd0)
@@ -334,7 +344,8 @@ def register(subparsers) -> None:
         "--track",
         **vec,
         help="computed-torque control tracking q_ref(t): one expression of t per joint "
-        "(qd_ref, qdd_ref by symbolic differentiation)",
+        "(qd_ref, qdd_ref by symbolic differentiation), or a CSV file with columns t, q1..qn and "
+        "optionally qd1..qdn, qdd1..qddn (e.g. from symdyn excite), interpolated between samples",
     )
     s.add_argument("--kp", **vec, help="position gain(s) Kp, one or one per joint (default 100)")
     s.add_argument("--kd", **vec, help="velocity gain(s) Kd, one or one per joint (default 20)")

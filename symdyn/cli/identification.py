@@ -109,7 +109,10 @@ def cmd_excite(args: argparse.Namespace) -> int:
     traj.write_csv(robot, args.out, args.dt)
     print(f"{args.out}: one period T = {traj.period:g} s every {args.dt:g} s, {args.harmonics} harmonics")
     print(f"condition number of the base regressor over {args.samples} samples: {traj.condition_number:.4g}")
-    print("follow it with: symdyn simulate ROBOT --track " + ",".join(traj.expressions()))
+    print(
+        f"follow it with: symdyn simulate ROBOT --track {args.out} --duration T --dt H (T <= {traj.period:g})"
+    )
+    print("or, exactly: symdyn simulate ROBOT --track " + ",".join(traj.expressions()))
     return 0
 
 
