@@ -257,3 +257,20 @@ def test_two_processes_building_one_entry(temporary_cache):
     assert all(p.returncode == 0 for p in procs)
     root, count, _ = cache.usage()
     assert count == 1 and not list((root / "v1").glob(".build-*"))
+
+
+def test_a_warm_simulate_imports_no_sympy(tmp_path, temporary_cache):
+    """The warm command-line path (cached library) runs without importing SymPy (docs/speed.md)."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "a.csv"
+    argv = ["simulate", str(PLANAR), "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
+    assert main(argv) == 0  # builds the entry
+    code = (
+        "import sys; from symdyn.cli.main import main; "
+        f"assert main({argv!r}) == 0; print(sorted(m for m in sys.modules if m.split('.')[0] == 'sympy')[:3])"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip().splitlines()[-1] == "[]"

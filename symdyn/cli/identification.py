@@ -19,7 +19,6 @@ import sys
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.expressions import parse_expression
 from .common import add_robot_argument, load_robot_argument
 
 __all__ = ["register", "cmd_identify", "cmd_excite"]
@@ -27,6 +26,8 @@ __all__ = ["register", "cmd_identify", "cmd_excite"]
 
 def _values(items, what: str) -> list[float]:
     """Numbers or constant expressions, space- or comma-separated."""
+    from ..model.expressions import parse_expression  # SymPy: only when these options are given
+
     words = [w.strip() for item in items for w in str(item).split(",")]
     out = []
     for w in words:
