@@ -164,7 +164,9 @@ class FunctionRow:
     """A function before elimination: what `build_functions` turns into a FunctionSpec.
 
     `exprs` are the outputs' row-major entries over the program's intermediates (in the order
-    of `results`); `steps` the assignments they need beyond the dynamics' own program.
+    of `results`); `steps` the assignments they need beyond the dynamics' own program. Rows of
+    one `cse` group share a CSE pass; a family in a group of its own cannot change the code of
+    the others.
     """
 
     name: str
@@ -173,6 +175,7 @@ class FunctionRow:
     results: tuple[Output, ...]
     exprs: tuple[sp.Expr, ...]
     steps: tuple = ()
+    cse: str = ""
 
 
 @dataclass(frozen=True)
@@ -291,7 +294,13 @@ _OUTPUT_DOCS = {
 
 #: The families of generated functions, in the order of the generated files: each maps a derived
 #: robot and the input vectors to its FunctionRows (a new family is one module and one entry here).
-FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (dynamics_rows, forward_dynamics_rows)
+from .derivative_functions import derivative_rows  # noqa: E402 (it builds on the names above)
+
+FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
+    dynamics_rows,
+    forward_dynamics_rows,
+    derivative_rows,
+)
 
 
 def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
@@ -306,8 +315,12 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
     rows = [row for family in FAMILIES for row in family(dyn, x)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
-    needs = [e for row in rows for e in row.exprs] + [e for row in rows for _, e in row.steps]
-    needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
-    steps = dyn.program.needed(needs) + [s for row in rows for s in row.steps]
-    code = eliminate_many(steps, {row.name: list(row.exprs) for row in rows}, reserved=x.symbols)
+    code = {}
+    for group in dict.fromkeys(row.cse for row in rows):
+        members = [row for row in rows if row.cse == group]
+        needs = [e for row in members for e in row.exprs] + [e for row in members for _, e in row.steps]
+        if not group:
+            needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
+        steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
+        code |= eliminate_many(steps, {row.name: list(row.exprs) for row in members}, reserved=x.symbols)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]
