@@ -1,6 +1,7 @@
 """The derivative part of bench/run.py (issue 13): symdyn's derivative C against Pinocchio and CasADi.
 
-For each timed robot, in the same run as the other functions:
+For each of the arms (bench/robots.py ARMS: PUMA 560, Stanford, Panda), in the same run as the
+other functions:
 
 * symdyn's generated C: NAME_inverse_dynamics_derivatives, NAME_forward_dynamics_derivatives,
   NAME_mass_matrix_inverse (and NAME_linearize, which has no counterpart);
