@@ -49,6 +49,7 @@ from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
+from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
 from .model.robot import Robot
 from .model.symbols import joint_symbols
@@ -238,6 +239,23 @@ class Dynamics:
         shape = self.compact[name].shape
         out = np.asarray(self._numeric(name)(*vec, p), dtype=float).reshape(shape)
         return out[:, 0] if name not in ("M", "C") else out
+
+    def tip_wrench_torque(self, F, q=None, params=None):
+        """J_b(q)^T F: the joint torques balancing a wrench F = [m; f] that the end effector
+        applies to its environment, in the end-effector frame (Modern Robotics' F_tip;
+        symdyn.algorithms.tip_wrench). Add it to tau for MR's InverseDynamics.
+
+        Returns:
+            With q None: an n x 1 SymPy matrix over q (and F, if it holds symbols);
+            with q (n numbers) and params: an (n,) array.
+        """
+        if q is None:
+            return tip_wrench_torque(self.robot, F, list(self.q))
+        where = "Dynamics.tip_wrench_torque"
+        q = self.robot.joint_values(q, "q", where)
+        self.robot.param_values(params, where)
+        robot = self.robot.numeric(params)
+        return np.asarray(tip_wrench_torque(robot, F, [float(x) for x in q]), dtype=float)[:, 0]
 
     def __repr__(self) -> str:
         """One line: robot, joints, method and free parameters (the robot's table: `table()`)."""

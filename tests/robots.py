@@ -32,6 +32,10 @@ from symdyn.spatial.transform import Transform
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
 EXAMPLE_NAMES = tuple(sorted(p.stem for p in EXAMPLES_DIR.glob("*.yaml")))
+#: the examples written as DH tables (not `convention: poe`), for tests that rebuild DH products
+DH_EXAMPLE_NAMES = tuple(
+    n for n in EXAMPLE_NAMES if "convention: poe" not in (EXAMPLES_DIR / f"{n}.yaml").read_text()
+)
 QUANTITIES = ("M", "C", "V", "G", "tau")
 
 Z = sp.ImmutableMatrix([0, 0, 1])

@@ -26,7 +26,7 @@ from .compiled import CompiledDynamics, compiled_dynamics
 from .simulate import TIME, lambdify_time, simulate, time_expressions
 from .trajectory import Trajectory
 
-__all__ = ["Reference", "ComputedTorque", "pd_gains", "track"]
+__all__ = ["Reference", "ComputedTorque", "TrackingLaw", "pd_gains", "track"]
 
 
 def pd_gains(omega: float, zeta: float = 1.0) -> tuple[float, float]:
@@ -114,15 +114,25 @@ class ComputedTorque:
     __call__ = torque
 
     def law(self, reference: Reference):
-        """tau(t, q, qd) tracking `reference`: the torque function `simulate` takes."""
+        """tau(t, q, qd) tracking `reference`: the torque function `simulate` takes.
+
+        simulate recognises it (its `tracking` attribute) and runs the law inside its C loop.
+        """
         if reference.n != self.n:
             raise SymdynError(f"the reference has {reference.n} joints, the model {self.n}")
+        return TrackingLaw(self, reference)
 
-        def tau(t, q, qd):
-            r, rd, rdd = reference(t)
-            return self.torque(q, qd, r, rd, rdd)
 
-        return tau
+class TrackingLaw:
+    """The torque function tau(t, q, qd) of a ComputedTorque tracking a Reference."""
+
+    def __init__(self, controller: ComputedTorque, reference: Reference) -> None:
+        self.tracking = (controller, reference)
+
+    def __call__(self, t, q, qd) -> np.ndarray:
+        controller, reference = self.tracking
+        r, rd, rdd = reference(t)
+        return controller.torque(q, qd, r, rd, rdd)
 
 
 def track(
@@ -136,8 +146,10 @@ def track(
     integrator: str = "rk4",
     params=None,
     progress: bool | None = None,
+    rtol: float = 1e-6,
+    atol: float = 1e-9,
 ) -> Trajectory:
-    """Simulate the plant under `controller` tracking `reference`.
+    """Simulate the plant under `controller` tracking `reference` (rtol, atol: rk45 and dop853 only).
 
     q0, qd0 default to the reference's initial position and velocity. The result
     carries q_ref and qd_ref at the sample times.
@@ -153,6 +165,8 @@ def track(
         integrator=integrator,
         params=params,
         progress=progress,
+        rtol=rtol,
+        atol=atol,
     )
     q_ref, qd_ref, _ = reference(traj.t)
     if traj.q.ndim == 3:

@@ -13,13 +13,10 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-import sympy as sp
-
 from .. import __version__
-from ..dynamics import METHODS, derive
 from ..errors import SymdynError, SymdynWarning
 from .apps import register
-from .common import add_robot_argument, load_robot_argument
+from .common import METHODS, add_robot_argument, load_robot_argument
 
 __all__ = ["main"]
 
@@ -35,6 +32,8 @@ def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
 
 
 def _derive_text(dyn) -> str:
+    import sympy as sp
+
     lines = [
         f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
@@ -50,6 +49,8 @@ def _derive_text(dyn) -> str:
 
 
 def _derive_json(dyn) -> str:
+    import sympy as sp
+
     doc: dict = {
         "robot": dyn.robot.name,
         "method": dyn.method,
@@ -75,6 +76,12 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    if args.steps or args.at:
+        from .steps import cmd_derive_steps
+
+        return cmd_derive_steps(args)
+    from ..dynamics import derive
+
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
@@ -119,6 +126,10 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         help="trigonometric simplification of the closed forms (auto: up to 3 joints)",
     )
+    d.add_argument(
+        "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"
+    )
+    d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
     d.set_defaults(func=cmd_derive)
 
     g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
@@ -126,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument(
         "--target",
         action="append",
-        choices=("c", "casadi", "python", "latex"),
+        choices=("c", "casadi", "python", "latex", "matlab"),
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")

@@ -37,6 +37,7 @@ from ..dynamics import QUANTITIES, Dynamics
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import Eliminated, OpCount, eliminate_many
+from .tip_wrench import TIP_WRENCH_DOC, TIP_WRENCH_FUNCTION, tip_wrench_exprs, tip_wrench_symbols
 
 __all__ = [
     "FunctionSpec",
@@ -282,6 +283,16 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     ]
 
 
+def tip_wrench_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """tip_wrench_torque(q, F, p) for product-of-exponentials robots (symdyn.codegen.tip_wrench)."""
+    exprs = tip_wrench_exprs(dyn)
+    if exprs is None:
+        return []
+    F = Input("F", tip_wrench_symbols())
+    out = vector_output("tau_tip", dyn.n, "joint torques J_b^T F holding the end-effector wrench F")
+    return [FunctionRow(TIP_WRENCH_FUNCTION, TIP_WRENCH_DOC, (x.q, F, x.p), (out,), tuple(exprs))]
+
+
 _OUTPUT_DOCS = {
     "tau": "joint efforts tau = M qdd + V + G + F",
     "M": "joint-space mass (inertia) matrix M(q)",
@@ -299,6 +310,7 @@ from .derivative_functions import derivative_rows  # noqa: E402 (it builds on th
 FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     dynamics_rows,
     forward_dynamics_rows,
+    tip_wrench_rows,
     derivative_rows,
 )
 

@@ -17,6 +17,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...model.expressions import C_KEYWORDS
+from ..printing import free_name
 from ..render import PRECISIONS, RenderContext
 
 __all__ = ["CConfig", "CNames", "c_names", "C_RESERVED", "MATH_CALLS", "TEMPORARY"]
@@ -154,14 +155,8 @@ def c_names(ctx: RenderContext) -> CNames:
     for s in joint_symbols:
         assert str(s) not in reserved and not TEMPORARY.match(str(s)), f"joint symbol '{s}' is a C name"
     for p in params:
-        base = str(p)
-        candidate = base
-        k = 0
-        while candidate in reserved or candidate in used or TEMPORARY.match(candidate):
-            candidate = f"{base}_" if k == 0 else f"{base}_{k}"
-            k += 1
-        local_names[p] = candidate
-        used.add(candidate)
+        local_names[p] = free_name(str(p), reserved | used, TEMPORARY)
+        used.add(local_names[p])
     param_macro = {p: m for p, (m, _) in zip(params, param_macros, strict=True)}
     return CNames(
         header_file=f"{name}_dynamics.h",

@@ -23,6 +23,9 @@ from .printer import CPrinter
 
 __all__ = ["render", "render_context", "TOOLS"]
 
+#: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6).
+JOINT_INPUTS = ("q", "qd", "qdd", "tau")
+
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
 TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
 
@@ -42,7 +45,8 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     inputs, unused, reads = [], [], []
     for inp in spec.inputs:
         used = [s for s in inp.symbols if s in used_symbols]
-        inputs.append({"name": inp.name, "read": bool(used)})
+        size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+        inputs.append({"name": inp.name, "read": bool(used), "size": size})
         if not used:
             unused.append(inp.name)
         for s in used:

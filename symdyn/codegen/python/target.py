@@ -22,6 +22,9 @@ from .printer import NumpyPrinter, dtype, local_names
 
 __all__ = ["render", "file_name", "TOOLS"]
 
+#: The inputs with one value per joint (NDOF); any other input has a fixed size (F: 6).
+JOINT_INPUTS = ("q", "qd", "qdd", "tau")
+
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_numpy.py": ("sympy",)}
 
@@ -31,12 +34,16 @@ def file_name(name: str) -> str:
 
 
 def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
-    """One function as data: arguments, the input elements it reads, temporaries, output entries."""
+    """One function as data: arguments (and their sizes: NDOF or a number), the input elements
+    it reads, temporaries, output entries."""
     free = spec.free_symbols
     return {
         "name": spec.name,
         "doc": spec.doc,
         "inputs": [inp.name for inp in spec.inputs if inp.name != "p"],
+        "sizes": {
+            inp.name: "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols)) for inp in spec.inputs
+        },
         "has_p": any(inp.name == "p" for inp in spec.inputs),
         "lead": [inp.name for inp in spec.inputs],
         "unpack": [
