@@ -52,7 +52,7 @@ class PoeLink:
 
 def _vanishes(x: sp.Expr) -> bool:
     """x is zero: within TOLERANCE for a number, by simplification for an expression."""
-    x = sp.sympify(x)
+    x = sp.sympify(x, strict=True)  # a number or an expression already parsed, never text
     if not x.free_symbols:
         return abs(complex(sp.N(x))) <= TOLERANCE
     return sp.simplify(x) == 0
