@@ -75,10 +75,22 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    from . import derive_output as out
+
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
-    text = {"text": _derive_text, "json": _derive_json, "latex": _derive_latex}[args.format](dyn)
+    if args.format == "latex":
+        configuration = args.form == "configuration"
+        text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
+    elif args.prune is not None:
+        from ..algorithms.pruning import prune
+
+        if args.format != "text" or args.form != "configuration":
+            raise SymdynError("derive: --prune prints the configuration form as text only")
+        text = out.derive_text(dyn, args.form, args.lumped, prune(dyn.configuration_space, args.prune))
+    else:
+        text = {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
     sys.stdout.write(text)
     return 0
 
@@ -118,6 +130,22 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("auto", "yes", "no"),
         default="auto",
         help="trigonometric simplification of the closed forms (auto: up to 3 joints)",
+    )
+    d.add_argument(
+        "--form",
+        choices=("configuration", "compact", "expanded"),
+        default="configuration",
+        help="configuration: M, B [qd qd], Csq [qd^2], G, F (default); compact: named intermediates; "
+        "expanded: the full expansion",
+    )
+    d.add_argument(
+        "--lumped", action="store_true", help="name each distinct coefficient once (I1, I2, ..., g1, ...)"
+    )
+    d.add_argument(
+        "--prune",
+        type=float,
+        metavar="REL",
+        help="drop terms below REL of their entry's largest value over the joint ranges (AKB's 1%% model)",
     )
     d.set_defaults(func=cmd_derive)
 
