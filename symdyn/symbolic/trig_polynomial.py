@@ -466,6 +466,8 @@ class TrigRing:
         terms = []
         for (qpart, k, kind), items in groups.items():
             coef = fast_add([fast_mul([to_sympy_number(c), self.mono_expr(pp)]) for c, pp in items])
+            if coef.is_Add and len(items) > 1:  # parameters: common factors pulled out
+                coef = sp.factor_terms(coef)
             if coefficient is not None:
                 coef = coefficient(coef)
             terms.append(fast_mul([coef, self.mono_expr(qpart), self.trig_expr(k, kind)]))
