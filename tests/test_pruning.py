@@ -54,3 +54,23 @@ def test_prune_needs_numbers_and_a_threshold():
         prune(dyn.configuration_space, 0.01)
     with pytest.raises(SymdynError, match="between 0 and 1"):
         prune(derive(example("planar_3r")).configuration_space, 2.0)
+
+
+def test_generated_code_from_the_pruned_model_states_and_keeps_its_bound():
+    from symdyn import rnea
+    from symdyn.codegen import context
+    from symdyn.codegen.render import header_lines
+
+    robot = example("puma560")
+    ctx = context(robot, prune=0.01)
+    assert any("Pruned model (--prune 0.01)" in line for line in header_lines(ctx))
+    pr = prune(derive(robot, simplify=False).configuration_space, 0.01)
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        q = rng.uniform(-math.pi, math.pi, 6)
+        M, G = ctx.dynamics.evaluate("M", q), ctx.dynamics.evaluate("G", q)
+        M_true, G_true = rnea.mass_matrix(ctx.robot, q), rnea.gravity_torque(ctx.robot, q)
+        for i in range(6):
+            assert abs(G[i] - G_true[i]) <= pr.bounds.get(("G", i, 0), 0.0) + 1e-9
+            for j in range(i, 6):
+                assert abs(M[i, j] - M_true[i, j]) <= pr.bounds.get(("M", i, j), 0.0) + 1e-9

@@ -107,6 +107,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         precision=args.precision,
         force=args.force,
         method=args.method,
+        prune=args.prune,
     )
     for p in paths:
         print(p)
@@ -161,6 +162,13 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--precision", choices=("double", "float"), default="double")
     g.add_argument("--method", choices=METHODS, default="newton-euler")
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
+    g.add_argument(
+        "--prune",
+        type=float,
+        metavar="REL",
+        help="generate from the model without the terms below REL of their entry's largest value "
+        "(the bound goes into the headers)",
+    )
     g.set_defaults(func=cmd_generate)
     register(sub)  # simulate, analyze, check (the lecture's applications)
     return parser
