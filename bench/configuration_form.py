@@ -46,7 +46,7 @@ def _robots():
         ("PUMA 560", lambda: load_robot(ex / "puma560.yaml"), True),
         ("PUMA 560 (exact)", lambda: robot_from_data(_rational_data(raw), source="puma560"), True),
         ("Stanford", lambda: load_robot(ex / "stanford.yaml"), True),
-        ("Panda", lambda: load_robot(ex / "panda.yaml"), False),
+        ("Panda", lambda: load_robot(ex / "panda.yaml"), None),
         ("PUMA 560 (60 symbolic)", lambda: puma560_symbolic()[0], False),
     ]
 
@@ -57,7 +57,9 @@ def _ops(exprs) -> int:
     return count_ops([], list(exprs)).total
 
 
-def _row(label: str, make, expanded: bool) -> dict:
+def _row(label: str, make, expanded: bool | None) -> dict:
+    """One robot's figures; expanded None: neither the expanded form nor the lumped one (the
+    Panda's 200,000 terms make SymPy's term ordering, which lumping needs, take minutes)."""
     import sympy as sp
 
     from symdyn.algorithms.pruning import prune
@@ -73,10 +75,11 @@ def _row(label: str, make, expanded: bool) -> dict:
     cs = dyn.configuration_space
     row = {"robot": label, "seconds": seconds, "bytes": len(text.encode()), "gamma": len(cs.gamma)}
     row["configuration"] = {k: _ops(cs.matrix(k)) for k in ("M", "B", "Csq", "G")}
-    entries, definitions = configuration_entries(dyn, lumped=True)
-    lumped = {k: _ops(e for _, e in entries[k]) for k in ("M", "B", "Csq", "G")}
-    lumped["constants"] = _ops(v for _, v in definitions)
-    row["lumped"] = lumped
+    if expanded is not None:
+        entries, definitions = configuration_entries(dyn, lumped=True)
+        lumped = {k: _ops(e for _, e in entries[k]) for k in ("M", "B", "Csq", "G")}
+        lumped["constants"] = _ops(v for _, v in definitions)
+        row["lumped"] = lumped
     if not dyn.params:
         pruned = prune(cs, 0.01)
         row["pruned"] = {k: _ops(pruned.configuration.matrix(k)) for k in ("M", "B", "Csq", "G")}
@@ -104,6 +107,7 @@ def configuration_report(markdown: bool = False) -> str:
     for label, make, expanded in _robots():
         print(f"  [{label}] ...", file=sys.stderr, flush=True)
         rows.append(_row(label, make, expanded))
+        print(f"  {rows[-1]}", file=sys.stderr, flush=True)
     head = (
         "| robot | derive (s) | text (KB) | Christoffel symbols | M / B / Csq / G, configuration form | "
         "total | lumped (entries + constants) | 1 % pruned (bound) | compact M, V, G | expanded M, V, G | "
@@ -112,14 +116,19 @@ def configuration_report(markdown: bool = False) -> str:
     out = [head, "|" + "---|" * 11]
     for r in rows:
         c = r["configuration"]
-        lumped = r["lumped"]
+        lumped = r.get("lumped")
         pruned = r.get("pruned")
         bound = f" ({r['bound']:.3g})" if pruned else ""
         lam = f"{r['lambdify_V']:.2f}" if r.get("lambdify_V") is not None else "—"
         out.append(
             f"| {r['robot']} | {r['seconds']:.1f} | {r['bytes'] / 1000:.0f} | {r['gamma']} | "
             f"{c['M']:,} / {c['B']:,} / {c['Csq']:,} / {c['G']:,} | {_total(c)} | "
-            f"{_total({k: v for k, v in lumped.items() if k != 'constants'})} + {lumped['constants']:,} | "
+            + (
+                f"{_total({k: v for k, v in lumped.items() if k != 'constants'})} + {lumped['constants']:,}"
+                if lumped
+                else "—"
+            )
+            + " | "
             f"{_total(pruned)}{bound} | {r['compact']:,} | {_total(r.get('expanded'))} | {lam} |"
         )
     out.append("")

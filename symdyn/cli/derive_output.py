@@ -197,8 +197,9 @@ def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False
 
 
 def _latex_label(name: str, label: str) -> str:
-    """M[1,2] -> M_{1,2}, B[1,(2,3)] -> B_{1,(2,3)}, G[1] -> G_{1}."""
-    return f"{name}_{{{label[len(name) + 1 : -1]}}}"
+    """M[1,2] -> M_{1,2}, B[1,(2,3)] -> B_{1,(2,3)}, Csq[2,1] -> C^{\\mathrm{sq}}_{2,1}, G[1] -> G_{1}."""
+    head = "C^{\\mathrm{sq}}" if name == "Csq" else name
+    return f"{head}_{{{label[len(name) + 1 : -1]}}}"
 
 
 def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
@@ -222,4 +223,10 @@ def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
             lines = nt.lines(nt.prepare(e))
             rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
         out.append("\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}")
+    abbreviations = [
+        f"${nt.names[ph]} = \\{'sin' if kind == 's' else 'cos'}(" + " + ".join(f"q_{{{i}}}" for i in idx) + ")$"
+        for ph, (kind, idx) in sorted(nt.trig.items(), key=lambda item: item[0].name)
+    ]
+    if abbreviations:
+        out.insert(1, "Abbreviations: " + ", ".join(abbreviations) + ".")
     return "\n".join(out) + "\n"
