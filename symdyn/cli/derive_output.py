@@ -223,10 +223,10 @@ def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
             lines = nt.lines(nt.prepare(e))
             rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
         out.append("\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}")
-    abbreviations = [
-        f"${nt.names[ph]} = \\{'sin' if kind == 's' else 'cos'}(" + " + ".join(f"q_{{{i}}}" for i in idx) + ")$"
-        for ph, (kind, idx) in sorted(nt.trig.items(), key=lambda item: item[0].name)
-    ]
+    abbreviations = []
+    for ph, (kind, idx) in sorted(nt.trig.items(), key=lambda item: item[0].name):
+        angle = " + ".join(f"q_{{{i}}}" for i in idx)
+        abbreviations.append(f"${nt.names[ph]} = \\{'sin' if kind == 's' else 'cos'}({angle})$")
     if abbreviations:
         out.insert(1, "Abbreviations: " + ", ".join(abbreviations) + ".")
     return "\n".join(out) + "\n"
