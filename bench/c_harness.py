@@ -20,6 +20,9 @@ from machine import C_COMPILER, FLAGS, run
 from row import FUNCTIONS, Row
 from states import CHECK_TOL, NCHECK, NSTATES, rel_err
 
+import symdyn
+from symdyn.model.parameters import numeric_parameters
+
 __all__ = ["HARNESS", "parse_harness", "build_c", "check_c", "time_compiled"]
 
 HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench/run.py), do not edit. */
@@ -34,10 +37,10 @@ HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench
 #define N {n}
 #define K {nstates}
 #define MAXREPS 1000
-#define NB 10
+#define NB 12
 
 static double Q[K][N], QD[K][N], QDD[K][N], TAU[K][N];
-static double OUT[N * N];
+static double OUT[N * N + N * {prefix}_NSTD]; /* the largest output: M or Y */
 static volatile double sink;
 static const double *P = NULL; /* numeric robot: no free parameters */
 static const casadi_real *cr_arg[64];
@@ -47,7 +50,8 @@ static casadi_real *cr_w;
 
 static const char *LABELS[NB] = {{
     "inverse_dynamics", "cr_inverse_dynamics", "mass_matrix", "cr_mass_matrix", "gravity",
-    "cr_gravity", "coriolis_matrix", "coriolis", "friction", "forward_dynamics"}};
+    "cr_gravity", "coriolis_matrix", "coriolis", "friction", "forward_dynamics", "regressor",
+    "base_regressor"}};
 
 static double now_ns(void)
 {{
@@ -106,6 +110,8 @@ static double run_bench(int b, long it)
     case 7: LOOP(N, {prefix}_coriolis(Q[k], QD[k], P, OUT));
     case 8: LOOP(N, {prefix}_friction(QD[k], P, OUT));
     case 9: LOOP(N, {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT));
+    case 10: LOOP(N * {prefix}_NSTD, {prefix}_regressor(Q[k], QD[k], QDD[k], P, OUT));
+    case 11: LOOP(N * {prefix}_NBASE, {prefix}_base_regressor(Q[k], QD[k], QDD[k], P, OUT));
     default: return -1.0;
     }}
     return (now_ns() - s) / (double)it;
@@ -160,6 +166,9 @@ int main(int argc, char **argv)
             {prefix}_gravity(Q[k], P, OUT); print_out("gravity", k, N);
             {prefix}_friction(QD[k], P, OUT); print_out("friction", k, N);
             {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT); print_out("forward_dynamics", k, N);
+            {prefix}_regressor(Q[k], QD[k], QDD[k], P, OUT); print_out("regressor", k, N * {prefix}_NSTD);
+            {prefix}_base_regressor(Q[k], QD[k], QDD[k], P, OUT);
+            print_out("base_regressor", k, N * {prefix}_NBASE);
             CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]); print_out("cr_inverse_dynamics", k, N);
             CR(cr_{prefix}_mass_matrix, Q[k]); print_out("cr_mass_matrix", k, N * N);
             CR(cr_{prefix}_gravity, Q[k]); print_out("cr_gravity", k, N);
@@ -225,6 +234,7 @@ def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
 def check_c(row: Row, robot, exe: Path, states_file: Path, states, refs: list[dict]) -> None:
     """Compare the harness's outputs at the first NCHECK states with `refs` (see `references`)."""
     checks, _ = parse_harness(run([exe, states_file, "check", NCHECK]).stdout)
+    pi_b = symdyn.derive(robot, simplify=False).linear_compact()[1].matrix() @ numeric_parameters(robot)
     worst: dict[str, float] = {}
     for k in range(NCHECK):
         ref = refs[k]
@@ -240,6 +250,9 @@ def check_c(row: Row, robot, exe: Path, states_file: Path, states, refs: list[di
             "gravity": rel_err(got["gravity"], ref["gravity"]),
             "friction": rel_err(got["friction"], ref["friction"]),
             "forward_dynamics": rel_err(got["forward_dynamics"], ref["forward_dynamics"]),
+            "regressor": rel_err(got["regressor"], ref["regressor"]),
+            # Y_b pi_b, pi_b = K pi the base parameters' values (symdyn.algorithms.base_parameters)
+            "base_regressor": rel_err(got["base_regressor"].reshape(n, -1) @ pi_b, ref["inverse_dynamics"]),
             "cr_inverse_dynamics": rel_err(checks["cr_inverse_dynamics"][k], ref["inverse_dynamics"]),
             "cr_mass_matrix": rel_err(checks["cr_mass_matrix"][k], ref["mass_matrix"].T.ravel()),
             "cr_gravity": rel_err(checks["cr_gravity"][k], ref["gravity"]),

@@ -5,7 +5,8 @@ bench/pinocchio_harness.cpp builds the robot as a pinocchio::Model from the numb
 of mass in the body frame, armature = gear_ratio^2 J_m): a chain or a kinematic tree on a fixed
 base, in symdyn's depth-first link order. Robots with mimic joints are not modelled (the
 harness adds one independent joint per link; `check_pinocchio` leaves them out with a note).
-It checks rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix and aba against
+It checks rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix, aba and
+computeJointTorqueRegressor (Y pi + armature qdd, pi from toDynamicParameters) against
 symdyn.rnea's numbers, then times them. It is
 compiled header-only with g++ against the `pin` wheel's headers (cmeel.prefix/include) and
 Eigen's (the `cmeel-eigen` wheel, or the system's as `pkg-config eigen3` reports them);

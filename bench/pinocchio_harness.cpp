@@ -1,7 +1,7 @@
 // Pinocchio side of bench/run.py: build a symdyn Robot (a chain or a kinematic tree on a fixed base,
 // without mimic joints) as a pinocchio::Model, check it against
-// symdyn.rnea's numbers, and time rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix
-// and aba on the same pre-generated states as the C harness.
+// symdyn.rnea's numbers, and time rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix,
+// aba and computeJointTorqueRegressor on the same pre-generated states as the C harness.
 //
 //   pinocchio_harness MODEL.txt REPS TARGET_MS
 //
@@ -24,7 +24,7 @@
 //   info  joints N  pinocchio VERSION  eigen X.Y.Z
 //   check ALGORITHM MAX_RELATIVE_ERROR
 //   time  ALGORITHM ITERATIONS_PER_REP NS_PER_CALL_REP1 NS_PER_CALL_REP2 ...
-//     (repetitions interleaved across the five algorithms; bench/run.py takes the median)
+//     (repetitions interleaved across the six algorithms; bench/run.py takes the median)
 //
 // Compiled by bench/run.py with g++ -O3 -march=native -DNDEBUG -std=c++17 against the
 // pinocchio and Eigen headers of the `pin` and `cmeel-eigen` wheels (header-only use: the
@@ -47,6 +47,7 @@
 #endif
 #include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/crba.hpp"
+#include "pinocchio/algorithm/regressor.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
 
 using pinocchio::Data;
@@ -215,7 +216,11 @@ int main(int argc, char ** argv)
   // --- check against symdyn.rnea
   expect(in, "ncheck");
   const int C = read<int>(in, "ncheck");
-  double e_rnea = 0, e_crba = 0, e_grav = 0, e_cor = 0, e_aba = 0;
+  double e_rnea = 0, e_crba = 0, e_grav = 0, e_cor = 0, e_aba = 0, e_reg = 0;
+  // the inertial parameters in toDynamicParameters order: Y pi + armature qdd is rnea's tau
+  VectorXd pi(10 * n);
+  for (int j = 0; j < n; ++j)
+    pi.segment<10>(10 * j) = model.inertias[j + 1].toDynamicParameters();
   for (int c = 0; c < C; ++c)
   {
     const int k = read<int>(in, "check state");
@@ -244,6 +249,8 @@ int main(int argc, char ** argv)
     const MatrixXd Cp = pinocchio::computeCoriolisMatrix(model, data, Q[k], QD[k]);
     e_cor = std::max(e_cor, rel_err(Cp * QD[k], V));
     e_aba = std::max(e_aba, rel_err(pinocchio::aba(model, data, Q[k], QD[k], TAU[k]), qdd));
+    const MatrixXd Y = pinocchio::computeJointTorqueRegressor(model, data, Q[k], QD[k], QDD[k]);
+    e_reg = std::max(e_reg, rel_err(VectorXd(Y * pi + model.armature.cwiseProduct(QDD[k])), tau));
   }
   std::printf(
     "info joints %d pinocchio %s eigen %d.%d.%d\n", n, PINOCCHIO_VERSION, EIGEN_WORLD_VERSION,
@@ -253,12 +260,13 @@ int main(int argc, char ** argv)
   std::printf("check gravity %.3e\n", e_grav);
   std::printf("check coriolis_matrix %.3e\n", e_cor);
   std::printf("check aba %.3e\n", e_aba);
+  std::printf("check regressor %.3e\n", e_reg);
   std::fflush(stdout);
 
   // --- timing: same states and protocol as the C harness of bench/run.py
   const int last = n - 1;
-  const char * labels[] = {"rnea", "crba", "gravity", "coriolis_matrix", "aba"};
-  const int NB = 5;
+  const char * labels[] = {"rnea", "crba", "gravity", "coriolis_matrix", "aba", "regressor"};
+  const int NB = 6;
   auto run_bench = [&](int b, long it) -> double {
     switch (b)
     {
@@ -275,6 +283,10 @@ int main(int argc, char ** argv)
       });
     case 4:
       return loop(it, K, [&](int k) { return pinocchio::aba(model, data, Q[k], QD[k], TAU[k])[k % n]; });
+    case 5:
+      return loop(it, K, [&](int k) {
+        return pinocchio::computeJointTorqueRegressor(model, data, Q[k], QD[k], QDD[k])(k % n, 10 * n - 1);
+      });
     }
     return -1.0;
   };

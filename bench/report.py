@@ -169,7 +169,11 @@ def targets(rows: dict[str, Row], sym: Row | None, have_pin: bool) -> list[str]:
                 f"{verdict(ops <= 0.8 * cro)}  {r.name} {fn}: goal 0.8x the CasADi route's flops: "
                 f"{ops} ops vs {cro} = {ops / cro:.2f}x"
             )
-    for fn, alg in (("coriolis_matrix", "coriolis_matrix"), ("forward_dynamics", "aba")):
+    for fn, alg in (
+        ("coriolis_matrix", "coriolis_matrix"),
+        ("forward_dynamics", "aba"),
+        ("regressor", "regressor"),
+    ):
         lines += [_against_pinocchio(r, fn, alg, 0.5, have_pin) for r in arms]
     for fn in ("inverse_dynamics", "mass_matrix", "gravity"):
         lines += [_against_pinocchio(r, fn, PINOCCHIO[fn], 0.25, have_pin) for r in trees]

@@ -25,6 +25,8 @@ SHORT = {
     "gravity": "G",
     "friction": "F",
     "forward_dynamics": "FD",
+    "regressor": "Y",
+    "base_regressor": "Yb",
 }
 CASADI_FUNCTIONS = casadi_route.FUNCTIONS  # inverse_dynamics, mass_matrix, gravity
 PINOCCHIO = {  # symdyn function -> the Pinocchio algorithm timed against it
@@ -33,6 +35,7 @@ PINOCCHIO = {  # symdyn function -> the Pinocchio algorithm timed against it
     "gravity": "gravity",
     "coriolis_matrix": "coriolis_matrix",
     "forward_dynamics": "aba",
+    "regressor": "regressor",
 }
 PINOCCHIO_NAMES = {
     "rnea": "rnea",
@@ -40,6 +43,7 @@ PINOCCHIO_NAMES = {
     "gravity": "computeGeneralizedGravity",
     "coriolis_matrix": "computeCoriolisMatrix",
     "aba": "aba",
+    "regressor": "computeJointTorqueRegressor",
 }
 
 

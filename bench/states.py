@@ -45,8 +45,11 @@ def references(robot, states, k: int) -> dict[str, np.ndarray]:
     z = np.zeros_like(q)
     M = oracle.mass_matrix(robot, q)
     h0 = oracle.rnea(robot, q, qd, z, friction=False)
+    from symdyn.rnea_regressor import regressor
+
     return {
         "inverse_dynamics": oracle.rnea(robot, q, qd, qdd),
+        "regressor": regressor(robot, q, qd, qdd),
         "mass_matrix": M,
         "coriolis": oracle.bias_torque(robot, q, qd),
         "gravity": oracle.gravity_torque(robot, q),

@@ -13,24 +13,78 @@ spatial -> model -> parsers; symbolic -> algorithms -> dynamics -> codegen -> ap
 
 __version__ = "0.1.0"
 
+import importlib as _importlib
 import sys as _sys
+from typing import TYPE_CHECKING
 
-from . import rnea  # noqa: E402  (a callable module: symdyn.rnea(robot, q, qd, qdd))
-from .algorithms import kinematics  # noqa: E402
-from .codegen import generate  # noqa: E402
-from .dynamics import Dynamics, derive  # noqa: E402
 from .errors import SymdynError, SymdynWarning  # noqa: E402
-from .model import inertia  # noqa: E402
-from .model.parameters import standard_parameters  # noqa: E402
-from .model.robot import Link, Robot  # noqa: E402
-from .parsers import load_robot, load_urdf, robot_from_data  # noqa: E402
 
-# `symdyn.inertia` and `symdyn.kinematics` are public modules: keep `import symdyn.inertia` working.
-_sys.modules[__name__ + ".inertia"] = inertia
-_sys.modules[__name__ + ".kinematics"] = kinematics
+if TYPE_CHECKING:  # what the names below are, for type checkers and the API reference
+    from . import rnea
+    from .algorithms import kinematics
+    from .apps.compile import compile
+    from .codegen import generate
+    from .dynamics import Dynamics, derive
+    from .model import inertia
+    from .model.parameters import standard_parameters
+    from .model.robot import Link, Robot
+    from .parsers import load_robot, load_urdf, robot_from_data, robot_from_poe
+
+# Every other public name is imported on first use (PEP 562), so that `import symdyn` and a
+# cached `symdyn simulate` start without SymPy: name -> (module, attribute or None for the module).
+_LAZY = {
+    "rnea": (".rnea", None),  # a callable module: symdyn.rnea(robot, q, qd, qdd)
+    "kinematics": (".algorithms.kinematics", None),
+    "inertia": (".model.inertia", None),
+    "generate": (".codegen", "generate"),
+    "compile": (".apps.compile", "compile"),
+    "Dynamics": (".dynamics", "Dynamics"),
+    "derive": (".dynamics", "derive"),
+    "standard_parameters": (".model.parameters", "standard_parameters"),
+    "Link": (".model.robot", "Link"),
+    "Robot": (".model.robot", "Robot"),
+    "load_robot": (".parsers", "load_robot"),
+    "load_urdf": (".parsers", "load_urdf"),
+    "robot_from_data": (".parsers", "robot_from_data"),
+    "robot_from_poe": (".parsers", "robot_from_poe"),
+}
+#: `symdyn.inertia` and `symdyn.kinematics` are public modules: `import symdyn.inertia` works too.
+_ALIASES = {"inertia": ".model.inertia", "kinematics": ".algorithms.kinematics"}
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'symdyn' has no attribute '{name}'")
+    module_name, attribute = _LAZY[name]
+    module = _importlib.import_module(module_name, __name__)
+    value = module if attribute is None else getattr(module, attribute)
+    globals()[name] = value
+    return value
+
+
+class _AliasFinder:
+    """Finds `symdyn.inertia` and `symdyn.kinematics` as the modules they stand for."""
+
+    @staticmethod
+    def find_spec(fullname, path=None, target=None):
+        alias = fullname.rpartition(".")[2]
+        if fullname.startswith(__name__ + ".") and fullname.count(".") == 1 and alias in _ALIASES:
+            module = _importlib.import_module(_ALIASES[alias], __name__)
+            _sys.modules[fullname] = module
+            return module.__spec__
+        return None
+
+
+_sys.meta_path.insert(0, _AliasFinder)
+
+
+def __dir__():
+    return sorted([*globals(), *_LAZY])
+
 
 __all__ = [
     "__version__",
+    "compile",
     "Dynamics",
     "Link",
     "Robot",
@@ -44,5 +98,6 @@ __all__ = [
     "load_urdf",
     "rnea",
     "robot_from_data",
+    "robot_from_poe",
     "standard_parameters",
 ]

@@ -43,6 +43,7 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
+from .algorithms.base_parameters import BaseParameters, find_base_parameters
 from .algorithms.configuration_space import ConfigurationSpace, configuration_space
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
@@ -50,7 +51,10 @@ from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
+from .algorithms.regressor import regressor as regressor_matrix
+from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
+from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
 from .symbolic.program import Program
@@ -132,6 +136,7 @@ class Dynamics:
     simplified: bool
     _closed: dict[str, sp.Matrix] = field(default_factory=dict, repr=False)
     _compiled: dict[str, object] = field(default_factory=dict, repr=False)
+    _linear: dict[str, object] = field(default_factory=dict, repr=False)
     _configuration: ConfigurationSpace | None = field(default=None, repr=False)
 
     @property
@@ -152,12 +157,20 @@ class Dynamics:
             SymdynError: an unknown name.
         """
         _check_quantity(name, "Dynamics.closed_form")
+        return self._expanded(name, self.compact[name])
+
+    def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
+        """The closed form of compact matrix m, cached under `name`: M, C, V, G, tau and bias of
+        an unsimplified derivation from the configuration-space form (canonical, the same from
+        either method; symdyn.algorithms.configuration_space), anything else by substituting
+        the program's intermediates back."""
         if name not in self._closed:
-            m = self.compact[name]
-            if self.simplified or name == "F":
-                entries = self.expanded(name)
-            else:  # canonical, from the configuration-space form (symdyn.algorithms.configuration_space)
+            if not self.simplified and name in ALL_QUANTITIES and name != "F":
                 entries = self.configuration_space.closed(name, self.qd, self.qdd, self.compact["F"])
+            else:
+                entries = self.program.expand(list(m))
+                if self.simplified:
+                    entries = [simplify_entry(e) for e in entries]
             self._closed[name] = sp.ImmutableMatrix(m.rows, m.cols, list(entries))
         return self._closed[name]
 
@@ -221,6 +234,47 @@ class Dynamics:
         """V + G + F = tau at qdd = 0, closed form."""
         return self.closed_form("bias")
 
+    def regressor_compact(self) -> sp.Matrix:
+        """The regressor Y (n x 13 nb) over the intermediates of `program`, tau = Y pi with pi the
+        standard parameters (symdyn.standard_parameters; symdyn.algorithms.regressor)."""
+        if "Y" not in self._linear:
+            self._linear["Y"] = regressor_matrix(self.robot, self.q, self.qd, self.qdd, self.program)
+        return self._linear["Y"]  # type: ignore[return-value]
+
+    def linear_compact(self) -> tuple[sp.Matrix, BaseParameters]:
+        """`regressor_compact()` and the base parameters found from it
+        (symdyn.algorithms.base_parameters); computed on first use.
+
+        Raises:
+            SymdynError: the base parameters depend on free parameters and some angle enters other
+                than as sin(q) and cos(q) (a mimic joint's multiplier, a joint offset).
+        """
+        Y = self.regressor_compact()
+        if "base" not in self._linear:
+            names = standard_parameters(self.robot)[0]
+            self._linear["base"] = find_base_parameters(
+                self.robot, Y, self.program, self.q, self.qd, self.qdd, names
+            )
+        return Y, self._linear["base"]  # type: ignore[return-value]
+
+    @property
+    def regressor(self) -> sp.Matrix:
+        """Y(q, qd, qdd), n x 13 nb, closed form: tau = Y pi (pi: symdyn.standard_parameters)."""
+        return self._expanded("regressor", self.regressor_compact())
+
+    @property
+    def base_parameters(self) -> tuple[tuple[str, sp.Expr], ...]:
+        """(name, expression) per base parameter: exact linear combinations of the standard
+        parameters' symbols (m1, mx1, ...), in the order of `base_regressor`'s columns."""
+        base = self.linear_compact()[1]
+        return tuple(zip(base.names, base.expressions, strict=True))
+
+    @property
+    def base_regressor(self) -> sp.Matrix:
+        """Y_b(q, qd, qdd), n x (number of base parameters), closed form: tau = Y_b pi_b."""
+        Y, base = self.linear_compact()
+        return self._expanded("base_regressor", Y.extract(list(range(Y.rows)), list(base.columns)))
+
     def assignments(self, names=QUANTITIES) -> list[tuple[sp.Symbol, sp.Expr]]:
         """The intermediates the given quantities need, in evaluation order.
 
@@ -272,6 +326,23 @@ class Dynamics:
         shape = self.compact[name].shape
         out = np.asarray(self._numeric(name)(*vec, p), dtype=float).reshape(shape)
         return out[:, 0] if name not in ("M", "C") else out
+
+    def tip_wrench_torque(self, F, q=None, params=None):
+        """J_b(q)^T F: the joint torques balancing a wrench F = [m; f] that the end effector
+        applies to its environment, in the end-effector frame (Modern Robotics' F_tip;
+        symdyn.algorithms.tip_wrench). Add it to tau for MR's InverseDynamics.
+
+        Returns:
+            With q None: an n x 1 SymPy matrix over q (and F, if it holds symbols);
+            with q (n numbers) and params: an (n,) array.
+        """
+        if q is None:
+            return tip_wrench_torque(self.robot, F, list(self.q))
+        where = "Dynamics.tip_wrench_torque"
+        q = self.robot.joint_values(q, "q", where)
+        self.robot.param_values(params, where)
+        robot = self.robot.numeric(params)
+        return np.asarray(tip_wrench_torque(robot, F, [float(x) for x in q]), dtype=float)[:, 0]
 
     def __repr__(self) -> str:
         """One line: robot, joints, method and free parameters (the robot's table: `table()`)."""

@@ -29,3 +29,15 @@ def pytest_runtest_makereport(item, call):
         reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else str(report.longrepr)
         report.outcome = "failed"
         report.longrepr = f"skipped under CI, where every tool the tests use is installed: {reason}"
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _temporary_symdyn_cache(tmp_path_factory):
+    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.cache)."""
+    old = os.environ.get("SYMDYN_CACHE_DIR")
+    os.environ["SYMDYN_CACHE_DIR"] = str(tmp_path_factory.mktemp("symdyn-cache"))
+    yield
+    if old is None:
+        os.environ.pop("SYMDYN_CACHE_DIR", None)
+    else:
+        os.environ["SYMDYN_CACHE_DIR"] = old

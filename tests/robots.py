@@ -32,6 +32,10 @@ from symdyn.spatial.transform import Transform
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
 EXAMPLE_NAMES = tuple(sorted(p.stem for p in EXAMPLES_DIR.glob("*.yaml")))
+#: the examples written as DH tables (not `convention: poe`), for tests that rebuild DH products
+DH_EXAMPLE_NAMES = tuple(
+    n for n in EXAMPLE_NAMES if "convention: poe" not in (EXAMPLES_DIR / f"{n}.yaml").read_text()
+)
 QUANTITIES = ("M", "C", "V", "G", "tau")
 
 Z = sp.ImmutableMatrix([0, 0, 1])
@@ -512,3 +516,12 @@ def branch_pairs(parents) -> list[tuple[int, int]]:
         return out
 
     return [(i, j) for j in range(len(parents)) for i in range(j) if i not in path(j)]
+
+
+def regressor_oracle(dyn, q, qd, qdd, params=None) -> dict[str, np.ndarray]:
+    """The generated regressor functions' expected values from the oracle's numeric regressor
+    (symdyn.rnea_regressor): Y, and its columns of the base parameters for Y_b (one state or a batch)."""
+    from symdyn.rnea_regressor import regressor
+
+    Y = regressor(dyn.robot, q, qd, qdd, params)
+    return {"regressor": Y, "base_regressor": Y[..., list(dyn.linear_compact()[1].columns)]}

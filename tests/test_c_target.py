@@ -34,6 +34,7 @@ from cbuild import (
     header_macros,
     write_files,
 )
+from robots import regressor_oracle
 
 import symdyn.codegen
 from symdyn.codegen import c as c_backend
@@ -275,7 +276,10 @@ def _driver(robot: str, q, qd, qdd, tau, p, params: list[str]) -> str:
         "gravity": ("q",),
         "friction": ("qd",),
         "forward_dynamics": ("q", "qd", "tau"),
+        "regressor": ("q", "qd", "qdd"),
+        "base_regressor": ("q", "qd", "qdd"),
     }
+    sizes = {"regressor": f"n * {robot}_NSTD", "base_regressor": f"n * {robot}_NBASE"}
     lines = [
         "#include <stdio.h>",
         "#include <stdlib.h>",
@@ -316,7 +320,7 @@ def _driver(robot: str, q, qd, qdd, tau, p, params: list[str]) -> str:
     ]
     lines += [f'    printf("P_{name} %d\\n", {robot}_P_{name});' for name in params]
     for fname, args in calls.items():
-        size = "n * n" if fname.endswith("matrix") else "n"
+        size = sizes.get(fname, "n * n" if fname.endswith("matrix") else "n")
         lines += [
             "    {",
             f"        double *out = malloc({size} * sizeof *out);",
@@ -369,6 +373,7 @@ def test_sanitised_driver(builds, robot, tmp_path):
         "friction": oracle.friction_torque(r, qd, params),
         "forward_dynamics": oracle.forward_dynamics(r, q, qd, tau, params),
     }
+    want |= {k: v.ravel() for k, v in regressor_oracle(ctx.dynamics, q, qd, qdd, params).items()}
     want["coriolis_matrix"] = got["coriolis_matrix"]
     _assert_close(got["coriolis_matrix"].reshape(r.n, r.n) @ qd, want["coriolis"], 1e-9, "C qd")
     for name in FUNCTIONS:

@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from symdyn import cli
-from symdyn.apps.control import ComputedTorque, Reference, pd_gains, track
+from symdyn.apps.control import ComputedTorque, Reference, SampledReference, pd_gains, track
 from symdyn.apps.simulate import with_parameters
 from symdyn.errors import SymdynError
 from symdyn.parsers import load_robot, robot_from_data
@@ -208,3 +208,68 @@ def test_cli_track_defaults_start_on_the_reference(tmp_path, monkeypatch):
     t = data[:, 0]
     assert np.allclose(data[:, 1], 0.5 * np.sin(2 * t), atol=1e-9)  # exact model: stays on it
     assert np.allclose(data[:, 2], 0.8 + 0.3 * np.cos(3 * t), atol=1e-9)
+
+
+def _reference_samples(h: float, duration: float):
+    """REF's closed form and derivatives sampled every h on [0, duration]."""
+    t = np.arange(0.0, duration + h / 2, h)
+    q = np.stack([0.5 * np.sin(2 * t), 0.8 + 0.3 * np.cos(3 * t)], axis=1)
+    qd = np.stack([np.cos(2 * t), -0.9 * np.sin(3 * t)], axis=1)
+    qdd = np.stack([-2 * np.sin(2 * t), -2.7 * np.cos(3 * t)], axis=1)
+    return t, q, qd, qdd
+
+
+def test_sampled_reference_interpolates_within_the_hermite_bound():
+    """Hermite error <= h^4/384 max|d^4 q/dt^4| (up to 81 * 0.3); qd_ref likewise; qdd_ref linear."""
+    h = 0.01
+    ref = SampledReference(*_reference_samples(h, 1.0))
+    exact = Reference(REF)
+    t = np.linspace(0.0, 1.0, 777)
+    got, want = ref(t), exact(t)
+    assert np.max(np.abs(got[0] - want[0])) <= h**4 / 384 * 81 * 0.3
+    assert np.max(np.abs(got[1] - want[1])) <= h**4 / 384 * 243 * 0.3
+    assert np.max(np.abs(got[2] - want[2])) <= h**2 / 8 * 81 * 0.3  # linear: h^2/8 max|q""""|
+    q0, qd0, qdd0 = ref(0.3)
+    assert q0.shape == (2,) and np.allclose(q0, exact(0.3)[0], atol=1e-15)
+    with pytest.raises(SymdynError, match=r"covers t in \[0, 1\]"):
+        ref(1.5)
+
+
+def test_cli_track_follows_a_csv_reference_like_its_expressions(tmp_path, monkeypatch):
+    """--track FILE.csv (t, q, qd, qdd columns) tracks as --track with the closed form does."""
+    t, q, qd, qdd = _reference_samples(0.01, 0.5)
+    path = tmp_path / "ref.csv"
+    header = "t,q1,q2,qd1,qd2,qdd1,qdd2"
+    np.savetxt(path, np.column_stack([t, q, qd, qdd]), delimiter=",", header=header, comments="", fmt="%.17g")
+    runs = {}
+    for name, track_arg in (("csv", [path]), ("exprs", REF)):
+        out = tmp_path / f"{name}.csv"
+        argv = ["simulate", ROGER, "--track", *track_arg, "--q0", *Q0, "--qd0", 0, 0, "--kp", 100, "--kd", 16]
+        assert run_cli([*argv, "--duration", "0.4", "--dt", "1e-3", "--out", out], monkeypatch) == 0
+        runs[name] = np.loadtxt(out, delimiter=",", skiprows=1)
+    # with the exact model the difference d of the two runs obeys d'' + Kd d' + Kp d = u, u the
+    # reference's error (qdd + Kd qd + Kp q of the interpolant minus the closed form's), so
+    # |d| <= max|u| * int|h| and |d'| <= max|u| * int|h'|, h the impulse response of that ODE
+    ts = np.linspace(0.0, 0.4, 40001)
+    sampled, exact = SampledReference(t, q, qd, qdd)(ts), Reference(REF)(ts)
+    u = np.max(np.abs(sum(k * (s - e) for k, s, e in zip((100.0, 16.0, 1.0), sampled, exact, strict=True))))
+    wd = 10.0 * np.sqrt(1 - 0.8**2)
+    h = np.exp(-8.0 * ts) * np.sin(wd * ts) / wd
+    hd = np.exp(-8.0 * ts) * (np.cos(wd * ts) - 8.0 / wd * np.sin(wd * ts))
+    bound_q, bound_qd = u * np.trapezoid(np.abs(h), ts), u * np.trapezoid(np.abs(hd), ts)
+    diff = np.abs(runs["csv"] - runs["exprs"])
+    assert 0 < np.max(diff[:, 1:3]) <= 1.01 * bound_q + 1e-12
+    assert np.max(diff[:, 3:5]) <= 1.01 * bound_qd + 1e-12
+    too_long = [
+        "simulate",
+        ROGER,
+        "--track",
+        path,
+        "--duration",
+        "1",
+        "--dt",
+        "1e-3",
+        "--out",
+        tmp_path / "x.csv",
+    ]
+    assert run_cli(too_long, monkeypatch) != 0 and not (tmp_path / "x.csv").exists()

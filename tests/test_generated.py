@@ -105,7 +105,7 @@ def test_generated_file_is_up_to_date(robot, fname, fresh):
 def test_every_file_is_compared_unless_its_own_tool_changed():
     """A changed CasADi skips only the .casadi files; a changed SymPy skips all; symdyn none."""
     names = [name for _, name in _committed()]
-    assert {n.rsplit(".", 1)[-1] for n in names} == {"c", "h", "py", "tex", "casadi"}
+    assert {n.rsplit(".", 1)[-1] for n in names} == {"c", "h", "py", "tex", "casadi", "m"}
     current = versions()
     for tool, skipped in (
         ("casadi", {n for n in names if n.endswith(".casadi")}),
@@ -121,7 +121,7 @@ def test_every_file_is_compared_unless_its_own_tool_changed():
 
 def test_files_without_casadi_among_their_tools_render_without_casadi(fresh, monkeypatch):
     """The dependency table follows the code: with casadi unimportable, every file whose tools
-    exclude casadi (the C, NumPy and LaTeX files and the casadi module's text) renders to the
+    exclude casadi (the C, NumPy, LaTeX and MATLAB files and the casadi module's text) renders to the
     same bytes, and the .casadi files cannot be made at all."""
     import symdyn.codegen
     from symdyn.codegen import casadi as casadi_backend
@@ -129,7 +129,7 @@ def test_files_without_casadi_among_their_tools_render_without_casadi(fresh, mon
     robot = load_robot(ROOT / "examples" / "roger_arm.yaml")
     ctx = symdyn.codegen.context(robot)
     monkeypatch.setitem(sys.modules, "casadi", None)  # `import casadi` raises ImportError
-    files = symdyn.codegen.render(robot, targets=("c", "python", "latex"))
+    files = symdyn.codegen.render(robot, targets=("c", "python", "latex", "matlab"))
     files["roger_arm_casadi.py"] = casadi_backend.render_module(ctx)
     want = {name for name in fresh["roger_arm"] if "casadi" not in file_tools(name)}
     assert set(files) == want

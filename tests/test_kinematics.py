@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from robots import (
+    DH_EXAMPLE_NAMES,
     EXAMPLE_NAMES,
     RobotSpec,
     assert_close,
@@ -118,7 +119,7 @@ def _setup(name, seed=0):
 # --------------------------------------------------------------------------- poses
 
 
-@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+@pytest.mark.parametrize("name", DH_EXAMPLE_NAMES)
 def test_poses_equal_the_dh_product(name):
     robot, rng, p, values = _setup(name)
     numeric = robot.numeric(p)
@@ -173,7 +174,7 @@ def test_point_jacobian_by_finite_differences(name):
             assert_close(pose[3], [0, 0, 0, 1])
 
 
-@pytest.mark.parametrize("name", EXAMPLE_NAMES)
+@pytest.mark.parametrize("name", DH_EXAMPLE_NAMES)
 def test_end_effector_jacobian(name):
     """The last DH frame's origin, differentiated from the hand-written DH product."""
     robot, rng, p, values = _setup(name, 2)

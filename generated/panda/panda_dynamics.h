@@ -9,6 +9,8 @@
  *   gravity              98 ops: 50 mul, 36 add, 0 div, 12 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics   1415 ops: 771 mul, 625 add, 7 div, 12 trig, 0 other
+ *   regressor          1743 ops: 1020 mul, 704 add, 0 div, 12 trig, 7 other
+ *   base_regressor     1429 ops: 841 mul, 569 add, 0 div, 12 trig, 7 other
  */
 #ifndef PANDA_DYNAMICS_H
 #define PANDA_DYNAMICS_H
@@ -23,9 +25,174 @@ extern "C" {
 /** Number of free parameters: the length of p (p may be NULL). */
 #define panda_NPARAM 0
 
+/**
+ * Number of columns of Y (91), row-major panda_NDOF x panda_NSTD; its columns:
+ *     0  m1    standard parameter
+ *     1  mx1   standard parameter
+ *     2  my1   standard parameter
+ *     3  mz1   standard parameter
+ *     4  Ixx1  standard parameter
+ *     5  Ixy1  standard parameter
+ *     6  Iyy1  standard parameter
+ *     7  Ixz1  standard parameter
+ *     8  Iyz1  standard parameter
+ *     9  Izz1  standard parameter
+ *    10  Ia1   standard parameter
+ *    11  fv1   standard parameter
+ *    12  fc1   standard parameter
+ *    13  m2    standard parameter
+ *    14  mx2   standard parameter
+ *    15  my2   standard parameter
+ *    16  mz2   standard parameter
+ *    17  Ixx2  standard parameter
+ *    18  Ixy2  standard parameter
+ *    19  Iyy2  standard parameter
+ *    20  Ixz2  standard parameter
+ *    21  Iyz2  standard parameter
+ *    22  Izz2  standard parameter
+ *    23  Ia2   standard parameter
+ *    24  fv2   standard parameter
+ *    25  fc2   standard parameter
+ *    26  m3    standard parameter
+ *    27  mx3   standard parameter
+ *    28  my3   standard parameter
+ *    29  mz3   standard parameter
+ *    30  Ixx3  standard parameter
+ *    31  Ixy3  standard parameter
+ *    32  Iyy3  standard parameter
+ *    33  Ixz3  standard parameter
+ *    34  Iyz3  standard parameter
+ *    35  Izz3  standard parameter
+ *    36  Ia3   standard parameter
+ *    37  fv3   standard parameter
+ *    38  fc3   standard parameter
+ *    39  m4    standard parameter
+ *    40  mx4   standard parameter
+ *    41  my4   standard parameter
+ *    42  mz4   standard parameter
+ *    43  Ixx4  standard parameter
+ *    44  Ixy4  standard parameter
+ *    45  Iyy4  standard parameter
+ *    46  Ixz4  standard parameter
+ *    47  Iyz4  standard parameter
+ *    48  Izz4  standard parameter
+ *    49  Ia4   standard parameter
+ *    50  fv4   standard parameter
+ *    51  fc4   standard parameter
+ *    52  m5    standard parameter
+ *    53  mx5   standard parameter
+ *    54  my5   standard parameter
+ *    55  mz5   standard parameter
+ *    56  Ixx5  standard parameter
+ *    57  Ixy5  standard parameter
+ *    58  Iyy5  standard parameter
+ *    59  Ixz5  standard parameter
+ *    60  Iyz5  standard parameter
+ *    61  Izz5  standard parameter
+ *    62  Ia5   standard parameter
+ *    63  fv5   standard parameter
+ *    64  fc5   standard parameter
+ *    65  m6    standard parameter
+ *    66  mx6   standard parameter
+ *    67  my6   standard parameter
+ *    68  mz6   standard parameter
+ *    69  Ixx6  standard parameter
+ *    70  Ixy6  standard parameter
+ *    71  Iyy6  standard parameter
+ *    72  Ixz6  standard parameter
+ *    73  Iyz6  standard parameter
+ *    74  Izz6  standard parameter
+ *    75  Ia6   standard parameter
+ *    76  fv6   standard parameter
+ *    77  fc6   standard parameter
+ *    78  m7    standard parameter
+ *    79  mx7   standard parameter
+ *    80  my7   standard parameter
+ *    81  mz7   standard parameter
+ *    82  Ixx7  standard parameter
+ *    83  Ixy7  standard parameter
+ *    84  Iyy7  standard parameter
+ *    85  Ixz7  standard parameter
+ *    86  Iyz7  standard parameter
+ *    87  Izz7  standard parameter
+ *    88  Ia7   standard parameter
+ *    89  fv7   standard parameter
+ *    90  fc7   standard parameter
+ */
+#define panda_NSTD 91
+
+/**
+ * Number of columns of Yb (62), row-major panda_NDOF x panda_NBASE; its columns:
+ *     0  Izz1R  Ia1 + Iyy2 + Izz1
+ *     1  fv1    fv1
+ *     2  fc1    fc1
+ *     3  mx2    mx2
+ *     4  my2R   -0.316*m3 - 0.316*m4 - 0.316*m5 - 0.316*m6 - 0.316*m7 + my2 - mz3
+ *     5  Ixx2R  Ixx2 - Iyy2 + Iyy3 + 0.099856*m3 + 0.10666225*m4 + 0.10666225*m5 + 0.10666225*m6 + 0.10666225*m7 + 0.632*mz3
+ *     6  Ixy2   Ixy2
+ *     7  Ixz2   Ixz2
+ *     8  Iyz2   Iyz2
+ *     9  Izz2R  Ia2 + Iyy3 + Izz2 + 0.099856*m3 + 0.10666225*m4 + 0.10666225*m5 + 0.10666225*m6 + 0.10666225*m7 + 0.632*mz3
+ *    10  fv2    fv2
+ *    11  fc2    fc2
+ *    12  mx3R   0.0825*m4 + 0.0825*m5 + 0.0825*m6 + 0.0825*m7 + mx3
+ *    13  my3R   my3 - mz4
+ *    14  Ixx3R  Ixx3 - Iyy3 + Iyy4 - 0.00680625*m4
+ *    15  Ixy3R  Ixy3 + 0.0825*mz4
+ *    16  Ixz3   Ixz3
+ *    17  Iyz3   Iyz3
+ *    18  Izz3R  Iyy4 + Izz3 + 0.00680625*m4 + 0.0136125*m5 + 0.0136125*m6 + 0.0136125*m7
+ *    19  Ia3    Ia3
+ *    20  fv3    fv3
+ *    21  fc3    fc3
+ *    22  mx4R   -0.0825*m5 - 0.0825*m6 - 0.0825*m7 + mx4
+ *    23  my4R   0.384*m5 + 0.384*m6 + 0.384*m7 + my4 + mz5
+ *    24  Ixx4R  Ixx4 - Iyy4 + Iyy5 + 0.14064975*m5 + 0.14064975*m6 + 0.14064975*m7 + 0.768*mz5
+ *    25  Ixy4R  Ixy4 + 0.03168*m5 + 0.03168*m6 + 0.03168*m7 + 0.0825*mz5
+ *    26  Ixz4   Ixz4
+ *    27  Iyz4   Iyz4
+ *    28  Izz4R  Iyy5 + Izz4 + 0.15426225*m5 + 0.15426225*m6 + 0.15426225*m7 + 0.768*mz5
+ *    29  Ia4    Ia4
+ *    30  fv4    fv4
+ *    31  fc4    fc4
+ *    32  mx5    mx5
+ *    33  my5R   my5 - mz6
+ *    34  Ixx5R  Ixx5 - Iyy5 + Iyy6 + 0.007744*m7
+ *    35  Ixy5   Ixy5
+ *    36  Ixz5   Ixz5
+ *    37  Iyz5   Iyz5
+ *    38  Izz5R  Iyy6 + Izz5 + 0.007744*m7
+ *    39  Ia5    Ia5
+ *    40  fv5    fv5
+ *    41  fc5    fc5
+ *    42  mx6R   0.088*m7 + mx6
+ *    43  my6R   my6 - mz7
+ *    44  Ixx6R  Ixx6 - Iyy6 + Iyy7 - 0.007744*m7
+ *    45  Ixy6R  Ixy6 + 0.088*mz7
+ *    46  Ixz6   Ixz6
+ *    47  Iyz6   Iyz6
+ *    48  Izz6R  Iyy7 + Izz6 + 0.007744*m7
+ *    49  Ia6    Ia6
+ *    50  fv6    fv6
+ *    51  fc6    fc6
+ *    52  mx7    mx7
+ *    53  my7    my7
+ *    54  Ixx7R  Ixx7 - Iyy7
+ *    55  Ixy7   Ixy7
+ *    56  Ixz7   Ixz7
+ *    57  Iyz7   Iyz7
+ *    58  Izz7   Izz7
+ *    59  Ia7    Ia7
+ *    60  fv7    fv7
+ *    61  fc7    fc7
+ */
+#define panda_NBASE 62
+
 /* Upper-case aliases of the macros above. */
 #define PANDA_NDOF panda_NDOF
 #define PANDA_NPARAM panda_NPARAM
+#define PANDA_NSTD panda_NSTD
+#define PANDA_NBASE panda_NBASE
 
 /**
  * @brief tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
@@ -109,6 +276,32 @@ void panda_friction(const double qd[], const double p[], double F[]);
  * Cost per call: 1415 operations: 771 multiplications, 625 additions, 7 divisions, 12 trigonometric calls, 0 other calls.
  */
 void panda_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
+
+/**
+ * @brief Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body).
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), panda_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), panda_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), panda_NDOF values
+ * @param[in]  p    free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), panda_NDOF*panda_NSTD values, row-major: Y[i*panda_NSTD + j] is row i, column j
+ *
+ * Cost per call: 1743 operations: 1020 multiplications, 704 additions, 0 divisions, 12 trigonometric calls, 7 other calls.
+ */
+void panda_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Y[]);
+
+/**
+ * @brief Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters.
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), panda_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), panda_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), panda_NDOF values
+ * @param[in]  p    free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), panda_NDOF*panda_NBASE values, row-major: Yb[i*panda_NBASE + j] is row i, column j
+ *
+ * Cost per call: 1429 operations: 841 multiplications, 569 additions, 0 divisions, 12 trigonometric calls, 7 other calls.
+ */
+void panda_base_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Yb[]);
 
 #ifdef __cplusplus
 }

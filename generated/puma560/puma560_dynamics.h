@@ -9,6 +9,8 @@
  *   gravity              43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
  *   friction             24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
  *   forward_dynamics    749 ops: 419 mul, 308 add, 6 div, 10 trig, 6 other
+ *   regressor          1007 ops: 574 mul, 417 add, 0 div, 10 trig, 6 other
+ *   base_regressor      819 ops: 472 mul, 331 add, 0 div, 10 trig, 6 other
  */
 #ifndef PUMA560_DYNAMICS_H
 #define PUMA560_DYNAMICS_H
@@ -23,9 +25,151 @@ extern "C" {
 /** Number of free parameters: the length of p (p may be NULL). */
 #define puma560_NPARAM 0
 
+/**
+ * Number of columns of Y (78), row-major puma560_NDOF x puma560_NSTD; its columns:
+ *     0  m1    standard parameter
+ *     1  mx1   standard parameter
+ *     2  my1   standard parameter
+ *     3  mz1   standard parameter
+ *     4  Ixx1  standard parameter
+ *     5  Ixy1  standard parameter
+ *     6  Iyy1  standard parameter
+ *     7  Ixz1  standard parameter
+ *     8  Iyz1  standard parameter
+ *     9  Izz1  standard parameter
+ *    10  Ia1   standard parameter
+ *    11  fv1   standard parameter
+ *    12  fc1   standard parameter
+ *    13  m2    standard parameter
+ *    14  mx2   standard parameter
+ *    15  my2   standard parameter
+ *    16  mz2   standard parameter
+ *    17  Ixx2  standard parameter
+ *    18  Ixy2  standard parameter
+ *    19  Iyy2  standard parameter
+ *    20  Ixz2  standard parameter
+ *    21  Iyz2  standard parameter
+ *    22  Izz2  standard parameter
+ *    23  Ia2   standard parameter
+ *    24  fv2   standard parameter
+ *    25  fc2   standard parameter
+ *    26  m3    standard parameter
+ *    27  mx3   standard parameter
+ *    28  my3   standard parameter
+ *    29  mz3   standard parameter
+ *    30  Ixx3  standard parameter
+ *    31  Ixy3  standard parameter
+ *    32  Iyy3  standard parameter
+ *    33  Ixz3  standard parameter
+ *    34  Iyz3  standard parameter
+ *    35  Izz3  standard parameter
+ *    36  Ia3   standard parameter
+ *    37  fv3   standard parameter
+ *    38  fc3   standard parameter
+ *    39  m4    standard parameter
+ *    40  mx4   standard parameter
+ *    41  my4   standard parameter
+ *    42  mz4   standard parameter
+ *    43  Ixx4  standard parameter
+ *    44  Ixy4  standard parameter
+ *    45  Iyy4  standard parameter
+ *    46  Ixz4  standard parameter
+ *    47  Iyz4  standard parameter
+ *    48  Izz4  standard parameter
+ *    49  Ia4   standard parameter
+ *    50  fv4   standard parameter
+ *    51  fc4   standard parameter
+ *    52  m5    standard parameter
+ *    53  mx5   standard parameter
+ *    54  my5   standard parameter
+ *    55  mz5   standard parameter
+ *    56  Ixx5  standard parameter
+ *    57  Ixy5  standard parameter
+ *    58  Iyy5  standard parameter
+ *    59  Ixz5  standard parameter
+ *    60  Iyz5  standard parameter
+ *    61  Izz5  standard parameter
+ *    62  Ia5   standard parameter
+ *    63  fv5   standard parameter
+ *    64  fc5   standard parameter
+ *    65  m6    standard parameter
+ *    66  mx6   standard parameter
+ *    67  my6   standard parameter
+ *    68  mz6   standard parameter
+ *    69  Ixx6  standard parameter
+ *    70  Ixy6  standard parameter
+ *    71  Iyy6  standard parameter
+ *    72  Ixz6  standard parameter
+ *    73  Iyz6  standard parameter
+ *    74  Izz6  standard parameter
+ *    75  Ia6   standard parameter
+ *    76  fv6   standard parameter
+ *    77  fc6   standard parameter
+ */
+#define puma560_NSTD 78
+
+/**
+ * Number of columns of Yb (52), row-major puma560_NDOF x puma560_NBASE; its columns:
+ *     0  Izz1R  Ia1 + Iyy2 + Iyy3 + Izz1 + 0.2089662425*m3 + 0.2093783325*m4 + 0.2093783325*m5 + 0.2093783325*m6 + 0.3001*mz3
+ *     1  fv1    fv1
+ *     2  fc1    fc1
+ *     3  mx2R   0.4318*m3 + 0.4318*m4 + 0.4318*m5 + 0.4318*m6 + mx2
+ *     4  my2    my2
+ *     5  Ixx2R  Ixx2 - Iyy2 - 0.18645124*m3 - 0.18645124*m4 - 0.18645124*m5 - 0.18645124*m6
+ *     6  Ixy2   Ixy2
+ *     7  Ixz2R  Ixz2 - 0.06479159*m3 - 0.06479159*m4 - 0.06479159*m5 - 0.06479159*m6 - 0.4318*mz3
+ *     8  Iyz2   Iyz2
+ *     9  Izz2R  Ia2 + Izz2 + 0.18645124*m3 + 0.18645124*m4 + 0.18645124*m5 + 0.18645124*m6
+ *    10  fv2    fv2
+ *    11  fc2    fc2
+ *    12  mx3R   0.0203*m4 + 0.0203*m5 + 0.0203*m6 + mx3
+ *    13  my3R   0.4318*m4 + 0.4318*m5 + 0.4318*m6 + my3 + mz4
+ *    14  Ixx3R  Ixx3 - Iyy3 + Iyy4 + 0.18603915*m4 + 0.18603915*m5 + 0.18603915*m6 + 0.8636*mz4
+ *    15  Ixy3R  Ixy3 - 0.00876554*m4 - 0.00876554*m5 - 0.00876554*m6 - 0.0203*mz4
+ *    16  Ixz3   Ixz3
+ *    17  Iyz3   Iyz3
+ *    18  Izz3R  Iyy4 + Izz3 + 0.18686333*m4 + 0.18686333*m5 + 0.18686333*m6 + 0.8636*mz4
+ *    19  Ia3    Ia3
+ *    20  fv3    fv3
+ *    21  fc3    fc3
+ *    22  mx4    mx4
+ *    23  my4R   my4 - mz5
+ *    24  Ixx4R  Ixx4 - Iyy4 + Iyy5
+ *    25  Ixy4   Ixy4
+ *    26  Ixz4   Ixz4
+ *    27  Iyz4   Iyz4
+ *    28  Izz4R  Iyy5 + Izz4
+ *    29  Ia4    Ia4
+ *    30  fv4    fv4
+ *    31  fc4    fc4
+ *    32  mx5    mx5
+ *    33  my5R   my5 + mz6
+ *    34  Ixx5R  Ixx5 - Iyy5 + Iyy6
+ *    35  Ixy5   Ixy5
+ *    36  Ixz5   Ixz5
+ *    37  Iyz5   Iyz5
+ *    38  Izz5R  Iyy6 + Izz5
+ *    39  Ia5    Ia5
+ *    40  fv5    fv5
+ *    41  fc5    fc5
+ *    42  mx6    mx6
+ *    43  my6    my6
+ *    44  Ixx6R  Ixx6 - Iyy6
+ *    45  Ixy6   Ixy6
+ *    46  Ixz6   Ixz6
+ *    47  Iyz6   Iyz6
+ *    48  Izz6   Izz6
+ *    49  Ia6    Ia6
+ *    50  fv6    fv6
+ *    51  fc6    fc6
+ */
+#define puma560_NBASE 52
+
 /* Upper-case aliases of the macros above. */
 #define PUMA560_NDOF puma560_NDOF
 #define PUMA560_NPARAM puma560_NPARAM
+#define PUMA560_NSTD puma560_NSTD
+#define PUMA560_NBASE puma560_NBASE
 
 /**
  * @brief tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
@@ -109,6 +253,32 @@ void puma560_friction(const double qd[], const double p[], double F[]);
  * Cost per call: 749 operations: 419 multiplications, 308 additions, 6 divisions, 10 trigonometric calls, 6 other calls.
  */
 void puma560_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
+
+/**
+ * @brief Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body).
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), puma560_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), puma560_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), puma560_NDOF values
+ * @param[in]  p    free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), puma560_NDOF*puma560_NSTD values, row-major: Y[i*puma560_NSTD + j] is row i, column j
+ *
+ * Cost per call: 1007 operations: 574 multiplications, 417 additions, 0 divisions, 10 trigonometric calls, 6 other calls.
+ */
+void puma560_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Y[]);
+
+/**
+ * @brief Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters.
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), puma560_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), puma560_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), puma560_NDOF values
+ * @param[in]  p    free parameters: none (puma560_NPARAM is 0), so p may be NULL; not read by this function
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), puma560_NDOF*puma560_NBASE values, row-major: Yb[i*puma560_NBASE + j] is row i, column j
+ *
+ * Cost per call: 819 operations: 472 multiplications, 331 additions, 0 divisions, 10 trigonometric calls, 6 other calls.
+ */
+void puma560_base_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Yb[]);
 
 #ifdef __cplusplus
 }

@@ -8,6 +8,8 @@
 #   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
 #   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
+#   regressor            35 ops: 18 mul, 11 add, 0 div, 4 trig, 2 other
+#   base_regressor       32 ops: 16 mul, 10 add, 0 div, 4 trig, 2 other
 """CasADi functions of the robot roger_arm: tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
 
     import roger_arm_casadi
@@ -40,6 +42,8 @@ __all__ = [
     "build_gravity",
     "build_friction",
     "build_forward_dynamics",
+    "build_regressor",
+    "build_base_regressor",
 ]
 
 NDOF = 2
@@ -312,6 +316,113 @@ def build_forward_dynamics() -> ca.Function:
     )
 
 
+def build_regressor() -> ca.Function:
+    """casadi.Function regressor(q[2], qd[2], qdd[2], p[5]) -> Y[2x26].
+
+    Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body).
+    19 temporaries; 35 operations (18 mul, 11 add, 0 div, 4 trig, 2 other).
+    """
+    q = ca.SX.sym("q", 2)
+    qd = ca.SX.sym("qd", 2)
+    qdd = ca.SX.sym("qdd", 2)
+    p = ca.SX.sym("p", 5)
+    x0 = p[0]*ca.sin(q[0])
+    x1 = p[0]*ca.cos(q[0])
+    x2 = ca.sign(qd[0])
+    x3 = x0 + p[1]*qdd[0]
+    x4 = ca.sin(q[1])
+    x5 = qd[0]*qd[0]
+    x6 = -x1 - x5*p[1]
+    x7 = ca.cos(q[1])
+    x8 = x3*x4 + x6*x7
+    x9 = x3*x7 - x4*x6
+    x10 = p[1]*x4
+    x11 = p[1]*x7
+    x12 = x10*x8 + x11*x9
+    x13 = qd[0] + qd[1]
+    x14 = x13*x13
+    x15 = qdd[0] + qdd[1]
+    x16 = x9 + x11*x15 - x10*x14
+    x17 = -x8 - x10*x15 - x11*x14
+    x18 = ca.sign(qd[1])
+    Y = ca.SX.zeros(2, 26)
+    Y[0, 1] = x0
+    Y[0, 2] = x1
+    Y[0, 9] = qdd[0]
+    Y[0, 10] = qdd[0]
+    Y[0, 11] = qd[0]
+    Y[0, 12] = x2
+    Y[0, 13] = x12
+    Y[0, 14] = x16
+    Y[0, 15] = x17
+    Y[0, 22] = x15
+    Y[1, 14] = x9
+    Y[1, 15] = -x8
+    Y[1, 22] = x15
+    Y[1, 23] = qdd[1]
+    Y[1, 24] = qd[1]
+    Y[1, 25] = x18
+    return ca.Function(
+        "regressor",
+        [q, qd, qdd, p],
+        [Y],
+        ["q", "qd", "qdd", "p"],
+        ["Y"],
+    )
+
+
+def build_base_regressor() -> ca.Function:
+    """casadi.Function base_regressor(q[2], qd[2], qdd[2], p[5]) -> Yb[2x11].
+
+    Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters.
+    18 temporaries; 32 operations (16 mul, 10 add, 0 div, 4 trig, 2 other).
+    """
+    q = ca.SX.sym("q", 2)
+    qd = ca.SX.sym("qd", 2)
+    qdd = ca.SX.sym("qdd", 2)
+    p = ca.SX.sym("p", 5)
+    x0 = p[0]*ca.sin(q[0])
+    x1 = p[0]*ca.cos(q[0])
+    x2 = ca.sign(qd[0])
+    x3 = qd[0] + qd[1]
+    x4 = x3*x3
+    x5 = qdd[0] + qdd[1]
+    x6 = x0 + p[1]*qdd[0]
+    x7 = ca.sin(q[1])
+    x8 = qd[0]*qd[0]
+    x9 = -x1 - x8*p[1]
+    x10 = ca.cos(q[1])
+    x11 = x6*x10 - x7*x9
+    x12 = p[1]*x7
+    x13 = p[1]*x10
+    x14 = x11 + x13*x5 - x12*x4
+    x15 = x6*x7 + x9*x10
+    x16 = -x15 - x12*x5 - x13*x4
+    x17 = ca.sign(qd[1])
+    Yb = ca.SX.zeros(2, 11)
+    Yb[0, 0] = x0
+    Yb[0, 1] = x1
+    Yb[0, 2] = qdd[0]
+    Yb[0, 3] = qd[0]
+    Yb[0, 4] = x2
+    Yb[0, 5] = x14
+    Yb[0, 6] = x16
+    Yb[0, 7] = x5
+    Yb[1, 5] = x11
+    Yb[1, 6] = -x15
+    Yb[1, 7] = x5
+    Yb[1, 8] = qdd[1]
+    Yb[1, 9] = qd[1]
+    Yb[1, 10] = x17
+    return ca.Function(
+        "base_regressor",
+        [q, qd, qdd, p],
+        [Yb],
+        ["q", "qd", "qdd", "p"],
+        ["Yb"],
+    )
+
+
 def functions() -> dict[str, ca.Function]:
     """The seven functions by name, each a casadi.Function over fresh SX symbols."""
     return {
@@ -322,4 +433,6 @@ def functions() -> dict[str, ca.Function]:
         "gravity": build_gravity(),
         "friction": build_friction(),
         "forward_dynamics": build_forward_dynamics(),
+        "regressor": build_regressor(),
+        "base_regressor": build_base_regressor(),
     }

@@ -9,6 +9,8 @@
  *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
+ *   regressor            35 ops: 18 mul, 11 add, 0 div, 4 trig, 2 other
+ *   base_regressor       32 ops: 16 mul, 10 add, 0 div, 4 trig, 2 other
  */
 #include "roger_arm_dynamics.h"
 
@@ -231,4 +233,141 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x38 = x31*x8 - x33*x37;
     qdd[0] = x38;
     qdd[1] = x37;
+}
+
+/* Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body) (35 operations: 18 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 2 other calls) */
+void roger_arm_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Y[])
+{
+    const double q1 = q[0];
+    const double q2 = q[1];
+    const double qd1 = qd[0];
+    const double qd2 = qd[1];
+    const double qdd1 = qdd[0];
+    const double qdd2 = qdd[1];
+    const double g = p[roger_arm_P_g];
+    const double l1 = p[roger_arm_P_l1];
+    const double x0 = g*sin(q1);
+    const double x1 = g*cos(q1);
+    const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
+    const double x3 = x0 + l1*qdd1;
+    const double x4 = sin(q2);
+    const double x5 = qd1*qd1;
+    const double x6 = -x1 - x5*l1;
+    const double x7 = cos(q2);
+    const double x8 = x3*x4 + x6*x7;
+    const double x9 = x3*x7 - x4*x6;
+    const double x10 = l1*x4;
+    const double x11 = l1*x7;
+    const double x12 = x10*x8 + x11*x9;
+    const double x13 = qd1 + qd2;
+    const double x14 = x13*x13;
+    const double x15 = qdd1 + qdd2;
+    const double x16 = x9 + x11*x15 - x10*x14;
+    const double x17 = -x8 - x10*x15 - x11*x14;
+    const double x18 = ((double)((qd2 > 0) - (qd2 < 0)));
+    Y[0] = 0.0;
+    Y[1] = x0;
+    Y[2] = x1;
+    Y[3] = 0.0;
+    Y[4] = 0.0;
+    Y[5] = 0.0;
+    Y[6] = 0.0;
+    Y[7] = 0.0;
+    Y[8] = 0.0;
+    Y[9] = qdd1;
+    Y[10] = qdd1;
+    Y[11] = qd1;
+    Y[12] = x2;
+    Y[13] = x12;
+    Y[14] = x16;
+    Y[15] = x17;
+    Y[16] = 0.0;
+    Y[17] = 0.0;
+    Y[18] = 0.0;
+    Y[19] = 0.0;
+    Y[20] = 0.0;
+    Y[21] = 0.0;
+    Y[22] = x15;
+    Y[23] = 0.0;
+    Y[24] = 0.0;
+    Y[25] = 0.0;
+    Y[26] = 0.0;
+    Y[27] = 0.0;
+    Y[28] = 0.0;
+    Y[29] = 0.0;
+    Y[30] = 0.0;
+    Y[31] = 0.0;
+    Y[32] = 0.0;
+    Y[33] = 0.0;
+    Y[34] = 0.0;
+    Y[35] = 0.0;
+    Y[36] = 0.0;
+    Y[37] = 0.0;
+    Y[38] = 0.0;
+    Y[39] = 0.0;
+    Y[40] = x9;
+    Y[41] = -x8;
+    Y[42] = 0.0;
+    Y[43] = 0.0;
+    Y[44] = 0.0;
+    Y[45] = 0.0;
+    Y[46] = 0.0;
+    Y[47] = 0.0;
+    Y[48] = x15;
+    Y[49] = qdd2;
+    Y[50] = qd2;
+    Y[51] = x18;
+}
+
+/* Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters (32 operations: 16 multiplications, 10 additions, 0 divisions, 4 trigonometric calls, 2 other calls) */
+void roger_arm_base_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Yb[])
+{
+    const double q1 = q[0];
+    const double q2 = q[1];
+    const double qd1 = qd[0];
+    const double qd2 = qd[1];
+    const double qdd1 = qdd[0];
+    const double qdd2 = qdd[1];
+    const double g = p[roger_arm_P_g];
+    const double l1 = p[roger_arm_P_l1];
+    const double x0 = g*sin(q1);
+    const double x1 = g*cos(q1);
+    const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
+    const double x3 = qd1 + qd2;
+    const double x4 = x3*x3;
+    const double x5 = qdd1 + qdd2;
+    const double x6 = x0 + l1*qdd1;
+    const double x7 = sin(q2);
+    const double x8 = qd1*qd1;
+    const double x9 = -x1 - x8*l1;
+    const double x10 = cos(q2);
+    const double x11 = x6*x10 - x7*x9;
+    const double x12 = l1*x7;
+    const double x13 = l1*x10;
+    const double x14 = x11 + x13*x5 - x12*x4;
+    const double x15 = x6*x7 + x9*x10;
+    const double x16 = -x15 - x12*x5 - x13*x4;
+    const double x17 = ((double)((qd2 > 0) - (qd2 < 0)));
+    Yb[0] = x0;
+    Yb[1] = x1;
+    Yb[2] = qdd1;
+    Yb[3] = qd1;
+    Yb[4] = x2;
+    Yb[5] = x14;
+    Yb[6] = x16;
+    Yb[7] = x5;
+    Yb[8] = 0.0;
+    Yb[9] = 0.0;
+    Yb[10] = 0.0;
+    Yb[11] = 0.0;
+    Yb[12] = 0.0;
+    Yb[13] = 0.0;
+    Yb[14] = 0.0;
+    Yb[15] = 0.0;
+    Yb[16] = x11;
+    Yb[17] = -x15;
+    Yb[18] = x5;
+    Yb[19] = qdd2;
+    Yb[20] = qd2;
+    Yb[21] = x17;
 }

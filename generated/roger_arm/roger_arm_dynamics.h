@@ -9,6 +9,8 @@
  *   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
+ *   regressor            35 ops: 18 mul, 11 add, 0 div, 4 trig, 2 other
+ *   base_regressor       32 ops: 16 mul, 10 add, 0 div, 4 trig, 2 other
  */
 #ifndef ROGER_ARM_DYNAMICS_H
 #define ROGER_ARM_DYNAMICS_H
@@ -30,6 +32,53 @@ extern "C" {
 #define roger_arm_P_l2 3
 #define roger_arm_P_m2 4
 
+/**
+ * Number of columns of Y (26), row-major roger_arm_NDOF x roger_arm_NSTD; its columns:
+ *     0  m1    standard parameter
+ *     1  mx1   standard parameter
+ *     2  my1   standard parameter
+ *     3  mz1   standard parameter
+ *     4  Ixx1  standard parameter
+ *     5  Ixy1  standard parameter
+ *     6  Iyy1  standard parameter
+ *     7  Ixz1  standard parameter
+ *     8  Iyz1  standard parameter
+ *     9  Izz1  standard parameter
+ *    10  Ia1   standard parameter
+ *    11  fv1   standard parameter
+ *    12  fc1   standard parameter
+ *    13  m2    standard parameter
+ *    14  mx2   standard parameter
+ *    15  my2   standard parameter
+ *    16  mz2   standard parameter
+ *    17  Ixx2  standard parameter
+ *    18  Ixy2  standard parameter
+ *    19  Iyy2  standard parameter
+ *    20  Ixz2  standard parameter
+ *    21  Iyz2  standard parameter
+ *    22  Izz2  standard parameter
+ *    23  Ia2   standard parameter
+ *    24  fv2   standard parameter
+ *    25  fc2   standard parameter
+ */
+#define roger_arm_NSTD 26
+
+/**
+ * Number of columns of Yb (11), row-major roger_arm_NDOF x roger_arm_NBASE; its columns:
+ *     0  mx1R   l1*m2 + mx1
+ *     1  my1    my1
+ *     2  Izz1R  Ia1 + Izz1 + l1**2*m2
+ *     3  fv1    fv1
+ *     4  fc1    fc1
+ *     5  mx2    mx2
+ *     6  my2    my2
+ *     7  Izz2   Izz2
+ *     8  Ia2    Ia2
+ *     9  fv2    fv2
+ *    10  fc2    fc2
+ */
+#define roger_arm_NBASE 11
+
 /* Upper-case aliases of the macros above. */
 #define ROGER_ARM_NDOF roger_arm_NDOF
 #define ROGER_ARM_NPARAM roger_arm_NPARAM
@@ -38,6 +87,8 @@ extern "C" {
 #define ROGER_ARM_P_M1 roger_arm_P_m1
 #define ROGER_ARM_P_L2 roger_arm_P_l2
 #define ROGER_ARM_P_M2 roger_arm_P_m2
+#define ROGER_ARM_NSTD roger_arm_NSTD
+#define ROGER_ARM_NBASE roger_arm_NBASE
 
 /**
  * @brief tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
@@ -121,6 +172,32 @@ void roger_arm_friction(const double qd[], const double p[], double F[]);
  * Cost per call: 56 operations: 33 multiplications, 17 additions, 2 divisions, 4 trigonometric calls, 0 other calls.
  */
 void roger_arm_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
+
+/**
+ * @brief Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body).
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), roger_arm_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), roger_arm_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), roger_arm_NDOF values
+ * @param[in]  p    free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), roger_arm_NDOF*roger_arm_NSTD values, row-major: Y[i*roger_arm_NSTD + j] is row i, column j
+ *
+ * Cost per call: 35 operations: 18 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 2 other calls.
+ */
+void roger_arm_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Y[]);
+
+/**
+ * @brief Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters.
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), roger_arm_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), roger_arm_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), roger_arm_NDOF values
+ * @param[in]  p    free parameters, roger_arm_NPARAM values, index p with the roger_arm_P_<name> macros
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), roger_arm_NDOF*roger_arm_NBASE values, row-major: Yb[i*roger_arm_NBASE + j] is row i, column j
+ *
+ * Cost per call: 32 operations: 16 multiplications, 10 additions, 0 divisions, 4 trigonometric calls, 2 other calls.
+ */
+void roger_arm_base_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Yb[]);
 
 #ifdef __cplusplus
 }

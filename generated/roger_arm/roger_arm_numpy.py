@@ -8,6 +8,8 @@
 #   gravity              20 ops: 12 mul, 4 add, 0 div, 4 trig, 0 other
 #   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
 #   forward_dynamics     56 ops: 33 mul, 17 add, 2 div, 4 trig, 0 other
+#   regressor            35 ops: 18 mul, 11 add, 0 div, 4 trig, 2 other
+#   base_regressor       32 ops: 16 mul, 10 add, 0 div, 4 trig, 2 other
 """Dynamics of the robot roger_arm: tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
 
 Every function takes one state (vectors of shape (NDOF,)) or a batch with a
@@ -342,5 +344,168 @@ def forward_dynamics(q, qd, tau, p=None):
         [
             x38,
             x37,
+        ],
+    )
+
+
+def regressor(q, qd, qdd, p=None):
+    """Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body).
+
+    Returns Y of shape (2, 26) for one state, (N, 2, 26) for a batch.
+    """
+    q = _vector(q, NDOF, "q")
+    qd = _vector(qd, NDOF, "qd")
+    qdd = _vector(qdd, NDOF, "qdd")
+    p = _params(p)
+    _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    qd1 = qd[..., 0]
+    qd2 = qd[..., 1]
+    qdd1 = qdd[..., 0]
+    qdd2 = qdd[..., 1]
+    g = p[..., 0]
+    l1 = p[..., 1]
+    x0 = g*np.sin(q1)
+    x1 = g*np.cos(q1)
+    x2 = np.sign(qd1)
+    x3 = l1*qdd1 + x0
+    x4 = np.sin(q2)
+    x5 = qd1*qd1
+    x6 = -l1*x5 - x1
+    x7 = np.cos(q2)
+    x8 = x3*x4 + x6*x7
+    x9 = x3*x7 - x4*x6
+    x10 = l1*x4
+    x11 = l1*x7
+    x12 = x10*x8 + x11*x9
+    x13 = qd1 + qd2
+    x14 = x13*x13
+    x15 = qdd1 + qdd2
+    x16 = -x10*x14 + x11*x15 + x9
+    x17 = -x10*x15 - x11*x14 - x8
+    x18 = np.sign(qd2)
+    return _assemble(
+        _lead,
+        (2, 26),
+        [
+            0,
+            x0,
+            x1,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            qdd1,
+            qdd1,
+            qd1,
+            x2,
+            x12,
+            x16,
+            x17,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            x15,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            x9,
+            -x8,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            x15,
+            qdd2,
+            qd2,
+            x18,
+        ],
+    )
+
+
+def base_regressor(q, qd, qdd, p=None):
+    """Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters.
+
+    Returns Yb of shape (2, 11) for one state, (N, 2, 11) for a batch.
+    """
+    q = _vector(q, NDOF, "q")
+    qd = _vector(qd, NDOF, "qd")
+    qdd = _vector(qdd, NDOF, "qdd")
+    p = _params(p)
+    _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    q1 = q[..., 0]
+    q2 = q[..., 1]
+    qd1 = qd[..., 0]
+    qd2 = qd[..., 1]
+    qdd1 = qdd[..., 0]
+    qdd2 = qdd[..., 1]
+    g = p[..., 0]
+    l1 = p[..., 1]
+    x0 = g*np.sin(q1)
+    x1 = g*np.cos(q1)
+    x2 = np.sign(qd1)
+    x3 = qd1 + qd2
+    x4 = x3*x3
+    x5 = qdd1 + qdd2
+    x6 = l1*qdd1 + x0
+    x7 = np.sin(q2)
+    x8 = qd1*qd1
+    x9 = -l1*x8 - x1
+    x10 = np.cos(q2)
+    x11 = x10*x6 - x7*x9
+    x12 = l1*x7
+    x13 = l1*x10
+    x14 = x11 - x12*x4 + x13*x5
+    x15 = x10*x9 + x6*x7
+    x16 = -x12*x5 - x13*x4 - x15
+    x17 = np.sign(qd2)
+    return _assemble(
+        _lead,
+        (2, 11),
+        [
+            x0,
+            x1,
+            qdd1,
+            qd1,
+            x2,
+            x14,
+            x16,
+            x5,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            x11,
+            -x15,
+            x5,
+            qdd2,
+            qd2,
+            x17,
         ],
     )

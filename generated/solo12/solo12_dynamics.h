@@ -9,6 +9,8 @@
  *   gravity             108 ops: 60 mul, 24 add, 0 div, 24 trig, 0 other
  *   friction              0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
  *   forward_dynamics   1156 ops: 652 mul, 472 add, 8 div, 24 trig, 0 other
+ *   regressor           928 ops: 512 mul, 380 add, 0 div, 24 trig, 12 other
+ *   base_regressor      772 ops: 424 mul, 312 add, 0 div, 24 trig, 12 other
  */
 #ifndef SOLO12_DYNAMICS_H
 #define SOLO12_DYNAMICS_H
@@ -23,9 +25,273 @@ extern "C" {
 /** Number of free parameters: the length of p (p may be NULL). */
 #define solo12_NPARAM 0
 
+/**
+ * Number of columns of Y (156), row-major solo12_NDOF x solo12_NSTD; its columns:
+ *     0  m1     standard parameter
+ *     1  mx1    standard parameter
+ *     2  my1    standard parameter
+ *     3  mz1    standard parameter
+ *     4  Ixx1   standard parameter
+ *     5  Ixy1   standard parameter
+ *     6  Iyy1   standard parameter
+ *     7  Ixz1   standard parameter
+ *     8  Iyz1   standard parameter
+ *     9  Izz1   standard parameter
+ *    10  Ia1    standard parameter
+ *    11  fv1    standard parameter
+ *    12  fc1    standard parameter
+ *    13  m2     standard parameter
+ *    14  mx2    standard parameter
+ *    15  my2    standard parameter
+ *    16  mz2    standard parameter
+ *    17  Ixx2   standard parameter
+ *    18  Ixy2   standard parameter
+ *    19  Iyy2   standard parameter
+ *    20  Ixz2   standard parameter
+ *    21  Iyz2   standard parameter
+ *    22  Izz2   standard parameter
+ *    23  Ia2    standard parameter
+ *    24  fv2    standard parameter
+ *    25  fc2    standard parameter
+ *    26  m3     standard parameter
+ *    27  mx3    standard parameter
+ *    28  my3    standard parameter
+ *    29  mz3    standard parameter
+ *    30  Ixx3   standard parameter
+ *    31  Ixy3   standard parameter
+ *    32  Iyy3   standard parameter
+ *    33  Ixz3   standard parameter
+ *    34  Iyz3   standard parameter
+ *    35  Izz3   standard parameter
+ *    36  Ia3    standard parameter
+ *    37  fv3    standard parameter
+ *    38  fc3    standard parameter
+ *    39  m4     standard parameter
+ *    40  mx4    standard parameter
+ *    41  my4    standard parameter
+ *    42  mz4    standard parameter
+ *    43  Ixx4   standard parameter
+ *    44  Ixy4   standard parameter
+ *    45  Iyy4   standard parameter
+ *    46  Ixz4   standard parameter
+ *    47  Iyz4   standard parameter
+ *    48  Izz4   standard parameter
+ *    49  Ia4    standard parameter
+ *    50  fv4    standard parameter
+ *    51  fc4    standard parameter
+ *    52  m5     standard parameter
+ *    53  mx5    standard parameter
+ *    54  my5    standard parameter
+ *    55  mz5    standard parameter
+ *    56  Ixx5   standard parameter
+ *    57  Ixy5   standard parameter
+ *    58  Iyy5   standard parameter
+ *    59  Ixz5   standard parameter
+ *    60  Iyz5   standard parameter
+ *    61  Izz5   standard parameter
+ *    62  Ia5    standard parameter
+ *    63  fv5    standard parameter
+ *    64  fc5    standard parameter
+ *    65  m6     standard parameter
+ *    66  mx6    standard parameter
+ *    67  my6    standard parameter
+ *    68  mz6    standard parameter
+ *    69  Ixx6   standard parameter
+ *    70  Ixy6   standard parameter
+ *    71  Iyy6   standard parameter
+ *    72  Ixz6   standard parameter
+ *    73  Iyz6   standard parameter
+ *    74  Izz6   standard parameter
+ *    75  Ia6    standard parameter
+ *    76  fv6    standard parameter
+ *    77  fc6    standard parameter
+ *    78  m7     standard parameter
+ *    79  mx7    standard parameter
+ *    80  my7    standard parameter
+ *    81  mz7    standard parameter
+ *    82  Ixx7   standard parameter
+ *    83  Ixy7   standard parameter
+ *    84  Iyy7   standard parameter
+ *    85  Ixz7   standard parameter
+ *    86  Iyz7   standard parameter
+ *    87  Izz7   standard parameter
+ *    88  Ia7    standard parameter
+ *    89  fv7    standard parameter
+ *    90  fc7    standard parameter
+ *    91  m8     standard parameter
+ *    92  mx8    standard parameter
+ *    93  my8    standard parameter
+ *    94  mz8    standard parameter
+ *    95  Ixx8   standard parameter
+ *    96  Ixy8   standard parameter
+ *    97  Iyy8   standard parameter
+ *    98  Ixz8   standard parameter
+ *    99  Iyz8   standard parameter
+ *   100  Izz8   standard parameter
+ *   101  Ia8    standard parameter
+ *   102  fv8    standard parameter
+ *   103  fc8    standard parameter
+ *   104  m9     standard parameter
+ *   105  mx9    standard parameter
+ *   106  my9    standard parameter
+ *   107  mz9    standard parameter
+ *   108  Ixx9   standard parameter
+ *   109  Ixy9   standard parameter
+ *   110  Iyy9   standard parameter
+ *   111  Ixz9   standard parameter
+ *   112  Iyz9   standard parameter
+ *   113  Izz9   standard parameter
+ *   114  Ia9    standard parameter
+ *   115  fv9    standard parameter
+ *   116  fc9    standard parameter
+ *   117  m10    standard parameter
+ *   118  mx10   standard parameter
+ *   119  my10   standard parameter
+ *   120  mz10   standard parameter
+ *   121  Ixx10  standard parameter
+ *   122  Ixy10  standard parameter
+ *   123  Iyy10  standard parameter
+ *   124  Ixz10  standard parameter
+ *   125  Iyz10  standard parameter
+ *   126  Izz10  standard parameter
+ *   127  Ia10   standard parameter
+ *   128  fv10   standard parameter
+ *   129  fc10   standard parameter
+ *   130  m11    standard parameter
+ *   131  mx11   standard parameter
+ *   132  my11   standard parameter
+ *   133  mz11   standard parameter
+ *   134  Ixx11  standard parameter
+ *   135  Ixy11  standard parameter
+ *   136  Iyy11  standard parameter
+ *   137  Ixz11  standard parameter
+ *   138  Iyz11  standard parameter
+ *   139  Izz11  standard parameter
+ *   140  Ia11   standard parameter
+ *   141  fv11   standard parameter
+ *   142  fc11   standard parameter
+ *   143  m12    standard parameter
+ *   144  mx12   standard parameter
+ *   145  my12   standard parameter
+ *   146  mz12   standard parameter
+ *   147  Ixx12  standard parameter
+ *   148  Ixy12  standard parameter
+ *   149  Iyy12  standard parameter
+ *   150  Ixz12  standard parameter
+ *   151  Iyz12  standard parameter
+ *   152  Izz12  standard parameter
+ *   153  Ia12   standard parameter
+ *   154  fv12   standard parameter
+ *   155  fc12   standard parameter
+ */
+#define solo12_NSTD 156
+
+/**
+ * Number of columns of Yb (96), row-major solo12_NDOF x solo12_NBASE; its columns:
+ *     0  my1R    0.014*m2 + 0.05145*m3 + my1 + my2 + my3
+ *     1  mz1     mz1
+ *     2  Ixx1R   Ia1 + Ixx1 + Izz2 + Izz3 + 0.000196*m2 + 0.0026471025*m3 + 0.028*my2 + 0.1029*my3
+ *     3  fv1     fv1
+ *     4  fc1     fc1
+ *     5  mx2     mx2
+ *     6  mz2R    -0.16*m3 + mz2
+ *     7  Ixx2R   Ixx2 - Izz2 + 0.0256*m3
+ *     8  Ixy2    Ixy2
+ *     9  Iyy2R   Ia2 + Iyy2 + 0.0256*m3
+ *    10  Ixz2    Ixz2
+ *    11  Iyz2R   Iyz2 + 0.005992*m3 + 0.16*my3
+ *    12  fv2     fv2
+ *    13  fc2     fc2
+ *    14  mx3     mx3
+ *    15  mz3     mz3
+ *    16  Ixx3R   Ixx3 - Izz3
+ *    17  Ixy3    Ixy3
+ *    18  Iyy3    Iyy3
+ *    19  Ixz3    Ixz3
+ *    20  Iyz3    Iyz3
+ *    21  Ia3     Ia3
+ *    22  fv3     fv3
+ *    23  fc3     fc3
+ *    24  my4R    -0.014*m5 - 0.05145*m6 + my4 + my5 + my6
+ *    25  mz4     mz4
+ *    26  Ixx4R   Ia4 + Ixx4 + Izz5 + Izz6 + 0.000196*m5 + 0.0026471025*m6 - 0.028*my5 - 0.1029*my6
+ *    27  fv4     fv4
+ *    28  fc4     fc4
+ *    29  mx5     mx5
+ *    30  mz5R    -0.16*m6 + mz5
+ *    31  Ixx5R   Ixx5 - Izz5 + 0.0256*m6
+ *    32  Ixy5    Ixy5
+ *    33  Iyy5R   Ia5 + Iyy5 + 0.0256*m6
+ *    34  Ixz5    Ixz5
+ *    35  Iyz5R   Iyz5 - 0.005992*m6 + 0.16*my6
+ *    36  fv5     fv5
+ *    37  fc5     fc5
+ *    38  mx6     mx6
+ *    39  mz6     mz6
+ *    40  Ixx6R   Ixx6 - Izz6
+ *    41  Ixy6    Ixy6
+ *    42  Iyy6    Iyy6
+ *    43  Ixz6    Ixz6
+ *    44  Iyz6    Iyz6
+ *    45  Ia6     Ia6
+ *    46  fv6     fv6
+ *    47  fc6     fc6
+ *    48  my7R    0.014*m8 + 0.05145*m9 + my7 + my8 + my9
+ *    49  mz7     mz7
+ *    50  Ixx7R   Ia7 + Ixx7 + Izz8 + Izz9 + 0.000196*m8 + 0.0026471025*m9 + 0.028*my8 + 0.1029*my9
+ *    51  fv7     fv7
+ *    52  fc7     fc7
+ *    53  mx8     mx8
+ *    54  mz8R    -0.16*m9 + mz8
+ *    55  Ixx8R   Ixx8 - Izz8 + 0.0256*m9
+ *    56  Ixy8    Ixy8
+ *    57  Iyy8R   Ia8 + Iyy8 + 0.0256*m9
+ *    58  Ixz8    Ixz8
+ *    59  Iyz8R   Iyz8 + 0.005992*m9 + 0.16*my9
+ *    60  fv8     fv8
+ *    61  fc8     fc8
+ *    62  mx9     mx9
+ *    63  mz9     mz9
+ *    64  Ixx9R   Ixx9 - Izz9
+ *    65  Ixy9    Ixy9
+ *    66  Iyy9    Iyy9
+ *    67  Ixz9    Ixz9
+ *    68  Iyz9    Iyz9
+ *    69  Ia9     Ia9
+ *    70  fv9     fv9
+ *    71  fc9     fc9
+ *    72  my10R   -0.014*m11 - 0.05145*m12 + my10 + my11 + my12
+ *    73  mz10    mz10
+ *    74  Ixx10R  Ia10 + Ixx10 + Izz11 + Izz12 + 0.000196*m11 + 0.0026471025*m12 - 0.028*my11 - 0.1029*my12
+ *    75  fv10    fv10
+ *    76  fc10    fc10
+ *    77  mx11    mx11
+ *    78  mz11R   -0.16*m12 + mz11
+ *    79  Ixx11R  Ixx11 - Izz11 + 0.0256*m12
+ *    80  Ixy11   Ixy11
+ *    81  Iyy11R  Ia11 + Iyy11 + 0.0256*m12
+ *    82  Ixz11   Ixz11
+ *    83  Iyz11R  Iyz11 - 0.005992*m12 + 0.16*my12
+ *    84  fv11    fv11
+ *    85  fc11    fc11
+ *    86  mx12    mx12
+ *    87  mz12    mz12
+ *    88  Ixx12R  Ixx12 - Izz12
+ *    89  Ixy12   Ixy12
+ *    90  Iyy12   Iyy12
+ *    91  Ixz12   Ixz12
+ *    92  Iyz12   Iyz12
+ *    93  Ia12    Ia12
+ *    94  fv12    fv12
+ *    95  fc12    fc12
+ */
+#define solo12_NBASE 96
+
 /* Upper-case aliases of the macros above. */
 #define SOLO12_NDOF solo12_NDOF
 #define SOLO12_NPARAM solo12_NPARAM
+#define SOLO12_NSTD solo12_NSTD
+#define SOLO12_NBASE solo12_NBASE
 
 /**
  * @brief tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
@@ -109,6 +375,32 @@ void solo12_friction(const double qd[], const double p[], double F[]);
  * Cost per call: 1156 operations: 652 multiplications, 472 additions, 8 divisions, 24 trigonometric calls, 0 other calls.
  */
 void solo12_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
+
+/**
+ * @brief Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body).
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), solo12_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), solo12_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), solo12_NDOF values
+ * @param[in]  p    free parameters: none (solo12_NPARAM is 0), so p may be NULL; not read by this function
+ * @param[out] Y    regressor of the standard parameters (symdyn.standard_parameters order), solo12_NDOF*solo12_NSTD values, row-major: Y[i*solo12_NSTD + j] is row i, column j
+ *
+ * Cost per call: 928 operations: 512 multiplications, 380 additions, 0 divisions, 24 trigonometric calls, 12 other calls.
+ */
+void solo12_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Y[]);
+
+/**
+ * @brief Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters.
+ *
+ * @param[in]  q    joint positions q1..qn (rad or m), solo12_NDOF values
+ * @param[in]  qd   joint velocities qd1..qdn (rad/s or m/s), solo12_NDOF values
+ * @param[in]  qdd  joint accelerations qdd1..qddn (rad/s^2 or m/s^2), solo12_NDOF values
+ * @param[in]  p    free parameters: none (solo12_NPARAM is 0), so p may be NULL; not read by this function
+ * @param[out] Yb   regressor of the base parameters (Dynamics.base_parameters order), solo12_NDOF*solo12_NBASE values, row-major: Yb[i*solo12_NBASE + j] is row i, column j
+ *
+ * Cost per call: 772 operations: 424 multiplications, 312 additions, 0 divisions, 24 trigonometric calls, 12 other calls.
+ */
+void solo12_base_regressor(const double q[], const double qd[], const double qdd[], const double p[], double Yb[]);
 
 #ifdef __cplusplus
 }

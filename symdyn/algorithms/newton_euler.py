@@ -52,7 +52,7 @@ from ..spatial.motion import Force
 from ..symbolic.program import Program
 from .frames import JointFrame, joint_frames
 
-__all__ = ["newton_euler"]
+__all__ = ["newton_euler", "outward", "tilde", "LinkAcceleration"]
 
 
 class LinkAcceleration(NamedTuple):
@@ -94,7 +94,7 @@ def _body_wrench(link: Link, W: v3.Mat, motion: LinkAcceleration, program: Progr
     return Force(N, F)
 
 
-def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
+def tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
     """W = [wd x] + [w x]^2, so that wd x r + w x (w x r) = W r for any point r of the link."""
     sq = [program.let(v3.product(w[j], w[j]), f"ww{k}_") for j in range(3)]
     xy, xz, yz = (program.let(v3.product(w[a], w[b]), f"ww{k}_") for a, b in ((0, 1), (0, 2), (1, 2)))
@@ -106,7 +106,7 @@ def _tilde(program: Program, w: v3.Vec, wd: v3.Vec, k: str) -> v3.Mat:
     return tuple(program.let_vector(row, f"W{k}_") for row in W)  # type: ignore[return-value]
 
 
-def _outward(
+def outward(
     link: Link,
     frame: JointFrame,
     parent: LinkAcceleration,
@@ -179,8 +179,8 @@ def newton_euler(
         k = f"{tag}{i + 1}"
         p = parents[i]
         parent, W_parent = (base, v3.ZERO33) if p < 0 else (motions[p], Ws[p])
-        motion = _outward(link, frames[i], parent, W_parent, qd[i], qdd[i], program, k)
-        W = _tilde(program, motion.w, motion.wd, k)
+        motion = outward(link, frames[i], parent, W_parent, qd[i], qdd[i], program, k)
+        W = tilde(program, motion.w, motion.wd, k)
         motions.append(motion)
         Ws.append(W)
         wrenches.append(_body_wrench(link, W, motion, program, k))

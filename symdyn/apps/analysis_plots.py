@@ -11,15 +11,18 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.robot import Robot
 from .conditioning import Analysis
 from .geometry import ellipse_points
 from .output import figure, figure_bytes, plot_format, write_atomic
 from .task_space import TASK_AXES
+
+if TYPE_CHECKING:
+    from ..model.robot import Robot
 
 __all__ = ["plot_analysis", "plot_workspace"]
 

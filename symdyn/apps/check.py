@@ -38,18 +38,33 @@ from ..errors import SymdynError
 from ..model.expressions import parse_expression
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
+from .check_state import AT_KEY, TOLERANCE_KEY, compare_at_state
+from .check_steps import check_steps
 
-__all__ = ["QUANTITIES", "EntryResult", "CheckReport", "load_answers", "parse_answers", "check_answers"]
+__all__ = [
+    "QUANTITIES",
+    "STEPS_KEY",
+    "EntryResult",
+    "CheckReport",
+    "read_answers",
+    "load_answers",
+    "parse_answers",
+    "answer_entry",
+    "compare_entry",
+    "check_answers",
+]
 
 QUANTITIES = ("M", "C", "V", "G", "F", "tau")
 MATRICES = ("M", "C")
 SAMPLES = 16
 RTOL = 1e-9
 SIMPLIFY_MAX_OPS = 400  # larger differences are judged numerically only
+#: the key of answers for the derivation's intermediate steps (symdyn.apps.check_steps)
+STEPS_KEY = "steps"
 
 
 def _entry_label(name: str, index: tuple[int, ...]) -> str:
-    return f"{name}[{','.join(str(i) for i in index)}]"
+    return f"{name}[{','.join(str(i) for i in index)}]" if index else name
 
 
 def _parse_entry(value: object, file: str | None, label: str) -> sp.Expr:
@@ -62,17 +77,16 @@ def parse_answers(data: object, robot: Robot, file: str | None = None) -> dict[s
     if not isinstance(data, Mapping):
         kind = "empty file" if data is None else type(data).__name__
         raise SymdynError(f"expected a mapping of M, C, V, G, F, tau to answers, got {kind}", file=file)
-    unknown = [str(k) for k in data if k not in QUANTITIES]
+    unknown = [str(k) for k in data if k not in (*QUANTITIES, STEPS_KEY, AT_KEY, TOLERANCE_KEY)]
     if unknown:
         raise SymdynError(
-            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)})", file=file
+            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)} and {STEPS_KEY}, "
+            f"or numbers {AT_KEY} a state with a {TOLERANCE_KEY})",
+            file=file,
         )
     if not data:
-        raise SymdynError("no answers given (any of M, C, V, G, F, tau)", file=file)
+        raise SymdynError(f"no answers given (any of M, C, V, G, F, tau, {STEPS_KEY})", file=file)
     n = robot.n
-    q, qd, qdd = joint_symbols(n)
-    allowed = set(robot.params) | set(q) | set(qd) | set(qdd)
-    values = robot.value_map
     out: dict[str, sp.Matrix] = {}
     for name in QUANTITIES:
         if name not in data:
@@ -97,41 +111,50 @@ def parse_answers(data: object, robot: Robot, file: str | None = None) -> dict[s
                 raise SymdynError(f"{name} must be a list of {n} entries", file=file, field=name)
             cells = [((i + 1,), raw[i]) for i in range(n)]
             shape = (n, 1)
-        entries = []
-        for index, value in cells:
-            label = _entry_label(name, index)
-            if isinstance(value, list):
-                raise SymdynError("expected one expression, got a list", file=file, field=label)
-            expr = _parse_entry(value, file, label).xreplace(values)
-            extra = sorted(str(s) for s in expr.free_symbols - allowed)
-            if extra:
-                names = ", ".join(str(s) for s in robot.params) or "none"
-                raise SymdynError(
-                    f"unknown name(s) {', '.join(extra)}: use the robot's free parameters ({names}) and "
-                    f"q1..q{n}, qd1..qd{n}, qdd1..qdd{n} (write cos(q2), not c2)",
-                    file=file,
-                    field=label,
-                )
-            entries.append(expr)
+        entries = [answer_entry(value, robot, file, _entry_label(name, index)) for index, value in cells]
         out[name] = sp.Matrix(*shape, entries)
     return out
 
 
-def load_answers(path: str | os.PathLike, robot: Robot) -> dict[str, sp.Matrix]:
-    """Read an answers file (YAML, safe loader) for `robot`."""
+def answer_entry(value: object, robot: Robot, file: str | None, label: str) -> sp.Expr:
+    """One answer entry over the robot's free parameters and joint symbols (valued parameters
+    replaced by their values); `label` names it in messages."""
+    n = robot.n
+    if isinstance(value, list):
+        raise SymdynError("expected one expression, got a list", file=file, field=label)
+    expr = _parse_entry(value, file, label).xreplace(robot.value_map)
+    q, qd, qdd = joint_symbols(n)
+    extra = sorted(str(s) for s in expr.free_symbols - (set(robot.params) | set(q) | set(qd) | set(qdd)))
+    if extra:
+        names = ", ".join(str(s) for s in robot.params) or "none"
+        raise SymdynError(
+            f"unknown name(s) {', '.join(extra)}: use the robot's free parameters ({names}) and "
+            f"q1..q{n}, qd1..qd{n}, qdd1..qdd{n} (write cos(q2), not c2)",
+            file=file,
+            field=label,
+        )
+    return expr
+
+
+def read_answers(path: str | os.PathLike) -> object:
+    """The data of an answers file (YAML, safe loader)."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
         raise SymdynError(f"not a UTF-8 text file: {exc.reason}", file=str(p)) from None
     try:
-        data = yaml.safe_load(text)
+        return yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or "invalid YAML"
         raise SymdynError(f"invalid YAML{where}: {problem}", file=str(p)) from None
-    return parse_answers(data, robot, str(p))
+
+
+def load_answers(path: str | os.PathLike, robot: Robot) -> dict[str, sp.Matrix]:
+    """Read an answers file (YAML, safe loader) for `robot`."""
+    return parse_answers(read_answers(path), robot, str(Path(path)))
 
 
 @dataclass
@@ -139,7 +162,8 @@ class EntryResult:
     """One compared entry: 1-based `index`, symdyn's `expected` and the answer's `got`.
 
     status: "symbolic" (the difference simplifies to 0), "numeric" (equal at every
-    random point, simplification inconclusive) or "differs".
+    random point, simplification inconclusive), "at the state" (numbers at the state of an
+    `at:` key, symdyn.apps.check_state) or "differs".
     """
 
     quantity: str
@@ -166,6 +190,8 @@ class CheckReport:
     method: str
     samples: int
     results: list[EntryResult] = field(default_factory=list)
+    #: the first step of the recursion (in the order it is computed) whose answer differs
+    first_step: str | None = None
 
     @property
     def ok(self) -> bool:
@@ -177,9 +203,13 @@ class CheckReport:
 
     def summary(self) -> str:
         total = len(self.results)
-        names = ", ".join(dict.fromkeys(r.quantity for r in self.results))
+        steps = len({r.quantity for r in self.results if r.quantity not in QUANTITIES})
+        finals = [q for q in dict.fromkeys(r.quantity for r in self.results) if q in QUANTITIES]
+        names = ", ".join([f"{steps} step{'s' * (steps != 1)}"] * bool(steps) + finals)
         if self.ok:
             numeric = sum(r.status == "numeric" for r in self.results)
+            if any(r.status == "at the state" for r in self.results):
+                return f"{self.robot}: all {total} entries of {names} match at the given state"
             how = (
                 "all symbolically"
                 if not numeric
@@ -199,6 +229,8 @@ class CheckReport:
                 lines.append(r.line())
             elif verbose:
                 lines.append(f"{r.label}: matches ({r.status})")
+        if self.first_step:
+            lines.append(f"first differing step: {self.first_step}")
         lines.append(self.summary())
         return "\n".join(lines) + "\n"
 
@@ -233,6 +265,16 @@ def _symbolic_zero(diff: sp.Expr) -> bool:
         return False
 
 
+def compare_entry(expected: sp.Expr, got: sp.Expr, symbols: list[sp.Symbol], points: np.ndarray) -> str:
+    """ "symbolic", "numeric" or "differs" (module docstring) for one answer entry."""
+    diff = _chop(sp.expand(got - expected), expected, got)
+    if diff == 0:
+        return "symbolic"
+    if not _numeric_zero(diff, sp.Abs(expected) + sp.Abs(got), symbols, points):
+        return "differs"
+    return "symbolic" if _symbolic_zero(diff) else "numeric"
+
+
 def check_answers(
     robot: Robot,
     answers: str | os.PathLike | Mapping,
@@ -240,10 +282,16 @@ def check_answers(
     samples: int = SAMPLES,
     seed: int = 0,
 ) -> CheckReport:
-    """Compare answers (a file or a mapping as in the YAML) with symdyn's derivation of `robot`."""
+    """Compare answers (a file or a mapping as in the YAML) with symdyn's derivation of `robot`.
+
+    Answers for the derivation's steps (the `steps` key) are compared by
+    symdyn.apps.check_steps, before the final quantities, in the order the steps are computed.
+    """
     if method not in METHODS:
         raise SymdynError(f"unknown method '{method}' (use {' or '.join(METHODS)})")
-    parsed = parse_answers(answers, robot) if isinstance(answers, Mapping) else load_answers(answers, robot)
+    file = None if isinstance(answers, Mapping) else str(Path(answers))
+    data = answers if isinstance(answers, Mapping) else read_answers(answers)
+    parsed = parse_answers(data, robot, file)
     dyn = derive(robot, method=method)
     symbols = [*dyn.q, *dyn.qd, *dyn.qdd, *dyn.params]
     rng = np.random.default_rng(seed)
@@ -256,17 +304,26 @@ def check_answers(
         ]
     )
     report = CheckReport(robot.name, method, samples)
+    if AT_KEY in data:
+        if STEPS_KEY in data:
+            raise SymdynError(f"{STEPS_KEY} are checked symbolically: leave out {AT_KEY}", file=file)
+        at = compare_at_state(dyn, parsed, data[AT_KEY], data.get(TOLERANCE_KEY), file)
+        report.results = [EntryResult(*r) for r in at]
+        return report
+    if STEPS_KEY in data:
+        steps, report.first_step = check_steps(
+            robot,
+            data[STEPS_KEY],
+            method,
+            file,
+            lambda value, label: answer_entry(value, robot, file, label),
+            lambda e, g: compare_entry(e, g, symbols, points),
+        )
+        report.results = [EntryResult(*s) for s in steps]
     for name, got in parsed.items():
         expected = dyn.closed_form(name)
         for k in range(len(got)):
             index = (k // n + 1, k % n + 1) if name in MATRICES else (k + 1,)
             e, g = expected[k], got[k]
-            diff = _chop(sp.expand(g - e), e, g)
-            if diff == 0:
-                status = "symbolic"
-            elif not _numeric_zero(diff, sp.Abs(e) + sp.Abs(g), symbols, points):
-                status = "differs"
-            else:
-                status = "symbolic" if _symbolic_zero(diff) else "numeric"
-            report.results.append(EntryResult(name, index, e, g, status))
+            report.results.append(EntryResult(name, index, e, g, compare_entry(e, g, symbols, points)))
     return report

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.robot import Robot
 from .compiled import CompiledDynamics, compiled_dynamics
 from .geometry import (
     AccelerationPolytope,
@@ -29,6 +29,9 @@ from .geometry import (
     inertia_ellipsoid,
 )
 from .task_space import default_axes, joint_vector, parse_axes, task_jacobian
+
+if TYPE_CHECKING:
+    from ..model.robot import Robot
 
 __all__ = ["Analysis", "analyze", "MEASURE_NOTE", "LENGTHS_NOTE"]
 
@@ -154,7 +157,7 @@ class Analysis:
 
 
 def analyze(
-    robot: Robot,
+    robot: Robot | CompiledDynamics,
     q,
     qd=None,
     torque_limits=1.0,
@@ -166,8 +169,12 @@ def analyze(
 
     torque_limits: one bound for every joint or one per joint (N m or N); axes: task
     rows of the end-effector Jacobian (default: the linear axes that move, e.g. x, y
-    for a planar arm). `dynamics` reuses a CompiledDynamics of the same robot.
+    for a planar arm). `dynamics` reuses a CompiledDynamics of the same robot; `robot` may
+    itself be a CompiledDynamics (its parameters bound, its kinematics from the cache).
     """
+    if isinstance(robot, CompiledDynamics):
+        dynamics = compiled_dynamics(robot, params)
+        robot = dynamics
     n = robot.n
     q = joint_vector(q, n, "q")
     qd = np.zeros(n) if qd is None else joint_vector(qd, n, "qd")
@@ -178,7 +185,7 @@ def analyze(
     V = np.asarray(dyn.coriolis(q, qd), dtype=float)
     G = np.asarray(dyn.gravity(q), dtype=float)
     F = np.asarray(dyn.friction(qd), dtype=float)
-    J, Jdq = task_jacobian(robot, q, qd, names, params)
+    J, Jdq = task_jacobian(dyn if isinstance(robot, CompiledDynamics) else robot, q, qd, names, params)
     try:
         Minv = np.linalg.inv(M)
     except np.linalg.LinAlgError as exc:
@@ -188,7 +195,7 @@ def analyze(
     bias = v_vel + v_grav
     A = J @ Minv @ np.diag(limits)
     return Analysis(
-        robot=robot.name,
+        robot=dyn.robot.name,
         q=q,
         qd=qd,
         axes=names,

@@ -26,7 +26,7 @@ from .compiled import CompiledDynamics, compiled_dynamics
 from .simulate import TIME, lambdify_time, simulate, time_expressions
 from .trajectory import Trajectory
 
-__all__ = ["Reference", "ComputedTorque", "pd_gains", "track"]
+__all__ = ["Reference", "SampledReference", "ComputedTorque", "TrackingLaw", "pd_gains", "track"]
 
 
 def pd_gains(omega: float, zeta: float = 1.0) -> tuple[float, float]:
@@ -59,6 +59,61 @@ class Reference:
     def __call__(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         out = [f(t) for f in self._f]  # each (n,) or (n, len(t))
         return tuple(np.moveaxis(x, 0, -1) for x in out)  # type: ignore[return-value]
+
+
+class SampledReference:
+    """A joint-space reference given by samples (t_k, q_k, qd_k, qdd_k), e.g. a CSV file.
+
+    Between samples q_ref is the cubic Hermite interpolant of (q_k, qd_k), qd_ref that of
+    (qd_k, qdd_k) and qdd_ref is linear, so a trajectory sampled from a smooth one (such as
+    `symdyn excite`'s Fourier series) is followed with an O(h^4) error in q_ref for a sample
+    spacing h. Times outside [t_0, t_N] are an error, not an extrapolation.
+    """
+
+    def __init__(self, t, q, qd, qdd, where: str = "reference") -> None:
+        self.t = np.asarray(t, dtype=float)
+        self.q, self.qd, self.qdd = (np.asarray(x, dtype=float) for x in (q, qd, qdd))
+        if self.t.ndim != 1 or len(self.t) < 2 or np.any(np.diff(self.t) <= 0):
+            raise SymdynError(f"{where}: the times must increase strictly (at least two samples)")
+        self.where = where
+
+    @classmethod
+    def from_csv(cls, path, n: int) -> SampledReference:
+        """The columns t, q1..qn and (optionally) qd1..qdn, qdd1..qddn of a CSV file
+        (symdyn.apps.identify.read_measurements: without them, a Savitzky-Golay estimate)."""
+        from .identify import read_measurements
+
+        data = read_measurements(path, n, torques=False)
+        return cls(data.t, data.q, data.qd, data.qdd, where=str(path))
+
+    @property
+    def n(self) -> int:
+        return self.q.shape[1]
+
+    @property
+    def span(self) -> tuple[float, float]:
+        return float(self.t[0]), float(self.t[-1])
+
+    def __call__(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        ts = np.atleast_1d(np.asarray(t, dtype=float))
+        lo, hi = self.span
+        if np.any(ts < lo - 1e-12) or np.any(ts > hi + 1e-12):
+            raise SymdynError(f"{self.where}: the reference covers t in [{lo:g}, {hi:g}] s only")
+        k = np.clip(np.searchsorted(self.t, ts, side="right") - 1, 0, len(self.t) - 2)
+        h = (self.t[k + 1] - self.t[k])[:, None]
+        s = ((ts - self.t[k])[:, None]) / h
+        q_ref = _hermite(self.q[k], self.q[k + 1], self.qd[k] * h, self.qd[k + 1] * h, s)
+        qd_ref = _hermite(self.qd[k], self.qd[k + 1], self.qdd[k] * h, self.qdd[k + 1] * h, s)
+        qdd_ref = (1 - s) * self.qdd[k] + s * self.qdd[k + 1]
+        if np.ndim(t) == 0:
+            return q_ref[0], qd_ref[0], qdd_ref[0]
+        return q_ref, qd_ref, qdd_ref
+
+
+def _hermite(y0, y1, m0, m1, s):
+    """The cubic Hermite interpolant at s in [0, 1] of values y0, y1 and scaled slopes m0, m1."""
+    s2, s3 = s * s, s * s * s
+    return (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * y1 + (s3 - s2) * m1
 
 
 def _gain(K, n: int, name: str) -> np.ndarray:
@@ -114,15 +169,25 @@ class ComputedTorque:
     __call__ = torque
 
     def law(self, reference: Reference):
-        """tau(t, q, qd) tracking `reference`: the torque function `simulate` takes."""
+        """tau(t, q, qd) tracking `reference`: the torque function `simulate` takes.
+
+        simulate recognises it (its `tracking` attribute) and runs the law inside its C loop.
+        """
         if reference.n != self.n:
             raise SymdynError(f"the reference has {reference.n} joints, the model {self.n}")
+        return TrackingLaw(self, reference)
 
-        def tau(t, q, qd):
-            r, rd, rdd = reference(t)
-            return self.torque(q, qd, r, rd, rdd)
 
-        return tau
+class TrackingLaw:
+    """The torque function tau(t, q, qd) of a ComputedTorque tracking a Reference."""
+
+    def __init__(self, controller: ComputedTorque, reference: Reference) -> None:
+        self.tracking = (controller, reference)
+
+    def __call__(self, t, q, qd) -> np.ndarray:
+        controller, reference = self.tracking
+        r, rd, rdd = reference(t)
+        return controller.torque(q, qd, r, rd, rdd)
 
 
 def track(
@@ -136,8 +201,10 @@ def track(
     integrator: str = "rk4",
     params=None,
     progress: bool | None = None,
+    rtol: float = 1e-6,
+    atol: float = 1e-9,
 ) -> Trajectory:
-    """Simulate the plant under `controller` tracking `reference`.
+    """Simulate the plant under `controller` tracking `reference` (rtol, atol: rk45 and dop853 only).
 
     q0, qd0 default to the reference's initial position and velocity. The result
     carries q_ref and qd_ref at the sample times.
@@ -153,6 +220,8 @@ def track(
         integrator=integrator,
         params=params,
         progress=progress,
+        rtol=rtol,
+        atol=atol,
     )
     q_ref, qd_ref, _ = reference(traj.t)
     if traj.q.ndim == 3:

@@ -8,16 +8,20 @@ exact: the symbolic time derivative of J, sum_j dJ/dq_j qd_j, times qd.
 
 from __future__ import annotations
 
+import inspect
+import re
 from collections.abc import Sequence
 from functools import lru_cache
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import sympy as sp
 
-from ..algorithms.kinematics import end_effector_jacobian
 from ..errors import SymdynError
-from ..model.robot import Robot
-from ..model.symbols import joint_symbols
+from .compile import CompiledDynamics
+
+if TYPE_CHECKING:
+    from ..model.robot import Robot
 
 __all__ = ["TASK_AXES", "parse_axes", "default_axes", "task_jacobian", "joint_vector"]
 
@@ -43,6 +47,11 @@ def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
 @lru_cache(maxsize=32)
 def _kinematics(robot: Robot):
     """(f(q, qd, p) -> (J 6xn, Jdot qd 6), the linear rows not identically zero, free params)."""
+    import sympy as sp
+
+    from ..algorithms.kinematics import end_effector_jacobian
+    from ..model.symbols import joint_symbols
+
     r = robot.resolved()
     q, qd, _ = joint_symbols(r.n)
     J = end_effector_jacobian(r, list(q))
@@ -52,25 +61,75 @@ def _kinematics(robot: Robot):
     bias = Jdot * qd
     f = sp.lambdify([list(q), list(qd), list(r.params)], [J, bias], modules="numpy", cse=True)
     live = tuple(TASK_AXES[i] for i in range(3) if any(x != 0 for x in J[i, :]))
-    return f, live, r.params
+    return f, live, tuple(str(p) for p in r.params)
 
 
-def default_axes(robot: Robot) -> tuple[str, ...]:
+_SOURCE = "task_space.py"
+
+
+def _store_kinematics(robot: Robot, folder: Path) -> dict:
+    """The cache entry of the kinematics: lambdify's source (numpy names only) and the live axes."""
+    f, live, params = _kinematics(robot)
+    text = inspect.getsource(f)
+    names = sorted(set(re.findall(r"\b([A-Za-z_][A-Za-z0-9_]*)\(", text)) - {f.__name__})
+    portable = all(getattr(np, name, None) is f.__globals__.get(name) for name in names)
+    if portable:
+        (folder / _SOURCE).write_text(text, encoding="utf-8")
+    return {
+        "live": list(live),
+        "params": list(params),
+        "function": f.__name__,
+        "names": names if portable else None,
+    }
+
+
+def _cached_kinematics(plant: CompiledDynamics):
+    """_kinematics from the plant's cache entry (no SymPy on a hit), or derived when not portable."""
+    found = plant.__dict__.get("_task_space")
+    if found is None:
+        entry = plant.derived_entry("task-space", _store_kinematics)
+        meta = entry.meta
+        if meta["names"] is None:
+            found = _kinematics(plant.robot)
+        else:
+            namespace = {name: getattr(np, name) for name in meta["names"]}
+            path = entry.file(_SOURCE)
+            # symdyn's own lambdify output for this robot, verified against the manifest's digest
+            exec(compile(path.read_text(encoding="utf-8"), str(path), "exec"), namespace)
+            found = namespace[meta["function"]], tuple(meta["live"]), tuple(meta["params"])
+        plant._task_space = found
+    return found
+
+
+def _kinematics_any(robot: Robot | CompiledDynamics):
+    return _cached_kinematics(robot) if isinstance(robot, CompiledDynamics) else _kinematics(robot)
+
+
+def default_axes(robot: Robot | CompiledDynamics) -> tuple[str, ...]:
     """The linear axes x, y, z whose Jacobian rows are not identically zero (x, y for a planar arm)."""
-    live = _kinematics(robot)[1]
+    live = _kinematics_any(robot)[1]
     return live or ("x", "y", "z")
 
 
-def task_jacobian(robot: Robot, q, qd=None, axes=None, params=None) -> tuple[np.ndarray, np.ndarray]:
-    """(J, Jdot qd) of the end-effector, rows `axes` (default `default_axes`), as numbers."""
-    f, _, free = _kinematics(robot)
+def task_jacobian(
+    robot: Robot | CompiledDynamics, q, qd=None, axes=None, params=None
+) -> tuple[np.ndarray, np.ndarray]:
+    """(J, Jdot qd) of the end-effector, rows `axes` (default `default_axes`), as numbers.
+
+    robot: a Robot (free parameters from `params`), or a CompiledDynamics with its parameters
+    bound, whose kinematics come from the cache.
+    """
+    f, _, free = _kinematics_any(robot)
     names = parse_axes(axes) or default_axes(robot)
     n = robot.n
     q = joint_vector(q, n, "q")
     qd = np.zeros(n) if qd is None else joint_vector(qd, n, "qd")
-    values = robot.param_values(params) if robot.params else {}
-    by_name = {str(k): v for k, v in values.items()}
-    p = [by_name[str(s)] for s in free]
+    if isinstance(robot, CompiledDynamics):
+        by_name = dict(zip(robot.param_names, [] if robot.p is None else robot.p, strict=True))
+    else:
+        values = robot.param_values(params) if robot.params else {}
+        by_name = {str(k): v for k, v in values.items()}
+    p = [by_name[s] for s in free]
     J, b = f(q, qd, p)
     J = np.asarray(J, dtype=float).reshape(6, n)
     b = np.asarray(b, dtype=float).reshape(6)

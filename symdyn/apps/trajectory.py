@@ -10,12 +10,15 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.robot import Robot
 from .output import figure, figure_bytes, plot_format, write_atomic
+
+if TYPE_CHECKING:
+    from ..model.robot import Robot
 
 __all__ = ["Trajectory", "plot_trajectory"]
 
@@ -48,9 +51,8 @@ class Trajectory:
         n = self.n
         header = ["t"] + [f"q{i}" for i in range(1, n + 1)] + [f"qd{i}" for i in range(1, n + 1)]
         rows = np.column_stack([self.t, self.q, self.qd])
-        lines = [",".join(header)]
-        lines += [",".join(f"{x:.17g}" for x in row) for row in rows]
-        return "\n".join(lines) + "\n"
+        row_format = ",".join(["%.17g"] * rows.shape[1]) + "\n"  # the digits of f"{x:.17g}"
+        return ",".join(header) + "\n" + (row_format * len(rows)) % tuple(rows.ravel().tolist())
 
     def write_csv(self, path: str | os.PathLike) -> Path:
         """Write csv_text() atomically (temporary file in the same folder, then rename)."""

@@ -1,8 +1,9 @@
-"""The `symdyn` subcommands simulate, analyze and check (added to the parser by `register`).
+"""The `symdyn` subcommands simulate, analyze, check and cache (added to the parser by `register`).
 
     symdyn simulate ROBOT [--q0 Q ...] [--qd0 QD ...] [--tau TAU ...]
            [--track QREF ... [--kp KP ...] [--kd KD ...] [--model-params NAME=VALUE ...]]
-           --duration T --dt H [--integrator rk4|euler|lecture|semi-implicit]
+           --duration T --dt H [--integrator rk4|euler|lecture|semi-implicit|rk45|dop853]
+           [--rtol R --atol A]
            [--params NAME=VALUE ...] --out traj.csv [--plot traj.png] [--progress]
     symdyn analyze ROBOT --q Q ... [--qd QD ...] --torque-limits L ... [--axes x,y]
            [--params NAME=VALUE ...] [--format text|json] [--plot fig.png]
@@ -19,14 +20,18 @@ prints as one line with exit status 1; `check` exits 1 when an answer differs.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.expressions import parse_expression
-from .common import add_robot_argument, load_robot_argument
+from .cache import cached_plant, register_cache
+from .common import METHODS, add_robot_argument, load_robot_argument
+
+#: A plain decimal number, read with float() instead of the expression parser (no SymPy needed).
+_PLAIN = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 __all__ = ["register", "cmd_simulate", "cmd_analyze", "cmd_check"]
 
@@ -48,6 +53,10 @@ def _numbers(items, what: str) -> list[float]:
     """Numbers or constant expressions ("pi/4") of a vector option."""
     values = []
     words = _words(items, what)
+    if all(_PLAIN.fullmatch(w) for w in words):
+        return [float(w) for w in words]
+    from ..model.expressions import parse_expression
+
     for k, w in enumerate(words, 1):
         e = parse_expression(w, field=f"{what}[{k}]" if len(words) > 1 else what)
         if e.free_symbols:
@@ -137,35 +146,68 @@ def _check_plot_path(path: str | None) -> None:
 # --------------------------------------------------------------------------- simulate
 
 
+def _plant(args: argparse.Namespace, params: dict, model_params: dict | None = None):
+    """The compiled robot (cached by file content and options), with the parameter values applied."""
+
+    def make_robot():
+        robot = _with_params(load_robot_argument(args), params)
+        return robot if model_params is None else _with_params(robot, model_params, "--model-params")
+
+    return cached_plant(args, make_robot, params=params, model_params=model_params)
+
+
+def _torques(items, n: int):
+    """--tau: plain numbers as floats (no parsing), else numbers or expressions of t."""
+    from ..apps.simulate import time_expressions
+
+    words = _words(items, "--tau")
+    if all(_PLAIN.fullmatch(w) for w in words) and len(words) in (1, n):
+        return [float(w) for w in words]
+    return time_expressions(words, n, "--tau")
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from ..apps.control import ComputedTorque, Reference, track
     from ..apps.output import write_atomic
-    from ..apps.simulate import simulate, time_expressions
+    from ..apps.simulate import simulate
     from ..apps.trajectory import plot_trajectory
 
     _check_out_path(args.out, "--out")
     _check_plot_path(args.plot)
-    robot = _with_params(load_robot_argument(args), _assignments(args.params, "--params"))
-    n = robot.n
+    params = _assignments(args.params, "--params")
     if args.track is not None and args.tau is not None:
         raise SymdynError("--tau and --track exclude each other (--track computes the torque)")
     if args.track is None:
         for opt in ("kp", "kd", "model_params"):
             if getattr(args, opt) is not None:
                 raise SymdynError(f"--{opt.replace('_', '-')} applies with --track only")
+    plant = _plant(args, params)
+    n = plant.n
+    tolerances = {"rtol": args.rtol, "atol": args.atol}
     if args.track is not None:
-        reference = Reference(_words(args.track, "--track"), n)
+        from ..apps.control import ComputedTorque, Reference, SampledReference, track
+
+        words = _words(args.track, "--track")
+        if len(words) == 1 and words[0].lower().endswith(".csv"):
+            reference = SampledReference.from_csv(words[0], n)
+            start, end = reference.span
+            if start > 0.0 or end < args.duration:
+                raise SymdynError(
+                    f"{words[0]}: the reference covers t in [{start:g}, {end:g}] s, "
+                    f"the simulation [0, {args.duration:g}] s"
+                )
+        else:
+            reference = Reference(words, n)
         r0, rd0, _ = reference(0.0)
         q0 = _vector(args.q0, n, "--q0", default=r0)
         qd0 = _vector(args.qd0, n, "--qd0", default=rd0)
-        model = robot
+        model = plant
         if args.model_params is not None:
-            model = _with_params(robot, _assignments(args.model_params, "--model-params"), "--model-params")
+            model = _plant(args, params, _assignments(args.model_params, "--model-params"))
         kp = _gains(args.kp, n, "--kp", 100.0)
         kd = _gains(args.kd, n, "--kd", 20.0)
         controller = ComputedTorque(model, kp, kd)
         traj = track(
-            robot,
+            plant,
             reference,
             controller,
             q0,
@@ -174,13 +216,14 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             dt=args.dt,
             integrator=args.integrator,
             progress=True if args.progress else None,
+            **tolerances,
         )
     else:
         q0 = _vector(args.q0, n, "--q0", default=np.zeros(n))
         qd0 = _vector(args.qd0, n, "--qd0", default=np.zeros(n))
-        tau = None if args.tau is None else time_expressions(_words(args.tau, "--tau"), n, "--tau")
+        tau = None if args.tau is None else _torques(args.tau, n)
         traj = simulate(
-            robot,
+            plant,
             q0,
             qd0,
             duration=args.duration,
@@ -188,6 +231,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             tau=tau,
             integrator=args.integrator,
             progress=True if args.progress else None,
+            **tolerances,
         )
     image = plot_trajectory(traj) if args.plot else None  # rendered before anything is written
     write_atomic(args.out, traj.csv_text())
@@ -220,12 +264,13 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     axes = parse_axes(args.axes)
     if args.plot and axes is not None and len(axes) != 2:
         raise SymdynError(f"--plot draws a 2-D task space: give two --axes (got {args.axes})")
-    robot = _with_params(load_robot_argument(args), _assignments(args.params, "--params"))
-    n = robot.n
+    params = _assignments(args.params, "--params")
+    plant = _plant(args, params)
+    n = plant.n
     q = _vector(args.q, n, "--q")
     qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
     limits = _numbers(args.torque_limits, "--torque-limits")
-    result = analyze(robot, q, qd, torque_limits=limits, axes=axes)
+    result = analyze(plant, q, qd, torque_limits=limits, axes=axes)
     image = None
     if args.plot:
         if len(result.axes) != 2:
@@ -233,6 +278,11 @@ def cmd_analyze(args: argparse.Namespace) -> int:
                 "--plot draws a 2-D task space: give two --axes "
                 f"(the default here is {','.join(result.axes)})"
             )
+        from ..apps.compile import RobotInfo
+
+        robot = plant.robot
+        if isinstance(robot, RobotInfo):  # the plant came from the cache: the picture needs the Robot
+            robot = _with_params(load_robot_argument(args), params)
         image = plot_analysis(result, robot=robot)
     sys.stdout.write(result.to_json() if args.format == "json" else result.to_text())
     if image is not None:
@@ -271,8 +321,7 @@ def _positive(text: str) -> float:
 
 def register(subparsers) -> None:
     """Add the subcommands simulate, analyze and check to `symdyn`'s subparsers."""
-    from ..apps.simulate import INTEGRATORS
-    from ..dynamics import METHODS
+    from ..apps.stepping import INTEGRATORS
 
     vec = {"nargs": "+", "metavar": "V"}
 
@@ -295,7 +344,8 @@ def register(subparsers) -> None:
         "--track",
         **vec,
         help="computed-torque control tracking q_ref(t): one expression of t per joint "
-        "(qd_ref, qdd_ref by symbolic differentiation)",
+        "(qd_ref, qdd_ref by symbolic differentiation), or a CSV file with columns t, q1..qn and "
+        "optionally qd1..qdn, qdd1..qddn (e.g. from symdyn excite), interpolated between samples",
     )
     s.add_argument("--kp", **vec, help="position gain(s) Kp, one or one per joint (default 100)")
     s.add_argument("--kd", **vec, help="velocity gain(s) Kd, one or one per joint (default 20)")
@@ -312,7 +362,14 @@ def register(subparsers) -> None:
         choices=INTEGRATORS,
         default="rk4",
         help="rk4 (default); euler = lecture: the scheme of slide 19, q += qd dt + qdd dt^2/2, "
-        "qd += qdd dt; semi-implicit: qd += qdd dt, then q += qd dt",
+        "qd += qdd dt; semi-implicit: qd += qdd dt, then q += qd dt; rk45, dop853: adaptive steps "
+        "(scipy) under --rtol/--atol, the state written every dt",
+    )
+    s.add_argument(
+        "--rtol", type=_positive, default=1e-6, help="rk45/dop853: relative tolerance (default 1e-6)"
+    )
+    s.add_argument(
+        "--atol", type=_positive, default=1e-9, help="rk45/dop853: absolute tolerance (default 1e-9)"
     )
     s.add_argument("--params", nargs="+", metavar="NAME=VALUE", help="parameter values (free or overriding)")
     s.add_argument("--out", required=True, help="CSV file to write (atomically)")
@@ -358,3 +415,4 @@ def register(subparsers) -> None:
     c.add_argument("--samples", type=int, default=16, help="random points for the numeric comparison")
     c.add_argument("--verbose", action="store_true", help="also list the entries that match")
     c.set_defaults(func=cmd_check)
+    register_cache(subparsers)

@@ -4,7 +4,11 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_robot_argument", "load_robot_argument"]
+__all__ = ["add_robot_argument", "load_robot_argument", "METHODS"]
+
+#: symdyn.dynamics.METHODS, spelled here so that building the parser imports no SymPy
+#: (tests/test_cli.py checks that the two agree).
+METHODS = ("newton-euler", "lagrange")
 
 
 def load_robot_argument(args: argparse.Namespace):

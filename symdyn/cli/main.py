@@ -13,13 +13,11 @@ import sys
 import warnings
 from collections.abc import Sequence
 
-import sympy as sp
-
 from .. import __version__
-from ..dynamics import METHODS, derive
 from ..errors import SymdynError, SymdynWarning
 from .apps import register
-from .common import add_robot_argument, load_robot_argument
+from .common import METHODS, add_robot_argument, load_robot_argument
+from .identification import register as register_identification
 
 __all__ = ["main"]
 
@@ -35,6 +33,8 @@ def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
 
 
 def _derive_text(dyn) -> str:
+    import sympy as sp
+
     lines = [
         f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
@@ -50,6 +50,8 @@ def _derive_text(dyn) -> str:
 
 
 def _derive_json(dyn) -> str:
+    import sympy as sp
+
     doc: dict = {
         "robot": dyn.robot.name,
         "method": dyn.method,
@@ -75,6 +77,11 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    if args.steps or args.at:
+        from .steps import cmd_derive_steps
+
+        return cmd_derive_steps(args)
+    from ..dynamics import derive
     from . import derive_output as out
 
     robot = load_robot_argument(args)
@@ -148,6 +155,10 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="REL",
         help="drop terms below REL of their entry's largest value over the joint ranges (AKB's 1%% model)",
     )
+    d.add_argument(
+        "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"
+    )
+    d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
     d.set_defaults(func=cmd_derive)
 
     g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
@@ -155,7 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument(
         "--target",
         action="append",
-        choices=("c", "casadi", "python", "latex"),
+        choices=("c", "casadi", "python", "latex", "matlab"),
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")
@@ -171,6 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     g.set_defaults(func=cmd_generate)
     register(sub)  # simulate, analyze, check (the lecture's applications)
+    register_identification(sub)  # identify, excite
     return parser
 
 

@@ -26,7 +26,7 @@ from .render import PRECISIONS, RenderContext
 
 __all__ = ["generate", "render", "file_tools", "TARGETS", "FUNCTION_NAMES"]
 
-TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex"}
+TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex", "matlab": "matlab"}
 
 
 def _target_module(name: str):

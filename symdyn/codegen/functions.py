@@ -1,8 +1,10 @@
-"""The seven generated functions (docs/generated-code.md), as target-independent straight-line code.
+"""The generated functions (docs/generated-code.md), as target-independent straight-line code.
 
 Each `FunctionSpec` names its inputs (q, qd, qdd or tau, p: vectors of SymPy
-symbols), one output (tau, M, C, V, G, F or qdd, row-major), and the
-eliminated temporaries (symdyn.symbolic.simplify) that compute it. Printers for C,
+symbols), its outputs (`Output`: tau, M, C, V, G, F, qdd, ...; any number, any shape,
+row-major), and the eliminated temporaries (symdyn.symbolic.simplify) that compute them.
+Functions come in families (FAMILIES): each is a builder returning `FunctionRow`s over the
+derived program, and `build_functions` eliminates all rows in one CSE pass. Printers for C,
 CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
 
 forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
@@ -26,6 +28,7 @@ masses M cannot be known to be singular, and forward_dynamics is generated.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import sympy as sp
@@ -34,8 +37,22 @@ from ..dynamics import QUANTITIES, Dynamics
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import Eliminated, OpCount, eliminate_many
+from .tip_wrench import TIP_WRENCH_DOC, TIP_WRENCH_FUNCTION, tip_wrench_exprs, tip_wrench_symbols
 
-__all__ = ["FunctionSpec", "Input", "build_functions", "FUNCTION_NAMES"]
+__all__ = [
+    "FunctionSpec",
+    "FunctionRow",
+    "Input",
+    "Inputs",
+    "Output",
+    "DIMS",
+    "FAMILIES",
+    "OWN_CSE",
+    "build_functions",
+    "vector_output",
+    "joint_matrix_output",
+    "FUNCTION_NAMES",
+]
 
 FUNCTION_NAMES = (
     "inverse_dynamics",
@@ -45,6 +62,8 @@ FUNCTION_NAMES = (
     "gravity",
     "friction",
     "forward_dynamics",
+    "regressor",
+    "base_regressor",
 )
 
 
@@ -56,16 +75,62 @@ class Input:
     symbols: tuple[sp.Symbol, ...]
 
 
+#: Size names of the outputs (Output.dims): "1" for a vector's columns, "n" for the joints, "2n"
+#: for the state x = (q, qd); a target spells each as its own expression (C: a macro), and a
+#: family of functions that needs another size adds the name and every target's spelling.
+DIMS = ("1", "n", "2n", "nstd", "nbase")
+
+
+@dataclass(frozen=True)
+class Output:
+    """One output array of a generated function: its argument name, shape and meaning.
+
+    `dims` names the two sizes for the targets (see DIMS); a vector has dims (rows, "1") and
+    a matrix is stored row-major, entry [i*cols + j] being row i, column j.
+    """
+
+    name: str
+    rows: int
+    cols: int
+    doc: str
+    dims: tuple[str, str]
+
+    @property
+    def size(self) -> int:
+        return self.rows * self.cols
+
+    @property
+    def matrix(self) -> bool:
+        """A matrix even when it has one column (M of a one-joint robot is 1 x 1)."""
+        return self.dims[1] != "1"
+
+
+def vector_output(name: str, n: int, doc: str) -> Output:
+    """An n x 1 output over the joints (tau, V, G, F, qdd)."""
+    return Output(name, n, 1, doc, ("n", "1"))
+
+
+def joint_matrix_output(name: str, n: int, doc: str) -> Output:
+    """An n x n output over the joints, row-major (M, C, derivatives by q or qd)."""
+    return Output(name, n, n, doc, ("n", "n"))
+
+
 @dataclass(frozen=True)
 class FunctionSpec:
-    """One generated function: inputs, one output array, and the code computing it."""
+    """One generated function: inputs, one or more output arrays, and the code computing them.
+
+    `code.outputs` holds every output's row-major entries, the outputs one after the other in
+    the order of `results` (the order of the arguments); `entries(result)` is one output's part.
+    """
 
     name: str
     doc: str
     inputs: tuple[Input, ...]
-    output: str
-    shape: tuple[int, int]
+    results: tuple[Output, ...]
     code: Eliminated
+
+    def __post_init__(self) -> None:
+        assert len(self.code.outputs) == sum(r.size for r in self.results), f"{self.name}: output sizes"
 
     @property
     def ops(self) -> OpCount:
@@ -77,7 +142,17 @@ class FunctionSpec:
 
     @property
     def outputs(self):
+        """Every entry of every output, in argument order (see `entries`)."""
         return self.code.outputs
+
+    def entries(self, result: Output) -> list:
+        """The row-major entries of one of this function's outputs."""
+        start = 0
+        for r in self.results:
+            if r is result:
+                return list(self.code.outputs[start : start + r.size])
+            start += r.size
+        raise KeyError(f"{result.name} is not an output of {self.name}")
 
     @property
     def free_symbols(self) -> set[sp.Symbol]:
@@ -86,6 +161,48 @@ class FunctionSpec:
             *(e.free_symbols for _, e in self.code.temporaries),
             *(sp.sympify(e).free_symbols for e in self.code.outputs),
         )
+
+
+@dataclass(frozen=True)
+class FunctionRow:
+    """A function before elimination: what `build_functions` turns into a FunctionSpec.
+
+    `exprs` are the outputs' row-major entries over the program's intermediates (in the order
+    of `results`); `steps` the assignments they need beyond the dynamics' own program.
+    """
+
+    name: str
+    doc: str
+    inputs: tuple[Input, ...]
+    results: tuple[Output, ...]
+    exprs: tuple[sp.Expr, ...]
+    steps: tuple = ()
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """The input vectors every function family draws from: q, qd, qdd, tau and p."""
+
+    q: Input
+    qd: Input
+    qdd: Input
+    tau: Input
+    p: Input
+
+    @classmethod
+    def of(cls, dyn: Dynamics) -> Inputs:
+        n = dyn.n
+        return cls(
+            Input("q", tuple(dyn.q)),
+            Input("qd", tuple(dyn.qd)),
+            Input("qdd", tuple(dyn.qdd)),
+            Input("tau", tuple(sp.Symbol(f"tau{i + 1}") for i in range(n))),
+            Input("p", tuple(dyn.params)),
+        )
+
+    @property
+    def symbols(self) -> tuple[sp.Symbol, ...]:
+        return (*self.q.symbols, *self.qd.symbols, *self.qdd.symbols, *self.tau.symbols, *self.p.symbols)
 
 
 def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
@@ -118,60 +235,124 @@ def _solvable(dyn: Dynamics) -> bool:
             f"robot '{robot.name}': forward_dynamics is not generated: joint(s) {names} move no mass "
             "or inertia, so M(q) is singular; the other functions are",
             SymdynWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
     return not idle
 
 
-def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
-    """The generated functions for a derived robot, with CSE applied per function.
-
-    All seven, or the six without forward_dynamics (and a SymdynWarning) when a joint moves
-    no mass or inertia (see the module docstring).
-    """
+def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """The six functions of tau = M qdd + V + G + F and its terms (slide 16), over `dyn.program`."""
     n = dyn.n
-    q = Input("q", tuple(dyn.q))
-    qd = Input("qd", tuple(dyn.qd))
-    qdd = Input("qdd", tuple(dyn.qdd))
-    tau = Input("tau", tuple(sp.Symbol(f"tau{i + 1}") for i in range(n)))
-    p = Input("p", tuple(dyn.params))
     c = dyn.compact
     table = [
-        ("inverse_dynamics", "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)", (q, qd, qdd, p), "tau", c["tau"]),
-        ("mass_matrix", "M(q), row-major n x n", (q, p), "M", c["M"]),
-        (
-            "coriolis_matrix",
-            "C(q, qd) from Christoffel symbols, row-major; C qd = V",
-            (q, qd, p),
-            "C",
-            c["C"],
-        ),
-        ("coriolis", "V(q, qd) = C(q, qd) qd", (q, qd, p), "V", c["V"]),
-        ("gravity", "G(q)", (q, p), "G", c["G"]),
-        ("friction", "F(qd) = viscous qd + coulomb sign(qd)", (qd, p), "F", c["F"]),
+        ("inverse_dynamics", "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)", (x.q, x.qd, x.qdd, x.p), "tau"),
+        ("mass_matrix", "M(q), row-major n x n", (x.q, x.p), "M"),
+        ("coriolis_matrix", "C(q, qd) from Christoffel symbols, row-major; C qd = V", (x.q, x.qd, x.p), "C"),
+        ("coriolis", "V(q, qd) = C(q, qd) qd", (x.q, x.qd, x.p), "V"),
+        ("gravity", "G(q)", (x.q, x.p), "G"),
+        ("friction", "F(qd) = viscous qd + coulomb sign(qd)", (x.qd, x.p), "F"),
     ]
-    program_outputs = [e for name in QUANTITIES for e in c[name]] + list(c["bias"])
-    steps = dyn.program.needed(program_outputs)
-    if _solvable(dyn):
-        fd = Program()
-        b = [fd.let(tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
-        order = list(range(n)) if dyn.robot.is_chain else list(reversed(range(n)))
-        solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
-        qdd_out = [solved[order.index(i)] for i in range(n)]
-        table.append(
-            (
-                "forward_dynamics",
-                "qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T)",
-                (q, qd, tau, p),
-                "qdd",
-                sp.Matrix(qdd_out),
-            )
-        )
-        steps += fd.needed(qdd_out)
-    outputs = {name: list(exprs) for name, _, _, _, exprs in table}
-    inputs = (*q.symbols, *qd.symbols, *qdd.symbols, *tau.symbols, *p.symbols)
-    code = eliminate_many(steps, outputs, reserved=inputs)
+    rows = []
+    for name, doc, inputs, out in table:
+        shape = joint_matrix_output if out in ("M", "C") else vector_output
+        rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), tuple(c[out])))
+    return rows
+
+
+def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """forward_dynamics, the unrolled LDL^T solve of M qdd = tau - bias (module docstring), or
+    nothing (with a SymdynWarning) when M is singular by construction."""
+    if not _solvable(dyn):
+        return []
+    n = dyn.n
+    c = dyn.compact
+    fd = Program()
+    b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
+    order = list(range(n)) if dyn.robot.is_chain else list(reversed(range(n)))
+    solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+    qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
-        FunctionSpec(name, doc, inputs, out, (exprs.rows, exprs.cols), code[name])
-        for name, doc, inputs, out, exprs in table
+        FunctionRow(
+            "forward_dynamics",
+            "qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T)",
+            (x.q, x.qd, x.tau, x.p),
+            (vector_output("qdd", n, _OUTPUT_DOCS["qdd"]),),
+            tuple(qdd_out),
+            tuple(fd.needed(qdd_out)),
+        )
     ]
+
+
+def tip_wrench_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """tip_wrench_torque(q, F, p) for product-of-exponentials robots (symdyn.codegen.tip_wrench)."""
+    exprs = tip_wrench_exprs(dyn)
+    if exprs is None:
+        return []
+    F = Input("F", tip_wrench_symbols())
+    out = vector_output("tau_tip", dyn.n, "joint torques J_b^T F holding the end-effector wrench F")
+    return [FunctionRow(TIP_WRENCH_FUNCTION, TIP_WRENCH_DOC, (x.q, F, x.p), (out,), tuple(exprs))]
+
+
+_OUTPUT_DOCS = {
+    "tau": "joint efforts tau = M qdd + V + G + F",
+    "M": "joint-space mass (inertia) matrix M(q)",
+    "C": "Coriolis matrix C(q, qd) (Christoffel symbols), C qd = V",
+    "V": "Coriolis and centrifugal efforts V(q, qd)",
+    "G": "gravity efforts G(q)",
+    "F": "friction efforts F(qd)",
+    "qdd": "joint accelerations",
+}
+
+
+#: The families of generated functions, in the order of the generated files: each maps a derived
+#: robot and the input vectors to its FunctionRows (a new family is one module and one entry here).
+def regressor_family(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """regressor and base_regressor (symdyn.codegen.regressor_functions, which builds on this module)."""
+    from .regressor_functions import regressor_rows
+
+    return regressor_rows(dyn, x)
+
+
+FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
+    dynamics_rows,
+    forward_dynamics_rows,
+    regressor_family,
+    tip_wrench_rows,
+)
+
+
+#: Families eliminated in a CSE pass of their own: they add intermediates to `dyn.program`, and a
+#: joint pass would let those change the other functions' temporaries.
+OWN_CSE: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (regressor_family,)
+
+
+def _eliminated(
+    dyn: Dynamics, rows: list[FunctionRow], x: Inputs, base: list[sp.Expr]
+) -> dict[str, Eliminated]:
+    """One CSE pass over `rows` (their outputs, extra steps and the `base` needs)."""
+    needs = [e for row in rows for e in row.exprs] + [e for row in rows for _, e in row.steps] + base
+    steps = dyn.program.needed(needs) + [s for row in rows for s in row.steps]
+    return eliminate_many(steps, {row.name: list(row.exprs) for row in rows}, reserved=x.symbols)
+
+
+def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
+    """The generated functions of a derived robot, one CSE pass over all of them (and one more
+    per family of OWN_CSE).
+
+    All of FAMILIES' rows: the seven of docs/generated-code.md, or six without forward_dynamics
+    (and a SymdynWarning) when a joint moves no mass or inertia (see the module docstring), then
+    regressor and base_regressor (symdyn.codegen.regressor_functions).
+    Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
+    among the needs, so adding a family never changes the others' temporaries).
+    """
+    x = Inputs.of(dyn)
+    groups = [(family in OWN_CSE, family(dyn, x)) for family in FAMILIES]
+    rows = [row for _, group in groups for row in group]
+    names = [row.name for row in rows]
+    assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
+    base = [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
+    code = _eliminated(dyn, [row for own, group in groups if not own for row in group], x, base)
+    for own, group in groups:
+        if own and group:
+            code.update(_eliminated(dyn, group, x, []))
+    return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

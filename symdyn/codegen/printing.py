@@ -12,7 +12,18 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["TreePrinter"]
+__all__ = ["TreePrinter", "free_name"]
+
+
+def free_name(base: str, taken, temporary) -> str:
+    """`base`, or `base_`, `base_1`, `base_2`, ... : the first that is not in `taken` and does
+    not match `temporary` (the pattern of the eliminated temporaries' names), for a local of
+    generated code named after a free parameter."""
+    candidate, k = base, 0
+    while candidate in taken or temporary.match(candidate):
+        candidate = f"{base}_" if k == 0 else f"{base}_{k}"
+        k += 1
+    return candidate
 
 
 class TreePrinter:

@@ -6,10 +6,11 @@ import os
 
 from ..errors import SymdynError
 from ..model.robot import Robot
+from .poe import robot_from_poe
 from .robot_file import load_robot, robot_from_data
 from .urdf import load_urdf
 
-__all__ = ["load", "load_robot", "load_urdf", "robot_from_data"]
+__all__ = ["load", "load_robot", "load_urdf", "robot_from_data", "robot_from_poe"]
 
 
 def load(path: str | os.PathLike, base: str | None = None, tip: str | None = None) -> Robot:

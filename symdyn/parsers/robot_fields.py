@@ -59,6 +59,7 @@ MOTOR_KEYS = ("inertia", "gear_ratio")
 MIMIC_KEYS = ("joint", "multiplier", "offset")
 _AXES = ("x", "y", "z")
 _LINK_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.\-]*\Z")
+LINK_NAME = _LINK_NAME  # the pattern of a link name, for the other robot-file readers
 
 
 @dataclass
@@ -195,7 +196,8 @@ class RobotFileReader:
     def _read_convention(self, value: object) -> None:
         if value not in CONVENTIONS:
             raise self.error(
-                f"convention must be 'standard' or 'modified', not {value!r}", field="convention"
+                f"convention must be 'standard' or 'modified' (DH) or 'poe', not {value!r}",
+                field="convention",
             )
         self.convention = value
 

@@ -34,6 +34,7 @@ from ..model.inertia import check_inertia, tensor_from_components
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
+from .poe_file import PoeFileReader
 from .robot_fields import LinkData, RobotFileReader
 from .robot_tree import link_mimics, link_parents
 from .source import read_source
@@ -147,12 +148,31 @@ def _check_link_numbers(
 
 
 def _build(data: object, file: str | None, digest: str | None) -> Robot:
-    reader = RobotFileReader(file)
+    poe = isinstance(data, dict) and data.get("convention") == "poe"
+    reader = PoeFileReader(file) if poe else RobotFileReader(file)
     reader.read(data)
     values = _resolve_values(reader)
     subs = {sp.Symbol(n): v for n, v in values.items()}
     params = tuple(sp.Symbol(n) for n in dict.fromkeys(reader.order) if n not in values)
+    links = reader.links_of_model(subs) if isinstance(reader, PoeFileReader) else _dh_links(reader, subs)
+    gravity = reader.gravity
+    if gravity is None:
+        gravity = DEFAULT_GRAVITY
+    assert reader.name is not None
+    return Robot(
+        name=reader.name,
+        links=tuple(links),
+        gravity=sp.ImmutableMatrix(3, 1, list(gravity)),
+        params=params,
+        values=tuple((sp.Symbol(n), v) for n, v in values.items()),
+        source=file,
+        source_sha256=digest,
+        convention=reader.convention,
+    )
 
+
+def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
+    """The links of a DH robot file (standard or modified), each row relative to its parent's frame."""
     parents, mimics = link_parents(reader), link_mimics(reader)
     links: list[Link] = []
     frames: list[Transform] = []  # each link's DH frame in its body frame
@@ -181,18 +201,4 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
                 mimic=mimics[i],
             )
         )
-
-    gravity = reader.gravity
-    if gravity is None:
-        gravity = DEFAULT_GRAVITY
-    assert reader.name is not None
-    return Robot(
-        name=reader.name,
-        links=tuple(links),
-        gravity=sp.ImmutableMatrix(3, 1, list(gravity)),
-        params=params,
-        values=tuple((sp.Symbol(n), v) for n, v in values.items()),
-        source=file,
-        source_sha256=digest,
-        convention=reader.convention,
-    )
+    return links

@@ -17,6 +17,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...model.expressions import C_KEYWORDS
+from ..printing import free_name
 from ..render import PRECISIONS, RenderContext
 
 __all__ = ["CConfig", "CNames", "c_names", "C_RESERVED", "MATH_CALLS", "TEMPORARY"]
@@ -97,6 +98,7 @@ class CNames:
     functions: dict[str, str]  # spec name -> C function name
     locals: dict[sp.Symbol, str]  # input symbol -> C local name
     param_macro: dict[sp.Symbol, str]  # parameter symbol -> its index macro
+    dims: dict[str, str]  # size name of an output (symdyn.codegen.functions.DIMS) -> C expression
 
 
 def _aliases(written: list[str], taken: set[str]) -> tuple[tuple[str, str], ...]:
@@ -133,7 +135,12 @@ def c_names(ctx: RenderContext) -> CNames:
     param_macros = tuple((f"{name}_P_{p}", k) for k, p in enumerate(params))
     functions = {f.name: f"{name}_{f.name}" for f in ctx.functions}
     guard = f"{name.upper()}_DYNAMICS_H"
-    written = [ndof, nparam] + [m for m, _ in param_macros]
+    column_dims = {r.dims[1] for f in ctx.functions for r in f.results} & {"nstd", "nbase"}
+    written = (
+        [ndof, nparam]
+        + [m for m, _ in param_macros]
+        + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
+    )
     taken = set(written) | set(functions.values()) | {guard}
     aliases = _aliases(written, taken)
 
@@ -144,20 +151,17 @@ def c_names(ctx: RenderContext) -> CNames:
             f"robot '{name}': parameter name(s) {', '.join(clash)} clash with the joint or effort "
             "symbols of the generated functions"
         )
-    reserved = C_RESERVED | taken | {a for a, _ in aliases}
+    arguments = {r.name for f in ctx.functions for r in f.results} | {
+        inp.name for f in ctx.functions for inp in f.inputs
+    }
+    reserved = C_RESERVED | taken | {a for a, _ in aliases} | arguments
     used = {str(s) for s in joint_symbols}
     local_names: dict[sp.Symbol, str] = {s: str(s) for s in joint_symbols}
     for s in joint_symbols:
         assert str(s) not in reserved and not TEMPORARY.match(str(s)), f"joint symbol '{s}' is a C name"
     for p in params:
-        base = str(p)
-        candidate = base
-        k = 0
-        while candidate in reserved or candidate in used or TEMPORARY.match(candidate):
-            candidate = f"{base}_" if k == 0 else f"{base}_{k}"
-            k += 1
-        local_names[p] = candidate
-        used.add(candidate)
+        local_names[p] = free_name(str(p), reserved | used, TEMPORARY)
+        used.add(local_names[p])
     param_macro = {p: m for p, (m, _) in zip(params, param_macros, strict=True)}
     return CNames(
         header_file=f"{name}_dynamics.h",
@@ -171,4 +175,5 @@ def c_names(ctx: RenderContext) -> CNames:
         functions=functions,
         locals=local_names,
         param_macro=param_macro,
+        dims={"1": "1", "n": ndof, "2n": f"(2*{ndof})", "nstd": f"{name}_NSTD", "nbase": f"{name}_NBASE"},
     )

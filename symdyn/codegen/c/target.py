@@ -17,11 +17,15 @@ from __future__ import annotations
 
 from ...errors import SymdynError
 from ..functions import FunctionSpec
+from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .printer import CPrinter
 
 __all__ = ["render", "render_context", "TOOLS"]
+
+#: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6).
+JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
 TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
@@ -42,27 +46,40 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     inputs, unused, reads = [], [], []
     for inp in spec.inputs:
         used = [s for s in inp.symbols if s in used_symbols]
-        inputs.append({"name": inp.name, "read": bool(used)})
+        size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+        inputs.append({"name": inp.name, "read": bool(used), "size": size})
         if not used:
             unused.append(inp.name)
         for s in used:
             index = names.param_macro[s] if inp.name == "p" else str(inp.symbols.index(s))
             reads.append((names.locals[s], inp.name, index))
-    rows, cols = spec.shape
-    assert len(spec.outputs) == rows * cols and cols in (1, ctx.robot.n), f"{spec.name}: shape {spec.shape}"
+    outputs = []
+    for result in spec.results:
+        rows, cols = (names.dims[d] for d in result.dims)
+        if result.matrix:
+            size = f"{rows}*{cols} values, row-major: {result.name}[i*{cols} + j] is row i, column j"
+        else:
+            size = f"{rows} values"
+        entries = spec.entries(result)
+        outputs.append(
+            {
+                "name": result.name,
+                "doc": result.doc,
+                "size": size,
+                "stores": [(k, printer.doprint(e)) for k, e in enumerate(entries)],
+            }
+        )
     return {
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
         "ops": spec.ops.summary(),
         "inputs": inputs,
-        "output": spec.output,
-        "matrix": cols > 1,
-        "width": max(len(a) for a in [*(inp.name for inp in spec.inputs), spec.output]),
+        "outputs": outputs,
+        "width": max(len(a) for a in [*(inp.name for inp in spec.inputs), *(r.name for r in spec.results)]),
         "unused": unused,
         "reads": reads,
         "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in spec.temporaries],
-        "stores": [(k, printer.doprint(e)) for k, e in enumerate(spec.outputs)],
     }
 
 
@@ -84,7 +101,27 @@ def render_context(ctx: RenderContext) -> dict:
         "param_macros": list(names.param_macros),
         "aliases": list(names.aliases),
         "functions": [_function_view(ctx, names, spec) for spec in ctx.functions],
+        "column_sizes": _column_sizes(ctx, names),
     }
+
+
+def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
+    """The column counts of the regressor outputs (size names nstd, nbase): macro, count and the
+    table naming every column (symdyn.codegen.regressor_functions.columns)."""
+    sizes = {}
+    for spec in ctx.functions:
+        for r in spec.results:
+            if r.dims[1] in ("nstd", "nbase") and r.dims[1] not in sizes:
+                table = columns(ctx.dynamics, r.dims[1])
+                assert len(table) == r.cols and not any("*/" in t for _, t in table)
+                sizes[r.dims[1]] = {
+                    "macro": names.dims[r.dims[1]],
+                    "count": r.cols,
+                    "output": r.name,
+                    "columns": table,
+                    "width": max(len(c) for c, _ in table),
+                }
+    return list(sizes.values())
 
 
 def render(ctx: RenderContext) -> dict[str, str]:

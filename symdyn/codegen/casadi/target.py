@@ -52,10 +52,11 @@ def _function_view(spec: FunctionSpec) -> tuple[dict, bool]:
         if x in names:
             raise SymdynError(f"casadi target: temporary '{x}' has the name of an input symbol")
         names[x] = str(x)
-    if spec.output in {inp.name for inp in spec.inputs} | {str(x) for x, _ in spec.temporaries}:
-        raise SymdynError(f"casadi target: output name '{spec.output}' of {spec.name} is taken")
+    taken = {inp.name for inp in spec.inputs} | {str(x) for x, _ in spec.temporaries}
+    for result in spec.results:
+        if result.name in taken:
+            raise SymdynError(f"casadi target: output name '{result.name}' of {spec.name} is taken")
     printer = CasadiPrinter(names)
-    rows, cols = spec.shape
     o = spec.ops
     cost = {"temporaries": len(spec.temporaries), "total": o.total, **asdict(o)} if spec.temporaries else None
     view = {
@@ -64,10 +65,19 @@ def _function_view(spec: FunctionSpec) -> tuple[dict, bool]:
         "inputs": [(inp.name, len(inp.symbols)) for inp in spec.inputs],
         "cost": cost,
         "temporaries": [(str(x), printer.doprint(e)) for x, e in spec.temporaries],
-        "output": spec.output,
-        "rows": rows,
-        "cols": cols,
-        "entries": [(k // cols, k % cols, printer.doprint(e)) for k, e in enumerate(spec.outputs) if e != 0],
+        "outputs": [
+            {
+                "name": r.name,
+                "rows": r.rows,
+                "cols": r.cols,
+                "entries": [
+                    (k // r.cols, k % r.cols, printer.doprint(e))
+                    for k, e in enumerate(spec.entries(r))
+                    if e != 0
+                ],
+            }
+            for r in spec.results
+        ],
     }
     return view, printer.uses_math
 

@@ -27,6 +27,7 @@ import sympy as sp
 from ...dynamics import AUTO_SIMPLIFY_MAX_JOINTS, Dynamics
 from ...symbolic.simplify import eliminate
 from ..render import RenderContext, environment, header_lines
+from .base_parameters import base_parameters_latex
 from .notation import MATRIX_WIDTH, Notation, escape_text, width
 
 __all__ = ["render", "latex_document_body", "dynamics_latex", "file_name", "AMSMATH_NOTE", "TOOLS"]
@@ -145,9 +146,12 @@ def dynamics_latex(dyn: Dynamics) -> str:
 
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_dynamics.tex: fragment} for the robot of `ctx`."""
+    body = latex_document_body(ctx.dynamics)
+    if any(f.name == "base_regressor" for f in ctx.functions):
+        body += base_parameters_latex(ctx.dynamics)
     text = (
         environment()
         .get_template("latex/dynamics.tex.j2")
-        .render(header=header_lines(ctx), note=AMSMATH_NOTE, body=latex_document_body(ctx.dynamics))
+        .render(header=header_lines(ctx), note=AMSMATH_NOTE, body=body)
     )
     return {file_name(ctx.name): text}

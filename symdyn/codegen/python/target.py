@@ -22,11 +22,11 @@ from .printer import NumpyPrinter, dtype, local_names
 
 __all__ = ["render", "file_name", "TOOLS"]
 
+#: The inputs with one value per joint (NDOF); any other input has a fixed size (F: 6).
+JOINT_INPUTS = ("q", "qd", "qdd", "tau")
+
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_numpy.py": ("sympy",)}
-
-#: Outputs that stay matrices even for one joint (shape (1, 1)); the others are vectors.
-_MATRICES = ("M", "C")
 
 
 def file_name(name: str) -> str:
@@ -34,13 +34,16 @@ def file_name(name: str) -> str:
 
 
 def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
-    """One function as data: arguments, the input elements it reads, temporaries, output entries."""
+    """One function as data: arguments (and their sizes: NDOF or a number), the input elements
+    it reads, temporaries, output entries."""
     free = spec.free_symbols
-    rows, cols = spec.shape
     return {
         "name": spec.name,
         "doc": spec.doc,
         "inputs": [inp.name for inp in spec.inputs if inp.name != "p"],
+        "sizes": {
+            inp.name: "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols)) for inp in spec.inputs
+        },
         "has_p": any(inp.name == "p" for inp in spec.inputs),
         "lead": [inp.name for inp in spec.inputs],
         "unpack": [
@@ -50,9 +53,14 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
             if s in free
         ],
         "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in spec.temporaries],
-        "output": spec.output,
-        "shape": [rows, cols] if spec.output in _MATRICES else [rows],
-        "entries": [printer.doprint(e) for e in spec.outputs],
+        "outputs": [
+            {
+                "name": r.name,
+                "shape": [r.rows, r.cols] if r.matrix else [r.rows],
+                "entries": [printer.doprint(e) for e in spec.entries(r)],
+            }
+            for r in spec.results
+        ],
     }
 
 

@@ -1,0 +1,383 @@
+"""`symdyn.compile`: a robot's generated functions as fast Python methods, from a cached C library.
+
+The robot is derived and its code generated once (symdyn.codegen: the C target, the
+NumPy target and the batch wrappers of symdyn.codegen.c.runtime); the C is compiled
+with the system's compiler (symdyn.codegen.c.build) into a shared library, and all of
+it is stored in the cache (symdyn.apps.cache) under a hash of the robot's content,
+symdyn's version and the options. The next call for the same robot loads the library
+without deriving anything.
+
+Every generated function becomes a method of `CompiledDynamics` with the generated
+function's name and inputs (without p, which is bound): whatever the code generator
+emits, including functions with several outputs (returned as a tuple) or outputs that
+are not square. One state (vectors of their size) runs one C call; a batch (leading
+axes, e.g. (B, n)) runs one call of NAME_batch, whose loop is in C. Joint quantities are
+in joint space (rad or m), the base frame fixes gravity, as in docs/generated-code.md.
+
+The methods bind through cffi's ABI mode: measured on this machine, a 7-joint function called with
+NumPy arrays costs about 2.7 us through cffi (ffi.from_buffer) against 5.8-6.3 us through
+ctypes (docs/speed.md). cffi parses the declarations when a method is first used (about
+0.1 s), so the stepping loop, called once per run, goes through ctypes instead. Without a C
+compiler the methods are the generated NumPy module's, with one warning.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import types
+import warnings
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SymdynError, SymdynWarning
+from . import cache
+
+__all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
+
+#: The slowdown the fallback warning quotes (measured, docs/speed.md).
+_FALLBACK_NOTE = (
+    "about 10 times slower per call from Python (Panda forward dynamics: ~130 us against ~12 us) and "
+    "about 300 times slower in simulations, whose loop then runs in Python instead of C; "
+    "install a C compiler (cc, gcc or clang) or set CC"
+)
+_warned = False
+
+
+@dataclasses.dataclass(frozen=True)
+class RobotInfo:
+    """What the applications need of a robot when it comes from the cache: its name and size."""
+
+    name: str
+    n: int
+    params: tuple[str, ...] = ()
+
+
+def _canonical(value):
+    """A deterministic, content-only description of a robot (dataclasses, tuples, SymPy objects)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return [type(value).__name__] + [
+            [f.name, _canonical(getattr(value, f.name))]
+            for f in dataclasses.fields(value)
+            if f.name != "source"
+        ]
+    if isinstance(value, (tuple, list)):
+        return [_canonical(v) for v in value]
+    if isinstance(value, (str, int, float, bool)) or value is None:
+        return value
+    import sympy as sp
+
+    return sp.srepr(value)
+
+
+def robot_digest(robot) -> str:
+    """SHA-256 of the robot's content (every field but the file it came from)."""
+    import hashlib
+    import json
+
+    return hashlib.sha256(json.dumps(_canonical(robot)).encode()).hexdigest()
+
+
+def _options(method: str, precision: str = "double") -> dict:
+    from .build import COMPILE_FLAGS, find_compiler
+
+    compiler = find_compiler()
+    return {
+        "method": method,
+        "precision": precision,
+        "compiler": compiler,
+        "flags": list(COMPILE_FLAGS) if compiler else None,
+    }
+
+
+def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
+    """build(folder): derive, generate (C, NumPy, runtime), compile; return the entry's metadata."""
+
+    def build(folder: Path) -> dict:
+        from ..codegen import c as c_target
+        from ..codegen import context
+        from ..codegen import python as numpy_target
+        from ..codegen.c.runtime import function_table, render_runtime
+        from .build import compile_library, library_suffix
+
+        ctx = context(robot, options["precision"], method)
+        files = {**c_target.render(ctx), **render_runtime(ctx), **numpy_target.render(ctx)}
+        for name, text in files.items():
+            (folder / name).write_text(text, encoding="utf-8")
+        library = None
+        if options["compiler"]:
+            library = f"lib{ctx.name}{library_suffix()}"
+            compile_library(
+                options["compiler"],
+                {k: v for k, v in files.items() if k.endswith((".c", ".h"))},
+                folder / library,
+            )
+        return {
+            "robot": {"name": ctx.name, "n": ctx.robot.n, "params": [str(s) for s in ctx.dynamics.params]},
+            "functions": function_table(ctx),
+            "numpy": numpy_target.file_name(ctx.name),
+            "library": library,
+        }
+
+    return build
+
+
+def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: str = "newton-euler"):
+    """A CompiledDynamics from the cache entry of `key_parts` (plus the options), built when missing.
+
+    make_robot() is called only to build the entry (a cache hit never derives nor loads it);
+    the result then carries a RobotInfo instead of the Robot.
+    """
+    options = _options(method)
+    key = cache.entry_key(**key_parts, **options)
+    entry = cache.lookup(key)
+    robot = None
+    if entry is None:
+        robot = make_robot()
+        entry = cache.get_or_build(key, _build(robot, method, options))
+    self = CompiledDynamics._from_entry(entry, robot, params)
+    self._source = ({**key_parts, "method": method}, make_robot)
+    return self
+
+
+def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamics:
+    """The robot's generated functions compiled to C, with its free parameters bound to `params`.
+
+    params: None (no free parameters), a map name -> value, or one value per free parameter
+    in the robot's order. The library is cached (docs/speed.md: the cache); the second
+    compile of an unchanged robot loads it in milliseconds.
+    """
+    from ..model.robot import Robot
+
+    if not isinstance(robot, Robot):
+        raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
+    from ..codegen.functions import FAMILIES
+
+    families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
+    return cached_dynamics(
+        {"robot": robot_digest(robot), "families": families}, lambda: robot, params, method
+    )
+
+
+def _bind(names: list[str], robot, params) -> np.ndarray | None:
+    """The parameter vector in `names` order (None when there are none)."""
+    if robot is not None and not isinstance(robot, RobotInfo):
+        values = robot.param_values(params) if robot.params else {}
+        by_name = {str(k): v for k, v in values.items()}
+        if params is not None and not robot.params and len(params):
+            raise SymdynError(f"robot '{robot.name}' has no free parameters, got {params!r}")
+    elif params is None:
+        if names:
+            raise SymdynError(f"the robot has free parameters ({', '.join(names)}); give their values")
+        by_name = {}
+    elif isinstance(params, Mapping):
+        by_name = {str(k): float(v) for k, v in params.items()}
+        wrong = sorted(set(by_name) ^ set(names))
+        if wrong:
+            raise SymdynError(f"parameters: expected values for {', '.join(names)}; got {', '.join(by_name)}")
+    else:
+        given = [float(v) for v in params]
+        if len(given) != len(names):
+            raise SymdynError(
+                f"parameters: expected {len(names)} values ({', '.join(names)}), got {len(given)}"
+            )
+        by_name = dict(zip(names, given, strict=True))
+    return np.array([float(by_name[n]) for n in names], dtype=np.float64) if names else None
+
+
+class CompiledDynamics:
+    """The generated functions of a robot as methods, bound to values of its free parameters.
+
+    CompiledDynamics(robot, params) is symdyn.compile(robot, params). `backend` is "c" or
+    "numpy" (no C compiler); `functions` names the methods; `module` is the generated
+    NumPy module; `robot` the Robot (or a RobotInfo when it came from the cache alone).
+    """
+
+    def __init__(self, robot, params=None, method: str = "newton-euler") -> None:
+        other = compile(robot, params, method)
+        self.__dict__.update(other.__dict__)
+
+    @classmethod
+    def _from_entry(cls, entry: cache.Entry, robot, params) -> CompiledDynamics:
+        self = cls.__new__(cls)
+        meta = entry.meta
+        info = meta["robot"]
+        self.robot = robot if robot is not None else RobotInfo(info["name"], info["n"], tuple(info["params"]))
+        self.param_names = tuple(info["params"])
+        self.p = _bind(info["params"], robot, params)
+        self._entry = entry
+        self._module = None
+        self.functions = tuple(f["name"] for f in meta["functions"])
+        self._library = entry.file(meta["library"]) if meta["library"] else None
+        self.backend = "c" if self._library is not None else "numpy"
+        if self._library is None:
+            _warn_fallback()
+            for f in meta["functions"]:
+                setattr(self, f["name"], _numpy_method(self, f["name"]))
+        return self
+
+    def __getattr__(self, name: str):
+        """The C methods, bound on first use (cffi parses the declarations then: ~0.1 s)."""
+        entry = self.__dict__.get("_entry")
+        if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
+            raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
+        ffi, lib = _load_library(self._library, entry.meta["functions"])
+        p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
+        for f in entry.meta["functions"]:
+            setattr(self, f["name"], _c_method(ffi, lib, f, p_ptr))
+        return self.__dict__[name]
+
+    @property
+    def cdll(self):
+        """The library through ctypes (loads in microseconds; symdyn.apps.stepping calls it once per run)."""
+        assert self.backend == "c"
+        import ctypes
+
+        return _CDLLS.setdefault(str(self._library), ctypes.CDLL(str(self._library)))
+
+    def pointer(self, name: str) -> int:
+        """The address of the C function `name` (for the stepping loop's function pointers)."""
+        import ctypes
+
+        c_name = next(f["c_name"] for f in self._entry.meta["functions"] if f["name"] == name)
+        return ctypes.cast(getattr(self.cdll, c_name), ctypes.c_void_p).value
+
+    @property
+    def n(self) -> int:
+        return self.robot.n
+
+    @property
+    def module(self) -> types.ModuleType:
+        """The generated NumPy module of the robot (NAME_numpy.py from the cache entry)."""
+        if self._module is None:
+            path = self._entry.file(self._entry.meta["numpy"])
+            module = types.ModuleType(path.stem)
+            module.__file__ = str(path)
+            # symdyn's own output for this robot, verified against the cache manifest's digest
+            exec(compile_source(path), module.__dict__)
+            self._module = module
+        return self._module
+
+    def derived_entry(self, kind: str, build: Callable) -> cache.Entry:
+        """A further cache entry of this robot, e.g. its task-space kinematics (symdyn.apps.task_space).
+
+        Keyed like the robot's own entry plus `kind`; on a miss build(robot, folder) writes its
+        files and returns its metadata, the Robot loaded only then when it came from the cache.
+        """
+        parts, make_robot = self._source
+        key = cache.entry_key(**parts, kind=kind)
+        entry = cache.lookup(key)
+        if entry is None:
+            robot = self.robot if not isinstance(self.robot, RobotInfo) else make_robot()
+            entry = cache.get_or_build(key, lambda folder: build(robot, folder))
+        return entry
+
+    def __repr__(self) -> str:
+        names = ", ".join(self.functions)
+        return f"<CompiledDynamics {self.robot.name}: {self.n} joints, {self.backend}, {names}>"
+
+
+def compile_source(path: Path):
+    """The code object of a generated Python file."""
+    import builtins
+
+    return builtins.compile(path.read_text(encoding="utf-8"), str(path), "exec")
+
+
+def _warn_fallback() -> None:
+    global _warned
+    if not _warned:
+        _warned = True
+        warnings.warn(
+            f"no C compiler found: using the generated NumPy module, {_FALLBACK_NOTE}",
+            SymdynWarning,
+            stacklevel=4,
+        )
+
+
+def _numpy_method(owner: CompiledDynamics, name: str) -> Callable:
+    def call(*args):
+        return getattr(owner.module, name)(*args, owner.p)
+
+    call.__name__ = name
+    return call
+
+
+def _declarations(functions: list[dict]) -> str:
+    """The cdef of every generated function and its batch wrapper."""
+    lines = []
+    for f in functions:
+        ins = ", ".join(f"const double {name}[]" for name, _ in f["inputs"])
+        outs = ", ".join(f"double {name}[]" for name, *_ in f["outputs"])
+        lines.append(f"void {f['c_name']}({ins}, {outs});")
+        lines.append(f"void {f['c_name']}_batch(long count, {ins}, {outs});")
+    return "\n".join(lines)
+
+
+_LIBRARIES: dict[str, tuple] = {}
+_CDLLS: dict = {}
+
+
+def _load_library(path: Path, functions: list[dict]):
+    """(ffi, lib) for the library at `path` (opened once per process)."""
+    key = str(path)
+    if key not in _LIBRARIES:
+        import cffi
+
+        ffi = cffi.FFI()
+        ffi.cdef(_declarations(functions))
+        _LIBRARIES[key] = (ffi, ffi.dlopen(key))
+    return _LIBRARIES[key]
+
+
+def _c_method(ffi, lib, f: dict, p_ptr) -> Callable:
+    """One generated function as a Python callable: one state per C call, a batch through NAME_batch."""
+    single = getattr(lib, f["c_name"])
+    batch = getattr(lib, f["c_name"] + "_batch")
+    sizes = [size for name, size in f["inputs"] if name != "p"]
+    names = [name for name, _ in f["inputs"] if name != "p"]
+    with_p = len(sizes) != len(f["inputs"])
+    shapes = [(rows, cols) if matrix else (rows,) for _, rows, cols, matrix in f["outputs"]]
+    one = len(shapes) == 1
+    buf = ffi.from_buffer
+    p_args = (p_ptr,) if with_p else ()
+    f64, ndarray = np.dtype(np.float64), np.ndarray
+    one_state = [(size,) for size in sizes]
+
+    def call(*args):
+        if len(args) != len(sizes):
+            raise TypeError(f"{f['name']}({', '.join(names)}) takes {len(sizes)} arguments, got {len(args)}")
+        pointers = []
+        for a, shape in zip(args, one_state, strict=True):  # the fast path: one state, float64 arrays
+            if a.__class__ is not ndarray or a.dtype != f64 or a.shape != shape or not a.flags.c_contiguous:
+                break
+            pointers.append(buf("double[]", a))
+        else:
+            outs = [np.empty(shape) for shape in shapes]
+            single(*pointers, *p_args, *[buf("double[]", o) for o in outs])
+            return outs[0] if one else tuple(outs)
+        arrays = [np.ascontiguousarray(a, dtype=f64) for a in args]
+        if all(a.shape == shape for a, shape in zip(arrays, one_state, strict=True)):
+            return call(*arrays)
+        return _batch_call(batch, buf, arrays, sizes, names, p_args, shapes, one, f["name"])
+
+    call.__name__ = f["name"]
+    call.__doc__ = f"{f['doc']} (generated C; inputs {', '.join(names)})."
+    return call
+
+
+def _batch_call(batch, buf, arrays, sizes, names, p_args, shapes, one, name):
+    for a, s, n in zip(arrays, sizes, names, strict=True):
+        if a.ndim == 0 or a.shape[-1] != s:
+            raise ValueError(f"{name}: {n} must have shape ({s},) or (..., {s}); got {a.shape}")
+    lead = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
+    count = int(np.prod(lead, dtype=np.int64))
+    flat = [
+        np.ascontiguousarray(np.broadcast_to(a, (*lead, s))).reshape(count, s)
+        for a, s in zip(arrays, sizes, strict=True)
+    ]
+    outs = [np.empty((*lead, *shape)) for shape in shapes]
+    if count:
+        batch(count, *[buf("double[]", a) for a in flat], *p_args, *[buf("double[]", o) for o in outs])
+    return outs[0] if one else tuple(outs)

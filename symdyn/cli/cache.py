@@ -1,0 +1,72 @@
+"""`symdyn cache`: where the cache is and how big (or --clear); and the applications' cached robot.
+
+The applications (simulate, analyze) key their cache entry by the robot file's bytes and
+the options that change the robot (--base, --tip, --params), so a second run of an unchanged
+file finds its compiled library without parsing the file, deriving or importing SymPy
+(symdyn.apps.compile.cached_dynamics).
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+
+__all__ = ["register_cache", "cmd_cache", "cached_plant"]
+
+
+def cached_plant(args: argparse.Namespace, make_robot, **options):
+    """The CompiledDynamics of the robot argument, from the cache when the file is unchanged.
+
+    make_robot() loads the robot (with its options applied) on a cache miss; `options`
+    (e.g. params={...}) are part of the key.
+    """
+    from ..apps.compile import cached_dynamics
+
+    try:
+        with open(args.robot, "rb") as fh:
+            digest = hashlib.sha256(fh.read()).hexdigest()
+    except OSError:
+        return _uncached(make_robot)
+    key = {"file": digest, "base": args.base, "tip": args.tip, **options}
+    return cached_dynamics(key, make_robot)
+
+
+def _uncached(make_robot):
+    """The loader's own error for a file that cannot be read (it raises before anything is built)."""
+    from ..apps.compile import compile
+
+    return compile(make_robot())
+
+
+def _size(count: int) -> str:
+    for unit in ("B", "kB", "MB", "GB"):
+        if count < 1000 or unit == "GB":
+            return f"{count:.0f} {unit}" if unit == "B" else f"{count:.1f} {unit}"
+        count /= 1000
+    raise AssertionError
+
+
+def cmd_cache(args: argparse.Namespace) -> int:
+    from ..apps import cache
+
+    if args.clear:
+        removed = cache.clear()
+        print(f"{cache.cache_dir()}: removed {removed} entr{'y' if removed == 1 else 'ies'}")
+        return 0
+    root, count, size = cache.usage()
+    entries = f"{count} entr{'y' if count == 1 else 'ies'}"
+    print(f"{root}: {entries}, {_size(size)} (relocate with ${cache.CACHE_ENV})")
+    return 0
+
+
+def register_cache(subparsers) -> None:
+    """Add the subcommand `cache` to `symdyn`'s subparsers."""
+    c = subparsers.add_parser(
+        "cache",
+        help="show the cache of compiled robots (location, size) or clear it",
+        description="symdyn caches each robot's generated code and compiled library, keyed by the robot's "
+        "content, symdyn's version and the options. Without options: print the cache folder, its entries "
+        "and size. The folder is $SYMDYN_CACHE_DIR, else the user's cache folder (~/.cache/symdyn on Linux).",
+    )
+    c.add_argument("--clear", action="store_true", help="remove every cache entry")
+    c.set_defaults(func=cmd_cache)

@@ -1,0 +1,145 @@
+"""The `symdyn` subcommands identify and excite (added to the parser by `register`).
+
+    symdyn identify ROBOT DATA.csv [--params NAME=VALUE ...] [--format text|json] [--plot fig.png]
+    symdyn excite ROBOT --out excite.csv [--q0 ...] [--q-range ...] [--qd-max ...] [--qdd-max ...]
+           [--period T] [--harmonics L] [--samples S] [--evaluations E] [--dt H] [--seed K]
+           [--params NAME=VALUE ...]
+
+identify estimates the base parameters (symdyn.apps.identify) from a CSV of t, q, [qd, qdd,] tau;
+excite writes an exciting trajectory (symdyn.apps.excite) as a CSV identify reads and prints the
+--track expressions `symdyn simulate` follows. Warnings go to stderr as `symdyn: warning: ...`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+
+from ..errors import SymdynError
+from .common import add_robot_argument, load_robot_argument
+
+__all__ = ["register", "cmd_identify", "cmd_excite"]
+
+
+def _values(items, what: str) -> list[float]:
+    """Numbers or constant expressions, space- or comma-separated."""
+    from ..model.expressions import parse_expression  # SymPy: only when these options are given
+
+    words = [w.strip() for item in items for w in str(item).split(",")]
+    out = []
+    for w in words:
+        e = parse_expression(w, field=what) if w else None
+        if e is None or e.free_symbols or not np.isfinite(float(e)):
+            raise SymdynError(f"{what}: '{w}' is not a finite number")
+        out.append(float(e))
+    return out
+
+
+def _robot(args: argparse.Namespace):
+    """The robot with --params applied; every free parameter must have a value."""
+    from ..apps.compiled import with_parameters
+
+    params = {}
+    for w in [w.strip() for item in args.params or [] for w in str(item).split(",")]:
+        name, sep, value = w.partition("=")
+        if not sep or not name.strip():
+            raise SymdynError(f"--params: expected NAME=VALUE, got '{w}'")
+        params[name.strip()] = _values([value], f"--params {name.strip()}")[0]
+    robot = with_parameters(load_robot_argument(args), params)
+    if robot.params:
+        names = ", ".join(map(str, robot.params))
+        raise SymdynError(
+            f"robot '{robot.name}' has free parameters ({names}); give them with --params NAME=VALUE"
+        )
+    return robot
+
+
+def _per_joint(items, n: int, what: str):
+    if items is None:
+        return None
+    values = _values(items, what)
+    if len(values) not in (1, n):
+        raise SymdynError(f"{what}: expected 1 or {n} values, got {len(values)}")
+    return np.array(values)
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    from ..apps.identify import identify, plot_identification, read_measurements
+    from ..dynamics import derive
+
+    robot = _robot(args)
+    data = read_measurements(args.data, robot.n)
+    result = identify(robot, data, derive(robot, simplify=False).base_parameters)
+    image = plot_identification(result, data) if args.plot else None
+    print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else result.text(), end="")
+    if args.format == "json":
+        print()
+    for line in result.warnings():
+        print(f"symdyn: warning: {line}", file=sys.stderr)
+    if data.differentiated:
+        print("symdyn: note: qd and qdd estimated from q (Savitzky-Golay filter)", file=sys.stderr)
+    if image is not None:
+        from ..apps.output import write_atomic
+
+        write_atomic(args.plot, image)
+    return 0
+
+
+def cmd_excite(args: argparse.Namespace) -> int:
+    from ..apps.excite import excite
+
+    robot = _robot(args)
+    n = robot.n
+    if not args.dt > 0:
+        raise SymdynError("--dt must be positive")
+    traj = excite(
+        robot,
+        q0=_per_joint(args.q0, n, "--q0"),
+        q_range=_per_joint(args.q_range, n, "--q-range"),
+        qd_max=_per_joint(args.qd_max, n, "--qd-max"),
+        qdd_max=_per_joint(args.qdd_max, n, "--qdd-max"),
+        period=args.period,
+        harmonics=args.harmonics,
+        samples=args.samples,
+        evaluations=args.evaluations,
+        seed=args.seed,
+    )
+    traj.write_csv(robot, args.out, args.dt)
+    print(f"{args.out}: one period T = {traj.period:g} s every {args.dt:g} s, {args.harmonics} harmonics")
+    print(f"condition number of the base regressor over {args.samples} samples: {traj.condition_number:.4g}")
+    print(
+        f"follow it with: symdyn simulate ROBOT --track {args.out} --duration T --dt H (T <= {traj.period:g})"
+    )
+    print("or, exactly: symdyn simulate ROBOT --track " + ",".join(traj.expressions()))
+    return 0
+
+
+def register(sub) -> None:
+    """Add identify and excite to the subcommands."""
+    i = sub.add_parser("identify", help="estimate the base parameters from measured torques (CSV)")
+    add_robot_argument(i)
+    i.add_argument("data", help="CSV with columns t, q1..qn, [qd1..qdn, qdd1..qddn,] tau1..taun")
+    i.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
+    i.add_argument("--format", choices=("text", "json"), default="text")
+    i.add_argument("--plot", help="draw measured and predicted torques to this PNG (or .pdf, .svg)")
+    i.set_defaults(func=cmd_identify)
+
+    e = sub.add_parser("excite", help="an exciting trajectory (Fourier series) for identification")
+    add_robot_argument(e)
+    vec = {"nargs": "+", "default": None}
+    e.add_argument("--out", required=True, help="CSV file to write: t, q, qd, qdd and the file's tau")
+    e.add_argument("--q0", **vec, help="centre of each joint's motion (default 0)")
+    e.add_argument("--q-range", **vec, help="largest |q - q0| per joint (default 1 rad, 0.1 m)")
+    e.add_argument("--qd-max", **vec, help="largest |qd| per joint (default 1.5 rad/s, 0.3 m/s)")
+    e.add_argument("--qdd-max", **vec, help="largest |qdd| per joint (default 3 rad/s^2, 1 m/s^2)")
+    e.add_argument("--period", type=float, default=10.0, help="period T in s (default 10)")
+    e.add_argument("--harmonics", type=int, default=5, help="harmonics per joint (default 5)")
+    e.add_argument("--samples", type=int, default=100, help="samples per period for the condition number")
+    e.add_argument("--evaluations", type=int, default=1000, help="optimiser evaluations (default 1000)")
+    e.add_argument("--dt", type=float, default=0.01, help="CSV sample spacing in s (default 0.01)")
+    e.add_argument("--seed", type=int, default=0, help="random starts (default 0)")
+    e.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
+    e.set_defaults(func=cmd_excite)

@@ -1,0 +1,276 @@
+"""symdyn.compile, its cache and the applications on it, against the generated NumPy module.
+
+The compiled C (through cffi, the stepping loop in C) must give what the generated NumPy module
+gives (the NumPy backend, chosen by pointing CC at no compiler), to 1e-12: every generated
+function, simulated trajectories of a serial arm and a tree robot with every fixed-step
+integrator, computed-torque tracking, and the energy drift of a frictionless free swing. The
+forward dynamics is also checked against the numeric oracle symdyn.rnea. The cache must rebuild
+a corrupt or foreign entry and never trust it. Every test uses a temporary cache folder.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cbuild import compilers
+from robots import example, y_robot
+
+import symdyn
+from symdyn.apps import cache
+from symdyn.apps.compile import CompiledDynamics, compile
+from symdyn.apps.control import ComputedTorque, Reference, track
+from symdyn.apps.simulate import simulate
+from symdyn.cli.main import main
+from symdyn.codegen import functions as fn
+from symdyn.errors import SymdynWarning
+from symdyn.rnea import forward_dynamics as oracle_forward
+
+PLANAR = Path(__file__).resolve().parent.parent / "examples" / "planar_3r.yaml"
+pytestmark = pytest.mark.skipif(not compilers(), reason="needs a C compiler")
+
+
+@pytest.fixture(autouse=True, scope="module")
+def module_cache(tmp_path_factory):
+    """One temporary cache for the module's tests (each robot is built once)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv(cache.CACHE_ENV, str(tmp_path_factory.mktemp("cache")))
+        mp.delenv("CC", raising=False)
+        yield
+
+
+@pytest.fixture
+def temporary_cache(tmp_path, monkeypatch):
+    """An empty cache of its own, for the tests of the cache itself."""
+    monkeypatch.setenv(cache.CACHE_ENV, str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def _numpy_backend(robot, monkeypatch, params=None):
+    """The same robot on the generated NumPy module (no C compiler found)."""
+    with monkeypatch.context() as mp:
+        mp.setenv("CC", "no-such-compiler-symdyn")
+        with pytest.warns(SymdynWarning, match="times slower"):
+            mp.setattr("symdyn.apps.compile._warned", False)
+            slow = compile(robot, params)
+    assert slow.backend == "numpy"
+    return slow
+
+
+ROBOTS = {"arm": lambda: example("puma560"), "tree": y_robot}
+
+
+def _params(robot):
+    return {str(p): 0.3 + 0.1 * k for k, p in enumerate(robot.params)} or None
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_every_function_equals_the_numpy_module(name, monkeypatch):
+    robot = ROBOTS[name]()
+    fast = compile(robot, _params(robot))
+    assert fast.backend == "c" and "forward_dynamics" in fast.functions
+    rng = np.random.default_rng(3)
+    n = robot.n
+    args = {
+        "q": rng.uniform(-2, 2, (4, n)),
+        "qd": rng.uniform(-2, 2, (4, n)),
+        "qdd": rng.uniform(-2, 2, (4, n)),
+    }
+    args["tau"] = rng.uniform(-5, 5, (4, n))
+    for f in fast._entry.meta["functions"]:
+        inputs = [args[i] for i, _ in f["inputs"] if i != "p"]
+        batch = getattr(fast, f["name"])(*inputs)
+        want = getattr(fast.module, f["name"])(*inputs, fast.p)
+        np.testing.assert_allclose(batch, want, rtol=1e-12, atol=1e-12)
+        one = getattr(fast, f["name"])(*(x[1] for x in inputs))
+        np.testing.assert_allclose(one, want[1], rtol=1e-12, atol=1e-12)
+    for k in range(4):
+        qdd = fast.forward_dynamics(args["q"][k], args["qd"][k], args["tau"][k])
+        want = oracle_forward(robot, args["q"][k], args["qd"][k], args["tau"][k], fast.p)
+        np.testing.assert_allclose(qdd, want, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+@pytest.mark.parametrize("integrator", ["rk4", "euler", "semi-implicit"])
+def test_simulation_in_c_equals_the_numpy_path(name, integrator, monkeypatch):
+    robot = ROBOTS[name]()
+    params = _params(robot)
+    fast, slow = compile(robot, params), _numpy_backend(robot, monkeypatch, params)
+    q0 = np.linspace(0.2, -0.4, robot.n)
+    for tau in (None, ["0.5*sin(3*t)"] * robot.n):
+        a = simulate(fast, q0, duration=0.25, dt=2e-3, tau=tau, integrator=integrator)
+        b = simulate(slow, q0, duration=0.25, dt=2e-3, tau=tau, integrator=integrator)
+        for x, y in ((a.q, b.q), (a.qd, b.qd), (a.tau, b.tau)):
+            np.testing.assert_allclose(x, y, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_energy_along_a_swing_equals_the_numpy_path(name, monkeypatch):
+    """The kinetic energy 1/2 qd^T M(q) qd along a free swing (its drift) is the NumPy path's."""
+    robot = ROBOTS[name]()
+    params = _params(robot)
+    fast, slow = compile(robot, params), _numpy_backend(robot, monkeypatch, params)
+    q0, qd0 = np.linspace(0.1, 0.5, robot.n), np.linspace(1.0, -0.5, robot.n)
+    drift = []
+    for plant in (fast, slow):
+        traj = simulate(plant, q0, qd0, duration=0.3, dt=1e-3)
+        M = plant.mass_matrix(traj.q)
+        kinetic = 0.5 * np.einsum("ki,kij,kj->k", traj.qd, M, traj.qd)
+        drift.append(kinetic - kinetic[0])
+    np.testing.assert_allclose(drift[0], drift[1], rtol=1e-12, atol=1e-12)
+
+
+def test_tracking_in_c_equals_the_python_callback(monkeypatch):
+    robot = symdyn.load_robot(PLANAR)
+    plant = compile(robot)
+    reference = Reference(["0.3*sin(2*t)", "0.2*cos(t)", "t/4"])
+    controller = ComputedTorque(plant, 100, 20)
+    a = track(plant, reference, controller, duration=0.2, dt=1e-3)
+    b = simulate(
+        plant,
+        *reference(0.0)[:2],
+        duration=0.2,
+        dt=1e-3,
+        tau=lambda t, q, qd: controller.law(reference)(t, q, qd),
+    )
+    np.testing.assert_allclose(a.q, b.q, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(a.tau, b.tau, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["rk45", "dop853"])
+def test_adaptive_integrators_agree_with_fine_rk4(method):
+    robot = symdyn.load_robot(PLANAR)
+    a = simulate(robot, [0.1, 0.2, 0.3], duration=0.5, dt=1e-2, integrator=method, rtol=1e-10, atol=1e-12)
+    b = simulate(robot, [0.1, 0.2, 0.3], duration=0.5, dt=1e-4)
+    np.testing.assert_allclose(a.q[-1], b.q[-1], atol=1e-8)
+    assert a.integrator == method and a.q.shape == (51, 3)
+
+
+def _family(dyn, x):
+    n, M, G = dyn.n, dyn.compact["M"], dyn.compact["G"]
+    both = fn.FunctionRow(
+        "mass_and_gravity", "M and G", (x.q, x.p),
+        (fn.joint_matrix_output("M", n, "M"), fn.vector_output("G", n, "G")), (*M, *G),
+    )  # fmt: skip
+    tall = fn.FunctionRow(
+        "stacked", "[M; 2M]", (x.q, x.p), (fn.Output("S", 2 * n, n, "S", ("2n", "n")),), (*M, *(2 * M))
+    )
+    return [both, tall]
+
+
+def test_any_generated_function_becomes_a_method(monkeypatch):
+    """Several outputs (a tuple) and a non-square output, one state and a batch."""
+    monkeypatch.setattr(fn, "FAMILIES", (*fn.FAMILIES, _family))
+    robot = symdyn.load_robot(PLANAR)
+    c = compile(robot)
+    q = np.array([[0.1, 0.2, 0.3], [-0.4, 0.5, 0.6]])
+    M, G = c.mass_and_gravity(q)
+    np.testing.assert_allclose(M, c.mass_matrix(q), rtol=1e-14)
+    np.testing.assert_allclose(G, c.gravity(q), rtol=1e-14)
+    S = c.stacked(q[0])
+    assert S.shape == (6, 3)
+    np.testing.assert_allclose(S[3:], 2 * c.mass_matrix(q[0]), rtol=1e-14)
+
+
+def test_cache_hit_corrupt_and_foreign_entries(temporary_cache):
+    robot = symdyn.load_robot(PLANAR)
+    first = compile(robot)
+    folder = first._entry.path
+    assert compile(robot)._entry.path == folder
+    library = folder / first._entry.meta["library"]
+    library.write_bytes(library.read_bytes()[:100])  # truncated: the digest no longer matches
+    assert cache.lookup(first._entry.key) is None and not folder.exists()
+    again = compile(robot)
+    assert again._entry.path == folder and again.mass_matrix([0, 0, 0]).shape == (3, 3)
+    manifest = folder / "manifest.json"
+    data = json.loads(manifest.read_text())
+    data["key"] = "0" * 64  # a foreign entry under this key
+    manifest.write_text(json.dumps(data))
+    assert cache.lookup(first._entry.key) is None
+    root, count, size = cache.usage()
+    assert root == temporary_cache and count == 0 and size == 0
+    compile(robot)
+    assert cache.usage()[1] == 1 and cache.clear() == 1 and cache.usage()[1] == 0
+
+
+def test_parameters_bound_by_name_or_vector():
+    robot = example("roger_arm")
+    names = [str(p) for p in robot.params]
+    values = [0.2 + 0.1 * k for k in range(len(names))]
+    a = compile(robot, dict(zip(names, values, strict=True)))
+    b = CompiledDynamics(robot, values)
+    q = [0.3, -0.2]
+    np.testing.assert_array_equal(a.mass_matrix(q), b.mass_matrix(q))
+
+
+def test_cli_cache_and_a_warm_simulate(tmp_path, capsys, temporary_cache):
+    out = tmp_path / "a.csv"
+    argv = ["simulate", str(PLANAR), "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
+    assert main(argv) == 0
+    cold = out.read_text()
+    assert main(argv) == 0 and out.read_text() == cold
+    assert main([*argv[:-2], "--integrator", "dop853", "--rtol", "1e-9", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["cache"]) == 0
+    assert "1 entry" in capsys.readouterr().out
+    assert main(["cache", "--clear"]) == 0
+    assert "removed 1 entry" in capsys.readouterr().out
+
+
+def test_the_parser_methods_are_the_derivations():
+    from symdyn.cli.common import METHODS
+    from symdyn.dynamics import METHODS as DERIVED
+
+    assert METHODS == DERIVED
+
+
+def test_analyze_on_the_cached_plant_equals_the_robot_route():
+    """analyze on a CompiledDynamics (its kinematics read back from the cache) is analyze on the Robot."""
+    from symdyn.apps.analysis import analyze
+    from symdyn.apps.compile import cached_dynamics
+
+    robot = example("puma560")
+    q, qd = np.linspace(0.1, 0.6, 6), np.linspace(-0.3, 0.2, 6)
+    want = analyze(robot, q, qd, torque_limits=50)
+    for _ in range(2):  # built, then read back from the cache without the Robot
+        plant = cached_dynamics({"name": "puma"}, lambda: robot)
+        got = analyze(plant, q, qd, torque_limits=50)
+        np.testing.assert_allclose(got.J, want.J, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(got.Jdot_qd, want.Jdot_qd, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(got.polytope.vertices, want.polytope.vertices, rtol=1e-10, atol=1e-10)
+        assert got.axes == want.axes
+    assert not isinstance(plant.robot, type(robot))
+
+
+def test_two_processes_building_one_entry(temporary_cache):
+    """Concurrent builds of the same robot both succeed and leave one verified entry."""
+    import subprocess
+    import sys
+
+    code = f"import symdyn; c = symdyn.compile(symdyn.load_robot({str(PLANAR)!r})); print(c.backend)"
+    procs = [
+        subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True) for _ in range(2)
+    ]
+    assert [p.communicate(timeout=300)[0].strip() for p in procs] == ["c", "c"]
+    assert all(p.returncode == 0 for p in procs)
+    root, count, _ = cache.usage()
+    assert count == 1 and not list((root / "v1").glob(".build-*"))
+
+
+def test_a_warm_simulate_imports_no_sympy(tmp_path, temporary_cache):
+    """The warm command-line path (cached library) runs without importing SymPy (docs/speed.md)."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "a.csv"
+    argv = ["simulate", str(PLANAR), "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
+    assert main(argv) == 0  # builds the entry
+    code = (
+        "import sys; from symdyn.cli.main import main; "
+        f"assert main({argv!r}) == 0; print(sorted(m for m in sys.modules if m.split('.')[0] == 'sympy')[:3])"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip().splitlines()[-1] == "[]"

@@ -1,0 +1,143 @@
+"""symdyn.codegen.functions: function families with several outputs of any shape, in every target.
+
+A test family (added to FAMILIES for the test only) has a function with two outputs, M and G
+in one call, and one with a 2n x n output S = [M; 2 M] (size names "2n" and "n"). Rendered by
+the C target (compiled with warnings as errors and called through ctypes), the NumPy target
+and the CasADi target, their values must equal the independent numeric CRBA and gravity of
+symdyn.rnea, and the generated files of the robot's seven functions must not change.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib
+import types
+
+import numpy as np
+import pytest
+from cbuild import compile_shared, header_macros, write_files
+from robots import derived, example
+
+from symdyn.codegen import functions as fn
+from symdyn.codegen import render
+
+rn = importlib.import_module("symdyn.rnea")
+ROBOT = "planar_3r"
+
+
+def _test_family(dyn, x: fn.Inputs) -> list[fn.FunctionRow]:
+    n = dyn.n
+    M, G = dyn.compact["M"], dyn.compact["G"]
+    both = fn.FunctionRow(
+        "mass_and_gravity",
+        "M(q) and G(q) in one call",
+        (x.q, x.p),
+        (fn.joint_matrix_output("M", n, "the mass matrix"), fn.vector_output("G", n, "gravity efforts")),
+        (*M, *G),
+    )
+    stacked = fn.FunctionRow(
+        "stacked_mass",
+        "S = [M; 2 M]",
+        (x.q, x.p),
+        (fn.Output("S", 2 * n, n, "M over 2 M", ("2n", "n")),),
+        (*M, *(2 * M)),
+    )
+    return [both, stacked]
+
+
+@pytest.fixture(scope="module")
+def files():
+    dyn = derived(ROBOT, "newton-euler")
+    plain = render(dyn.robot, targets=("c", "python", "casadi"))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(fn, "FAMILIES", (*fn.FAMILIES, _test_family))
+        extended = render(dyn.robot, targets=("c", "python", "casadi"))
+    return dyn, plain, extended
+
+
+def _states(robot, count=5):
+    rng = np.random.default_rng(7)
+    return rng.uniform(-np.pi, np.pi, (count, robot.n))
+
+
+def test_seven_functions_unchanged_by_an_added_family(files):
+    """Adding a family never changes the existing functions' code (the CSE needs are fixed)."""
+    _, plain, extended = files
+    name = f"{ROBOT}_dynamics.c"
+    for fname in ("inverse_dynamics", "mass_matrix", "forward_dynamics"):
+        body = plain[name].split(f"void {ROBOT}_{fname}(")[1].split("\n}\n")[0]
+        assert body in extended[name]
+
+
+def test_c_several_outputs_and_non_square(files, tmp_path):
+    dyn, _, extended = files
+    robot = dyn.robot
+    n = robot.n
+    write_files({k: v for k, v in extended.items() if k.startswith(f"{ROBOT}_dynamics.")}, tmp_path)
+    header = (tmp_path / f"{ROBOT}_dynamics.h").read_text()
+    assert "double M[], double G[]);" in header
+    assert f"S  M over 2 M, (2*{ROBOT}_NDOF)*{ROBOT}_NDOF values, row-major" in header
+    assert int(header_macros(header)[f"{ROBOT}_NDOF"]) == n
+    lib = ctypes.CDLL(str(compile_shared([tmp_path / f"{ROBOT}_dynamics.c"], tmp_path / "lib.so")))
+    ptr = ctypes.POINTER(ctypes.c_double)
+    for q in _states(robot):
+        qa = np.ascontiguousarray(q)
+        M = np.full((n, n), np.nan)
+        G = np.full(n, np.nan)
+        S = np.full((2 * n, n), np.nan)
+        getattr(lib, f"{ROBOT}_mass_and_gravity")(
+            qa.ctypes.data_as(ptr), None, M.ctypes.data_as(ptr), G.ctypes.data_as(ptr)
+        )
+        getattr(lib, f"{ROBOT}_stacked_mass")(qa.ctypes.data_as(ptr), None, S.ctypes.data_as(ptr))
+        np.testing.assert_allclose(M, rn.mass_matrix(robot, q), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(G, rn.gravity_torque(robot, q), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(S, np.vstack([M, 2 * M]), rtol=1e-15, atol=0)
+
+
+def test_numpy_and_casadi_several_outputs(files):
+    dyn, _, extended = files
+    robot = dyn.robot
+    module = types.ModuleType("gen")
+    exec(compile(extended[f"{ROBOT}_numpy.py"], "gen", "exec"), module.__dict__)  # symdyn's own output
+    casadi_module = types.ModuleType("gen_casadi")
+    exec(compile(extended[f"{ROBOT}_casadi.py"], "gen_casadi", "exec"), casadi_module.__dict__)
+    ca_f = casadi_module.functions()
+    qs = _states(robot)
+    M_batch, G_batch = module.mass_and_gravity(qs)
+    assert M_batch.shape == (len(qs), robot.n, robot.n) and G_batch.shape == (len(qs), robot.n)
+    assert module.stacked_mass(qs).shape == (len(qs), 2 * robot.n, robot.n)
+    assert ca_f["mass_and_gravity"].name_out() == ["M", "G"]
+    for k, q in enumerate(qs):
+        M_want, G_want = rn.mass_matrix(robot, q), rn.gravity_torque(robot, q)
+        M, G = module.mass_and_gravity(q)
+        np.testing.assert_allclose(M, M_want, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(G, G_want, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(M_batch[k], M_want, rtol=1e-12, atol=1e-12)
+        Mc, Gc = ca_f["mass_and_gravity"](q, [])
+        np.testing.assert_allclose(np.array(Mc), M_want, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(np.array(Gc).ravel(), G_want, rtol=1e-12, atol=1e-12)
+        Sc = np.array(ca_f["stacked_mass"](q, []))
+        np.testing.assert_allclose(Sc, np.vstack([M_want, 2 * M_want]), rtol=1e-12, atol=1e-12)
+
+
+def test_duplicate_function_names_are_refused():
+    dyn = derived(ROBOT, "newton-euler")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(fn, "FAMILIES", (*fn.FAMILIES, fn.dynamics_rows))
+        with pytest.raises(AssertionError, match="duplicate"):
+            fn.build_functions(dyn)
+
+
+def test_output_entries_are_the_slices_of_the_code(files):
+    dyn = derived(ROBOT, "newton-euler")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(fn, "FAMILIES", (*fn.FAMILIES, _test_family))
+        specs = {s.name: s for s in fn.build_functions(dyn)}
+    both = specs["mass_and_gravity"]
+    M_out, G_out = both.results
+    assert (M_out.matrix, G_out.matrix) == (True, False)
+    assert len(both.entries(M_out)) == dyn.n**2 and len(both.entries(G_out)) == dyn.n
+    assert both.entries(M_out) + both.entries(G_out) == list(both.outputs)
+    with pytest.raises(KeyError):
+        both.entries(specs["stacked_mass"].results[0])
+    assert example(ROBOT).n == dyn.n

@@ -1,0 +1,158 @@
+"""Identification (symdyn.apps.identify, symdyn.apps.excite, `symdyn identify`, `symdyn excite`).
+
+The round trip: torques computed by the numeric RNEA symdyn.rnea (independent of the regressor and
+of the generated code) along an exciting trajectory of `excite` must give back the base parameters
+K pi of the robot file: noise-free to 1e-8 relative (1e-10 of the largest for the ones that are
+zero), with Gaussian noise within 3 standard deviations, and the torques to the noise level. The
+trajectory must respect its limits, its CSV must be what `identify` reads, its --track expressions
+must be its q(t), and velocities and accelerations estimated from q alone (Savitzky-Golay) must
+match the exact ones of the Fourier series.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import cache
+
+import numpy as np
+import pytest
+import sympy as sp
+from robots import EXAMPLES_DIR, derived, example
+
+import symdyn
+from symdyn.apps.excite import excite
+from symdyn.apps.identify import Measurements, differentiate, identify, read_measurements
+from symdyn.apps.simulate import time_expressions
+from symdyn.cli.main import main
+from symdyn.errors import SymdynError
+from symdyn.model.parameters import numeric_parameters
+
+ROBOT = "scara"  # revolute and prismatic joints, friction, rotor inertia
+
+
+@cache
+def trajectory():
+    return excite(example(ROBOT), evaluations=60, harmonics=4, samples=60)
+
+
+def truth(name: str = ROBOT) -> np.ndarray:
+    return derived(name, "newton-euler").linear_compact()[1].matrix() @ numeric_parameters(example(name))
+
+
+def measurements(noise: float = 0.0, seed: int = 0) -> Measurements:
+    traj, robot = trajectory(), example(ROBOT)
+    t = np.arange(0.0, traj.period, 0.01)
+    q, qd, qdd = traj(t)
+    tau = symdyn.rnea(robot, q, qd, qdd)
+    tau = tau + np.random.default_rng(seed).normal(0.0, 1.0, tau.shape) * noise * np.std(tau, axis=0)
+    return Measurements(t, q, qd, qdd, tau)
+
+
+def test_noise_free_round_trip():
+    data = measurements()
+    result = identify(example(ROBOT), data, derived(ROBOT, "newton-euler").base_parameters)
+    want = truth()
+    big = np.abs(want) > 1e-10 * np.abs(want).max()
+    assert np.all(np.abs(result.estimate - want)[big] <= 1e-8 * np.abs(want)[big])
+    assert np.all(np.abs(result.estimate - want)[~big] <= 1e-10 * np.abs(want).max())
+    assert np.allclose(result.predicted, data.tau, rtol=0, atol=1e-9 * np.abs(data.tau).max())
+    assert result.samples == len(data.t) and result.residual_rms.shape == (4,)
+
+
+def test_noisy_round_trip_within_three_standard_deviations():
+    data = measurements(noise=0.02, seed=3)
+    result = identify(example(ROBOT), data, derived(ROBOT, "newton-euler").base_parameters)
+    z = np.abs(result.estimate - truth()) / result.std
+    assert z.max() < 3.0, z
+    clean = measurements().tau
+    assert np.all(np.sqrt(np.mean((result.predicted - clean) ** 2, axis=0)) < 0.02 * np.std(clean, axis=0))
+    assert np.all(result.residual_rms < 0.03 * np.std(clean, axis=0))
+
+
+def test_excite_respects_its_limits_and_improves_the_condition():
+    traj, robot = trajectory(), example(ROBOT)
+    q, qd, qdd = traj(np.linspace(0.0, traj.period, 400))
+    revolute = np.array([lk.joint == "revolute" for lk in robot.links])
+    assert np.all(np.abs(q).max(axis=0) <= np.where(revolute, 1.0, 0.1) * 1.01)
+    assert np.all(np.abs(qd).max(axis=0) <= np.where(revolute, 1.5, 0.3) * 1.01)
+    assert np.all(np.abs(qdd).max(axis=0) <= np.where(revolute, 3.0, 1.0) * 1.01)
+    start = excite(robot, evaluations=1, harmonics=4, samples=60)
+    assert traj.condition_number <= start.condition_number
+
+
+def test_track_expressions_are_the_trajectory():
+    traj = trajectory()
+    exprs = time_expressions(traj.expressions(), 4, "--track")
+    t = np.linspace(0.0, 10.0, 7)
+    got = np.array([[float(e.subs(sp.Symbol("t"), x)) for e in exprs] for x in t])
+    np.testing.assert_allclose(got, traj(t)[0], atol=1e-9)
+
+
+def test_savitzky_golay_velocities_and_accelerations():
+    traj = trajectory()
+    t = np.arange(0.0, traj.period, 0.005)
+    q, qd, qdd = traj(t)
+    fq, fqd, fqdd = differentiate(t, q)
+    inner = slice(20, -20)
+    np.testing.assert_allclose(fq[inner], q[inner], atol=1e-8)
+    np.testing.assert_allclose(fqd[inner], qd[inner], atol=1e-5 * np.abs(qd).max())
+    np.testing.assert_allclose(fqdd[inner], qdd[inner], atol=1e-3 * np.abs(qdd).max())
+
+
+def test_cli_excite_then_identify_json(tmp_path, capsys):
+    csv = tmp_path / "ex.csv"
+    path = str(EXAMPLES_DIR / f"{ROBOT}.yaml")
+    args = ["excite", path, "--out", str(csv), "--evaluations", "20", "--harmonics", "3", "--samples", "40"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "--track" in out and csv.is_file()
+    assert main(["identify", path, str(csv), "--format", "json", "--plot", str(tmp_path / "id.png")]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert list(report) == ["base_parameters", "condition_number", "residual_rms", "samples"]
+    names = [b["name"] for b in report["base_parameters"]]
+    assert names == [name for name, _ in derived(ROBOT, "newton-euler").base_parameters]
+    assert set(report["base_parameters"][0]) == {"name", "expression", "estimate", "std"}
+    got = np.array([b["estimate"] for b in report["base_parameters"]])
+    want = truth()
+    assert np.abs(got - want).max() <= 1e-8 * np.abs(want).max()
+    assert (tmp_path / "id.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_identify_from_positions_only(tmp_path, capsys):
+    """Without qd and qdd columns they come from q by the Savitzky-Golay filter."""
+    traj, robot = trajectory(), example(ROBOT)
+    t = np.arange(0.0, traj.period, 0.005)
+    q, qd, qdd = traj(t)
+    tau = symdyn.rnea(robot, q, qd, qdd)
+    header = "t," + ",".join(f"q{i}" for i in range(1, 5)) + "," + ",".join(f"tau{i}" for i in range(1, 5))
+    rows = np.column_stack([t, q, tau])
+    (tmp_path / "m.csv").write_text(
+        header + "\n" + "\n".join(",".join(f"{x:.17g}" for x in r) for r in rows) + "\n"
+    )
+    assert main(["identify", str(EXAMPLES_DIR / f"{ROBOT}.yaml"), str(tmp_path / "m.csv")]) == 0
+    captured = capsys.readouterr()
+    assert "condition number" in captured.out and "Savitzky-Golay" in captured.err
+
+
+@pytest.mark.parametrize(
+    "text,match",
+    [
+        ("t,q1,q2,q3,q4,tau1,tau2,tau3\n0,0,0,0,0,0,0,0\n", "missing column.*tau4"),
+        ("t,q1,q2,q3,q4,qd1,qd2,qd3,qd4,tau1,tau2,tau3,tau4\n", "give both"),
+        ("t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n0,0,0,0,0,0,0,x,0\n", "line 2: not a number"),
+        ("t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n0,0,0,0,0,0,0,0,0\n1,0,0,0,0,0,0,0,0\n", "at least 21"),
+    ],
+)
+def test_bad_measurement_files_are_one_clear_message(tmp_path, text, match):
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    with pytest.raises(SymdynError, match=match):
+        read_measurements(path, 4)
+
+
+def test_cli_bad_input_exits_1(tmp_path, capsys):
+    path = str(EXAMPLES_DIR / f"{ROBOT}.yaml")
+    assert main(["identify", path, str(tmp_path / "missing.csv")]) == 1
+    assert "symdyn: error:" in capsys.readouterr().err
+    assert main(["identify", str(EXAMPLES_DIR / "roger_arm.yaml"), str(tmp_path / "x.csv")]) == 1
+    assert "free parameters" in capsys.readouterr().err
