@@ -1,7 +1,10 @@
 // Pinocchio side of bench/run.py: build a symdyn Robot (a chain or a kinematic tree on a fixed base,
 // without mimic joints) as a pinocchio::Model, check it against
 // symdyn.rnea's numbers, and time rnea, crba, computeGeneralizedGravity, computeCoriolisMatrix,
-// aba and computeJointTorqueRegressor on the same pre-generated states as the C harness.
+// aba and computeJointTorqueRegressor on the same pre-generated states as the C harness; and the
+// analytical derivatives computeRNEADerivatives, computeABADerivatives and computeMinverse
+// (checked against central differences of Pinocchio's own rnea and aba and against the inverse
+// of crba).
 //
 //   pinocchio_harness MODEL.txt REPS TARGET_MS
 //
@@ -45,9 +48,11 @@
   #include "pinocchio/multibody/data.hpp"
   #include "pinocchio/multibody/model.hpp"
 #endif
+#include "pinocchio/algorithm/aba-derivatives.hpp"
 #include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/crba.hpp"
 #include "pinocchio/algorithm/regressor.hpp"
+#include "pinocchio/algorithm/rnea-derivatives.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
 
 using pinocchio::Data;
@@ -174,6 +179,51 @@ static double rel_err(const MatrixXd & got, const MatrixXd & want)
   return (got - want).cwiseAbs().maxCoeff() / scale;
 }
 
+static MatrixXd symmetric(MatrixXd A)  // Pinocchio fills the upper triangle of M and M^-1
+{
+  A.triangularView<Eigen::StrictlyLower>() = A.transpose().triangularView<Eigen::StrictlyLower>();
+  return A;
+}
+
+// The derivatives against central differences (step 1e-6) of rnea and aba, M^-1 against crba.
+static void check_derivatives(
+  const Model & model, Data & data, const std::vector<VectorXd> & Q, const std::vector<VectorXd> & QD,
+  const std::vector<VectorXd> & QDD, const std::vector<VectorXd> & TAU, int count)
+{
+  const int n = model.nv;
+  const double h = 1e-6;
+  double e_rd = 0, e_ad = 0, e_mi = 0;
+  MatrixXd dq(n, n), dv(n, n), da(n, n), fq(n, n), fv(n, n);
+  for (int k = 0; k < count; ++k)
+  {
+    pinocchio::computeRNEADerivatives(model, data, Q[k], QD[k], QDD[k], dq, dv, da);
+    pinocchio::computeABADerivatives(model, data, Q[k], QD[k], TAU[k], fq, fv, da);
+    for (int j = 0; j < n; ++j)
+    {
+      VectorXd e = VectorXd::Zero(n);
+      e[j] = h;
+      // rnea and aba return a reference into `data`: copy each result before the next call
+      auto diff = [&](auto && f) -> VectorXd {
+        const VectorXd plus = f(e);
+        const VectorXd minus = f(VectorXd(-e));
+        return (plus - minus) / (2 * h);
+      };
+      const VectorXd cq = diff([&](const VectorXd & d) { return pinocchio::rnea(model, data, Q[k] + d, QD[k], QDD[k]); });
+      const VectorXd cv = diff([&](const VectorXd & d) { return pinocchio::rnea(model, data, Q[k], QD[k] + d, QDD[k]); });
+      const VectorXd aq = diff([&](const VectorXd & d) { return pinocchio::aba(model, data, Q[k] + d, QD[k], TAU[k]); });
+      const VectorXd av = diff([&](const VectorXd & d) { return pinocchio::aba(model, data, Q[k], QD[k] + d, TAU[k]); });
+      e_rd = std::max({e_rd, rel_err(dq.col(j), cq), rel_err(dv.col(j), cv)});
+      e_ad = std::max({e_ad, rel_err(fq.col(j), aq), rel_err(fv.col(j), av)});
+    }
+    const MatrixXd Minv = symmetric(pinocchio::computeMinverse(model, data, Q[k]));
+    const MatrixXd M = symmetric(pinocchio::crba(model, data, Q[k]));
+    e_mi = std::max(e_mi, rel_err(Minv * M, MatrixXd::Identity(n, n)));
+  }
+  std::printf("dcheck rnea_derivatives %.3e\n", e_rd);
+  std::printf("dcheck aba_derivatives %.3e\n", e_ad);
+  std::printf("dcheck minverse %.3e\n", e_mi);
+}
+
 // ns per call of `body` over `it` calls on states k = 0, 1, ... (cycling: the state changes every
 // call), one output element per call accumulated into the volatile sink.
 template<typename Body>
@@ -261,12 +311,15 @@ int main(int argc, char ** argv)
   std::printf("check coriolis_matrix %.3e\n", e_cor);
   std::printf("check aba %.3e\n", e_aba);
   std::printf("check regressor %.3e\n", e_reg);
+  check_derivatives(model, data, Q, QD, QDD, TAU, C);
   std::fflush(stdout);
 
   // --- timing: same states and protocol as the C harness of bench/run.py
   const int last = n - 1;
-  const char * labels[] = {"rnea", "crba", "gravity", "coriolis_matrix", "aba", "regressor"};
-  const int NB = 6;
+  const char * labels[] = {"rnea",     "crba",           "gravity",         "coriolis_matrix", "aba",
+                           "regressor", "rnea_derivatives", "aba_derivatives", "minverse"};
+  const int NB = 9;
+  MatrixXd dq(n, n), dv(n, n), da(n, n);
   auto run_bench = [&](int b, long it) -> double {
     switch (b)
     {
@@ -287,6 +340,18 @@ int main(int argc, char ** argv)
       return loop(it, K, [&](int k) {
         return pinocchio::computeJointTorqueRegressor(model, data, Q[k], QD[k], QDD[k])(k % n, 10 * n - 1);
       });
+    case 6:  // dtau/dq, dtau/dqd (and dtau/dqdd = M, upper triangle)
+      return loop(it, K, [&](int k) {
+        pinocchio::computeRNEADerivatives(model, data, Q[k], QD[k], QDD[k], dq, dv, da);
+        return dq(k % n, last) + dv(k % n, 0);
+      });
+    case 7:  // dqdd/dq, dqdd/dqd and dqdd/dtau = M^-1 (upper triangle)
+      return loop(it, K, [&](int k) {
+        pinocchio::computeABADerivatives(model, data, Q[k], QD[k], TAU[k], dq, dv, da);
+        return dq(k % n, last) + dv(k % n, 0);
+      });
+    case 8:  // upper triangle, as Pinocchio leaves it
+      return loop(it, K, [&](int k) { return pinocchio::computeMinverse(model, data, Q[k])(0, k % n); });
     }
     return -1.0;
   };

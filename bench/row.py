@@ -67,3 +67,4 @@ class Row:
     checks: dict = field(default_factory=dict)  # what -> max relative error
     samples: dict = field(default_factory=dict)  # harness label -> ns per call of every repetition
     notes: list = field(default_factory=list)
+    derivatives: dict = field(default_factory=dict)  # bench/derivatives.py: ns, checks, op counts

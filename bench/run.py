@@ -40,6 +40,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import casadi_route  # noqa: E402
+import derivatives  # noqa: E402
 import pin_harness  # noqa: E402
 import report  # noqa: E402
 import robots  # noqa: E402
@@ -93,6 +94,8 @@ def bench_robot(name: str, path: Path, work: Path, opts, pin_exe: Path | None) -
         pin_cmd = pin_harness.check_pinocchio(row, robot, pin_exe, work, states, refs)
     log(f"[{name}] time the C" + (" and Pinocchio" if pin_cmd else "") + " ...")
     time_compiled(row, [exe, states_file, "time"], pin_cmd, opts)
+    if name in robots.ARMS:  # the arms the derivative goals name (a 32-joint tree's CasADi route is huge)
+        derivatives.bench_derivatives(row, robot, gen_dir, work, states_file, states, pin_cmd, opts)
 
     log(f"[{name}] NumPy RNEA and casadi.Function from Python ...")
     time_numpy_and_casadi(row, robot, fns, states, opts.py_reps, opts.py_budget)
@@ -159,6 +162,7 @@ def main(argv=None) -> int:
         seconds=time.perf_counter() - t_start,
     )
     report.write(rows, sym, info)
+    print(derivatives.write_report(rows))
     return 0
 
 

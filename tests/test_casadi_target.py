@@ -43,6 +43,7 @@ from robots import (
 from symdyn.codegen import FUNCTION_NAMES
 from symdyn.codegen import casadi as casadi_backend
 from symdyn.codegen import render as render_targets
+from symdyn.codegen.derivative_functions import DERIVATIVE_FUNCTION_NAMES
 from symdyn.codegen.functions import build_functions
 from symdyn.codegen.render import RenderContext
 
@@ -92,7 +93,7 @@ def generated(tmp_path_factory):
             spec = importlib.util.spec_from_file_location(f"_symdyn_casadi_{name}", path)
             module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(module)
-            names = [spec.name for spec in ctx.functions]  # the seven, and tip_wrench_torque for PoE robots
+            names = [spec.name for spec in ctx.functions]  # the seven, tip_wrench_torque (PoE), derivatives
             loaded = {f: ca.Function.load(str(folder / f"{ctx.name}_{f}.casadi")) for f in names}
             cache_[name] = Generated(name, example(name), ctx, files, module, module.functions(), loaded)
         return cache_[name]
@@ -141,7 +142,8 @@ def test_files_signatures_and_module_text(name, generated):
     n, k = robot.n, len(dyn.params)
     names = [spec.name for spec in g.ctx.functions]
     assert names[: len(FUNCTION_NAMES)] == list(FUNCTION_NAMES)
-    assert names[len(FUNCTION_NAMES) :] == (["tip_wrench_torque"] if robot.convention == "poe" else [])
+    tip = ["tip_wrench_torque"] if robot.convention == "poe" else []
+    assert names[len(FUNCTION_NAMES) :] == tip + list(DERIVATIVE_FUNCTION_NAMES)
     expected = {f"{robot.name}_casadi.py"} | {f"{robot.name}_{f}.casadi" for f in names}
     assert set(g.files) == expected
     text = g.files[f"{robot.name}_casadi.py"]

@@ -150,3 +150,16 @@ def test_needed_lists_dependencies_in_order():
     assert [s for s, _ in p.needed([d])] == [a, c, d]
     assert [s for s, _ in p.needed([b])] == [b]
     assert p.needed([x + y]) == []
+
+
+def test_copy_takes_new_intermediates_alone():
+    x, y = sp.symbols("x y")
+    prog = Program()
+    a = prog.let(sp.sin(x) * y)
+    twin = prog.copy("c")
+    assert twin.let(sp.sin(x) * y) == a  # shares what was there
+    b = twin.let(sp.cos(x) * y)
+    assert len(twin) == 2 and len(prog) == 1 and not prog.is_intermediate(b)
+    c = prog.let(x * y + 1)
+    assert c != b  # numbered on, so the two never give one name two meanings
+    assert twin.expand([b]) == [sp.cos(x) * y]

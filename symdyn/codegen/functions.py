@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import sympy as sp
 
@@ -47,7 +47,6 @@ __all__ = [
     "Output",
     "DIMS",
     "FAMILIES",
-    "OWN_CSE",
     "build_functions",
     "vector_output",
     "joint_matrix_output",
@@ -168,7 +167,9 @@ class FunctionRow:
     """A function before elimination: what `build_functions` turns into a FunctionSpec.
 
     `exprs` are the outputs' row-major entries over the program's intermediates (in the order
-    of `results`); `steps` the assignments they need beyond the dynamics' own program.
+    of `results`); `steps` the assignments they need beyond the dynamics' own program. Rows of
+    one `cse` group share a CSE pass; a family in a group of its own cannot change the code of
+    the others.
     """
 
     name: str
@@ -177,6 +178,7 @@ class FunctionRow:
     results: tuple[Output, ...]
     exprs: tuple[sp.Expr, ...]
     steps: tuple = ()
+    cse: str = ""
 
 
 @dataclass(frozen=True)
@@ -307,52 +309,46 @@ _OUTPUT_DOCS = {
 #: The families of generated functions, in the order of the generated files: each maps a derived
 #: robot and the input vectors to its FunctionRows (a new family is one module and one entry here).
 def regressor_family(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
-    """regressor and base_regressor (symdyn.codegen.regressor_functions, which builds on this module)."""
+    """regressor and base_regressor (symdyn.codegen.regressor_functions, which builds on this
+    module), in a CSE pass of their own."""
     from .regressor_functions import regressor_rows
 
-    return regressor_rows(dyn, x)
+    return [replace(row, cse="regressor") for row in regressor_rows(dyn, x)]
 
+
+from .derivative_functions import derivative_rows  # noqa: E402 (it builds on the names above)
 
 FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     dynamics_rows,
     forward_dynamics_rows,
     regressor_family,
     tip_wrench_rows,
+    derivative_rows,
 )
 
 
-#: Families eliminated in a CSE pass of their own: they add intermediates to `dyn.program`, and a
-#: joint pass would let those change the other functions' temporaries.
-OWN_CSE: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (regressor_family,)
-
-
-def _eliminated(
-    dyn: Dynamics, rows: list[FunctionRow], x: Inputs, base: list[sp.Expr]
-) -> dict[str, Eliminated]:
-    """One CSE pass over `rows` (their outputs, extra steps and the `base` needs)."""
-    needs = [e for row in rows for e in row.exprs] + [e for row in rows for _, e in row.steps] + base
-    steps = dyn.program.needed(needs) + [s for row in rows for s in row.steps]
-    return eliminate_many(steps, {row.name: list(row.exprs) for row in rows}, reserved=x.symbols)
-
-
 def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
-    """The generated functions of a derived robot, one CSE pass over all of them (and one more
-    per family of OWN_CSE).
+    """The generated functions of a derived robot, one CSE pass per `FunctionRow.cse` group.
 
     All of FAMILIES' rows: the seven of docs/generated-code.md, or six without forward_dynamics
     (and a SymdynWarning) when a joint moves no mass or inertia (see the module docstring), then
-    regressor and base_regressor (symdyn.codegen.regressor_functions).
+    regressor and base_regressor (symdyn.codegen.regressor_functions), tip_wrench_torque for
+    product-of-exponentials robots, and the derivatives (symdyn.codegen.derivative_functions).
+    The regressor and the derivatives add intermediates to `dyn.program`; each family has a pass
+    of its own so that it cannot change the other functions' temporaries.
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
     x = Inputs.of(dyn)
-    groups = [(family in OWN_CSE, family(dyn, x)) for family in FAMILIES]
-    rows = [row for _, group in groups for row in group]
+    rows = [row for family in FAMILIES for row in family(dyn, x)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
-    base = [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
-    code = _eliminated(dyn, [row for own, group in groups if not own for row in group], x, base)
-    for own, group in groups:
-        if own and group:
-            code.update(_eliminated(dyn, group, x, []))
+    code = {}
+    for group in dict.fromkeys(row.cse for row in rows):
+        members = [row for row in rows if row.cse == group]
+        needs = [e for row in members for e in row.exprs] + [e for row in members for _, e in row.steps]
+        if not group:
+            needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
+        steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
+        code |= eliminate_many(steps, {row.name: list(row.exprs) for row in members}, reserved=x.symbols)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

@@ -109,9 +109,21 @@ class Program:
         self._index: dict[sp.Symbol, int] = {}
         self._by_expr: dict[sp.Expr, sp.Symbol] = {}
         self._count = 0
+        self._tag = ""
 
     def __len__(self) -> int:
         return len(self.assignments)
+
+    def copy(self, tag: str) -> Program:
+        """An independent copy: new intermediates go into it alone, their names marked with `tag`
+        (``_<tag><hint><k>``), so they never clash with names this program gives later."""
+        twin = Program()
+        twin.assignments = list(self.assignments)
+        twin._index = dict(self._index)
+        twin._by_expr = dict(self._by_expr)
+        twin._count = self._count
+        twin._tag = self._tag + tag
+        return twin
 
     def is_intermediate(self, s: sp.Basic) -> bool:
         return s in self._index
@@ -132,7 +144,7 @@ class Program:
         if found is not None:
             return found
         self._count += 1
-        sym = sp.Symbol(f"_{hint}{self._count}")
+        sym = sp.Symbol(f"_{self._tag}{hint}{self._count}")
         self._index[sym] = len(self.assignments)
         self.assignments.append((sym, expr))
         self._by_expr[expr] = sym

@@ -1,0 +1,126 @@
+"""The derivative functions (docs/generated-code.md), as target-independent function rows.
+
+    inverse_dynamics_derivatives(q, qd, qdd, p, dtau_dq, dtau_dqd)
+    forward_dynamics_derivatives(q, qd, tau, p, dqdd_dq, dqdd_dqd, Minv)
+    mass_matrix_inverse(q, p, Minv)
+    linearize(q, qd, tau, p, A, B)
+
+Every matrix is row-major, entry [i*cols + j] = d out_i / d in_j. linearize gives the
+continuous-time linearisation of the state equation xd = f(x, tau) = (qd, FD(q, qd, tau))
+about x = (q, qd) and tau:
+
+    A = df/dx = [[0, I], [dqdd/dq, dqdd/dqd]]  (2n x 2n),   B = df/dtau = [[0], [M^-1]]  (2n x n).
+
+The derivatives are those of symdyn.algorithms.derivatives: dtau/dq by forward mode over the
+program of Newton-Euler intermediates, dtau/dqd = 2 C + dF/dqd, M^-1 by the unrolled
+L D L^T factorisation (eliminated in the order forward_dynamics uses), and
+dqdd/dx = -M^-1 dtau/dx with dtau/dx evaluated at qdd = FD(q, qd, tau) = M^-1 (tau - bias).
+The Coulomb friction sign(qd) contributes zero (its derivative almost everywhere).
+
+The three functions that invert M are left out, like forward_dynamics, when M is singular
+by construction (a joint that moves no mass or inertia, Robot.idle_joints; the forward
+dynamics family already warns about it).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..algorithms.derivatives import effort_jacobians, elimination_order, ldlt_inverse, matmul, substitute
+from ..dynamics import Dynamics
+from .functions import FunctionRow, Inputs, Output, joint_matrix_output
+
+__all__ = ["derivative_rows", "DERIVATIVE_FUNCTION_NAMES"]
+
+DERIVATIVE_FUNCTION_NAMES = (
+    "inverse_dynamics_derivatives",
+    "forward_dynamics_derivatives",
+    "mass_matrix_inverse",
+    "linearize",
+)
+
+
+def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
+    """The matrices' entries, each row-major, one matrix after the other."""
+    return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
+
+
+def state_matrices(dq: sp.Matrix, dqd: sp.Matrix, Minv: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
+    """A = [[0, I], [dq, dqd]] and B = [[0], [Minv]] of linearize (module docstring)."""
+    n = Minv.rows
+    A = sp.zeros(2 * n, 2 * n)
+    A[:n, n:] = sp.eye(n)
+    A[n:, :n] = dq
+    A[n:, n:] = dqd
+    B = sp.zeros(2 * n, n)
+    B[n:, :] = Minv
+    return A, B
+
+
+def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """The four derivative functions of a derived robot (module docstring); only
+    inverse_dynamics_derivatives when M is singular by construction.
+
+    The intermediates are written into a copy of `dyn.program` (the derivation is not changed)
+    and passed on as the rows' steps.
+    """
+    n = dyn.n
+    c = dyn.compact
+    prog = dyn.program.copy("d")
+    first = len(prog.assignments)
+    dq, dqd = effort_jacobians(prog, list(c["tau"]), c["C"], list(c["F"]), list(dyn.q), list(dyn.qd))
+    rows = [
+        (
+            "inverse_dynamics_derivatives",
+            "dtau/dq and dtau/dqd of tau = M(q) qdd + V(q, qd) + G(q) + F(qd)",
+            (x.q, x.qd, x.qdd, x.p),
+            (
+                joint_matrix_output("dtau_dq", n, "dtau_i/dq_j"),
+                joint_matrix_output("dtau_dqd", n, "dtau_i/dqd_j"),
+            ),
+            _entries(dq, dqd),
+        ),
+    ]
+    if not dyn.robot.idle_joints():
+        Minv = ldlt_inverse(sp.Matrix(c["M"]), elimination_order(n, dyn.robot.is_chain), prog, "Di")
+        # qdd = FD(q, qd, tau) = M^-1 (tau - bias) with the same M^-1, then dtau/dx at that qdd
+        b = sp.Matrix([prog.let(x.tau.symbols[i] - c["bias"][i], "Db") for i in range(n)])
+        qdd = matmul(Minv, b, prog, "Dqdd")
+        at_fd = substitute(prog, _entries(dq), dict(zip(dyn.qdd, qdd, strict=True)), "Dfd")
+        ddq = matmul(-Minv, sp.Matrix(n, n, at_fd), prog, "Ddq")
+        ddqd = matmul(-Minv, dqd, prog, "Ddv")  # dtau/dqd does not depend on qdd
+        A, B = state_matrices(ddq, ddqd, Minv)
+        inv_doc = "M(q)^-1 = dqdd/dtau"
+        rows += [
+            (
+                "forward_dynamics_derivatives",
+                "dqdd/dq and dqdd/dqd of qdd = FD(q, qd, tau) = M(q)^-1 (tau - V - G - F), and M(q)^-1",
+                (x.q, x.qd, x.tau, x.p),
+                (
+                    joint_matrix_output("dqdd_dq", n, "dqdd_i/dq_j"),
+                    joint_matrix_output("dqdd_dqd", n, "dqdd_i/dqd_j"),
+                    joint_matrix_output("Minv", n, inv_doc),
+                ),
+                _entries(ddq, ddqd, Minv),
+            ),
+            (
+                "mass_matrix_inverse",
+                "M(q)^-1 by the unrolled L D L^T factorisation",
+                (x.q, x.p),
+                (joint_matrix_output("Minv", n, inv_doc),),
+                _entries(Minv),
+            ),
+            (
+                "linearize",
+                "xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1]",
+                (x.q, x.qd, x.tau, x.p),
+                (
+                    Output("A", 2 * n, 2 * n, "df/dx", ("2n", "2n")),
+                    Output("B", 2 * n, n, "df/dtau", ("2n", "n")),
+                ),
+                _entries(A, B),
+            ),
+        ]
+    # build_functions gathers every row's steps into one program: the first row carries them all
+    steps = [tuple(prog.assignments[first:])] + [()] * (len(rows) - 1)
+    return [FunctionRow(*row, s, cse="derivatives") for row, s in zip(rows, steps, strict=True)]
