@@ -128,7 +128,18 @@ def main(argv=None) -> int:
         help="derivations run at once (default 1; more finishes sooner but the times share the CPUs)",
     )
     p.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    p.add_argument(
+        "--configuration",
+        action="store_true",
+        help="instead: the configuration-space form of the PUMA 560, Stanford arm and Panda "
+        "(bench/configuration_form.py)",
+    )
     args = p.parse_args(argv)
+    if args.configuration:
+        from configuration_form import configuration_report
+
+        print(configuration_report(args.markdown), end="")
+        return 0
     if args.max_joints < 1:
         p.error("--max-joints must be at least 1")
 

@@ -44,6 +44,7 @@ import sympy as sp
 from sympy.core.parameters import distribute
 
 from .algorithms.base_parameters import BaseParameters, find_base_parameters
+from .algorithms.configuration_space import ConfigurationSpace, configuration_space
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
@@ -136,6 +137,7 @@ class Dynamics:
     _closed: dict[str, sp.Matrix] = field(default_factory=dict, repr=False)
     _compiled: dict[str, object] = field(default_factory=dict, repr=False)
     _linear: dict[str, object] = field(default_factory=dict, repr=False)
+    _configuration: ConfigurationSpace | None = field(default=None, repr=False)
 
     @property
     def n(self) -> int:
@@ -158,13 +160,50 @@ class Dynamics:
         return self._expanded(name, self.compact[name])
 
     def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
-        """The closed form of compact matrix m, cached under `name`."""
+        """The closed form of compact matrix m, cached under `name`: M, C, V, G, tau and bias of
+        an unsimplified derivation from the configuration-space form (canonical, the same from
+        either method; symdyn.algorithms.configuration_space), anything else by substituting
+        the program's intermediates back."""
         if name not in self._closed:
-            entries = self.program.expand(list(m))
-            if self.simplified:
-                entries = [simplify_entry(e) for e in entries]
-            self._closed[name] = sp.ImmutableMatrix(m.rows, m.cols, entries)
+            if not self.simplified and name in ALL_QUANTITIES and name != "F":
+                entries = self.configuration_space.closed(name, self.qd, self.qdd, self.compact["F"])
+            else:
+                entries = self.program.expand(list(m))
+                if self.simplified:
+                    entries = [simplify_entry(e) for e in entries]
+            self._closed[name] = sp.ImmutableMatrix(m.rows, m.cols, list(entries))
         return self._closed[name]
+
+    def expanded(self, name: str) -> list[sp.Expr]:
+        """Quantity `name` by substituting the program's intermediates back (simplified if
+        requested): the full expansion of the recursion, entries in row-major order."""
+        _check_quantity(name, "Dynamics.expanded")
+        entries = self.program.expand(list(self.compact[name]))
+        return [simplify_entry(e) for e in entries] if self.simplified else entries
+
+    @property
+    def configuration_space(self) -> ConfigurationSpace:
+        """tau = M qdd + B [qd qd] + Csq [qd^2] + G + F with M, G and the Christoffel symbols
+        as canonical trigonometric polynomials (the same from either method)."""
+        if self._configuration is None:
+            c = self.compact
+            self._configuration = configuration_space(self.program, c["M"], list(c["G"]), list(self.q))
+        return self._configuration
+
+    @property
+    def B(self) -> sp.Matrix:
+        """Coriolis coefficients, n x n(n-1)/2: B[k, (i, j)] = 2 Gamma^k_ij, columns (1,2), (1,3), ..."""
+        return self.configuration_space.matrix("B")
+
+    @property
+    def Csq(self) -> sp.Matrix:
+        """Centrifugal coefficients, n x n: Csq[k, i] = Gamma^k_ii (V = B [qd qd] + Csq [qd^2])."""
+        return self.configuration_space.matrix("Csq")
+
+    @property
+    def christoffel(self) -> dict[tuple[int, int, int], sp.Expr]:
+        """The nonzero Christoffel symbols Gamma^k_ij of M, i <= j, keyed by 0-based (k, i, j)."""
+        return self.configuration_space.christoffel()
 
     @property
     def M(self) -> sp.Matrix:

@@ -67,6 +67,9 @@ def test_derive_text_names_entries_one_based():
     m, g, l, q1 = sp.symbols("m g l q1")
     assert sp.simplify(sp.sympify(lines["M[1,1]"]) - m * l**2) == 0
     assert sp.simplify(sp.sympify(lines["G[1]"]) - m * g * l * sp.sin(q1)) == 0
+    assert "B[" not in out.stdout and "Csq[" not in out.stdout  # one joint: no velocity terms
+    out = run("derive", str(EXAMPLES / "roger_eye.yaml"), "--form", "expanded")
+    lines = dict(line.split(" = ", 1) for line in out.stdout.splitlines() if " = " in line)
     assert sp.sympify(lines["V[1]"]) == 0
 
 

@@ -82,11 +82,22 @@ def cmd_derive(args: argparse.Namespace) -> int:
 
         return cmd_derive_steps(args)
     from ..dynamics import derive
+    from . import derive_output as out
 
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
-    text = {"text": _derive_text, "json": _derive_json, "latex": _derive_latex}[args.format](dyn)
+    if args.format == "latex":
+        configuration = args.form == "configuration"
+        text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
+    elif args.prune is not None:
+        from ..algorithms.pruning import prune
+
+        if args.format != "text" or args.form != "configuration":
+            raise SymdynError("derive: --prune prints the configuration form as text only")
+        text = out.derive_text(dyn, args.form, args.lumped, prune(dyn.configuration_space, args.prune))
+    else:
+        text = {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
     sys.stdout.write(text)
     return 0
 
@@ -103,6 +114,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         precision=args.precision,
         force=args.force,
         method=args.method,
+        prune=args.prune,
     )
     for p in paths:
         print(p)
@@ -128,6 +140,22 @@ def build_parser() -> argparse.ArgumentParser:
         help="trigonometric simplification of the closed forms (auto: up to 3 joints)",
     )
     d.add_argument(
+        "--form",
+        choices=("configuration", "compact", "expanded"),
+        default="configuration",
+        help="configuration: M, B [qd qd], Csq [qd^2], G, F (default); compact: named intermediates; "
+        "expanded: the full expansion",
+    )
+    d.add_argument(
+        "--lumped", action="store_true", help="name each distinct coefficient once (I1, I2, ..., g1, ...)"
+    )
+    d.add_argument(
+        "--prune",
+        type=float,
+        metavar="REL",
+        help="drop terms below REL of their entry's largest value over the joint ranges (AKB's 1%% model)",
+    )
+    d.add_argument(
         "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"
     )
     d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
@@ -145,6 +173,13 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--precision", choices=("double", "float"), default="double")
     g.add_argument("--method", choices=METHODS, default="newton-euler")
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
+    g.add_argument(
+        "--prune",
+        type=float,
+        metavar="REL",
+        help="generate from the model without the terms below REL of their entry's largest value "
+        "(the bound goes into the headers)",
+    )
     g.set_defaults(func=cmd_generate)
     register(sub)  # simulate, analyze, check (the lecture's applications)
     register_identification(sub)  # identify, excite

@@ -47,12 +47,20 @@ def file_tools(file_name: str) -> tuple[str, ...]:
     return tools[matches[-1]]
 
 
-def context(robot: Robot, precision: str = "double", method: str = "newton-euler") -> RenderContext:
-    """Derive the robot and build the target-independent function specs."""
+def context(
+    robot: Robot, precision: str = "double", method: str = "newton-euler", prune: float | None = None
+) -> RenderContext:
+    """Derive the robot and build the target-independent function specs (from the pruned
+    configuration-space form when `prune` is given, symdyn.codegen.pruned)."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
     dyn = derive(robot, method=method, simplify=False)
-    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), precision)
+    notes: tuple[str, ...] = ()
+    if prune is not None:
+        from .pruned import pruned_dynamics
+
+        dyn, notes = pruned_dynamics(dyn, prune)
+    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), precision, notes)
 
 
 def render(
@@ -60,10 +68,11 @@ def render(
     targets: Sequence[str] = ("c", "casadi"),
     precision: str = "double",
     method: str = "newton-euler",
+    prune: float | None = None,
 ) -> dict[str, str | bytes]:
     """All files of the requested targets, in memory (name -> content)."""
     modules = [_target_module(t) for t in dict.fromkeys(targets)]
-    ctx = context(robot, precision, method)
+    ctx = context(robot, precision, method, prune)
     files: dict[str, str | bytes] = {}
     for module in modules:
         files.update(module.render(ctx))
@@ -77,11 +86,13 @@ def generate(
     precision: str = "double",
     force: bool = False,
     method: str = "newton-euler",
+    prune: float | None = None,
 ) -> list[Path]:
-    """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir."""
+    """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir
+    (`prune`: from the significance-pruned model, symdyn.codegen.pruned)."""
     if not isinstance(robot, Robot):
         from ..parsers import load
 
         robot = load(robot)
-    files = render(robot, targets, precision, method)
+    files = render(robot, targets, precision, method, prune)
     return write_files(out_dir, files, force=force)

@@ -33,6 +33,8 @@ class RenderContext:
     dynamics: Dynamics
     functions: tuple[FunctionSpec, ...]
     precision: str = "double"
+    #: extra header lines (what `generate --prune` dropped and the bound it guarantees)
+    notes: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
@@ -60,7 +62,7 @@ def header_lines(ctx: RenderContext) -> list[str]:
             f"  {f.name:<{width}}  {o.total:5d} ops: {o.mul} mul, {o.add} add, {o.div} div, "
             f"{o.trig} trig, {o.other} other"
         )
-    return lines
+    return lines + list(ctx.notes)
 
 
 def _template_root() -> Path:

@@ -1,0 +1,232 @@
+"""What `symdyn derive` prints, in its three forms (text, JSON or LaTeX each):
+
+- "configuration" (the default): tau = M qdd + B [qd qd] + Csq [qd^2] + G + F
+  (symdyn.algorithms.configuration_space), M by its upper triangle, the nonzero entries of B
+  and Csq, then G and F; canonical closed forms, the same from either method; with `lumped`,
+  each distinct coefficient named once (symdyn.symbolic.lumping) and defined at the end;
+- "compact": the program of named intermediates after common-subexpression elimination, one
+  assignment per line as the generated code computes them, then M, C, V, G, F over them;
+- "expanded": the recursion's full expansion (the output of symdyn before the configuration
+  form), M, C, V, G, F.
+
+JSON always has the keys M, C, V, G, F, and B and Csq in the configuration form; every
+expression string parses with sympy.sympify.
+"""
+
+from __future__ import annotations
+
+import json
+
+import sympy as sp
+
+from ..algorithms.configuration_space import pair_columns
+from ..dynamics import Dynamics
+from ..symbolic.lumping import Lumper
+from ..symbolic.simplify import count_ops, eliminate
+
+__all__ = ["FORMS", "derive_text", "derive_json", "configuration_entries", "prune_summary"]
+
+FORMS = ("configuration", "compact", "expanded")
+PRINTED = ("M", "C", "V", "G", "F")
+
+
+def _header(dyn: Dynamics, equation: str) -> list[str]:
+    return [
+        f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
+        f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
+        + (", ".join(map(str, dyn.params)) or "none"),
+        f"# {equation}",
+    ]
+
+
+def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None):
+    """(labelled entries, lumped definitions) of the configuration-space form.
+
+    Returns:
+        A dict name -> list of (label, expression) for M (upper triangle), B and Csq (nonzero
+        entries), G and F; and the list of (constant, value) when `lumped`. `cs`: another
+        configuration-space form of `dyn` (a pruned one) instead of its own.
+    """
+    cs = cs or dyn.configuration_space
+    n = dyn.n
+    pairs = pair_columns(n)
+    inertial, gravity = Lumper(dyn.q, "I"), Lumper(dyn.q, "g")
+
+    def get(name, r, c, lumper):
+        e = cs.expr(name, r, c)
+        return lumper.lump(e) if lumped else e
+
+    out = {
+        "M": [(f"M[{i + 1},{j + 1}]", get("M", i, j, inertial)) for i in range(n) for j in range(i, n)],
+        "B": [
+            (f"B[{k + 1},({i + 1},{j + 1})]", get("B", k, c, inertial))
+            for k in range(n)
+            for c, (i, j) in enumerate(pairs)
+            if cs.poly("B", k, c)
+        ],
+        "Csq": [
+            (f"Csq[{k + 1},{i + 1}]", get("Csq", k, i, inertial))
+            for k in range(n)
+            for i in range(n)
+            if cs.poly("Csq", k, i)
+        ],
+        "G": [(f"G[{k + 1}]", get("G", k, 0, gravity)) for k in range(n)],
+        "F": [(f"F[{k + 1}]", e) for k, e in enumerate(dyn.closed_form("F"))],
+    }
+    return out, inertial.definitions + gravity.definitions
+
+
+def prune_summary(dyn: Dynamics, pruned) -> list[str]:
+    """Comment lines: what --prune REL guarantees and what it saves (operation counts)."""
+    ops = {}
+    for name in ("M", "B", "Csq", "G"):
+        before = count_ops([], list(dyn.configuration_space.matrix(name))).total
+        ops[name] = (before, count_ops([], list(pruned.configuration.matrix(name))).total)
+    text = ", ".join(f"{k} {a} -> {b}" for k, (a, b) in ops.items())
+    total = tuple(sum(v[i] for v in ops.values()) for i in (0, 1))
+    return [
+        f"# pruned at {pruned.rel:g} of each entry's largest value over the joint ranges (+-pi): "
+        f"{pruned.terms_before} -> {pruned.terms_after} terms",
+        f"# guaranteed: |error of an entry| <= {pruned.worst():.4g} x its largest value "
+        "(per entry: the sum of the dropped terms' maxima)",
+        f"# operations {text}; total {total[0]} -> {total[1]}",
+    ]
+
+
+def _configuration_text(dyn: Dynamics, lumped: bool, pruned=None) -> str:
+    n = dyn.n
+    pairs = ", ".join(f"{dyn.qd[i]}*{dyn.qd[j]}" for i, j in pair_columns(n)) or "none"
+    lines = _header(dyn, "tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)")
+    lines.append(f"# [qd qd] = ({pairs}); [qd^2] = ({', '.join(f'{v}**2' for v in dyn.qd)})")
+    if pruned is not None:
+        lines += prune_summary(dyn, pruned)
+    entries, definitions = configuration_entries(dyn, lumped, pruned and pruned.configuration)
+    for name, items in entries.items():
+        lines.append("")
+        lines += [f"{label} = {sp.sstr(e)}" for label, e in items] or [f"# {name} = 0"]
+    if definitions:
+        lines += ["", "# lumped constants"] + [f"{s} = {sp.sstr(v)}" for s, v in definitions]
+    return "\n".join(lines) + "\n"
+
+
+def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
+    cols = shape[1]
+    return f"{name}[{k // cols + 1},{k % cols + 1}]" if name in ("M", "C") else f"{name}[{k + 1}]"
+
+
+def _matrices(dyn: Dynamics, form: str) -> dict[str, sp.Matrix]:
+    if form == "expanded":
+        return {k: sp.Matrix(*dyn.compact[k].shape, dyn.expanded(k)) for k in PRINTED}
+    return {k: dyn.closed_form(k) for k in PRINTED}
+
+
+def _compact(dyn: Dynamics):
+    """The eliminated program: temporaries and M, C, V, G, F over them."""
+    outputs = [e for k in PRINTED for e in dyn.compact[k]]
+    code = eliminate(dyn.assignments(PRINTED), outputs, prefix="x")
+    mats, k = {}, 0
+    for name in PRINTED:
+        shape = dyn.compact[name].shape
+        size = shape[0] * shape[1]
+        mats[name] = sp.Matrix(*shape, list(code.outputs[k : k + size]))
+        k += size
+    return code.temporaries, mats
+
+
+def derive_text(dyn: Dynamics, form: str = "configuration", lumped: bool = False, pruned=None) -> str:
+    """The text of `symdyn derive` in one of FORMS (`pruned`: symdyn.algorithms.pruning.Pruned,
+    configuration form only)."""
+    if form == "configuration":
+        return _configuration_text(dyn, lumped, pruned)
+    lines = _header(dyn, "tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd")
+    if form == "compact":
+        temporaries, mats = _compact(dyn)
+        lines.append("")
+        lines += [f"{s} = {sp.sstr(e)}" for s, e in temporaries]
+    else:
+        mats = _matrices(dyn, form)
+    for name in PRINTED:
+        m = mats[name]
+        lines.append("")
+        lines += [f"{_entry_name(name, m.shape, k)} = {sp.sstr(e)}" for k, e in enumerate(m)]
+    return "\n".join(lines) + "\n"
+
+
+def _nested(m: sp.Matrix, vector: bool) -> list:
+    if vector:
+        return [sp.sstr(e) for e in m]
+    return [[sp.sstr(m[i, j]) for j in range(m.cols)] for i in range(m.rows)]
+
+
+def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False) -> str:
+    """The JSON of `symdyn derive`: keys M, C, V, G, F (and B, Csq, lumped in the
+    configuration form; assignments in the compact form)."""
+    doc: dict = {
+        "robot": dyn.robot.name,
+        "method": dyn.method,
+        "joints": dyn.n,
+        "form": form,
+        "q": [str(s) for s in dyn.q],
+        "qd": [str(s) for s in dyn.qd],
+        "qdd": [str(s) for s in dyn.qdd],
+        "params": [str(s) for s in dyn.params],
+    }
+    if form == "compact":
+        temporaries, mats = _compact(dyn)
+        doc["assignments"] = [[str(s), sp.sstr(e)] for s, e in temporaries]
+    else:
+        mats = _matrices(dyn, form)
+    if form == "configuration" and lumped:
+        entries, definitions = configuration_entries(dyn, lumped=True)
+        n, pairs = dyn.n, pair_columns(dyn.n)
+        index = {label: e for items in entries.values() for label, e in items}
+        M = sp.Matrix(n, n, lambda i, j: index[f"M[{min(i, j) + 1},{max(i, j) + 1}]"])
+        mats = {**mats, "M": M, "G": sp.Matrix([e for _, e in entries["G"]])}
+        doc["lumped"] = {str(s): sp.sstr(v) for s, v in definitions}
+        B = sp.Matrix(
+            n, len(pairs), lambda k, c: index.get(f"B[{k + 1},({pairs[c][0] + 1},{pairs[c][1] + 1})]", 0)
+        )
+        Csq = sp.Matrix(n, n, lambda k, i: index.get(f"Csq[{k + 1},{i + 1}]", 0))
+    elif form == "configuration":
+        B, Csq = dyn.B, dyn.Csq
+    for name in PRINTED:
+        doc[name] = _nested(mats[name], name not in ("M", "C"))
+    if form == "configuration":
+        doc["B"], doc["Csq"] = _nested(sp.Matrix(B), False), _nested(sp.Matrix(Csq), False)
+    return json.dumps(doc, indent=2) + "\n"
+
+
+def _latex_label(name: str, label: str) -> str:
+    """M[1,2] -> M_{1,2}, B[1,(2,3)] -> B_{1,(2,3)}, Csq[2,1] -> C^{\\mathrm{sq}}_{2,1}, G[1] -> G_{1}."""
+    head = "C^{\\mathrm{sq}}" if name == "Csq" else name
+    return f"{head}_{{{label[len(name) + 1 : -1]}}}"
+
+
+def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
+    """The configuration-space form in LaTeX (amsmath): one align* per quantity, each entry
+    broken over lines at its top-level + and - when long (symdyn.codegen.latex.Notation)."""
+    from ..codegen.latex import Notation
+
+    nt = Notation(dyn)
+    entries, definitions = configuration_entries(dyn, lumped)
+    for s, _ in definitions:
+        nt.names[s] = f"{s.name[0]}_{{{s.name[1:]}}}"
+    out = [
+        "% tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)  (needs \\usepackage{amsmath})",
+    ]
+    for name, items in [*entries.items(), ("lumped", [(str(s), v) for s, v in definitions])]:
+        if not items:
+            continue
+        rows = []
+        for label, e in items:
+            head = nt.names[sp.Symbol(label)] if name == "lumped" else _latex_label(name, label)
+            lines = nt.lines(nt.prepare(e))
+            rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
+        out.append("\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}")
+    abbreviations = []
+    for ph, (kind, idx) in sorted(nt.trig.items(), key=lambda item: item[0].name):
+        angle = " + ".join(f"q_{{{i}}}" for i in idx)
+        abbreviations.append(f"${nt.names[ph]} = \\{'sin' if kind == 's' else 'cos'}({angle})$")
+    if abbreviations:
+        out.insert(1, "Abbreviations: " + ", ".join(abbreviations) + ".")
+    return "\n".join(out) + "\n"

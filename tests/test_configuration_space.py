@@ -1,0 +1,166 @@
+"""The configuration-space form tau = M qdd + B [qd qd] + Csq [qd^2] + G + F
+(symdyn.algorithms.configuration_space): the same canonical closed forms from both routes,
+and values equal to the numeric oracle symdyn.rnea."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+import sympy as sp
+from robots import EXAMPLE_NAMES, example, random_params, random_state, rational_example, solo_robot, y_robot
+from test_mimic import CASES as MIMIC_CASES
+
+from symdyn import rnea
+from symdyn.algorithms.configuration_space import pair_columns
+from symdyn.dynamics import derive
+from symdyn.symbolic.simplify import count_ops
+
+NAMES = ("M", "B", "Csq", "G")
+#: the Panda's Lagrange route expands base-frame inertias R I R^T (tens of thousands of terms
+#: each) and takes minutes: its Newton-Euler form is checked against the oracle instead
+SLOW = ("panda",)
+
+
+def _both(robot):
+    return [derive(robot, method=m, simplify=False) for m in ("newton-euler", "lagrange")]
+
+
+def _entries(dyn, name):
+    cs = dyn.configuration_space
+    rows, cols = cs.shape(name)
+    return [cs.ring.named(cs.poly(name, r, c)) for r in range(rows) for c in range(cols)]
+
+
+def _assert_same_terms(a, b, exact: bool, what: str) -> None:
+    for name in NAMES:
+        for k, (ta, tb) in enumerate(zip(_entries(a, name), _entries(b, name), strict=True)):
+            assert ta.keys() == tb.keys(), f"{what} {name}[{k}]: different terms"
+            for key, ca in ta.items():
+                cb = tb[key]
+                if exact:
+                    assert not isinstance(ca, float) and ca == cb, f"{what} {name}[{k}] {key}: {ca} != {cb}"
+                else:
+                    assert math.isclose(float(ca), float(cb), rel_tol=1e-12), f"{what} {name}[{k}] {key}"
+
+
+@pytest.mark.parametrize("name", [n for n in EXAMPLE_NAMES if n not in SLOW])
+def test_routes_give_identical_strings_exact_data(name):
+    a, b = _both(rational_example(name))
+    _assert_same_terms(a, b, exact=True, what=name)
+    for q in NAMES:
+        assert [sp.sstr(e) for e in getattr(a, q)] == [sp.sstr(e) for e in getattr(b, q)], (name, q)
+
+
+@pytest.mark.parametrize("name", [n for n in EXAMPLE_NAMES if n not in SLOW])
+def test_routes_agree_float_data(name):
+    a, b = _both(example(name))
+    _assert_same_terms(a, b, exact=False, what=name)
+
+
+TREES = {
+    "ytree": y_robot,
+    "solo": solo_robot,
+    **{f"mimic_{k}": (lambda v=v: v[0]) for k, v in MIMIC_CASES.items()},
+}
+
+
+@pytest.mark.parametrize("case", sorted(TREES))
+def test_trees_and_mimic_joints(case):
+    robot = TREES[case]()
+    a, b = _both(robot)
+    _assert_same_terms(a, b, exact=False, what=case)
+    # structural zeros of a tree's M stay exact zeros
+    for i in range(a.n):
+        for j in range(a.n):
+            if a.compact["M"][i, j] == 0:
+                assert a.M[i, j] == 0
+
+
+def _value(dyn, name: str, q, values) -> np.ndarray:
+    """Entries of M, B, Csq or G at q, from their polynomials (lambdify would overflow
+    Python's compiler on the Panda's longest entries)."""
+    cs = dyn.configuration_space
+    rows, cols = cs.shape(name)
+    out = [cs.ring.numeric(cs.poly(name, r, c), values)(q) for r in range(rows) for c in range(cols)]
+    return np.array(out, dtype=float).reshape(rows, cols)
+
+
+@pytest.mark.parametrize("name", [*EXAMPLE_NAMES, "ytree", "mimic_chain"])
+def test_values_equal_the_oracle(name):
+    robot = TREES[name]() if name in TREES else example(name)
+    dyn = derive(robot, simplify=False)
+    small = name not in SLOW
+    if small:
+        args = [list(dyn.q), list(dyn.qd), list(dyn.params)]
+        V_f, C_f = (sp.lambdify(args, getattr(dyn, k), "numpy") for k in ("V", "C"))
+    rng = np.random.default_rng(11)
+    pairs = pair_columns(dyn.n)
+    for _ in range(3):
+        p = random_params(dyn.robot, rng)
+        q, qd, _ = random_state(dyn.robot, rng)
+        values = dict(zip(dyn.params, p, strict=True))
+        M, G = rnea.mass_matrix(dyn.robot, q, values), rnea.gravity_torque(dyn.robot, q, values)
+        V = rnea.bias_torque(dyn.robot, q, qd, values)
+        tol_m = 1e-9 * (1 + np.abs(M).max())
+        tol_v = tol_m * (1 + np.abs(qd).max() ** 2)
+        np.testing.assert_allclose(_value(dyn, "M", q, values), M, atol=tol_m)
+        np.testing.assert_allclose(_value(dyn, "G", q, values).ravel(), G, atol=1e-9 * (1 + np.abs(G).max()))
+        qdqd = np.array([qd[i] * qd[j] for i, j in pairs])
+        V_cs = (_value(dyn, "B", q, values) @ qdqd if pairs else 0) + _value(dyn, "Csq", q, values) @ qd**2
+        np.testing.assert_allclose(V_cs, V, atol=tol_v)
+        if small:
+            np.testing.assert_allclose(np.asarray(V_f(q, qd, p), dtype=float).ravel(), V, atol=tol_v)
+            np.testing.assert_allclose(np.asarray(C_f(q, qd, p), dtype=float) @ qd, V, atol=tol_v)
+
+
+def test_christoffel_symbols_of_a_two_link_arm():
+    """Craig (2005), eq. 6.59: the planar two-link arm with point masses at the link tips has
+    V = (-m2 l1 l2 s2 (2 qd1 qd2 + qd2^2), m2 l1 l2 s2 qd1^2): B = (-2 m2 l1 l2 s2, 0),
+    Csq = [[0, -m2 l1 l2 s2], [m2 l1 l2 s2, 0]]."""
+    m1, m2, l1, l2 = sp.symbols("m1 m2 l1 l2", positive=True)
+    from symdyn.parsers.robot_file import robot_from_data
+
+    links = [
+        {
+            "name": f"l{i}",
+            "joint": "revolute",
+            "a": f"l{i}",
+            "alpha": 0,
+            "d": 0,
+            "theta": 0,
+            "mass": f"m{i}",
+            "com": [0, 0, 0],
+            "inertia": {"ixx": 0, "iyy": 0, "izz": 0},
+        }
+        for i in (1, 2)
+    ]
+    robot = robot_from_data(
+        {
+            "name": "craig2",
+            "convention": "standard",
+            "gravity": [0, -9.81, 0],
+            "parameters": {"m1": None, "m2": None, "l1": None, "l2": None},
+            "links": links,
+        }
+    )
+    for dyn in _both(robot):
+        s2 = sp.sin(dyn.q[1])
+        m2, l1, l2 = (sp.Symbol(n) for n in ("m2", "l1", "l2"))
+        assert sp.expand(dyn.B[0, 0] + 2 * m2 * l1 * l2 * s2) == 0
+        assert dyn.B[1, 0] == 0
+        assert sp.expand(dyn.Csq[0, 1] + m2 * l1 * l2 * s2) == 0
+        assert sp.expand(dyn.Csq[1, 0] - m2 * l1 * l2 * s2) == 0
+        assert dyn.Csq[0, 0] == 0 and dyn.Csq[1, 1] == 0
+        assert set(dyn.christoffel) == {(0, 0, 1), (0, 1, 1), (1, 0, 0)}
+
+
+def test_puma_velocity_terms_are_compact():
+    """V of the PUMA 560 (exact data) from the Christoffel symbols: within 2x their size."""
+    dyn = derive(rational_example("puma560"), simplify=False)
+    gamma = count_ops([], list(dyn.christoffel.values())).total
+    assert len(dyn.christoffel) == 84
+    assert count_ops([], list(dyn.V)).total <= 2 * gamma
+    assert all(isinstance(c, Fraction) for p in dyn.configuration_space.gamma.values() for c in p.values())
