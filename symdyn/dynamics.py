@@ -162,10 +162,15 @@ class Dynamics:
     def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
         """The closed form of compact matrix m, cached under `name`: M, C, V, G, tau and bias of
         an unsimplified derivation from the configuration-space form (canonical, the same from
-        either method; symdyn.algorithms.configuration_space), anything else by substituting
-        the program's intermediates back."""
+        either method; symdyn.algorithms.configuration_space) when it is readable (at most
+        READABLE_TERMS terms), anything else by substituting the program's intermediates back."""
         if name not in self._closed:
-            if not self.simplified and name in ALL_QUANTITIES and name != "F":
+            if (
+                not self.simplified
+                and name in ALL_QUANTITIES
+                and name != "F"
+                and self.configuration_space.readable
+            ):
                 entries = self.configuration_space.closed(name, self.qd, self.qdd, self.compact["F"])
             else:
                 entries = self.program.expand(list(m))

@@ -109,3 +109,29 @@ def test_latex_configuration_form_breaks_long_entries(capsys):
     text = _run(capsys, str(EXAMPLES / "puma560.yaml"), "--format", "latex")
     assert "\\begin{align*}" in text and "B_{1,(1,2)} &=" in text
     assert "&\\quad" in text  # long entries continue on further lines
+
+
+def test_an_unreadable_form_falls_back_to_the_expansion_and_compact(monkeypatch, capsys):
+    """Past READABLE_TERMS the closed forms are the recursion's expansion (equal values) and
+    `derive` prints --form compact with a note; an explicit --form configuration still prints it."""
+    from symdyn.algorithms import configuration_space as cs_module
+    from symdyn.dynamics import derive
+
+    robot = example("puma560")
+    readable = derive(robot, simplify=False)
+    assert readable.configuration_space.terms <= cs_module.READABLE_TERMS
+    monkeypatch.setattr(cs_module, "READABLE_TERMS", 100)
+    big = derive(robot, simplify=False)
+    assert not big.configuration_space.readable
+    assert big.closed_form("G") == sp.ImmutableMatrix(big.expanded("G"))
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-np.pi, np.pi, robot.n)
+    subs = dict(zip(big.q, q, strict=True))
+    got = np.array([float(e.xreplace(subs)) for e in big.closed_form("G")])
+    np.testing.assert_allclose(got, rnea.gravity_torque(robot, q), rtol=1e-10, atol=1e-10)
+    path = Path(__file__).resolve().parents[1] / "examples" / "puma560.yaml"
+    assert main(["derive", str(path)]) == 0
+    captured = capsys.readouterr()
+    assert "printing --form compact" in captured.err and "B[" not in captured.out
+    assert main(["derive", str(path), "--form", "configuration"]) == 0
+    assert "B[" in capsys.readouterr().out

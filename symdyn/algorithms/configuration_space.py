@@ -39,6 +39,13 @@ __all__ = ["ConfigurationSpace", "configuration_space", "pair_columns", "christo
 _HALF = Fraction(1, 2)
 
 
+#: Above this many terms (M, G and the Christoffel symbols together) the canonical form is not
+#: a readable closed form: PUMA 560 1,198 terms, Stanford 795, the PUMA with its 60 inertial
+#: parameters symbolic 34,019; the Panda's 228,647 would take minutes to print and megabytes of
+#: text, so Dynamics.closed_form expands the recursion for it and `derive` prints --form compact.
+READABLE_TERMS = 100_000
+
+
 def pair_columns(n: int) -> list[tuple[int, int]]:
     """The columns of B: (i, j), i < j, in the order (0, 1), (0, 2), ..., (n-2, n-1) (0-based)."""
     return [(i, j) for i in range(n) for j in range(i + 1, n)]
@@ -62,6 +69,18 @@ class ConfigurationSpace:
     #: maps a SymPy coefficient (a number times parameters) to its printed form
     coefficient: Callable | None = None
     _sympy: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def terms(self) -> int:
+        """The size of the form: terms of M's upper triangle, of G and of the Christoffel symbols."""
+        n = self.n
+        upper = sum(len(self.M[i][j]) for i in range(n) for j in range(i, n))
+        return upper + sum(len(p) for p in self.G) + sum(len(p) for p in self.gamma.values())
+
+    @property
+    def readable(self) -> bool:
+        """Small enough to print and to serve as closed form (READABLE_TERMS)."""
+        return self.terms <= READABLE_TERMS
 
     @property
     def n(self) -> int:

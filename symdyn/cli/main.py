@@ -81,12 +81,23 @@ def cmd_derive(args: argparse.Namespace) -> int:
         from .steps import cmd_derive_steps
 
         return cmd_derive_steps(args)
+    from ..algorithms.configuration_space import READABLE_TERMS
     from ..dynamics import derive
     from . import derive_output as out
 
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
+    if args.form is None:
+        args.form = "configuration"
+        if not dyn.configuration_space.readable:
+            args.form = "compact"
+            print(
+                f"symdyn: note: the configuration-space form of '{robot.name}' has "
+                f"{dyn.configuration_space.terms:,} terms (more than {READABLE_TERMS:,}); printing "
+                "--form compact (ask for --form configuration to print it all the same)",
+                file=sys.stderr,
+            )
     if args.format == "latex":
         configuration = args.form == "configuration"
         text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
@@ -142,8 +153,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument(
         "--form",
         choices=("configuration", "compact", "expanded"),
-        default="configuration",
-        help="configuration: M, B [qd qd], Csq [qd^2], G, F (default); compact: named intermediates; "
+        default=None,
+        help="configuration: M, B [qd qd], Csq [qd^2], G, F (default, unless larger than "
+        "100,000 terms: then compact); compact: named intermediates; "
         "expanded: the full expansion",
     )
     d.add_argument(
