@@ -141,3 +141,22 @@ def test_output_entries_are_the_slices_of_the_code(files):
     with pytest.raises(KeyError):
         both.entries(specs["stacked_mass"].results[0])
     assert example(ROBOT).n == dyn.n
+
+
+def test_groups_select_families_with_unchanged_code():
+    """generate --functions dynamics: the seven functions, each with the code of a full build."""
+    from symdyn.errors import SymdynError
+
+    robot = derived(ROBOT, "newton-euler").robot
+    full = render(robot, targets=("c",))
+    seven = render(robot, targets=("c",), functions=("dynamics",))
+    header = seven[f"{ROBOT}_dynamics.h"]
+    names = ("inverse_dynamics", "mass_matrix", "coriolis_matrix", "coriolis", "gravity", "friction")
+    names += ("forward_dynamics",)
+    assert header.count("\nvoid ") == len(names) and "_regressor(" not in header
+    source, full_source = seven[f"{ROBOT}_dynamics.c"], full[f"{ROBOT}_dynamics.c"]
+    for name in names:
+        body = source.split(f"void {ROBOT}_{name}(")[1].split("\n}\n")[0]
+        assert body in full_source, name
+    with pytest.raises(SymdynError, match="unknown function group"):
+        render(robot, targets=("c",), functions=("dynamic",))

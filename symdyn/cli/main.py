@@ -126,6 +126,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         force=args.force,
         method=args.method,
         prune=args.prune,
+        functions=args.functions,
     )
     for p in paths:
         print(p)
@@ -184,6 +185,13 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--out", required=True, help="output folder")
     g.add_argument("--precision", choices=("double", "float"), default="double")
     g.add_argument("--method", choices=METHODS, default="newton-euler")
+    g.add_argument(
+        "--functions",
+        nargs="+",
+        choices=("dynamics", "regressor", "tip_wrench", "derivatives"),
+        help="only these groups of functions (default: all): dynamics (the seven of tau = M qdd + V + G + F "
+        "and forward dynamics), regressor, tip_wrench (product-of-exponentials robots), derivatives",
+    )
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
     g.add_argument(
         "--prune",

@@ -20,7 +20,7 @@ from pathlib import Path
 from ..dynamics import derive
 from ..errors import SymdynError
 from ..model.robot import Robot
-from .functions import FUNCTION_NAMES, build_functions
+from .functions import FUNCTION_NAMES, GROUPS, build_functions
 from .output import write_files
 from .render import PRECISIONS, RenderContext
 
@@ -48,10 +48,15 @@ def file_tools(file_name: str) -> tuple[str, ...]:
 
 
 def context(
-    robot: Robot, precision: str = "double", method: str = "newton-euler", prune: float | None = None
+    robot: Robot,
+    precision: str = "double",
+    method: str = "newton-euler",
+    prune: float | None = None,
+    functions: Sequence[str] | None = None,
 ) -> RenderContext:
     """Derive the robot and build the target-independent function specs (from the pruned
-    configuration-space form when `prune` is given, symdyn.codegen.pruned)."""
+    configuration-space form when `prune` is given, symdyn.codegen.pruned; only the groups of
+    symdyn.codegen.functions.GROUPS named in `functions`, when given)."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
     dyn = derive(robot, method=method, simplify=False)
@@ -60,7 +65,14 @@ def context(
         from .pruned import pruned_dynamics
 
         dyn, notes = pruned_dynamics(dyn, prune)
-    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), precision, notes)
+    if functions is not None:
+        unknown = sorted(set(functions) - set(GROUPS))
+        if unknown or not functions:
+            raise SymdynError(
+                f"unknown function group(s) {', '.join(unknown) or '(none given)'} (one or more of "
+                f"{', '.join(GROUPS)})"
+            )
+    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, functions)), precision, notes)
 
 
 def render(
@@ -69,10 +81,11 @@ def render(
     precision: str = "double",
     method: str = "newton-euler",
     prune: float | None = None,
+    functions: Sequence[str] | None = None,
 ) -> dict[str, str | bytes]:
     """All files of the requested targets, in memory (name -> content)."""
     modules = [_target_module(t) for t in dict.fromkeys(targets)]
-    ctx = context(robot, precision, method, prune)
+    ctx = context(robot, precision, method, prune, functions)
     files: dict[str, str | bytes] = {}
     for module in modules:
         files.update(module.render(ctx))
@@ -87,12 +100,14 @@ def generate(
     force: bool = False,
     method: str = "newton-euler",
     prune: float | None = None,
+    functions: Sequence[str] | None = None,
 ) -> list[Path]:
     """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir
-    (`prune`: from the significance-pruned model, symdyn.codegen.pruned)."""
+    (`prune`: from the significance-pruned model, symdyn.codegen.pruned; `functions`: only these
+    groups of symdyn.codegen.functions.GROUPS, e.g. ("dynamics",) for the seven functions)."""
     if not isinstance(robot, Robot):
         from ..parsers import load
 
         robot = load(robot)
-    files = render(robot, targets, precision, method, prune)
+    files = render(robot, targets, precision, method, prune, functions)
     return write_files(out_dir, files, force=force)

@@ -28,7 +28,7 @@ masses M cannot be known to be singular, and forward_dynamics is generated.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import sympy as sp
@@ -47,6 +47,7 @@ __all__ = [
     "Output",
     "DIMS",
     "FAMILIES",
+    "GROUPS",
     "build_functions",
     "vector_output",
     "joint_matrix_output",
@@ -327,7 +328,16 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
 )
 
 
-def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
+#: The groups of functions `symdyn generate --functions` selects, by the builders of FAMILIES.
+GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] = {
+    "dynamics": (dynamics_rows, forward_dynamics_rows),
+    "regressor": (regressor_family,),
+    "tip_wrench": (tip_wrench_rows,),
+    "derivatives": (derivative_rows,),
+}
+
+
+def build_functions(dyn: Dynamics, groups: Sequence[str] | None = None) -> list[FunctionSpec]:
     """The generated functions of a derived robot, one CSE pass per `FunctionRow.cse` group.
 
     All of FAMILIES' rows: the seven of docs/generated-code.md, or six without forward_dynamics
@@ -335,12 +345,14 @@ def build_functions(dyn: Dynamics) -> list[FunctionSpec]:
     regressor and base_regressor (symdyn.codegen.regressor_functions), tip_wrench_torque for
     product-of-exponentials robots, and the derivatives (symdyn.codegen.derivative_functions).
     The regressor and the derivatives add intermediates to `dyn.program`; each family has a pass
-    of its own so that it cannot change the other functions' temporaries.
+    of its own so that it cannot change the other functions' temporaries. `groups` (names of
+    GROUPS; all by default) keeps only those families: their code is the same as in a full build.
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
     x = Inputs.of(dyn)
-    rows = [row for family in FAMILIES for row in family(dyn, x)]
+    chosen = None if groups is None else {b for g in groups for b in GROUPS[g]}
+    rows = [row for family in FAMILIES if chosen is None or family in chosen for row in family(dyn, x)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
     code = {}
