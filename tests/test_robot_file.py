@@ -524,7 +524,7 @@ def test_puma560_with_decimal_angles_is_the_pi_over_2_robot(tmp_path):
     assert ops["inverse_dynamics"].total == 434  # the count in generated/puma560/puma560_dynamics.h
     decimal_functions = symdyn.codegen.context(decimal).functions
     assert {f.name: f.ops for f in decimal_functions} == ops
-    assert len(ops) == 7
+    assert {"inverse_dynamics", "mass_matrix", "forward_dynamics", "regressor", "linearize"} <= set(ops)
 
     # the decimal robot's generated functions against the oracle on the pi/2 robot
     plant = CompiledDynamics(decimal)
