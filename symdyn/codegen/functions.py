@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import sympy as sp
 
@@ -307,22 +307,17 @@ _OUTPUT_DOCS = {
 }
 
 
+# The families in modules of their own build on the names above (each sets its rows' CSE group).
+from .derivative_functions import derivative_rows  # noqa: E402
+from .regressor_functions import regressor_rows  # noqa: E402
+
 #: The families of generated functions, in the order of the generated files: each maps a derived
 #: robot and the input vectors to its FunctionRows (a new family is one module and one entry here).
-def regressor_family(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
-    """regressor and base_regressor (symdyn.codegen.regressor_functions, which builds on this
-    module), in a CSE pass of their own."""
-    from .regressor_functions import regressor_rows
-
-    return [replace(row, cse="regressor") for row in regressor_rows(dyn, x)]
-
-
-from .derivative_functions import derivative_rows  # noqa: E402 (it builds on the names above)
 
 FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     dynamics_rows,
     forward_dynamics_rows,
-    regressor_family,
+    regressor_rows,
     tip_wrench_rows,
     derivative_rows,
 )
@@ -331,7 +326,7 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
 #: The groups of functions `symdyn generate --functions` selects, by the builders of FAMILIES.
 GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] = {
     "dynamics": (dynamics_rows, forward_dynamics_rows),
-    "regressor": (regressor_family,),
+    "regressor": (regressor_rows,),
     "tip_wrench": (tip_wrench_rows,),
     "derivatives": (derivative_rows,),
 }

@@ -56,6 +56,7 @@ def regressor_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 ),
             ),
             tuple(Y),
+            cse="regressor",
         )
     ]
     try:
@@ -79,6 +80,7 @@ def regressor_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 ),
             ),
             tuple(Yb),
+            cse="regressor",
         )
     )
     return rows
