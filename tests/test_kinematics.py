@@ -27,6 +27,7 @@ from robots import (
 )
 
 from symdyn.algorithms.kinematics import (
+    body_point_jacobian,
     end_effector_jacobian,
     forward_kinematics,
     frame_poses,
@@ -328,3 +329,31 @@ def test_tree_poses_and_jacobians(make):
         point = rng.uniform(-0.3, 0.3, 3)
         J = numeric_jacobian(robot, q, link=k, point=tuple(point))
         assert_close(J, fd_jacobian(robot, q, k, point, None), rtol=1e-6)
+
+
+@pytest.mark.parametrize("case", ["puma560", "stanford", "ytree", "solo", "mimic"])
+def test_body_jacobian_is_the_base_jacobian_rotated_into_the_link(case):
+    """J_body = blockdiag(R_k^T, R_k^T) J_base (Murray, Li, Sastry (1994), sec. 4.2), by the
+    base-frame Jacobian's finite differences of the oracle's poses; no column of a link's body
+    Jacobian involves the first joint's angle (of a chain without mimic joints)."""
+    from test_mimic import CASES as MIMIC_CASES
+
+    robot = {"ytree": y_robot, "solo": solo_robot, "mimic": lambda: next(iter(MIMIC_CASES.values()))[0]}.get(
+        case, lambda: example(case)
+    )()
+    rng = np.random.default_rng(21)
+    q, _, _ = random_state(robot, rng)
+    poses = rnea_poses(robot, q)
+    symbols = list(sp.symbols(f"q1:{robot.n + 1}"))
+    for k in range(robot.nb):
+        point = tuple(rng.uniform(-0.3, 0.3, 3))
+        body = body_point_jacobian(robot, k, point, symbols)
+        got = np.array(body.xreplace(dict(zip(symbols, q, strict=True))).tolist(), dtype=float)
+        R = poses[k][:3, :3]
+        want = np.vstack(
+            [R.T @ fd_jacobian(robot, q, k, point, None)[:3], R.T @ fd_jacobian(robot, q, k, point, None)[3:]]
+        )
+        assert_close(got, want, rtol=1e-6, what=f"{case} link {k + 1}")
+        chain = all(p == i - 1 for i, p in enumerate(robot.parents))
+        if chain and all(link.mimic is None for link in robot.links):
+            assert symbols[0] not in body.free_symbols, (case, k)

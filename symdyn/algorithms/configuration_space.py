@@ -33,6 +33,7 @@ import sympy as sp
 
 from ..symbolic.program import Program
 from ..symbolic.trig_polynomial import TrigPoly, TrigRing, add_into, chop, largest, scale
+from ..symbolic.trig_text import TrigText
 
 __all__ = ["ConfigurationSpace", "configuration_space", "pair_columns", "christoffel_name"]
 
@@ -69,6 +70,7 @@ class ConfigurationSpace:
     #: maps a SymPy coefficient (a number times parameters) to its printed form
     coefficient: Callable | None = None
     _sympy: dict = field(default_factory=dict, repr=False)
+    _printers: dict = field(default_factory=dict, repr=False)
 
     @property
     def terms(self) -> int:
@@ -111,6 +113,19 @@ class ConfigurationSpace:
         if hit is None:
             hit = self._sympy[key] = self.ring.to_sympy(self.poly(name, k, c), self.coefficient)
         return hit
+
+    def text(self, name: str, k: int, c: int = 0, coefficient: Callable | None = None) -> str:
+        """Entry (k, c) of M, B or Csq, or entry k of G, as SymPy-syntax text written straight
+        from its polynomial (symdyn.symbolic.trig_text: fast, canonical order); coefficient:
+        maps each group's coefficient to what to print (lumped constants), after the form's own."""
+        printer = self._printers.get(coefficient)
+        if printer is None:
+            own = self.coefficient
+            both = coefficient
+            if coefficient is not None and own is not None:
+                both = lambda x: coefficient(own(x))  # noqa: E731
+            printer = self._printers[coefficient] = TrigText(self.ring, both or own)
+        return printer.text(self.poly(name, k, c))
 
     def matrix(self, name: str) -> sp.ImmutableMatrix:
         """M, B, Csq (matrices) or G (a column) as SymPy closed forms."""

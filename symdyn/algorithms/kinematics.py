@@ -39,6 +39,7 @@ __all__ = [
     "forward_kinematics",
     "frame_poses",
     "point_jacobian",
+    "body_point_jacobian",
     "end_effector_jacobian",
     "numeric_pose",
     "numeric_jacobian",
@@ -145,15 +146,20 @@ def point_jacobian(
     if poses is None:
         poses = forward_kinematics(robot, q)
     r = poses[k].apply(_point(point, "point_jacobian"))
+    axes = {j: (poses[j].R * robot.links[j].axis, poses[j].p) for j in support(robot.parents, k)}
+    return _jacobian(robot, k, r, axes)
+
+
+def _jacobian(robot: Robot, k: int, r: sp.Matrix, axes: dict[int, tuple]) -> sp.Matrix:
+    """J = [Jv; Jw] (6 x n) of point r on link k from each supporting joint's (axis z_j, origin
+    o_j), all in one frame: revolute z x (r - o), z; prismatic z, 0; mimic columns summed."""
     J = sp.zeros(6, robot.n)
     coordinates = robot.coordinates
     filled: set[int] = set()
     for j in reversed(support(robot.parents, k)):  # from the base out, as j = 1 .. k of a chain
-        z = poses[j].R * robot.links[j].axis
+        z, o = axes[j]
         revolute = robot.links[j].joint == "revolute"
-        column = sp.Matrix.vstack(
-            z.cross(r - poses[j].p) if revolute else z, z if revolute else sp.zeros(3, 1)
-        )
+        column = sp.Matrix.vstack(z.cross(r - o) if revolute else z, z if revolute else sp.zeros(3, 1))
         c = coordinates[j]
         if c.index in filled or c.multiplier != 1:  # a mimic joint adds to its coordinate: J = J_b S
             column = column * c.multiplier
@@ -162,6 +168,49 @@ def point_jacobian(
             J[:, c.index] = column
         filled.add(c.index)
     return J
+
+
+def body_point_jacobian(
+    robot: Robot,
+    link: int,
+    point: Sequence = (0, 0, 0),
+    q: Sequence | None = None,
+    program: Program | None = None,
+) -> sp.Matrix:
+    """The Jacobian of a point fixed to a link, in that link's own body frame.
+
+    The columns of `point_jacobian` rotated into link k's frame: J_k = blockdiag(R_k^T, R_k^T) J
+    (Murray, Li, Sastry, A Mathematical Introduction to Robotic Manipulation (1994), sec. 4.2:
+    the body Jacobian of a frame at the point). Built from the relative transforms k_T_j of the
+    supporting links j, composed from k towards the base (k_T_lambda(j) = k_T_j j_T_lambda(j)),
+    so a column depends only on the joints between j and k, never on the joints below j: the
+    base pose, and with it the first joint, drops out of every product J_k^T X J_k.
+
+    Args:
+        robot: the model, nb links and n independent joints.
+        link: 0-based link index (negative counts from the end).
+        point: the point in that link's body frame (3 entries).
+        q: n joint positions; None: the symbols q1..qn.
+        program: if given, the entries of every k_T_j become named intermediates of it.
+
+    Returns:
+        6 x n: the point's linear velocity and the link's angular velocity per unit joint rate,
+        in link k's body frame; only the supporting joints' columns are nonzero.
+    """
+    k = _link_index(robot, link, "body_point_jacobian")
+    r = _vec3(_point(point, "body_point_jacobian"))
+    local = link_transforms(robot, q)
+    axes = {}
+    T = Transform.identity()  # k_T_j, j walking from k to the base
+    for j in support(robot.parents, k):
+        axes[j] = (T.R * robot.links[j].axis, T.p)
+        if robot.parents[j] >= 0:
+            T = _named(T @ local[j].inverse(), program, f"T{k + 1}_{robot.parents[j] + 1}")
+    return _jacobian(robot, k, r, axes)
+
+
+def _vec3(x: tuple) -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(3, 1, list(x))
 
 
 def end_effector_jacobian(robot: Robot, q: Sequence | None = None) -> sp.Matrix:

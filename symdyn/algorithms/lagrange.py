@@ -1,12 +1,18 @@
 """The Lagrange route: M from the link Jacobians, C from Christoffel symbols, G from the potential.
 
-In the base frame, with Jv_i the Jacobian of link i's centre of mass, Jw_i its
-angular-velocity Jacobian, R_i its orientation and I_i its inertia about the
-centre of mass (body axes), summed over the nb links of the tree and taken over the n
-independent coordinates (a column is nonzero only for the joints that support link i; a
-mimic joint q_j = s q_k + o adds s times its column to q_k's, symdyn.algorithms.kinematics):
+With Jv_i the Jacobian of link i's centre of mass, Jw_i its angular-velocity Jacobian,
+both written in link i's own body frame (the body Jacobian, Murray, Li and Sastry (1994),
+sec. 4.2), and I_i its inertia about the centre of mass in the same (body) axes, summed over
+the nb links of the tree and taken over the n independent coordinates (a column is nonzero
+only for the joints that support link i; a mimic joint q_j = s q_k + o adds s times its
+column to q_k's, symdyn.algorithms.kinematics):
 
-    M = sum_i m_i Jv_i^T Jv_i + Jw_i^T (R_i I_i R_i^T) Jw_i  (+ reflected motor inertia s^2 J)
+    M = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i  (+ reflected motor inertia s^2 J)
+
+the kinetic energy 1/2 qd^T M qd, which a rotation of the frame leaves unchanged; written in
+the base frame (Spong et al.'s Jv, Jw and R_i I_i R_i^T) the same M carries every joint angle
+below the link, including the first, only for them to cancel in the sum, which makes its
+closed form (symdyn.algorithms.configuration_space) many times costlier to build.
     P = -sum_i m_i g^T p_ci                   (g: gravitational acceleration)
     G_k = dP/dq_k
     C_kj = sum_i 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) qd_i
@@ -14,7 +20,9 @@ mimic joint q_j = s q_k + o adds s times its column to q_k's, symdyn.algorithms.
 Derivatives are taken by forward-mode differentiation through the program's
 named intermediates (symdyn.symbolic.program), never by expanding M.
 
-References: Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 7.2
+References: Murray, Li, Sastry, A Mathematical Introduction to Robotic Manipulation (1994),
+sec. 4.2 (M = sum J_i^T M_i J_i with body Jacobians); Spong, Hutchinson, Vidyasagar, Robot
+Modeling and Control (2006), sec. 7.2
 (kinetic and potential energy, M from the Jacobians) and sec. 7.3 (equations of motion,
 Christoffel symbols); Craig, Introduction to Robotics (3rd ed., 2005), sec. 6.9 (Lagrangian
 formulation). R. Grupen, "Dynamics" (2015) lists Lagrangian dynamics in its outline (slide 1)
@@ -27,7 +35,7 @@ import sympy as sp
 
 from ..model.robot import Robot
 from ..symbolic.program import Program
-from .kinematics import forward_kinematics, point_jacobian
+from .kinematics import body_point_jacobian, forward_kinematics
 
 __all__ = ["lagrange"]
 
@@ -52,12 +60,10 @@ def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dic
     P = sp.S.Zero
     g = sp.Matrix(robot.gravity)
     for i, link in enumerate(robot.links):
-        J = point_jacobian(robot, i, list(link.com), poses=poses)
+        J = body_point_jacobian(robot, i, list(link.com), list(q), program)
         Jv = J[:3, :].applyfunc(lambda x, i=i: program.let(x, f"Jv{i + 1}_"))
         Jw = J[3:, :]
-        R = sp.Matrix(poses[i].R)
-        I_base = (R * sp.Matrix(link.inertia) * R.T).applyfunc(lambda x, i=i: program.let(x, f"Ib{i + 1}_"))
-        M += link.mass * (Jv.T * Jv) + Jw.T * I_base * Jw
+        M += link.mass * (Jv.T * Jv) + Jw.T * sp.Matrix(link.inertia) * Jw
         pc = poses[i].apply(list(link.com))
         P -= link.mass * (g.T * sp.Matrix(pc))[0]
     for link, c in zip(robot.links, robot.coordinates, strict=True):

@@ -23,6 +23,7 @@ from ..algorithms.configuration_space import pair_columns
 from ..dynamics import Dynamics
 from ..symbolic.lumping import Lumper
 from ..symbolic.simplify import count_ops, eliminate
+from ..symbolic.trig_text import number_text
 
 __all__ = ["FORMS", "derive_text", "derive_json", "configuration_entries", "prune_summary"]
 
@@ -39,12 +40,14 @@ def _header(dyn: Dynamics, equation: str) -> list[str]:
     ]
 
 
-def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None):
+def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None, text: bool = False):
     """(labelled entries, lumped definitions) of the configuration-space form.
 
     Returns:
-        A dict name -> list of (label, expression) for M (upper triangle), B and Csq (nonzero
-        entries), G and F; and the list of (constant, value) when `lumped`. `cs`: another
+        A dict name -> list of (label, entry) for M (upper triangle), B and Csq (nonzero
+        entries), G and F; and the list of (constant, value) when `lumped`. An entry is a SymPy
+        expression, or with `text` its SymPy-syntax string written straight from the polynomial
+        (ConfigurationSpace.text: the fast way for large forms). `cs`: another
         configuration-space form of `dyn` (a pruned one) instead of its own.
     """
     cs = cs or dyn.configuration_space
@@ -53,9 +56,12 @@ def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None):
     inertial, gravity = Lumper(dyn.q, "I"), Lumper(dyn.q, "g")
 
     def get(name, r, c, lumper):
+        if text:
+            return cs.text(name, r, c, lumper.name if lumped else None)
         e = cs.expr(name, r, c)
         return lumper.lump(e) if lumped else e
 
+    F = dyn.closed_form("F")
     out = {
         "M": [(f"M[{i + 1},{j + 1}]", get("M", i, j, inertial)) for i in range(n) for j in range(i, n)],
         "B": [
@@ -71,7 +77,7 @@ def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None):
             if cs.poly("Csq", k, i)
         ],
         "G": [(f"G[{k + 1}]", get("G", k, 0, gravity)) for k in range(n)],
-        "F": [(f"F[{k + 1}]", e) for k, e in enumerate(dyn.closed_form("F"))],
+        "F": [(f"F[{k + 1}]", sp.sstr(e) if text else e) for k, e in enumerate(F)],
     }
     return out, inertial.definitions + gravity.definitions
 
@@ -93,6 +99,11 @@ def prune_summary(dyn: Dynamics, pruned) -> list[str]:
     ]
 
 
+def _value(v: sp.Expr) -> str:
+    """A lumped constant's value, a float to 15 digits as the entries print theirs."""
+    return number_text(float(v)) if v.is_Float else sp.sstr(v)
+
+
 def _configuration_text(dyn: Dynamics, lumped: bool, pruned=None) -> str:
     n = dyn.n
     pairs = ", ".join(f"{dyn.qd[i]}*{dyn.qd[j]}" for i, j in pair_columns(n)) or "none"
@@ -100,12 +111,12 @@ def _configuration_text(dyn: Dynamics, lumped: bool, pruned=None) -> str:
     lines.append(f"# [qd qd] = ({pairs}); [qd^2] = ({', '.join(f'{v}**2' for v in dyn.qd)})")
     if pruned is not None:
         lines += prune_summary(dyn, pruned)
-    entries, definitions = configuration_entries(dyn, lumped, pruned and pruned.configuration)
+    entries, definitions = configuration_entries(dyn, lumped, pruned and pruned.configuration, text=True)
     for name, items in entries.items():
         lines.append("")
-        lines += [f"{label} = {sp.sstr(e)}" for label, e in items] or [f"# {name} = 0"]
+        lines += [f"{label} = {e}" for label, e in items] or [f"# {name} = 0"]
     if definitions:
-        lines += ["", "# lumped constants"] + [f"{s} = {sp.sstr(v)}" for s, v in definitions]
+        lines += ["", "# lumped constants"] + [f"{s} = {_value(v)}" for s, v in definitions]
     return "\n".join(lines) + "\n"
 
 
@@ -171,29 +182,60 @@ def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False
         "qdd": [str(s) for s in dyn.qdd],
         "params": [str(s) for s in dyn.params],
     }
+    if form == "configuration":
+        doc.update(_configuration_json(dyn, lumped))
+        return json.dumps(doc, indent=2) + "\n"
     if form == "compact":
         temporaries, mats = _compact(dyn)
         doc["assignments"] = [[str(s), sp.sstr(e)] for s, e in temporaries]
     else:
         mats = _matrices(dyn, form)
-    if form == "configuration" and lumped:
-        entries, definitions = configuration_entries(dyn, lumped=True)
-        n, pairs = dyn.n, pair_columns(dyn.n)
-        index = {label: e for items in entries.values() for label, e in items}
-        M = sp.Matrix(n, n, lambda i, j: index[f"M[{min(i, j) + 1},{max(i, j) + 1}]"])
-        mats = {**mats, "M": M, "G": sp.Matrix([e for _, e in entries["G"]])}
-        doc["lumped"] = {str(s): sp.sstr(v) for s, v in definitions}
-        B = sp.Matrix(
-            n, len(pairs), lambda k, c: index.get(f"B[{k + 1},({pairs[c][0] + 1},{pairs[c][1] + 1})]", 0)
-        )
-        Csq = sp.Matrix(n, n, lambda k, i: index.get(f"Csq[{k + 1},{i + 1}]", 0))
-    elif form == "configuration":
-        B, Csq = dyn.B, dyn.Csq
     for name in PRINTED:
         doc[name] = _nested(mats[name], name not in ("M", "C"))
-    if form == "configuration":
-        doc["B"], doc["Csq"] = _nested(sp.Matrix(B), False), _nested(sp.Matrix(Csq), False)
     return json.dumps(doc, indent=2) + "\n"
+
+
+def _configuration_json(dyn: Dynamics, lumped: bool) -> dict:
+    """M, C, V, G, F, B, Csq (and lumped) of the configuration-space form as strings, written
+    from the polynomials: V_k = sum B[k,(i,j)] qd_i qd_j + sum Csq[k,i] qd_i^2 and
+    C_kj = sum_i Gamma^k_ij qd_i with Gamma^k_ij = B[k,(i,j)]/2 (i != j), Gamma^k_ii = Csq[k,i]."""
+    n = dyn.n
+    pairs = pair_columns(n)
+    entries, definitions = configuration_entries(dyn, lumped, text=True)
+    index = {label: e for items in entries.values() for label, e in items}
+    qd = [sp.sstr(v) for v in dyn.qd]
+    B = [[index.get(f"B[{k + 1},({i + 1},{j + 1})]", "0") for i, j in pairs] for k in range(n)]
+    Csq = [[index.get(f"Csq[{k + 1},{i + 1}]", "0") for i in range(n)] for k in range(n)]
+
+    def gamma(k: int, i: int, j: int) -> str:
+        """Gamma^k_ij times qd_i as text ("" when zero)."""
+        if i == j:
+            return f"({Csq[k][i]})*{qd[i]}" if Csq[k][i] != "0" else ""
+        b = B[k][pairs.index((min(i, j), max(i, j)))]
+        return f"({b})*{qd[i]}/2" if b != "0" else ""
+
+    def total(terms) -> str:
+        return " + ".join(t for t in terms if t) or "0"
+
+    V = [
+        total(
+            [f"({b})*{qd[i]}*{qd[j]}" for b, (i, j) in zip(B[k], pairs, strict=True) if b != "0"]
+            + [f"({c})*{qd[i]}**2" for i, c in enumerate(Csq[k]) if c != "0"]
+        )
+        for k in range(n)
+    ]
+    doc = {
+        "M": [[index[f"M[{min(i, j) + 1},{max(i, j) + 1}]"] for j in range(n)] for i in range(n)],
+        "C": [[total(gamma(k, i, j) for i in range(n)) for j in range(n)] for k in range(n)],
+        "V": V,
+        "G": [index[f"G[{k + 1}]"] for k in range(n)],
+        "F": [e for _, e in entries["F"]],
+        "B": B,
+        "Csq": Csq,
+    }
+    if lumped:
+        doc["lumped"] = {str(s): _value(v) for s, v in definitions}
+    return doc
 
 
 def _latex_label(name: str, label: str) -> str:
