@@ -34,7 +34,7 @@ def check_limits(limits, **where) -> tuple[float, float]:
     items = list(limits)
     if len(items) != 2:
         raise SymdynError(f"limits must be [lower, upper], got {len(items)} entries", **where)
-    values = []
+    values, texts = [], []
     for v in items:
         e = sp.sympify(v)
         if e.free_symbols:
@@ -46,9 +46,10 @@ def check_limits(limits, **where) -> tuple[float, float]:
             values.append(float(e))
         except TypeError:
             raise SymdynError(f"limits must be real numbers, got {e}", **where) from None
+        texts.append(f"{values[-1]:.4g}" if e.is_Number else f"{e} = {values[-1]:.4g}")
     lo, hi = values
     if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise SymdynError(f"limits must be finite, got [{lo:g}, {hi:g}]", **where)
+        raise SymdynError(f"limits must be finite, got [{texts[0]}, {texts[1]}]", **where)
     if not lo < hi:
-        raise SymdynError(f"the lower limit {lo:g} must be below the upper limit {hi:g}", **where)
+        raise SymdynError(f"the lower limit {texts[0]} must be below the upper limit {texts[1]}", **where)
     return lo, hi

@@ -336,8 +336,10 @@ class UrdfReader:
             for k in ("lower", "upper")
         )
         if lower > upper:
+            missing = [k for k in ("lower", "upper") if k not in limit.attrib]
+            hint = f" ('{missing[0]}' is not given: URDF makes it 0)" if missing else ""
             raise self.error(
-                f"the lower limit {lower} is above the upper limit {upper}",
+                f"the lower limit {float(lower):g} is above the upper limit {float(upper):g}{hint}",
                 line=limit.line,
                 **_at(where, label + ".limit"),
             )
