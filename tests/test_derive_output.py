@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
+import yaml
 from robots import example
 
 from symdyn import rnea
@@ -103,6 +104,19 @@ def test_prune_prints_its_bound_and_op_counts(capsys):
     text = _run(capsys, str(EXAMPLES / "puma560.yaml"), "--prune", "0.01")
     assert re.search(r"# guaranteed: \|error of an entry\| <= [0-9.e-]+ x its largest value", text)
     assert re.search(r"# operations M \d+ -> \d+", text)
+    assert "limits" not in (EXAMPLES / "puma560.yaml").read_text()  # so the ranges are +-pi
+    assert "\n# joint ranges: +-pi for q1..q6 (no limits)\n" in text
+
+
+def test_prune_names_the_robot_files_limits(tmp_path, capsys):
+    """planar_3r with limits on joints 1 and 2: the printout says which ranges it used."""
+    data = yaml.safe_load((EXAMPLES / "planar_3r.yaml").read_text())
+    data["links"][0]["limits"] = ["-pi/2", "pi/2"]
+    data["links"][1]["limits"] = [0, "3*pi/4"]
+    path = tmp_path / "planar_3r_limits.yaml"
+    path.write_text(yaml.safe_dump(data))
+    text = _run(capsys, str(path), "--prune", "0.05")
+    assert "\n# joint ranges: robot file limits for q1, q2; +-pi for q3 (no limits)\n" in text
 
 
 def test_latex_configuration_form_breaks_long_entries(capsys):

@@ -249,6 +249,18 @@ def test_file_and_lists_agree_and_the_file_loads_as_poe():
     assert_close(a.evaluate("tau", q, qd, qdd), b.evaluate("tau", q, qd, qdd), 1e-12)
 
 
+def test_limits_in_a_poe_file_are_the_joint_ranges():
+    data = yaml.safe_load((EXAMPLES / "mr_ur5.yaml").read_text())
+    data["links"][1]["limits"] = ["-pi/2", "pi/2"]
+    data["links"][5]["limits"] = [-6.28, 6.28]
+    robot = robot_from_data(data, source="ur5.yaml")
+    assert robot.links[1].limits == (-sp.pi / 2, sp.pi / 2)
+    assert robot.links[5].limits == (sp.Float("-6.28"), sp.Float("6.28"))
+    assert robot.joint_ranges() == (None, (-np.pi / 2, np.pi / 2), None, None, None, (-6.28, 6.28))
+    plain = symdyn.load_robot(EXAMPLES / "mr_ur5.yaml")
+    assert [dataclasses.replace(lk, limits=None) for lk in robot.links] == list(plain.links)
+
+
 def test_symbolic_entries_become_free_parameters():
     """A two-link planar arm with symbolic length and masses: PoE with SymPy matrices against
     the DH robot file of the same arm (point masses at the link ends, Craig's example 6.3)."""
@@ -315,6 +327,8 @@ def _with(a, index, value):
         (lambda d: d["links"][2].pop("screw"), "screw"),
         (lambda d: d["links"][1]["frame"].update(rotation=[[1, 0], [0, 1]]), "frame.rotation"),
         (lambda d: d.update(end_effector={"position": [0, 0]}), "end_effector.position"),
+        (lambda d: d["links"][3].update(limits=[1]), "limits"),
+        (lambda d: d["links"][3].update(limits=["pi", "-pi"]), "limits"),
     ],
 )
 def test_bad_poe_files_name_link_and_field(edit, field):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import difflib
 import hashlib
 import importlib
+import json
 import math
 import warnings
 from pathlib import Path
@@ -324,6 +325,12 @@ BAD_FILES = {
     "bad_expression_syntax.yaml": (2, "elbow", "a", "cannot parse"),
     "duplicate_link_name.yaml": (2, "shoulder", "name", "duplicate link name"),
     "bad_link_name.yaml": (2, "elbow joint", "name", "link name"),
+    "reversed_limits.yaml": (
+        2,
+        "elbow",
+        "limits",
+        "lower limit pi/2 = 1.571 must be below the upper limit -pi/2",
+    ),
 }
 
 
@@ -410,6 +417,14 @@ def test_bad_yaml_names_the_line(tmp_path):
         ({"joint": "revolute", "mass": None}, "mass", "null"),
         ({"joint": 1, "mass": 1}, "joint", "'revolute' or 'prismatic'"),
         ({"joint": "revolute", "mass": "m", "theta": "q2"}, "theta", "joint symbols"),
+        ({"joint": "revolute", "mass": 1, "limits": 1.5}, "limits", "expected [lower, upper]"),
+        ({"joint": "revolute", "mass": 1, "limits": [0, 1, 2]}, "limits", "got 3 entries"),
+        ({"joint": "revolute", "mass": 1, "limits": {"lower": 0}}, "limits", "got a mapping"),
+        ({"joint": "revolute", "mass": 1, "limits": ["x.y", 1]}, "limits.lower", "attribute"),
+        ({"joint": "revolute", "mass": 1, "limits": [0, "qmax"]}, "limits", "without a value (qmax)"),
+        ({"joint": "prismatic", "mass": 1, "limits": [0.2, 0.2]}, "limits", "below the upper limit"),
+        ({"joint": "revolute", "mass": 1, "limits": ["c", "c/2"]}, "limits", "0.5 must be below"),  # c = 0.5
+        ({"joint": "revolute", "mass": 1, "limit": [0, 1]}, "limit", "did you mean 'limits'"),
     ],
 )
 def test_link_field_errors_through_the_api(link, field, words):
@@ -467,6 +482,76 @@ def test_symbolic_values_are_checked_after_substitution():
     assert (info.value.link_index, info.value.field) == (1, "mass")
     data["parameters"]["k"] = None  # symbolic: cannot be judged, so accepted
     assert robot_from_data(data).params == (sp.Symbol("k"),)
+
+
+# ------------------------------------------------------------------ joint ranges
+
+RANGED = """\
+name: ranged
+convention: CONVENTION
+parameters:
+  qmax: 3*pi/4
+links:
+  - {name: a, joint: revolute, mass: 1, inertia: {ixx: 1, iyy: 1, izz: 1}, limits: [-pi/2, pi/2]}
+  - {name: b, joint: prismatic, mass: 1, limits: [0, 0.25]}
+  - {name: c, joint: revolute, mass: 1, limits: [-qmax, qmax]}
+  - {name: d, joint: revolute, mass: 1, limits: null}
+  - {name: e, joint: revolute, mass: 1}
+"""
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_limits_are_kept_as_written_and_resolve_to_numbers(tmp_path, convention):
+    path = tmp_path / "ranged.yaml"
+    path.write_text(RANGED.replace("CONVENTION", convention))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        robot = load_robot(path)
+    qmax = sp.Symbol("qmax")
+    assert [lk.limits for lk in robot.links] == [
+        (-sp.pi / 2, sp.pi / 2),
+        (0, sp.Float("0.25")),
+        (-qmax, qmax),
+        None,
+        None,
+    ]
+    assert robot.params == ()  # qmax has a value
+    assert robot.resolved().links[2].limits == (-3 * sp.pi / 4, 3 * sp.pi / 4)
+    assert robot.joint_ranges() == (
+        (-math.pi / 2, math.pi / 2),
+        (0.0, 0.25),
+        (-3 * math.pi / 4, 3 * math.pi / 4),
+        None,
+        None,
+    )
+    as_json = tmp_path / "ranged.json"
+    as_json.write_text(json.dumps(yaml.safe_load(path.read_text())))
+    assert load_robot(as_json).links == robot.links
+    table = repr(robot).splitlines()
+    assert table[1].split(" | ")[-1].strip() == "limits"
+    assert [row.split(" | ")[-1].strip() for row in table[3:]] == [
+        "[-1.571, 1.571]",  # numbers with 4 significant digits, as every number in the table
+        "[0, 0.25]",
+        "[-qmax, qmax]",
+        "-",
+        "-",
+    ]
+
+
+def test_a_robot_without_limits_prints_no_limits_column():
+    robot = _load("base_arm.yaml")
+    assert all(lk.limits is None for lk in robot.links)
+    assert "limits" not in repr(robot)
+
+
+def test_limits_with_a_free_parameter_are_refused_naming_it():
+    data = {"name": "a", "links": [{"name": "l", "joint": "revolute", "mass": 1, "limits": [0, "qmax"]}]}
+    with pytest.raises(SymdynError, match=r"names parameters without a value \(qmax\)") as info:
+        robot_from_data(data, source="a.yaml")
+    assert (info.value.file, info.value.link_index, info.value.field) == ("a.yaml", 1, "limits")
+    data["parameters"] = {"qmax": "2*pi/3"}
+    ((lo, hi),) = robot_from_data(data).joint_ranges()
+    assert lo == 0 and hi == pytest.approx(2 * math.pi / 3, rel=1e-15)
 
 
 # ------------------------------------------------------------------ warnings

@@ -174,6 +174,70 @@ def test_robot_fields():
         assert lk.axis == sp.ImmutableMatrix([0, 1, 0])
 
 
+# joint -> (type, the <limit> element or "", the expected limits of its link)
+LIMITS = {
+    "j1": ("revolute", '<limit effort="5" lower="-1.5" upper="2" velocity="1"/>', (sp.Float("-1.5"), 2)),
+    "j2": ("revolute", "", None),  # no <limit>
+    "j3": ("revolute", '<limit effort="5" velocity="1"/>', None),  # lower = upper = 0, the defaults
+    "j4": ("revolute", '<limit lower="0" upper="0" effort="0" velocity="0"/>', None),
+    "j5": ("revolute", '<limit upper="0.5" effort="1" velocity="1"/>', (0, sp.Float("0.5"))),
+    "j6": ("prismatic", '<limit lower="0" upper="0.04" effort="20" velocity="0.2"/>', (0, sp.Float("0.04"))),
+    "j7": ("continuous", '<limit lower="-1" upper="1" effort="1" velocity="1"/>', None),  # not read
+}
+
+
+def _limits_urdf(joints: dict) -> str:
+    """A chain b -> l1 -> l2 ... whose joint i is joints' i-th (type, <limit>) entry."""
+    body = '<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
+    links = "".join(f'<link name="l{i}">{body}</link>' for i in range(1, len(joints) + 1))
+    chain = "".join(
+        f'<joint name="{name}" type="{kind}"><parent link="{"b" if i == 1 else f"l{i - 1}"}"/>'
+        f'<child link="l{i}"/><axis xyz="0 0 1"/>{limit}</joint>'
+        for i, (name, (kind, limit, *_)) in enumerate(joints.items(), start=1)
+    )
+    return f'<robot name="ranged"><link name="b"/>{links}{chain}</robot>'
+
+
+def test_limits_of_revolute_and_prismatic_joints(tmp_path):
+    path = tmp_path / "ranged.urdf"
+    path.write_text(_limits_urdf(LIMITS))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        robot = load_urdf(path)
+    assert [lk.limits for lk in robot.links] == [want for _, _, want in LIMITS.values()]
+    assert robot.joint_ranges() == ((-1.5, 2.0), None, None, None, (0.0, 0.5), (0.0, 0.04), None)
+    two_link = load("two_link.urdf")  # shoulder <limit lower="-3" upper="3">, elbow continuous
+    assert [lk.limits for lk in two_link.links] == [(-3, 3), None]
+
+
+@pytest.mark.parametrize(
+    ("limit", "field", "fragment"),
+    [
+        ('<limit lower="1" upper="-1"/>', "joint(j1).limit", "the lower limit 1 is above the upper limit -1"),
+        (
+            '<limit lower="0.5"/>',
+            "joint(j1).limit",
+            "above the upper limit 0 ('upper' is not given: URDF makes it 0)",
+        ),
+        ('<limit lower="-pi" upper="1"/>', "joint(j1).limit.lower", "expected a number, got '-pi'"),
+        ('<limit lower="-1" upper="1e999"/>', "joint(j1).limit.upper", "1e999 is not a finite number"),
+        (
+            '<limit lower="-1" upper="1"/><limit lower="-2" upper="2"/>',
+            "joint(j1).limit",
+            "more than one <limit>",
+        ),
+    ],
+)
+def test_malformed_limits_are_refused(tmp_path, limit, field, fragment):
+    path = tmp_path / "bad_limit.urdf"
+    path.write_text(_limits_urdf({"j1": ("revolute", limit)}))
+    with pytest.raises(SymdynError) as info:
+        load_urdf(path)
+    err = info.value
+    assert (err.file, err.link_index, err.link_name, err.field) == (str(path), 2, "l1", field)
+    assert fragment in err.reason and "(line 1)" in err.reason
+
+
 def test_exact_numbers():
     robot = load("rpy_chain.urdf")
     a, b, c = robot.links
@@ -784,6 +848,23 @@ def test_real_robot_names_and_sizes():
         ("robot_2dof_planar", 2),  # "2dof_planar" made a C identifier
     ]
     assert [lk.name for lk in real("panda").links] == [f"panda_link{i}" for i in range(1, 8)]
+
+
+@needs_erd
+@pytest.mark.parametrize("name", ["panda", "ur5"])
+def test_real_robot_limits_are_the_xml_limits(name):
+    """Each link's limits are the <limit lower upper> of the joint whose child it is, read here
+    with ElementTree (the Panda's finger joints are locked by its tip: not loaded)."""
+    root = ET.parse(ERD / REAL[name][0]).getroot()
+    by_child = {j.find("child").get("link"): j for j in root.findall("joint")}
+    robot = real(name)
+    assert robot.links
+    for lk in robot.links:
+        joint = by_child[lk.name]
+        assert joint.get("type") == "revolute"
+        limit = joint.find("limit")
+        assert lk.limits is not None
+        assert tuple(float(x) for x in lk.limits) == (float(limit.get("lower")), float(limit.get("upper")))
 
 
 @needs_erd

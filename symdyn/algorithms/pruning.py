@@ -14,6 +14,11 @@ of the entry is then at most the sum of the dropped terms' bounds, which `Pruned
 states for every entry; V = B [qd qd] + Csq [qd^2] errs by at most
 sum bound(B[k,(i,j)]) |qd_i qd_j| + sum bound(Csq[k,i]) qd_i^2.
 
+The box (`joint_box`) is the robot's own joint ranges: each coordinate's `limits` (the robot
+file's `limits`, the URDF's <limit>; Robot.joint_ranges), else +-pi, a revolute joint's full
+turn. A prismatic joint without limits gets +-pi too, read as metres, as pruning always did:
+give it `limits` when it travels farther. The bounds hold for states inside the box only.
+
 Reference: B. Armstrong, O. Khatib, J. Burdick, "The explicit dynamic model and inertial
 parameters of the PUMA 560 arm", Proc. IEEE ICRA 1986 (the simplified models).
 """
@@ -23,7 +28,8 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import sympy as sp
@@ -32,7 +38,10 @@ from ..errors import SymdynError
 from ..symbolic.trig_polynomial import TrigPoly, TrigRing
 from .configuration_space import ConfigurationSpace, pair_columns
 
-__all__ = ["Pruned", "prune", "trig_bound"]
+if TYPE_CHECKING:
+    from ..model.robot import Robot
+
+__all__ = ["Pruned", "prune", "prune_robot", "trig_bound", "joint_box"]
 
 SAMPLES = 2000
 
@@ -77,6 +86,9 @@ class Pruned:
     bounds: dict[tuple[str, int, int], float]
     terms_before: int
     terms_after: int
+    #: the box the bounds hold over: (lower, upper) per joint, and where it came from
+    limits: list[tuple[float, float]] = field(default_factory=list)
+    ranges: str = ""
 
     def worst(self) -> float:
         """The largest error bound relative to its entry's largest value (0 if none dropped)."""
@@ -117,6 +129,7 @@ def prune(
     n = cs.n
     if not 0 < rel < 1:
         raise SymdynError(f"prune: the relative threshold must be between 0 and 1, got {rel}")
+    ranges = "joint ranges: +-pi" if limits is None else "joint ranges: as given"
     limits = [(-math.pi, math.pi)] * n if limits is None else [(float(a), float(b)) for a, b in limits]
     if len(limits) != n:
         raise SymdynError(f"prune: {len(limits)} joint ranges for {n} joints")
@@ -159,4 +172,49 @@ def prune(
             target = ("Csq", k, i) if i == j else ("B", k, pairs[(i, j)])
             largest[target] = scale * largest.pop(key)
             bounds[target] = scale * bounds.pop(key)
-    return Pruned(pruned, rel, largest, bounds, before, after)
+    return Pruned(pruned, rel, largest, bounds, before, after, limits, ranges)
+
+
+def _span(indices: list[int]) -> str:
+    """q1..q3, q5, q6 for coordinates 0, 1, 2, 4, 5 (runs of three or more shortened)."""
+    runs: list[list[int]] = []
+    for k in indices:
+        if runs and k == runs[-1][-1] + 1:
+            runs[-1].append(k)
+        else:
+            runs.append([k])
+    names = [[f"q{k + 1}" for k in r] for r in runs]
+    return ", ".join(f"{r[0]}..{r[-1]}" if len(r) > 2 else ", ".join(r) for r in names)
+
+
+def joint_box(robot: Robot) -> tuple[list[tuple[float, float]], str]:
+    """The joint ranges to prune over, and a line saying where they come from.
+
+    Returns:
+        (lower, upper) per independent coordinate: its link's `limits` (Robot.joint_ranges),
+        else +-pi (a prismatic joint's +-pi read as metres); and the text, e.g.
+        "joint ranges: robot file limits for q1..q5; +-pi for q6 (no limits)".
+
+    Raises:
+        SymdynError: limits that are not numbers lower < upper (naming the link).
+    """
+    ranges = robot.joint_ranges()
+    kinds = [lk.joint for lk in robot.links if lk.mimic is None]
+    origin = "URDF" if robot.convention == "urdf" else "robot file" if robot.source else "link"
+    groups: dict[str, list[int]] = {
+        f"{origin} limits": [],
+        "+-pi": [],
+        f"+-{math.pi:.4g} m": [],
+    }
+    for k, (r, kind) in enumerate(zip(ranges, kinds, strict=True)):
+        key = 0 if r is not None else 1 if kind == "revolute" else 2
+        groups[list(groups)[key]].append(k)
+    notes = {"+-pi": " (no limits)", f"+-{math.pi:.4g} m": " (prismatic, no limits)"}
+    text = "; ".join(f"{name} for {_span(ks)}{notes.get(name, '')}" for name, ks in groups.items() if ks)
+    return [(-math.pi, math.pi) if r is None else r for r in ranges], f"joint ranges: {text}"
+
+
+def prune_robot(cs: ConfigurationSpace, robot: Robot, rel: float) -> Pruned:
+    """`prune` over the robot's own joint ranges (joint_box), which `Pruned.ranges` names."""
+    limits, ranges = joint_box(robot)
+    return replace(prune(cs, rel, limits=limits), ranges=ranges)

@@ -91,8 +91,9 @@ def prune_summary(dyn: Dynamics, pruned) -> list[str]:
     text = ", ".join(f"{k} {a} -> {b}" for k, (a, b) in ops.items())
     total = tuple(sum(v[i] for v in ops.values()) for i in (0, 1))
     return [
-        f"# pruned at {pruned.rel:g} of each entry's largest value over the joint ranges (+-pi): "
+        f"# pruned at {pruned.rel:g} of each entry's largest value over the joint ranges: "
         f"{pruned.terms_before} -> {pruned.terms_after} terms",
+        f"# {pruned.ranges}",
         f"# guaranteed: |error of an entry| <= {pruned.worst():.4g} x its largest value "
         "(per entry: the sum of the dropped terms' maxima)",
         f"# operations {text}; total {total[0]} -> {total[1]}",

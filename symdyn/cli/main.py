@@ -102,11 +102,12 @@ def cmd_derive(args: argparse.Namespace) -> int:
         configuration = args.form == "configuration"
         text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
     elif args.prune is not None:
-        from ..algorithms.pruning import prune
+        from ..algorithms.pruning import prune_robot
 
         if args.format != "text" or args.form != "configuration":
             raise SymdynError("derive: --prune prints the configuration form as text only")
-        text = out.derive_text(dyn, args.form, args.lumped, prune(dyn.configuration_space, args.prune))
+        pruned = prune_robot(dyn.configuration_space, robot, args.prune)
+        text = out.derive_text(dyn, args.form, args.lumped, pruned)
     else:
         text = {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
     sys.stdout.write(text)

@@ -3,7 +3,8 @@
 The pruned form (symdyn.algorithms.pruning: AKB's "1 % model") replaces the derivation's
 program: M, G, V = B [qd qd] + Csq [qd^2], C_kj = sum_i Gamma^k_ij qd_i, tau and the bias
 are its closed forms (joint space), and the generated functions are built from them as from
-any derivation (symdyn.codegen.functions). The guaranteed bound goes into the headers.
+any derivation (symdyn.codegen.functions). The guaranteed bound, and the joint ranges it holds
+over (the robot's limits, else +-pi: symdyn.algorithms.pruning.joint_box), go into the headers.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import dataclasses
 
 import sympy as sp
 
-from ..algorithms.pruning import prune
+from ..algorithms.pruning import prune_robot
 from ..dynamics import ALL_QUANTITIES, Dynamics
 from ..symbolic.program import Program
 
@@ -22,7 +23,7 @@ __all__ = ["pruned_dynamics"]
 def pruned_dynamics(dyn: Dynamics, rel: float) -> tuple[Dynamics, tuple[str, ...]]:
     """A Dynamics whose quantities are the pruned configuration-space form of `dyn`, and
     the header lines that state what was dropped and the error bound it guarantees."""
-    pruned = prune(dyn.configuration_space, rel)
+    pruned = prune_robot(dyn.configuration_space, dyn.robot, rel)
     cs = pruned.configuration
     F = dyn.compact["F"]
     compact = {
@@ -36,8 +37,9 @@ def pruned_dynamics(dyn: Dynamics, rel: float) -> tuple[Dynamics, tuple[str, ...
     )
     notes = (
         f"Pruned model (--prune {rel:g}): terms of M, B, Csq, G below {rel:g} of their entry's",
-        f"largest value over the joint ranges (+-pi) dropped, {pruned.terms_before} -> {pruned.terms_after}",
+        f"largest value over the joint ranges dropped, {pruned.terms_before} -> {pruned.terms_after}",
         f"terms; every entry errs by at most {pruned.worst():.4g} times its largest value (the sum of",
-        "its dropped terms' maxima).",
+        "its dropped terms' maxima) while q stays in the joint ranges.",
+        pruned.ranges[0].upper() + pruned.ranges[1:] + ".",
     )
     return out, notes

@@ -18,6 +18,10 @@ frames the user wrote, never by the dynamics.
 Links come in depth-first order (a parent before its children; symdyn.model.topology).
 A link whose joint `mimic`s another's has no coordinate of its own, so the robot has
 `n` independent coordinates (degrees of freedom) and `nb` = len(links) bodies.
+
+A link may give its joint's range, `limits` = (lower, upper) in rad or m (the robot file's
+`limits`, the URDF's <limit>); None when it gives none. Nothing in the dynamics depends on it:
+significance pruning (symdyn.algorithms.pruning) bounds terms over these ranges.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from .limits import check_limits
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
@@ -79,6 +84,8 @@ class Link:
     parent: int | None = None
     #: this joint follows another: q = multiplier * q_other + offset (no coordinate of its own)
     mimic: Mimic | None = None
+    #: the joint's range (lower, upper) in rad or m: numbers, or expressions of valued parameters; None: none
+    limits: tuple[sp.Expr, sp.Expr] | None = None
 
     def joint_transform(self, q) -> Transform:
         """parent_T_i(q): the body frame of this link in its parent's body frame."""
@@ -111,6 +118,7 @@ class Link:
                 sp.sympify(self.mimic.multiplier).xreplace(x),
                 sp.sympify(self.mimic.offset).xreplace(x),
             ),
+            limits=None if self.limits is None else tuple(sp.sympify(v).xreplace(x) for v in self.limits),
         )
 
 
@@ -250,6 +258,21 @@ class Robot:
         coordinates = self.coordinates
         busy = {c.index for i, c in enumerate(coordinates) if i not in idle}
         return tuple(i for i in sorted(idle) if coordinates[i].index not in busy)
+
+    def joint_ranges(self) -> tuple[tuple[float, float] | None, ...]:
+        """Per independent coordinate, the range (lower, upper) its own link's `limits` give
+        (rad or m, valued parameters substituted), None where the link gives none. A mimic
+        joint's own limits do not enter: its coordinate is its master's.
+
+        Raises:
+            SymdynError: limits that are not numbers, or not lower < upper (naming the link).
+        """
+        out = []
+        for i, link in enumerate(self.resolved().links):
+            if link.mimic is None:
+                where = {"link_index": i + 1, "link_name": link.name, "file": self.source}
+                out.append(None if link.limits is None else check_limits(link.limits, **where))
+        return tuple(out)
 
     @property
     def value_map(self) -> dict[sp.Symbol, sp.Expr]:

@@ -3,7 +3,8 @@
 Each row shows the link's joint (R or P, or the joint it mimics), its parent, the joint's
 constant placement in the parent's body frame (translation and URDF roll-pitch-yaw of
 `Link.placement`, R = Rz(yaw) Ry(pitch) Rx(roll)), the axis in the link's body frame, the mass
-and the free parameters the link names. Numbers get 4 significant digits, symbols print as
+and the free parameters the link names, and, when any link gives one, the joint's range
+(`Link.limits`, "-" for a link without). Numbers get 4 significant digits, symbols print as
 written; nothing is expanded or simplified, so the table stays fast for long chains.
 The model is described in docs/python-api.md, "The model".
 """
@@ -107,6 +108,7 @@ def _link_params(link, params: Sequence[sp.Symbol]) -> str:
         link.friction.coulomb,
         link.motor.inertia,
         link.motor.gear_ratio,
+        *(link.limits or ()),
     )
     for x in fields:
         atoms |= sp.sympify(x).free_symbols
@@ -144,8 +146,11 @@ def robot_table(robot) -> str:
         The text, rows in the order of Robot.links, link numbers from 1.
     """
     names = [link.name for link in robot.links]
-    rows = [("#", "link", "joint", "parent", "placement", "axis", "mass", "params")]
+    ranged = any(link.limits is not None for link in robot.links)
+    titles = ("#", "link", "joint", "parent", "placement", "axis", "mass", "params")
+    rows = [titles + (("limits",) if ranged else ())]
     for i, (link, parent) in enumerate(zip(robot.links, robot.parents, strict=True)):
+        limits = "-" if link.limits is None else "[" + ", ".join(number_text(x) for x in link.limits) + "]"
         rows.append(
             (
                 str(i + 1),
@@ -156,6 +161,7 @@ def robot_table(robot) -> str:
                 axis_text(link.axis),
                 number_text(link.mass),
                 _link_params(link, robot.params) or "-",
+                *([limits] if ranged else []),
             )
         )
     widths = [max(len(r[k]) for r in rows) for k in range(len(rows[0]))]

@@ -6,6 +6,7 @@
         frame: {position: [x, y, z], rotation: [[...], [...], [...]]}   # M_{i-1,i}
         spatial_inertia: [Ixx, Iyy, Izz, m, m, m]   # the diagonal of G_i, or its 6 rows
         screw: [wx, wy, wz, vx, vy, vz]              # S_i, space frame
+        limits: [lower, upper]                       # optional: the joint's range (rad or m)
     end_effector: {position: [...], rotation: [...]}  # M_{n,n+1}
 
 The top-level keys name, gravity and parameters are read as in every robot file
@@ -14,6 +15,8 @@ symdyn.parsers.poe.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import sympy as sp
 
@@ -24,7 +27,7 @@ from .robot_fields import LINK_NAME, LinkData, RobotFileReader
 __all__ = ["POE_TOP_KEYS", "POE_LINK_KEYS", "FRAME_KEYS", "PoeFileReader"]
 
 POE_TOP_KEYS = ("name", "convention", "gravity", "parameters", "links", "end_effector")
-POE_LINK_KEYS = ("name", "frame", "spatial_inertia", "screw")
+POE_LINK_KEYS = ("name", "frame", "spatial_inertia", "screw", "limits")
 FRAME_KEYS = ("position", "rotation")
 
 
@@ -108,6 +111,8 @@ class PoeFileReader(RobotFileReader):
                 parts[key] = sp.ImmutableMatrix(
                     [self.expr(x, f"screw[{k}]", link) for k, x in enumerate(value)]
                 )
+            elif key == "limits":
+                self.limits(value, link)
         self.poe.append(PoeLink(link.name, parts["frame"], parts["spatial_inertia"], parts["screw"]))
         return link
 
@@ -128,4 +133,5 @@ class PoeFileReader(RobotFileReader):
             names = {"M.rotation": "frame.rotation", "G": "spatial_inertia", "S": "screw"}
             return self.error(message, link=link, field=names.get(field, field))
 
-        return poe_links(self.poe, self.end_effector, fail, subs, self.file)
+        links = poe_links(self.poe, self.end_effector, fail, subs, self.file)
+        return [replace(lk, limits=ld.limits) for lk, ld in zip(links, self.links, strict=True)]

@@ -20,6 +20,7 @@ import sympy as sp
 from ..errors import SymdynError, link_fields
 from ..model.angles import snap_angle
 from ..model.expressions import check_parameter_name, is_c_identifier, parse_expression_names
+from ..model.limits import check_limits
 from ..model.robot import JOINT_TYPES
 from .dh import CONVENTIONS
 from .source import did_you_mean
@@ -52,6 +53,7 @@ LINK_KEYS = (
     "friction",
     "motor",
     "mimic",
+    "limits",
 )
 INERTIA_KEYS = ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
 FRICTION_KEYS = ("viscous", "coulomb")
@@ -64,8 +66,9 @@ LINK_NAME = _LINK_NAME  # the pattern of a link name, for the other robot-file r
 
 @dataclass
 class LinkData:
-    """One link entry as written: parent, DH row, inertial data, friction, motor and mimic (defaults
-    for omitted keys). `parent` is the name written (None: null); `parent_given` whether it was."""
+    """One link entry as written: parent, DH row, inertial data, friction, motor, mimic and joint
+    range (defaults for omitted keys). `parent` is the name written (None: null); `parent_given`
+    whether it was."""
 
     index: int
     name: str
@@ -86,6 +89,7 @@ class LinkData:
     motor_inertia: sp.Expr = sp.S.Zero
     gear_ratio: sp.Expr = sp.S.One
     mimic: tuple[str, sp.Expr, sp.Expr] | None = None  # (link name, multiplier, offset)
+    limits: tuple[sp.Expr, sp.Expr] | None = None  # (lower, upper) as written
 
 
 class RobotFileReader:
@@ -280,6 +284,8 @@ class RobotFileReader:
                 link.parent, link.parent_given = value, True
             elif key == "mimic":
                 self._read_mimic(value, link)
+            elif key == "limits":
+                self.limits(value, link)
             elif key in ("alpha", "theta", "gamma"):
                 setattr(link, key, self.angle(value, key, link))
             elif key in ("a", "d", "b", "mass"):
@@ -299,6 +305,25 @@ class RobotFileReader:
                     attr = "motor_inertia" if k == "inertia" else k
                     setattr(link, attr, self.expr(v, f"motor.{k}", link))
         return link
+
+    def limits(self, value: object, link: LinkData) -> None:
+        """limits: [lower, upper], the joint's range in rad or m (null: none). Whether they are
+        numbers with lower < upper is checked once parameters have values (`check_limits`)."""
+        if value is None:
+            return
+        if not isinstance(value, list) or len(value) != 2:
+            got = f"{len(value)} entries" if isinstance(value, list) else _kind(value)
+            raise self.error(
+                f"expected [lower, upper], two numbers or expressions (rad or m), got {got}",
+                link=link,
+                field="limits",
+            )
+        link.limits = (self.expr(value[0], "limits.lower", link), self.expr(value[1], "limits.upper", link))
+
+    def check_limits(self, link: LinkData, subs: dict) -> None:
+        """Refuse a range that is not two numbers lower < upper once parameters have values."""
+        if link.limits is not None:
+            check_limits([v.xreplace(subs) for v in link.limits], file=self.file, **link_fields(link))
 
     def _read_mimic(self, value: object, link: LinkData) -> None:
         """mimic: {joint: LINK, multiplier: k, offset: o}, q_link = k q_LINK + o (null: none)."""

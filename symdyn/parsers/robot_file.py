@@ -155,6 +155,8 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
     subs = {sp.Symbol(n): v for n, v in values.items()}
     params = tuple(sp.Symbol(n) for n in dict.fromkeys(reader.order) if n not in values)
     links = reader.links_of_model(subs) if isinstance(reader, PoeFileReader) else _dh_links(reader, subs)
+    for ld in reader.links:
+        reader.check_limits(ld, subs)
     gravity = reader.gravity
     if gravity is None:
         gravity = DEFAULT_GRAVITY
@@ -199,6 +201,7 @@ def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
                 frame=frame,
                 parent=None if parents[i] == i - 1 else parents[i],
                 mimic=mimics[i],
+                limits=ld.limits,
             )
         )
     return links

@@ -28,8 +28,10 @@ a symdyn body frame unchanged (`Link.frame` is the identity):
   (symdyn.inertia.check_inertia: errors and warnings) only for the links that move,
   so a bad tensor on, say, a mobile base's antenna does not refuse its arm;
 * <dynamics damping="" friction=""> become friction.viscous and friction.coulomb;
-  limits, transmissions, visual and collision elements (and their meshes) are
-  ignored: nothing is ever fetched, from disk or the network.
+  <limit lower="" upper=""> of a revolute or prismatic joint becomes the link's `limits`
+  (lower = upper, the URDF defaults 0 and 0: no range; symdyn.parsers.urdf_elements);
+  effort and velocity limits, transmissions, visual and collision elements (and their
+  meshes) are ignored: nothing is ever fetched, from disk or the network.
 
 Default base: the root link. A tip cuts one chain out of the tree instead: the
 movable joints on the path from the base to the tip, in that order; everything
@@ -179,6 +181,7 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
                 friction=Friction(j.damping, j.friction),
                 parent=None if parent == i - 1 else parent,
                 mimic=_mimic(reader, j, index, where),
+                limits=j.limits,
             )
         )
     return Robot(

@@ -14,6 +14,11 @@ within 1e-3 rad of a nonzero multiple but not 1e-9 (1.5708) it is kept as writte
 with a SymdynWarning naming the file, the link, the field and the line, whether or
 not that link ends up in the robot (the whole file is read).
 A joint's <axis xyz> (default 1 0 0) is normalised.
+The <limit lower= upper=> of a revolute or prismatic joint is its range (lower and upper
+default to 0, as in the URDF specification): lower < upper gives `limits`; lower = upper
+(0 and 0 when neither is written) says nothing about the range, which stays None, as for a
+continuous joint (whose <limit> is not read); lower > upper is refused. Its other
+attributes (effort, velocity) are not read.
 """
 
 from __future__ import annotations
@@ -84,6 +89,7 @@ class UrdfJoint:
     friction: sp.Expr
     mimic: tuple[str, sp.Expr, sp.Expr] | None  # (joint, multiplier, offset)
     mimic_line: int = 0
+    limits: tuple[sp.Expr, sp.Expr] | None = None  # (lower, upper) of <limit>, lower < upper
 
     @property
     def movable(self) -> bool:
@@ -315,8 +321,29 @@ class UrdfReader:
             mimic = (master, factors[0], factors[1])
         self.joints[name] = UrdfJoint(
             name, el.line, kind, ends["parent"], ends["child"], origin, axis, damping, friction, mimic,
-            mimic_el.line if mimic_el is not None else 0,
+            mimic_el.line if mimic_el is not None else 0, self._limits(el, kind, where, label),
         )  # fmt: skip
+
+    def _limits(self, el: Element, kind: str, where: dict, label: str) -> tuple[sp.Expr, sp.Expr] | None:
+        """(lower, upper) of a revolute or prismatic joint's <limit>; None without a range."""
+        if kind not in ("revolute", "prismatic"):
+            return None
+        limit = self.one(el, "limit", _at(where, label + ".limit"))
+        if limit is None:
+            return None
+        lower, upper = (
+            self.number(limit.attrib.get(k, "0"), _at(where, f"{label}.limit.{k}"), limit.line)
+            for k in ("lower", "upper")
+        )
+        if lower > upper:
+            missing = [k for k in ("lower", "upper") if k not in limit.attrib]
+            hint = f" ('{missing[0]}' is not given: URDF makes it 0)" if missing else ""
+            raise self.error(
+                f"the lower limit {float(lower):g} is above the upper limit {float(upper):g}{hint}",
+                line=limit.line,
+                **_at(where, label + ".limit"),
+            )
+        return None if lower == upper else (lower, upper)
 
 
 def _at(where: dict, fld: str) -> dict:
