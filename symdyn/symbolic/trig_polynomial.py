@@ -285,6 +285,7 @@ class TrigRing:
         self.memo: dict[sp.Expr, TrigPoly] = {}
         self._named: set[sp.Symbol] = set()
         self._trig_cache: dict[tuple, sp.Expr] = {}
+        self._coefficients: dict[tuple, sp.Expr] = {}  # group_coefficient's, by its items
 
     # -- construction -----------------------------------------------------------------
     def constant(self, c) -> TrigPoly:
@@ -474,11 +475,16 @@ class TrigRing:
 
     def group_coefficient(self, items: list) -> sp.Expr:
         """The coefficient of one angle group as a SymPy expression: the sum of number times
-        parameter monomial, common factors pulled out of a sum of several."""
-        coef = fast_add([fast_mul([to_sympy_number(c), self.mono_expr(pp)]) for c, pp in items])
-        if coef.is_Add and len(items) > 1:
-            coef = sp.factor_terms(coef)
-        return coef
+        parameter monomial, common factors pulled out of a sum of several (memoised: printing
+        and lumping ask for the same ones)."""
+        key = tuple(items)
+        hit = self._coefficients.get(key)
+        if hit is None:
+            hit = fast_add([fast_mul([to_sympy_number(c), self.mono_expr(pp)]) for c, pp in items])
+            if hit.is_Add and len(items) > 1:
+                hit = sp.factor_terms(hit)
+            self._coefficients[key] = hit
+        return hit
 
     def to_sympy(self, p: TrigPoly, coefficient: Callable | None = None) -> sp.Expr:
         """The expression: terms grouped by their angle part (trig and coordinates), each with
