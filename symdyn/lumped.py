@@ -62,16 +62,26 @@ _TENSOR = (("Jxx", "Jxy", "Jxz"), ("Jxy", "Jyy", "Jyz"), ("Jxz", "Jyz", "Jzz"))
 class LumpedConstants:
     """The two namers of one configuration-space form and what their names mean.
 
-    inertial: names the coefficients of M, B and Csq (I1, I2, ...); gravity: those of G (g1, ...);
-    base: the base parameters the names are written in (None: naming by value); standard: each
-    standard parameter's symbol -> its value in the robot file's symbols.
+    form: the configuration-space form named; inertial: names the coefficients of M, B and Csq
+    (I1, I2, ...); gravity: those of G (g1, ...); base: the base parameters the names are written
+    in (None: naming by value); standard: each standard parameter's symbol -> its value in the
+    robot file's symbols.
     """
 
+    form: ConfigurationSpace
     inertial: Lumper
     gravity: Lumper
     base: BaseParameters | None = None
     standard: dict[sp.Symbol, sp.Expr] = field(default_factory=dict)
     note: str | None = None
+
+    def entry(self, name: str, k: int, c: int = 0, text: bool = False) -> sp.Expr | str:
+        """Entry (k, c) of M, B or Csq, or entry k of G (0-based, as ConfigurationSpace.poly),
+        its coefficients named; with `text` as `derive` prints it (ConfigurationSpace.text)."""
+        namer = (self.gravity if name == "G" else self.inertial).name
+        if text:
+            return self.form.text(name, k, c, namer)
+        return self.form.ring.to_sympy(self.form.poly(name, k, c), namer)
 
     def definitions(self) -> list[tuple[sp.Symbol, sp.Expr]]:
         """(I_k or g_k, its definition) in the order named: a combination of base parameters, or
@@ -249,15 +259,15 @@ def lumped_constants(dyn: Dynamics, cs: ConfigurationSpace | None = None) -> Lum
     as symdyn.symbolic.lumping.Lumper does alone. Otherwise each coefficient is written over the
     base parameters (module docstring); `notes` explains any exception.
 
-    Use: `lc.inertial.name` (M, B, Csq) and `lc.gravity.name` (G) as the coefficient map of
-    `ConfigurationSpace.text` or `TrigRing.to_sympy`, then `lc.definitions()`,
-    `lc.base_definitions()` and `lc.standard_definitions()`.
+    Use: `lc.entry(name, k, c)` for each entry, in the order `derive` prints them (names are
+    given as met), then `lc.definitions()`, `lc.base_definitions()` and
+    `lc.standard_definitions()`.
     """
     cs = cs or dyn.configuration_space
     q = list(dyn.q)
     names, values = standard_parameters(dyn.robot)
     reserved = {str(s) for s in dyn.params} | set(names)
-    plain = LumpedConstants(Lumper(q, "I", reserved=reserved), Lumper(q, "g", reserved=reserved))
+    plain = LumpedConstants(cs, Lumper(q, "I", reserved=reserved), Lumper(q, "g", reserved=reserved))
     if not symbolic_inertia(dyn.robot):
         return plain
     try:
@@ -288,4 +298,4 @@ def lumped_constants(dyn: Dynamics, cs: ConfigurationSpace | None = None) -> Lum
     standard = {sp.Symbol(n): v for n, v in zip(names, values, strict=True)}
     reserved |= set(base.names)
     lumpers = (Lumper(q, prefix, known[prefix], reserved) for prefix in ("I", "g"))
-    return LumpedConstants(*lumpers, base, standard)
+    return LumpedConstants(cs, *lumpers, base, standard)

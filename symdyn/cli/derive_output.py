@@ -3,7 +3,8 @@
 - "configuration" (the default): tau = M qdd + B [qd qd] + Csq [qd^2] + G + F
   (symdyn.algorithms.configuration_space), M by its upper triangle, the nonzero entries of B
   and Csq, then G and F; canonical closed forms, the same from either method; with `lumped`,
-  each distinct coefficient named once (symdyn.symbolic.lumping) and defined at the end;
+  each distinct coefficient named once and defined at the end (symdyn.lumped: by value, or over
+  the base parameters, which are listed too, when the inertial data is symbolic);
 - "compact": the program of named intermediates after common-subexpression elimination, one
   assignment per line as the generated code computes them, then M, C, V, G, F over them;
 - "expanded": the recursion's full expansion (the output of symdyn before the configuration
@@ -58,10 +59,9 @@ def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None, text: bo
     constants = lumped_constants(dyn, cs) if lumped else None
 
     def get(name, r, c):
-        namer = None if constants is None else (constants.gravity if name == "G" else constants.inertial).name
-        if text:
-            return cs.text(name, r, c, namer)
-        return cs.expr(name, r, c) if namer is None else cs.ring.to_sympy(cs.poly(name, r, c), namer)
+        if constants is not None:
+            return constants.entry(name, r, c, text)
+        return cs.text(name, r, c) if text else cs.expr(name, r, c)
 
     F = dyn.closed_form("F")
     out = {
