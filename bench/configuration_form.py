@@ -76,9 +76,9 @@ def _row(label: str, make, expanded: bool | None) -> dict:
     row = {"robot": label, "seconds": seconds, "bytes": len(text.encode()), "gamma": len(cs.gamma)}
     row["configuration"] = {k: _ops(cs.matrix(k)) for k in ("M", "B", "Csq", "G")}
     if expanded is not None:
-        entries, definitions = configuration_entries(dyn, lumped=True)
+        entries, constants = configuration_entries(dyn, lumped=True)
         lumped = {k: _ops(e for _, e in entries[k]) for k in ("M", "B", "Csq", "G")}
-        lumped["constants"] = _ops(v for _, v in definitions)
+        lumped["constants"] = _ops(v for _, v in constants.definitions())
         row["lumped"] = lumped
     if not dyn.params:
         pruned = prune(cs, 0.01)

@@ -3,7 +3,8 @@
 - "configuration" (the default): tau = M qdd + B [qd qd] + Csq [qd^2] + G + F
   (symdyn.algorithms.configuration_space), M by its upper triangle, the nonzero entries of B
   and Csq, then G and F; canonical closed forms, the same from either method; with `lumped`,
-  each distinct coefficient named once (symdyn.symbolic.lumping) and defined at the end;
+  each distinct coefficient named once and defined at the end (symdyn.lumped: by value, or over
+  the base parameters, which are listed too, when the inertial data is symbolic);
 - "compact": the program of named intermediates after common-subexpression elimination, one
   assignment per line as the generated code computes them, then M, C, V, G, F over them;
 - "expanded": the recursion's full expansion (the output of symdyn before the configuration
@@ -16,12 +17,13 @@ expression string parses with sympy.sympify.
 from __future__ import annotations
 
 import json
+import re
 
 import sympy as sp
 
 from ..algorithms.configuration_space import pair_columns
 from ..dynamics import Dynamics
-from ..symbolic.lumping import Lumper
+from ..lumped import lumped_constants
 from ..symbolic.simplify import count_ops, eliminate
 from ..symbolic.trig_text import number_text
 
@@ -41,45 +43,56 @@ def _header(dyn: Dynamics, equation: str) -> list[str]:
 
 
 def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None, text: bool = False):
-    """(labelled entries, lumped definitions) of the configuration-space form.
+    """(labelled entries, lumped constants) of the configuration-space form.
 
     Returns:
         A dict name -> list of (label, entry) for M (upper triangle), B and Csq (nonzero
-        entries), G and F; and the list of (constant, value) when `lumped`. An entry is a SymPy
-        expression, or with `text` its SymPy-syntax string written straight from the polynomial
-        (ConfigurationSpace.text: the fast way for large forms). `cs`: another
-        configuration-space form of `dyn` (a pruned one) instead of its own.
+        entries), G and F; and with `lumped` the `LumpedConstants` the coefficients were named
+        by (symdyn.lumped: over the base parameters when the inertial data is symbolic), else
+        None. An entry is a SymPy expression, or with `text` its SymPy-syntax string written
+        straight from the polynomial (ConfigurationSpace.text: the fast way for large forms).
+        `cs`: another configuration-space form of `dyn` (a pruned one) instead of its own.
     """
     cs = cs or dyn.configuration_space
     n = dyn.n
     pairs = pair_columns(n)
-    inertial, gravity = Lumper(dyn.q, "I"), Lumper(dyn.q, "g")
+    constants = lumped_constants(dyn, cs) if lumped else None
 
-    def get(name, r, c, lumper):
-        if text:
-            return cs.text(name, r, c, lumper.name if lumped else None)
-        e = cs.expr(name, r, c)
-        return lumper.lump(e) if lumped else e
+    def get(name, r, c):
+        if constants is not None:
+            return constants.entry(name, r, c, text)
+        return cs.text(name, r, c) if text else cs.expr(name, r, c)
 
     F = dyn.closed_form("F")
     out = {
-        "M": [(f"M[{i + 1},{j + 1}]", get("M", i, j, inertial)) for i in range(n) for j in range(i, n)],
+        "M": [(f"M[{i + 1},{j + 1}]", get("M", i, j)) for i in range(n) for j in range(i, n)],
         "B": [
-            (f"B[{k + 1},({i + 1},{j + 1})]", get("B", k, c, inertial))
+            (f"B[{k + 1},({i + 1},{j + 1})]", get("B", k, c))
             for k in range(n)
             for c, (i, j) in enumerate(pairs)
             if cs.poly("B", k, c)
         ],
         "Csq": [
-            (f"Csq[{k + 1},{i + 1}]", get("Csq", k, i, inertial))
+            (f"Csq[{k + 1},{i + 1}]", get("Csq", k, i))
             for k in range(n)
             for i in range(n)
             if cs.poly("Csq", k, i)
         ],
-        "G": [(f"G[{k + 1}]", get("G", k, 0, gravity)) for k in range(n)],
+        "G": [(f"G[{k + 1}]", get("G", k, 0)) for k in range(n)],
         "F": [(f"F[{k + 1}]", sp.sstr(e) if text else e) for k, e in enumerate(F)],
     }
-    return out, inertial.definitions + gravity.definitions
+    return out, constants
+
+
+def lumped_sections(constants) -> list[tuple[str, list[tuple[sp.Symbol, sp.Expr]]]]:
+    """(heading, definitions) of the lumped constants, the base parameters they use and the
+    standard parameters those use (empty ones left out)."""
+    sections = [
+        ("lumped constants", constants.definitions()),
+        ("base parameters", constants.base_definitions()),
+        ("standard parameters", constants.standard_definitions()),
+    ]
+    return [(head, items) for head, items in sections if items]
 
 
 def prune_summary(dyn: Dynamics, pruned) -> list[str]:
@@ -112,12 +125,14 @@ def _configuration_text(dyn: Dynamics, lumped: bool, pruned=None) -> str:
     lines.append(f"# [qd qd] = ({pairs}); [qd^2] = ({', '.join(f'{v}**2' for v in dyn.qd)})")
     if pruned is not None:
         lines += prune_summary(dyn, pruned)
-    entries, definitions = configuration_entries(dyn, lumped, pruned and pruned.configuration, text=True)
+    entries, constants = configuration_entries(dyn, lumped, pruned and pruned.configuration, text=True)
+    if constants is not None:
+        lines += [f"# note: {note}" for note in constants.notes()]
     for name, items in entries.items():
         lines.append("")
         lines += [f"{label} = {e}" for label, e in items] or [f"# {name} = 0"]
-    if definitions:
-        lines += ["", "# lumped constants"] + [f"{s} = {_value(v)}" for s, v in definitions]
+    for head, items in lumped_sections(constants) if constants is not None else []:
+        lines += ["", f"# {head}"] + [f"{s} = {_value(v)}" for s, v in items]
     return "\n".join(lines) + "\n"
 
 
@@ -202,7 +217,7 @@ def _configuration_json(dyn: Dynamics, lumped: bool) -> dict:
     C_kj = sum_i Gamma^k_ij qd_i with Gamma^k_ij = B[k,(i,j)]/2 (i != j), Gamma^k_ii = Csq[k,i]."""
     n = dyn.n
     pairs = pair_columns(n)
-    entries, definitions = configuration_entries(dyn, lumped, text=True)
+    entries, constants = configuration_entries(dyn, lumped, text=True)
     index = {label: e for items in entries.values() for label, e in items}
     qd = [sp.sstr(v) for v in dyn.qd]
     B = [[index.get(f"B[{k + 1},({i + 1},{j + 1})]", "0") for i, j in pairs] for k in range(n)]
@@ -234,8 +249,14 @@ def _configuration_json(dyn: Dynamics, lumped: bool) -> dict:
         "B": B,
         "Csq": Csq,
     }
-    if lumped:
-        doc["lumped"] = {str(s): _value(v) for s, v in definitions}
+    if constants is not None:
+        sections = dict(lumped_sections(constants))
+        doc["lumped"] = {str(s): _value(v) for s, v in sections.get("lumped constants", [])}
+        for head in ("base parameters", "standard parameters"):
+            if head in sections:
+                doc[head.replace(" ", "_")] = {str(s): _value(v) for s, v in sections[head]}
+        if constants.notes():
+            doc["notes"] = constants.notes()
     return doc
 
 
@@ -245,24 +266,39 @@ def _latex_label(name: str, label: str) -> str:
     return f"{head}_{{{label[len(name) + 1 : -1]}}}"
 
 
+def _latex_name(name: str) -> str:
+    """I12 -> I_{12}, Izz1R -> \\mathrm{Izz}_{1R}: letters, then the rest as a subscript."""
+    m = re.fullmatch(r"([A-Za-z]+)(\d\w*)", name)
+    if m is None:
+        return f"\\mathrm{{{name}}}"
+    head = m[1] if len(m[1]) == 1 else f"\\mathrm{{{m[1]}}}"
+    return f"{head}_{{{m[2]}}}"
+
+
 def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
     """The configuration-space form in LaTeX (amsmath): one align* per quantity, each entry
     broken over lines at its top-level + and - when long (symdyn.codegen.latex.Notation)."""
     from ..codegen.latex import Notation
 
     nt = Notation(dyn)
-    entries, definitions = configuration_entries(dyn, lumped)
-    for s, _ in definitions:
-        nt.names[s] = f"{s.name[0]}_{{{s.name[1:]}}}"
+    entries, constants = configuration_entries(dyn, lumped)
+    sections = lumped_sections(constants) if constants is not None else []
+    named = {s for _, items in sections for s, _ in items}
+    if constants is not None:
+        named |= constants.inertial.referenced | constants.gravity.referenced
+    for s in sorted(named, key=str):
+        nt.names.setdefault(s, _latex_name(s.name))
     out = [
         "% tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)  (needs \\usepackage{amsmath})",
     ]
-    for name, items in [*entries.items(), ("lumped", [(str(s), v) for s, v in definitions])]:
+    out += [f"% note: {note}" for note in (constants.notes() if constants is not None else [])]
+    definitions = [(head, [(str(s), v) for s, v in items]) for head, items in sections]
+    for name, items in [*entries.items(), *definitions]:
         if not items:
             continue
         rows = []
         for label, e in items:
-            head = nt.names[sp.Symbol(label)] if name == "lumped" else _latex_label(name, label)
+            head = nt.names[sp.Symbol(label)] if name not in entries else _latex_label(name, label)
             lines = nt.lines(nt.prepare(e))
             rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
         out.append("\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}")

@@ -161,7 +161,10 @@ def build_parser() -> argparse.ArgumentParser:
         "expanded: the full expansion",
     )
     d.add_argument(
-        "--lumped", action="store_true", help="name each distinct coefficient once (I1, I2, ..., g1, ...)"
+        "--lumped",
+        action="store_true",
+        help="name each distinct coefficient once (I1, I2, ..., g1, ...; over the base parameters "
+        "when the inertial data is symbolic)",
     )
     d.add_argument(
         "--prune",

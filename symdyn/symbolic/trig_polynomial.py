@@ -39,7 +39,18 @@ from sympy.core.mul import _mulsort
 from ..errors import SymdynError
 from .simplify import CHOP
 
-__all__ = ["TrigRing", "TrigPoly", "Key", "add_into", "scale", "number", "chop", "largest", "is_float_data"]
+__all__ = [
+    "TrigRing",
+    "TrigPoly",
+    "Key",
+    "add_into",
+    "scale",
+    "number",
+    "chop",
+    "largest",
+    "is_float_data",
+    "print_order",
+]
 
 Monomial = tuple[tuple[int, int], ...]
 Key = tuple[Monomial, tuple, int]
@@ -274,6 +285,7 @@ class TrigRing:
         self.memo: dict[sp.Expr, TrigPoly] = {}
         self._named: set[sp.Symbol] = set()
         self._trig_cache: dict[tuple, sp.Expr] = {}
+        self._coefficients: dict[tuple, sp.Expr] = {}  # group_coefficient's, by its items
 
     # -- construction -----------------------------------------------------------------
     def constant(self, c) -> TrigPoly:
@@ -451,24 +463,48 @@ class TrigRing:
     def mono_expr(self, mono: Monomial) -> sp.Expr:
         return fast_mul([self.gens[g] ** e for g, e in mono])
 
-    def to_sympy(self, p: TrigPoly, coefficient: Callable | None = None) -> sp.Expr:
-        """The expression: terms grouped by their angle part (trig and coordinates), each with
-        its polynomial in the parameters as a factor.
-
-        coefficient: maps (number, parameter monomial expression) -> SymPy expression; default
-        number * monomial.
-        """
-        groups: dict[tuple, list] = {}
+    def groups(self, p: TrigPoly) -> list[tuple[tuple, list]]:
+        """p's terms grouped by their angle part (monomial in the coordinates, k, kind): a list
+        of (group key, [(number, parameter monomial), ...]) in printed order (`print_order`)."""
+        out: dict[tuple, list] = {}
         for (mono, k, kind), c in p.items():
             qpart = tuple((g, e) for g, e in mono if g < self.n)
             ppart = tuple((g, e) for g, e in mono if g >= self.n)
-            groups.setdefault((qpart, k, kind), []).append((c, ppart))
+            out.setdefault((qpart, k, kind), []).append((c, ppart))
+        return sorted(out.items(), key=lambda item: print_order(item[0]))
+
+    def group_coefficient(self, items: list) -> sp.Expr:
+        """The coefficient of one angle group as a SymPy expression: the sum of number times
+        parameter monomial, common factors pulled out of a sum of several (memoised: printing
+        and lumping ask for the same ones)."""
+        key = tuple(items)
+        hit = self._coefficients.get(key)
+        if hit is None:
+            hit = fast_add([fast_mul([to_sympy_number(c), self.mono_expr(pp)]) for c, pp in items])
+            if hit.is_Add and len(items) > 1:
+                hit = sp.factor_terms(hit)
+            self._coefficients[key] = hit
+        return hit
+
+    def to_sympy(self, p: TrigPoly, coefficient: Callable | None = None) -> sp.Expr:
+        """The expression: terms grouped by their angle part (trig and coordinates), each with
+        its polynomial in the parameters as a factor (`group_coefficient`).
+
+        coefficient: maps a group's coefficient to the SymPy expression to use instead (lumped
+        constants); called in printed order.
+        """
         terms = []
-        for (qpart, k, kind), items in groups.items():
-            coef = fast_add([fast_mul([to_sympy_number(c), self.mono_expr(pp)]) for c, pp in items])
-            if coef.is_Add and len(items) > 1:  # parameters: common factors pulled out
-                coef = sp.factor_terms(coef)
+        for (qpart, k, kind), items in self.groups(p):
+            coef = self.group_coefficient(items)
             if coefficient is not None:
                 coef = coefficient(coef)
             terms.append(fast_mul([coef, self.mono_expr(qpart), self.trig_expr(k, kind)]))
         return fast_add(terms)
+
+
+def print_order(key: tuple) -> tuple:
+    """The order of angle groups: the constant first, then angles by the joints they involve and
+    their multiples, cos before sin."""
+    qpart, k, kind = key
+    joints = tuple(i for i, x in enumerate(k[:-1]) if x != 0)
+    return (len(joints), joints, tuple(float(x) for x in k), kind, qpart)

@@ -28,7 +28,7 @@ from fractions import Fraction
 
 import sympy as sp
 
-from .trig_polynomial import TrigPoly, TrigRing, fast_add, fast_mul, to_sympy_number
+from .trig_polynomial import TrigPoly, TrigRing
 
 __all__ = ["TrigText", "number_text"]
 
@@ -109,17 +109,10 @@ class TrigText:
 
     def text(self, p: TrigPoly) -> str:
         """The polynomial as one SymPy-syntax string ("0" when empty)."""
-        n = self.ring.n
-        groups: dict[tuple, list] = {}
-        for (mono, k, kind), c in p.items():
-            qpart = tuple((g, e) for g, e in mono if g < n)
-            ppart = tuple((g, e) for g, e in mono if g >= n)
-            groups.setdefault((qpart, k, kind), []).append((c, ppart))
         out: list[str] = []
-        for key in sorted(groups, key=_order):
-            qpart, k, kind = key
+        for (qpart, k, kind), items in self.ring.groups(p):
             factors = [f for f in (self.monomial(qpart), self.angle(k, kind)) if f]
-            negative, coef = self._coefficient(groups[key], bool(factors))
+            negative, coef = self._coefficient(items, bool(factors))
             body = "*".join(factors if coef == "1" and factors else [coef, *factors])
             if not out:
                 out.append(f"-{body}" if negative else body)
@@ -137,9 +130,7 @@ class TrigText:
             if (factors or negative) and not isinstance(c, (Fraction, float)) and sp.sympify(c).is_Add:
                 text = f"({text})"
             return negative, text
-        coef = fast_add([fast_mul([to_sympy_number(c), self.ring.mono_expr(pp)]) for c, pp in items])
-        if coef.is_Add and len(items) > 1:
-            coef = sp.factor_terms(coef)
+        coef = self.ring.group_coefficient(items)
         if self.coefficient is not None:
             coef = self.coefficient(coef)
         negative = coef.could_extract_minus_sign()
@@ -153,10 +144,3 @@ class TrigText:
 
 def _exact(x):
     return Fraction(x) if isinstance(x, int) else x
-
-
-def _order(key: tuple) -> tuple:
-    """Constant first, then angles by the joints they involve and their multiples, cos before sin."""
-    qpart, k, kind = key
-    joints = tuple(i for i, x in enumerate(k[:-1]) if x != 0)
-    return (len(joints), joints, tuple(float(x) for x in k), kind, qpart)
