@@ -1,7 +1,8 @@
 """The package's floors: each imports only lower ones, and no private name crosses a module.
 
 Floors, lowest first (symdyn/__init__.py): errors; spatial and symbolic; model; parsers,
-algorithms and the numeric oracle rnea (with rnea_inputs); dynamics; codegen; apps; cli; regenerate. A module
+algorithms and the numeric oracle rnea (with rnea_inputs); dynamics (with lumped, the lumped
+constants of a derivation); codegen; apps; cli; regenerate. A module
 may import its own floor and any lower one; `__version__` may come from the package root.
 """
 
@@ -50,6 +51,8 @@ def _imports(path: Path, parts: tuple[str, ...]):
 
 
 def _floor(parts: tuple[str, ...]) -> str:
+    if parts[0] == "lumped":  # works on a Dynamics, as dynamics does
+        return "dynamics"
     return "rnea" if parts[0] in ("rnea_inputs", "rnea_spatial", "rnea_regressor") else parts[0]  # the oracle
 
 
