@@ -234,7 +234,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             **tolerances,
         )
     image = plot_trajectory(traj) if args.plot else None  # rendered before anything is written
-    write_atomic(args.out, traj.csv_text())
+    write_atomic(args.out, traj.csv_bytes())  # in C with the compiled plant: the same bytes as csv_text
     if image is not None:
         write_atomic(args.plot, image)
     print(
