@@ -51,6 +51,8 @@ def csv_bytes(header: Sequence[str], rows: np.ndarray, plant: CompiledDynamics |
     if plant is None or plant.backend != "c":
         return csv_text(header, rows).encode()
     rows = np.ascontiguousarray(rows, dtype=np.float64)
-    out = np.empty(rows.size * _VALUE_BYTES, dtype=np.uint8)
-    count = _csv_function(plant)(rows.shape[0], rows.shape[1], rows.ctypes.data, out.ctypes.data)
-    return (",".join(header) + "\n").encode() + out[:count].tobytes()
+    head = (",".join(header) + "\n").encode()
+    out = np.empty(len(head) + rows.size * _VALUE_BYTES, dtype=np.uint8)
+    out[: len(head)] = np.frombuffer(head, dtype=np.uint8)
+    count = _csv_function(plant)(rows.shape[0], rows.shape[1], rows.ctypes.data, out.ctypes.data + len(head))
+    return out[: len(head) + count].tobytes()
