@@ -169,7 +169,7 @@ def _report(rows: list, steps: int, repeat: int, loads: list[str]) -> list[str]:
         "every process with Python's bytecode cache on (PYTHONDONTWRITEBYTECODE removed), after one untimed "
         "run of its route that wrote the .pyc files",
         f"warm command, C loop and anchor: medians of {repeat} runs; cold command and NumPy loop: one run",
-        f"{loads[0]} at the start, {loads[1]} at the end",
+        f"{loads[0]} (start), {loads[1].removeprefix('load average ')} (end)",
         "",
         f"{'route':<46} {'total s':>8} {'stepping s':>11} {'vs anchor':>10}",
     ]

@@ -6,7 +6,7 @@ of a trajectory holds its samples exactly. Two routes give the same bytes:
 * `csv_text`: Python's `%` operator, about 0.4 us a value (55 ms for the 150,000 values of
   the Panda's 10 s at 1 kHz, measured on the development machine);
 * `csv_bytes` with a compiled plant: symdyn_csv of templates/c/csv.c.j2, built into every
-  robot's cached library beside the stepping loop, about 50 ns a value (8 ms). It prints the
+  robot's cached library beside the stepping loop, about 40 ns a value (6 ms). It prints the
   digits from exact integer arithmetic (or the C library's snprintf outside its range), as
   correctly rounded as Python's, and spells nan, inf and -0 as Python does (glibc's
   snprintf alone would take 70 ms: it is no faster than Python).
