@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -11,7 +13,7 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
-from symdyn.cli.main import main
+from symdyn.cli.main import COMMANDS, build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -164,3 +166,50 @@ def test_generate_default_targets_are_c_and_casadi(tmp_path):
     names = {p.name for p in tmp_path.iterdir()}
     assert {"roger_eye_dynamics.c", "roger_eye_dynamics.h", "roger_eye_casadi.py"} <= names
     assert not any(n.endswith(".tex") or n.endswith("_numpy.py") for n in names)
+
+
+def _subcommands(parser):
+    return next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction").choices
+
+
+#: A valid command line of each subcommand (its required arguments), for the parsing comparison.
+VALID = {
+    "derive": ["robot.yaml"],
+    "generate": ["robot.yaml", "--out", "out"],
+    "simulate": ["robot.yaml", "--duration", "1", "--dt", "0.1", "--out", "a.csv"],
+    "analyze": ["robot.yaml", "--q", "0", "--torque-limits", "1"],
+    "check": ["robot.yaml", "answers.yaml"],
+    "cache": [],
+    "identify": ["robot.yaml", "data.csv"],
+    "excite": ["robot.yaml", "--out", "e.csv"],
+}
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_a_subcommand_built_alone_is_the_one_of_the_whole_parser(name, monkeypatch):
+    """main builds only the named subcommand's options: the same help, usage and parse as the whole parser."""
+    monkeypatch.setenv("COLUMNS", "100")
+    full, alone = build_parser(), build_parser(name)
+    assert list(_subcommands(full)) == list(COMMANDS) and list(_subcommands(alone)) == [name]
+    assert alone.format_usage() == full.format_usage()
+    assert _subcommands(alone)[name].format_help() == _subcommands(full)[name].format_help()
+    assert vars(alone.parse_args([name, *VALID[name]])) == vars(full.parse_args([name, *VALID[name]]))
+
+
+def test_symdyn_help_lists_every_subcommand():
+    out = run("--help")
+    assert out.returncode == 0
+    assert re.findall(r"^    (\w+) ", out.stdout, re.MULTILINE) == list(COMMANDS)
+
+
+def test_main_builds_the_named_subcommand_only(monkeypatch, capsys):
+    cli_main = importlib.import_module("symdyn.cli.main")  # the module (symdyn.cli.main is also the function)
+
+    built = []
+    real = cli_main.build_parser
+    monkeypatch.setattr(cli_main, "build_parser", lambda command=None: built.append(command) or real(command))
+    assert main(["cache"]) == 0
+    with pytest.raises(SystemExit):
+        main(["no-such-command"])
+    assert built == ["cache", None]  # an unknown word: the whole parser, whose error lists the commands
+    assert "invalid choice" in capsys.readouterr().err

@@ -197,6 +197,36 @@ def test_cache_hit_corrupt_and_foreign_entries(temporary_cache):
     assert cache.usage()[1] == 1 and cache.clear() == 1 and cache.usage()[1] == 0
 
 
+def test_a_hit_verifies_what_it_loads_and_the_rest_on_first_use(temporary_cache):
+    """A warm compile hashes the library it loads; a file it does not load is verified when first read."""
+    robot = symdyn.load_robot(PLANAR)
+    first = compile(robot)
+    entry = first._entry
+    library, module = entry.file(entry.meta["library"]), entry.file(entry.meta["numpy"])
+    source = entry.path / "planar_3r_dynamics.c"
+    source.write_text("/* edited */\n" + source.read_text())  # never loaded by a hit
+    text = module.read_text()
+    module.write_text(
+        text.replace("def mass_matrix(", "def mass_matrix(*args):\n    return 0\n\n\ndef _old(")
+    )
+    warm = compile(robot)
+    assert warm._entry.path == entry.path and source.read_text().startswith("/* edited */")
+    q = np.array([0.3, -0.2, 0.5])
+    assert np.array_equal(warm.module.mass_matrix(q, None), warm.mass_matrix(q))  # rebuilt, not trusted
+    assert not source.read_text().startswith("/* edited */") and module.read_text() == text
+    data = library.read_bytes()
+    library.unlink()  # a new file: the loaded library (mapped by this process) stays intact
+    library.write_bytes(data[:100])  # the file a hit loads, truncated: a miss, then a rebuild
+    again = compile(robot)
+    assert again._entry.path == entry.path and cache.lookup(entry.key) is not None
+    assert np.array_equal(again.mass_matrix(q), warm.mass_matrix(q))
+    lazy = cache.lookup(entry.key, lambda meta: [])
+    (entry.path / "symdyn_step.c").write_text("int x;\n")
+    with pytest.raises(cache.CorruptEntryError, match="symdyn_step.c"):
+        lazy.file("symdyn_step.c")
+    assert not entry.path.exists()
+
+
 def test_parameters_bound_by_name_or_vector():
     robot = example("roger_arm")
     names = [str(p) for p in robot.params]

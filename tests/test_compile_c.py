@@ -1,8 +1,9 @@
-"""The C that symdyn.compile adds (NAME_batch.c, symdyn_step.c) under the C contract's strict flags.
+"""The C that symdyn.compile adds (NAME_batch.c, symdyn_step.c, symdyn_csv.c) under the C contract's flags.
 
-Both files compile with -std=c99 -Wall -Wextra -Wpedantic -Werror (gcc and clang when installed),
+The files compile with -std=c99 -Wall -Wextra -Wpedantic -Werror (gcc and clang when installed),
 and a small program runs the stepping loop (RK4, a torque table and the computed-torque law) and
 a batch wrapper under -fsanitize=address,undefined; its numbers must be those of symdyn.simulate.
+Another runs the CSV writer under the sanitizers on awkward doubles; its text must be Python's "%.17g".
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from cbuild import SANITIZE_FLAGS, compile_program, compile_shared, compilers, w
 
 import symdyn
 from symdyn.apps.control import ComputedTorque, Reference, track
+from symdyn.apps.csv_format import csv_text
 from symdyn.apps.simulate import simulate
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
@@ -104,3 +106,45 @@ def test_stepping_loop_under_sanitizers_equals_simulate(files, tmp_path):
     plant = symdyn.compile(robot)
     M = plant.module.mass_matrix(np.array([[0.1, 0.2, 0.3], [-0.4, 0.5, 0.6]]))
     np.testing.assert_allclose(lines[2], M.ravel(), rtol=1e-12, atol=1e-12)
+
+
+# A driver of the CSV writer: doubles as bit patterns (hexadecimal, one a line) on stdin, one row of
+# COLS values per line of CSV on stdout.
+CSV_DRIVER = r"""
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+long symdyn_csv(long rows, int cols, const double x[], char out[]);
+#define COLS 4
+int main(void)
+{
+    static double x[4096];
+    static char out[4096 * 25];
+    unsigned long long bits;
+    long count = 0, n;
+    while (count < 4096 && scanf("%llx", &bits) == 1) {
+        memcpy(&x[count++], &bits, sizeof bits);
+    }
+    n = symdyn_csv(count / COLS, COLS, x, out);
+    fwrite(out, 1, (size_t)n, stdout);
+    return 0;
+}
+"""
+
+
+def test_csv_writer_under_sanitizers_equals_python(files, tmp_path):
+    """Python's "%.17g" (tests/test_csv_format.py has the long lists): here the bounds and shifts."""
+    _, sources = files
+    paths = write_files({"symdyn_csv.c": sources["symdyn_csv.c"], "main.c": CSV_DRIVER}, tmp_path)
+    exe = compile_program(paths, tmp_path / "csv", extra=SANITIZE_FLAGS)
+    rng = np.random.default_rng(3)
+    values = [0.0, -0.0, 0.1, -1e-300, 1e300, 5e-324, 1.7976931348623157e308, float("nan"), -float("inf")]
+    values += [2.0**53, 2.0**127, 2.0**128, 1e16, 1e17, 9.9999999999999984e16, 1e-5, 9.9999999999999991e-5]
+    values += [float(f"1e{k}") for k in range(-30, 40)] + list(rng.standard_normal(1000) * 1e3)
+    values += list(rng.integers(0, 2**64, 2000, dtype=np.uint64).view(np.float64))
+    values = np.resize(np.array(values), (len(values) // 4, 4))
+    stdin = "\n".join(f"{b:x}" for b in values.ravel().view(np.uint64))
+    env = dict(os.environ, UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+    proc = subprocess.run([str(exe)], input=stdin, capture_output=True, text=True, env=env, timeout=60)
+    assert proc.returncode == 0 and "runtime error" not in proc.stderr, proc.stderr
+    assert proc.stdout == csv_text([], values)[1:]  # without the (empty) header line

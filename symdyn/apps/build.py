@@ -12,8 +12,6 @@ from __future__ import annotations
 import os
 import shlex
 import shutil
-import subprocess
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -49,6 +47,9 @@ def compile_library(compiler: list[str], sources: Mapping[str, str], target: str
 
     Raises SymdynError with the compiler's messages when it fails.
     """
+    import subprocess  # here, not at the top: a cached run (find_compiler only) does not need it
+    import tempfile
+
     with tempfile.TemporaryDirectory(prefix="symdyn-build-") as tmp:
         for name, text in sources.items():
             Path(tmp, name).write_text(text, encoding="utf-8")

@@ -8,11 +8,16 @@ the key, the format, free-form metadata and the SHA-256 digest of every file.
 
 An entry is looked up by its key (`entry_key`: a SHA-256 over symdyn's version and
 whatever the caller says the content depends on). It is trusted only when its manifest
-names the same key and format and every file still has its recorded digest; anything
-else (a truncated file, a foreign or hand-edited folder) is removed and rebuilt. An entry
-is built in a private staging folder under the root and published by one rename, so a
-reader never sees half an entry, and two processes building the same entry both end
-with a complete one (the loser of the rename uses the winner's after verifying it).
+names the same key and format, its folder holds exactly the files the manifest lists, and
+every file still has its recorded digest before it is used: `lookup` checks the digests of
+the files the caller names as the ones it will load (all of them unless told), and
+`Entry.file` checks any other file when it is first asked for (so a warm run hashes the
+library it loads, not the generated sources it never reads). Anything else (a truncated
+file, a foreign or hand-edited folder) is removed and rebuilt; a file found corrupt by
+`Entry.file` removes the entry and raises `CorruptEntryError`, on which the caller rebuilds.
+An entry is built in a private staging folder under the root and published by one
+rename, so a reader never sees half an entry, and two processes building the same entry
+both end with a complete one (the loser of the rename uses the winner's after verifying it).
 """
 
 from __future__ import annotations
@@ -21,15 +26,25 @@ import hashlib
 import json
 import os
 import shutil
-import tempfile
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
 from .. import __version__
+from ..errors import SymdynError
 
-__all__ = ["CACHE_ENV", "Entry", "cache_dir", "entry_key", "lookup", "get_or_build", "clear", "usage"]
+__all__ = [
+    "CACHE_ENV",
+    "CorruptEntryError",
+    "Entry",
+    "cache_dir",
+    "entry_key",
+    "lookup",
+    "get_or_build",
+    "clear",
+    "usage",
+]
 
 #: The environment variable that relocates the cache.
 CACHE_ENV = "SYMDYN_CACHE_DIR"
@@ -52,19 +67,35 @@ def cache_dir() -> Path:
     return Path(platformdirs.user_cache_dir("symdyn", appauthor=False))
 
 
+def _stamps(folder: str, suffix: str, depth: int, under: str) -> list[tuple[str, int, int]]:
+    """(path below `under`, size, mtime in ns) of the files named *suffix in `folder`, `depth` levels down
+    (-1: every level), sub-folders "__pycache__" and hidden ones skipped."""
+    found = []
+    with os.scandir(folder) as entries:
+        for e in entries:
+            if e.is_dir() and depth != 0 and e.name != "__pycache__" and not e.name.startswith("."):
+                found += _stamps(e.path, suffix, depth - 1, under)
+            elif e.name.endswith(suffix) and depth <= 0 and e.is_file():
+                st = e.stat()
+                found.append((e.path[len(under) + 1 :], st.st_size, st.st_mtime_ns))
+    return found
+
+
 @lru_cache(maxsize=1)
 def code_fingerprint() -> str:
     """SHA-256 over the name, size and modification time of symdyn's modules and templates.
 
     Part of every key, so that an edited checkout (same version number) never reuses
-    artefacts of other code; it costs a stat per file, not a read.
+    artefacts of other code; it costs a stat per file, not a read. The templates are
+    templates/*/*.j2 beside the package (a checkout) or inside it (an installed wheel).
     """
-    package = Path(__file__).resolve().parents[1]
-    files = sorted(
-        [*package.rglob("*.py"), *package.parent.glob("templates/*/*.j2"), *package.glob("templates/*/*.j2")]
-    )
-    stamp = [(str(f.relative_to(f.parents[1])), f.stat().st_size, f.stat().st_mtime_ns) for f in files]
-    return hashlib.sha256(json.dumps(stamp).encode()).hexdigest()
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(package)
+    stamp = _stamps(package, ".py", -1, root)
+    for templates in (os.path.join(root, "templates"), os.path.join(package, "templates")):
+        if os.path.isdir(templates):
+            stamp += _stamps(templates, ".j2", 1, root)
+    return hashlib.sha256(json.dumps(sorted(stamp)).encode()).hexdigest()
 
 
 def entry_key(**parts) -> str:
@@ -78,19 +109,51 @@ def _digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+class CorruptEntryError(SymdynError):
+    """A file of a cache entry no longer has its recorded digest (the entry has been removed)."""
+
+
 @dataclass(frozen=True)
 class Entry:
-    """A verified cache entry: its folder, key and metadata."""
+    """A cache entry: its folder, key, metadata, and the manifest's digest of every file.
+
+    `checked` names the files whose digest has been verified in this process.
+    """
 
     path: Path
     key: str
     meta: dict
+    digests: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+    checked: set[str] = field(default_factory=set, repr=False, compare=False)
 
     def file(self, name: str) -> Path:
-        return self.path / name
+        """The path of the entry's file `name`, its digest verified before the first use.
+
+        Raises CorruptEntryError, after removing the entry, when the file no longer matches the manifest.
+        """
+        path = self.path / name
+        if name not in self.checked:
+            if not _matches(path, self.digests.get(name)):
+                _remove(self.path)
+                raise CorruptEntryError(
+                    f"{path}: the cache entry's file changed since it was built; entry removed"
+                )
+            self.checked.add(name)
+        return path
 
 
-def _verified(folder: Path, key: str) -> Entry | None:
+def _matches(path: Path, digest: str | None) -> bool:
+    try:
+        return digest is not None and _digest(path) == digest
+    except OSError:
+        return False
+
+
+def _verified(folder: Path, key: str, load: Callable[[dict], Iterable[str]] | None = None) -> Entry | None:
+    """The entry in `folder` when its manifest, its list of files and the digests of the files to load hold.
+
+    load(meta) names the files whose digests are checked now (default: every file).
+    """
     try:
         manifest = json.loads((folder / _MANIFEST).read_text(encoding="utf-8"))
         if manifest.get("key") != key or manifest.get("format") != FORMAT:
@@ -99,9 +162,12 @@ def _verified(folder: Path, key: str) -> Entry | None:
         present = {p.name for p in folder.iterdir()} - {_MANIFEST}
         if set(files) != present:
             return None
-        if any(_digest(folder / name) != digest for name, digest in files.items()):
+        entry = Entry(folder, key, manifest["meta"], dict(files))
+        names = files if load is None else [name for name in load(entry.meta) if name]
+        if any(not _matches(folder / name, files.get(name)) for name in names):
             return None
-        return Entry(folder, key, manifest["meta"])
+        entry.checked.update(names)
+        return entry
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return None
 
@@ -110,12 +176,16 @@ def _remove(folder: Path) -> None:
     shutil.rmtree(folder, ignore_errors=True)
 
 
-def lookup(key: str) -> Entry | None:
-    """The entry for `key` when it exists and verifies; a folder that does not verify is removed."""
+def lookup(key: str, load: Callable[[dict], Iterable[str]] | None = None) -> Entry | None:
+    """The entry for `key` when it exists and verifies; a folder that does not verify is removed.
+
+    load(meta): the names of the files the caller will load, from the entry's metadata; their
+    digests are verified now, the other files' when Entry.file first gives them (default: all now).
+    """
     folder = cache_dir() / _LAYOUT / key
     if not folder.is_dir():
         return None
-    entry = _verified(folder, key)
+    entry = _verified(folder, key, load)
     if entry is None:
         _remove(folder)
     return entry
@@ -129,6 +199,8 @@ def get_or_build(key: str, build: Callable[[Path], dict]) -> Entry:
     entry = lookup(key)
     if entry is not None:
         return entry
+    import tempfile
+
     layout = cache_dir() / _LAYOUT
     layout.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=layout))
@@ -141,7 +213,7 @@ def get_or_build(key: str, build: Callable[[Path], dict]) -> Entry:
         for _ in range(3):
             try:
                 os.rename(staging, final)
-                return Entry(final, key, meta)
+                return Entry(final, key, meta, files, set(files))
             except OSError:  # another process published first, or a bad folder sits there
                 entry = _verified(final, key)
                 if entry is not None:

@@ -123,21 +123,32 @@ def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
     return build
 
 
+def _loaded_files(meta: dict) -> list[str]:
+    """The file of an entry a CompiledDynamics loads at once: its library, or the NumPy module without one."""
+    return [meta["library"] or meta["numpy"]]
+
+
 def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: str = "newton-euler"):
     """A CompiledDynamics from the cache entry of `key_parts` (plus the options), built when missing.
 
     make_robot() is called only to build the entry (a cache hit never derives nor loads it);
-    the result then carries a RobotInfo instead of the Robot.
+    the result then carries a RobotInfo instead of the Robot. A hit verifies the digest of the
+    file it loads (the library); the others are verified when first read (cache.Entry.file).
     """
     options = _options(method)
     key = cache.entry_key(**key_parts, **options)
-    entry = cache.lookup(key)
+    entry = cache.lookup(key, _loaded_files)
     robot = None
     if entry is None:
         robot = make_robot()
         entry = cache.get_or_build(key, _build(robot, method, options))
     self = CompiledDynamics._from_entry(entry, robot, params)
     self._source = ({**key_parts, "method": method}, make_robot)
+
+    def rebuild() -> cache.Entry:
+        return cache.get_or_build(key, _build(robot if robot is not None else make_robot(), method, options))
+
+    self._rebuild = rebuild
     return self
 
 
@@ -251,7 +262,12 @@ class CompiledDynamics:
     def module(self) -> types.ModuleType:
         """The generated NumPy module of the robot (NAME_numpy.py from the cache entry)."""
         if self._module is None:
-            path = self._entry.file(self._entry.meta["numpy"])
+            name = self._entry.meta["numpy"]
+            try:
+                path = self._entry.file(name)
+            except cache.CorruptEntryError:  # changed since it was built: build the entry again
+                self._entry = self._rebuild()
+                path = self._entry.file(name)
             module = types.ModuleType(path.stem)
             module.__file__ = str(path)
             # symdyn's own output for this robot, verified against the cache manifest's digest

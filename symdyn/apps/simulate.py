@@ -360,7 +360,7 @@ def simulate(
     scheme = "euler" if integrator == "lecture" else integrator
     if scheme in ADAPTIVE:
         Q, QD, U = _adaptive(plant, scheme, q, qd, t, tau_at, rtol, atol)
-        return Trajectory(plant.robot, t, Q, QD, U, scheme)
+        return Trajectory(plant.robot, t, Q, QD, U, scheme, plant=plant)
     if progress is None:
         progress = steps >= PROGRESS_MIN_STEPS and sys.stderr.isatty()
     bar = ProgressBar(steps, duration, bool(progress))
@@ -369,4 +369,4 @@ def simulate(
         Q, QD, U = out if out is not None else _in_python(plant, scheme, q, qd, t, h, tau_at, bar)
     finally:
         bar.close()
-    return Trajectory(plant.robot, t, Q, QD, U, scheme)
+    return Trajectory(plant.robot, t, Q, QD, U, scheme, plant=plant)

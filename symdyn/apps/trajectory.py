@@ -2,23 +2,26 @@
 
 Joint positions q (rad or m), velocities qd and the applied torques tau (N m or N)
 are sampled at the times t of the integrator (symdyn.apps.simulate); a tracked
-reference (symdyn.apps.control) adds q_ref and qd_ref at the same times.
+reference (symdyn.apps.control) adds q_ref and qd_ref at the same times. The CSV
+(symdyn.apps.csv_format) is written by the plant's compiled library when it has one.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import SymdynError
+from .csv_format import csv_bytes, csv_text
 from .output import figure, figure_bytes, plot_format, write_atomic
 
 if TYPE_CHECKING:
     from ..model.robot import Robot
+    from .compile import CompiledDynamics
 
 __all__ = ["Trajectory", "plot_trajectory"]
 
@@ -28,7 +31,8 @@ class Trajectory:
     """A simulated run: sample times t (N,), states q, qd and torque tau (N, n), or (N, B, n) for a batch.
 
     tau[k] is the torque at (t_k, q_k, qd_k), the one applied at the start of step k.
-    `q_ref`, `qd_ref` hold a tracked reference at the same times (None without one).
+    `q_ref`, `qd_ref` hold a tracked reference at the same times (None without one);
+    `plant` is the compiled robot that produced the run (None for one made by hand).
     """
 
     robot: Robot
@@ -39,24 +43,30 @@ class Trajectory:
     integrator: str
     q_ref: np.ndarray | None = None
     qd_ref: np.ndarray | None = None
+    plant: CompiledDynamics | None = field(default=None, repr=False, compare=False)
 
     @property
     def n(self) -> int:
         return self.robot.n
 
-    def csv_text(self) -> str:
-        """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision."""
+    def _columns(self) -> tuple[list[str], np.ndarray]:
         if self.q.ndim != 2:
             raise SymdynError("CSV output holds one trajectory, not a batch")
         n = self.n
         header = ["t"] + [f"q{i}" for i in range(1, n + 1)] + [f"qd{i}" for i in range(1, n + 1)]
-        rows = np.column_stack([self.t, self.q, self.qd])
-        row_format = ",".join(["%.17g"] * rows.shape[1]) + "\n"  # the digits of f"{x:.17g}"
-        return ",".join(header) + "\n" + (row_format * len(rows)) % tuple(rows.ravel().tolist())
+        return header, np.column_stack([self.t, self.q, self.qd])
+
+    def csv_text(self) -> str:
+        """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision ("%.17g")."""
+        return csv_text(*self._columns())
+
+    def csv_bytes(self) -> bytes:
+        """csv_text() encoded, written in C by the plant's compiled library when there is one."""
+        return csv_bytes(*self._columns(), self.plant)
 
     def write_csv(self, path: str | os.PathLike) -> Path:
-        """Write csv_text() atomically (temporary file in the same folder, then rename)."""
-        return write_atomic(path, self.csv_text())
+        """Write csv_bytes() atomically (temporary file in the same folder, then rename)."""
+        return write_atomic(path, self.csv_bytes())
 
 
 def plot_trajectory(traj: Trajectory, path: str | os.PathLike | None = None) -> bytes:

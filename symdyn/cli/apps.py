@@ -1,4 +1,4 @@
-"""The `symdyn` subcommands simulate, analyze, check and cache (added to the parser by `register`).
+"""The `symdyn` subcommands simulate, analyze, check and cache (their parsers in `COMMANDS`).
 
     symdyn simulate ROBOT [--q0 Q ...] [--qd0 QD ...] [--tau TAU ...]
            [--track QREF ... [--kp KP ...] [--kd KD ...] [--model-params NAME=VALUE ...]]
@@ -27,13 +27,13 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SymdynError
-from .cache import cached_plant, register_cache
+from .cache import CACHE_HELP, cache_arguments, cached_plant
 from .common import METHODS, add_robot_argument, load_robot_argument
 
 #: A plain decimal number, read with float() instead of the expression parser (no SymPy needed).
 _PLAIN = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
-__all__ = ["register", "cmd_simulate", "cmd_analyze", "cmd_check"]
+__all__ = ["COMMANDS", "cmd_simulate", "cmd_analyze", "cmd_check"]
 
 
 # --------------------------------------------------------------------------- argument helpers
@@ -234,7 +234,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             **tolerances,
         )
     image = plot_trajectory(traj) if args.plot else None  # rendered before anything is written
-    write_atomic(args.out, traj.csv_text())
+    write_atomic(args.out, traj.csv_bytes())  # in C with the compiled plant: the same bytes as csv_text
     if image is not None:
         write_atomic(args.plot, image)
     print(
@@ -319,18 +319,18 @@ def _positive(text: str) -> float:
     return v
 
 
-def register(subparsers) -> None:
-    """Add the subcommands simulate, analyze and check to `symdyn`'s subparsers."""
+#: The options of a vector: values separated by spaces (or commas, split by _words).
+_VECTOR = {"nargs": "+", "metavar": "V"}
+
+
+def _simulate_arguments(s: argparse.ArgumentParser) -> None:
     from ..apps.stepping import INTEGRATORS
 
-    vec = {"nargs": "+", "metavar": "V"}
-
-    s = subparsers.add_parser(
-        "simulate",
-        help="simulate the robot (optionally under computed-torque control); write a CSV",
-        description="Integrate qdd = M^-1 (tau - V - G - F) from q0, qd0 and write t, q1..qn, qd1..qdn "
+    vec = _VECTOR
+    s.description = (
+        "Integrate qdd = M^-1 (tau - V - G - F) from q0, qd0 and write t, q1..qn, qd1..qdn "
         "as CSV. Vectors: values separated by spaces or commas; expressions allowed (pi/4), "
-        "torques and references may use t.",
+        "torques and references may use t."
     )
     add_robot_argument(s)
     s.add_argument("--q0", **vec, help="initial joint positions (default 0, or q_ref(0) with --track)")
@@ -379,12 +379,13 @@ def register(subparsers) -> None:
     )
     s.set_defaults(func=cmd_simulate)
 
-    a = subparsers.add_parser(
-        "analyze",
-        help="inertia ellipsoid, dynamic manipulability and acceleration polytope at a state",
-        description="Lecture slides 21-23 at (q, qd): the generalized inertia ellipsoid (eigenvectors and "
+
+def _analyze_arguments(a: argparse.ArgumentParser) -> None:
+    vec = _VECTOR
+    a.description = (
+        "Lecture slides 21-23 at (q, qd): the generalized inertia ellipsoid (eigenvectors and "
         "sqrt of eigenvalues of M M^T), the dynamic manipulability ellipsoid with its bias and "
-        "kappa_d = sqrt(det(J (M^T M)^-1 J^T)), and the acceleration polytope.",
+        "kappa_d = sqrt(det(J (M^T M)^-1 J^T)), and the acceleration polytope."
     )
     add_robot_argument(a)
     a.add_argument("--q", **vec, required=True, help="joint positions")
@@ -402,12 +403,12 @@ def register(subparsers) -> None:
     a.add_argument("--plot", help="draw the ellipses and the polytope (two axes) to this PNG")
     a.set_defaults(func=cmd_analyze)
 
-    c = subparsers.add_parser(
-        "check",
-        help="check answers (M, C, V, G, F, tau as expressions) against the derivation",
-        description="Compare an answers file (YAML: any of M, C, V, G, F, tau as expressions in the "
+
+def _check_arguments(c: argparse.ArgumentParser) -> None:
+    c.description = (
+        "Compare an answers file (YAML: any of M, C, V, G, F, tau as expressions in the "
         "robot's symbols and q1.., qd1.., qdd1..) with symdyn's derivation, symbolically and, when "
-        "inconclusive, numerically. Exit status 0 when every entry matches, 1 otherwise.",
+        "inconclusive, numerically. Exit status 0 when every entry matches, 1 otherwise."
     )
     add_robot_argument(c)
     c.add_argument("answers", help="answers file (YAML)")
@@ -415,4 +416,18 @@ def register(subparsers) -> None:
     c.add_argument("--samples", type=int, default=16, help="random points for the numeric comparison")
     c.add_argument("--verbose", action="store_true", help="also list the entries that match")
     c.set_defaults(func=cmd_check)
-    register_cache(subparsers)
+
+
+#: The subcommands of this module (symdyn.cli.main.COMMANDS): name -> (help, adds its arguments).
+COMMANDS = {
+    "simulate": (
+        "simulate the robot (optionally under computed-torque control); write a CSV",
+        _simulate_arguments,
+    ),
+    "analyze": (
+        "inertia ellipsoid, dynamic manipulability and acceleration polytope at a state",
+        _analyze_arguments,
+    ),
+    "check": ("check answers (M, C, V, G, F, tau as expressions) against the derivation", _check_arguments),
+    "cache": (CACHE_HELP, cache_arguments),
+}

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 
-__all__ = ["register_cache", "cmd_cache", "cached_plant"]
+__all__ = ["CACHE_HELP", "cache_arguments", "cmd_cache", "cached_plant"]
 
 
 def cached_plant(args: argparse.Namespace, make_robot, **options):
@@ -59,14 +59,16 @@ def cmd_cache(args: argparse.Namespace) -> int:
     return 0
 
 
-def register_cache(subparsers) -> None:
-    """Add the subcommand `cache` to `symdyn`'s subparsers."""
-    c = subparsers.add_parser(
-        "cache",
-        help="show the cache of compiled robots (location, size) or clear it",
-        description="symdyn caches each robot's generated code and compiled library, keyed by the robot's "
+#: The one-line help of `symdyn cache` (symdyn --help).
+CACHE_HELP = "show the cache of compiled robots (location, size) or clear it"
+
+
+def cache_arguments(c: argparse.ArgumentParser) -> None:
+    """The options of the subcommand `cache`."""
+    c.description = (
+        "symdyn caches each robot's generated code and compiled library, keyed by the robot's "
         "content, symdyn's version and the options. Without options: print the cache folder, its entries "
-        "and size. The folder is $SYMDYN_CACHE_DIR, else the user's cache folder (~/.cache/symdyn on Linux).",
+        "and size. The folder is $SYMDYN_CACHE_DIR, else the user's cache folder (~/.cache/symdyn on Linux)."
     )
     c.add_argument("--clear", action="store_true", help="remove every cache entry")
     c.set_defaults(func=cmd_cache)

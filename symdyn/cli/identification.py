@@ -1,4 +1,4 @@
-"""The `symdyn` subcommands identify and excite (added to the parser by `register`).
+"""The `symdyn` subcommands identify and excite (their parsers in `COMMANDS`).
 
     symdyn identify ROBOT DATA.csv [--params NAME=VALUE ...] [--format text|json] [--plot fig.png]
     symdyn excite ROBOT --out excite.csv [--q0 ...] [--q-range ...] [--qd-max ...] [--qdd-max ...]
@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import SymdynError
 from .common import add_robot_argument, load_robot_argument
 
-__all__ = ["register", "cmd_identify", "cmd_excite"]
+__all__ = ["COMMANDS", "cmd_identify", "cmd_excite"]
 
 
 def _values(items, what: str) -> list[float]:
@@ -117,9 +117,7 @@ def cmd_excite(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub) -> None:
-    """Add identify and excite to the subcommands."""
-    i = sub.add_parser("identify", help="estimate the base parameters from measured torques (CSV)")
+def _identify_arguments(i: argparse.ArgumentParser) -> None:
     add_robot_argument(i)
     i.add_argument("data", help="CSV with columns t, q1..qn, [qd1..qdn, qdd1..qddn,] tau1..taun")
     i.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
@@ -127,7 +125,8 @@ def register(sub) -> None:
     i.add_argument("--plot", help="draw measured and predicted torques to this PNG (or .pdf, .svg)")
     i.set_defaults(func=cmd_identify)
 
-    e = sub.add_parser("excite", help="an exciting trajectory (Fourier series) for identification")
+
+def _excite_arguments(e: argparse.ArgumentParser) -> None:
     add_robot_argument(e)
     vec = {"nargs": "+", "default": None}
     e.add_argument("--out", required=True, help="CSV file to write: t, q, qd, qdd and the file's tau")
@@ -143,3 +142,10 @@ def register(sub) -> None:
     e.add_argument("--seed", type=int, default=0, help="random starts (default 0)")
     e.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
     e.set_defaults(func=cmd_excite)
+
+
+#: The subcommands of this module (symdyn.cli.main.COMMANDS): name -> (help, adds its arguments).
+COMMANDS = {
+    "identify": ("estimate the base parameters from measured torques (CSV)", _identify_arguments),
+    "excite": ("an exciting trajectory (Fourier series) for identification", _excite_arguments),
+}

@@ -11,15 +11,15 @@ import argparse
 import json
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from .. import __version__
 from ..errors import SymdynError, SymdynWarning
-from .apps import register
+from .apps import COMMANDS as APPLICATIONS
 from .common import METHODS, add_robot_argument, load_robot_argument
-from .identification import register as register_identification
+from .identification import COMMANDS as IDENTIFICATION
 
-__all__ = ["main"]
+__all__ = ["main", "build_parser", "COMMANDS"]
 
 EXIT_BAD_INPUT = 1
 EXIT_INTERNAL = 3
@@ -134,15 +134,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="symdyn",
-        description="Symbolic equations of motion of robot manipulators, and code generated from them.",
-    )
-    parser.add_argument("--version", action="version", version=f"symdyn {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
-
-    d = sub.add_parser("derive", help="print M, C, V, G, F of a robot")
+def _derive_arguments(d: argparse.ArgumentParser) -> None:
     add_robot_argument(d)
     d.add_argument("--method", choices=METHODS, default="newton-euler")
     d.add_argument("--format", choices=("text", "latex", "json"), default="text")
@@ -178,7 +170,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
     d.set_defaults(func=cmd_derive)
 
-    g = sub.add_parser("generate", help="generate code (C, CasADi, NumPy, LaTeX)")
+
+def _generate_arguments(g: argparse.ArgumentParser) -> None:
     add_robot_argument(g)
     g.add_argument(
         "--target",
@@ -205,8 +198,40 @@ def build_parser() -> argparse.ArgumentParser:
         "(the bound goes into the headers)",
     )
     g.set_defaults(func=cmd_generate)
-    register(sub)  # simulate, analyze, check (the lecture's applications)
-    register_identification(sub)  # identify, excite
+
+
+#: Every subcommand, in the order `symdyn --help` lists them: name -> (help, adds its arguments).
+COMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
+    "derive": ("print M, C, V, G, F of a robot", _derive_arguments),
+    "generate": ("generate code (C, CasADi, NumPy, LaTeX)", _generate_arguments),
+    **APPLICATIONS,  # simulate, analyze, check, cache (the lecture's applications)
+    **IDENTIFICATION,  # identify, excite
+}
+
+
+def _named_command(argv: Sequence[str]) -> str | None:
+    """The subcommand the command line names (its first word that is not an option), if it is one."""
+    word = next((w for w in argv if not w.startswith("-")), None)
+    return word if word in COMMANDS else None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of `symdyn`; given a subcommand's name, the parser of that subcommand alone.
+
+    Building every subcommand's options costs start-up time a run does not need, so `main`
+    builds only the one named; the list of commands (usage, errors) is the same either way.
+    """
+    parser = argparse.ArgumentParser(
+        prog="symdyn",
+        description="Symbolic equations of motion of robot manipulators, and code generated from them.",
+    )
+    parser.add_argument("--version", action="version", version=f"symdyn {__version__}")
+    # with one subcommand built, the metavar keeps the usage naming them all (as argparse spells it)
+    metavar = None if command is None else "{" + ",".join(COMMANDS) + "}"
+    sub = parser.add_subparsers(dest="command", required=True, metavar=metavar)
+    for name, (help_text, add_arguments) in COMMANDS.items():
+        if command is None or name == command:
+            add_arguments(sub.add_parser(name, help=help_text))
     return parser
 
 
@@ -217,7 +242,8 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `symdyn` command; returns the exit status."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(_named_command(argv)).parse_args(argv)
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         warnings.showwarning = _show_warning
