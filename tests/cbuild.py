@@ -203,12 +203,14 @@ def build_dynamics(
     precision: str = "double",
     compiler: str = "gcc",
     opt: str = "-O2",
+    extra: Sequence[str] = (),
 ) -> CDynamics:
-    """Write the C target's files, compile NAME_dynamics.c to a shared library and load it."""
+    """Write the C target's files, compile NAME_dynamics.c to a shared library and load it
+    (`extra`: more compiler flags, e.g. -mavx2)."""
     out = Path(directory)
     write_files({k: v for k, v in files.items() if k.startswith(f"{name}_dynamics.")}, out)
     macros = header_macros((out / f"{name}_dynamics.h").read_text())
     lib = compile_shared(
-        [out / f"{name}_dynamics.c"], out / f"lib{name}_{precision}_{compiler}.so", compiler, opt
+        [out / f"{name}_dynamics.c"], out / f"lib{name}_{precision}_{compiler}.so", compiler, opt, extra=extra
     )
     return CDynamics(lib, name, int(macros[f"{name}_NDOF"]), int(macros[f"{name}_NPARAM"]), precision)

@@ -20,6 +20,87 @@
 
 #include <math.h>
 
+/*
+ * The sines and cosines: with AVX2 (gcc or clang -mavx2, or -march= a CPU that has it) each
+ * function fills an array with its angles and one call of panda_sincos gives all their sines
+ * and cosines, which panda_SIN(k, a) and panda_COS(k, a) read; without AVX2 they are the C
+ * library's sin(a) and cos(a), called where they are used.
+ */
+#if defined(__AVX2__)
+#define panda_SINCOS_VECTOR 1
+#define panda_SIN(k, a) sine[k]
+#define panda_COS(k, a) cosine[k]
+
+/*
+ * s[k] = sin(x[k]) and c[k] = cos(x[k]) for k < n; the arrays hold n rounded up to a multiple
+ * of 4, and the entries of x past n are finite (the callers pad with zeros). The angles
+ * go 4 at a time through straight-line code that the compiler turns into vector
+ * instructions: x is reduced by pi/2 in three parts (Cody and Waite, as fdlibm's medium case,
+ * the two roundings caught by TwoSum) and fdlibm's kernels give the sine and cosine on
+ * [-pi/4, pi/4]; within 1 ulp of the C library's sin and cos. |x| >= 2^19 pi/2, infinities
+ * and NaN go to the C library.
+ */
+static void panda_sincos(int n, const double *restrict x, double *restrict s, double *restrict c)
+{
+    const double invpio2 = 6.36619772367581382433e-01, shift = 0x1.8p52, chop = 0x1.8p28;
+    const double pio2_1 = 1.57079632673412561417e+00, pio2_2 = 6.07710050630396597660e-11;
+    const double pio2_3 = 2.02226624871116645580e-21, pio2_3t = 8.47842766036889956997e-32;
+    const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03;
+    const double S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06;
+    const double S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+    const double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03;
+    const double C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07;
+    const double C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+    int b, j, k;
+    for (b = 0; b < n; b += 4) {
+        /* no branch in this loop: every select is between values already computed */
+        for (j = 0; j < 4; ++j) {
+            const double a = x[b + j];
+            /* fn = a / (pi/2) rounded to an integer; |fn| < 2^20, so fn times each 33-bit part
+               of pi/2 = pio2_1 + pio2_2 + pio2_3 + pio2_3t is exact */
+            const double fn = (a * invpio2 + shift) - shift;
+            const double r1 = a - fn * pio2_1;
+            const double p2 = fn * pio2_2, r2 = r1 - p2, b2 = r2 - r1;
+            const double e2 = (r1 - (r2 - b2)) - (p2 + b2);
+            const double p3 = fn * pio2_3, r3 = r2 - p3, b3 = r3 - r2;
+            const double e3 = (r2 - (r3 - b3)) - (p3 + b3);
+            const double tail = (e2 + e3) - fn * pio2_3t;
+            /* a - fn pi/2 = y0 + y1, |y0| <= pi/4 */
+            const double y0 = r3 + tail;
+            const double y1 = (r3 - y0) + tail;
+            const double z = y0 * y0, v = z * y0;
+            /* fdlibm's __kernel_sin(y0, y1, 1) */
+            const double rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+            const double ks = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * S1);
+            /* fdlibm's __kernel_cos(y0, y1): qx = 0 below 0.3, 0.28125 above 0.78125, else
+               |y0|/4 cut to its leading bits */
+            const double rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+            const double ay = fabs(y0);
+            const double big = ay > 0.78125, mid = ay >= 0.3;
+            const double qx = mid * ((1.0 - big) * ((0.25 * ay + chop) - chop) + big * 0.28125);
+            const double kc = (1.0 - qx) - ((0.5 * z - qx) - (z * rc - y0 * y1));
+            /* the quadrant f4 = fn mod 4 in 0 .. 3 */
+            const double m4 = fn - 4.0 * ((fn * 0.25 + shift) - shift);
+            const double f4 = m4 + 4.0 * (double)(m4 < 0.0);
+            const int odd = f4 == 1.0 || f4 == 3.0;
+            const double sv = odd ? kc : ks, cv = odd ? ks : kc;
+            /* sin a = a below 2^-27 (so that sin -0 = -0) */
+            s[b + j] = fabs(a) < 0x1p-27 ? a : (f4 >= 2.0 ? -sv : sv);
+            c[b + j] = (f4 == 1.0 || f4 == 2.0) ? -cv : cv;
+        }
+    }
+    for (k = 0; k < n; ++k) {
+        if (!(fabs(x[k]) < 823549.6)) { /* |x| >= 2^19 pi/2, infinite or NaN */
+            s[k] = sin(x[k]);
+            c[k] = cos(x[k]);
+        }
+    }
+}
+#else
+#define panda_SIN(k, a) sin(a)
+#define panda_COS(k, a) cos(a)
+#endif
+
 /* tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (779 operations: 413 multiplications, 354 additions, 0 divisions, 12 trigonometric calls, 0 other calls) */
 void panda_inverse_dynamics(const double q[], const double qd[], const double qdd[], const double p[], double tau[])
 {
@@ -44,10 +125,24 @@ void panda_inverse_dynamics(const double q[], const double qd[], const double qd
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
     const double qdd7 = qdd[6];
-    const double x0 = sin(q2);
-    const double x1 = cos(q2);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_SIN(0, q2);
+    const double x1 = panda_COS(0, q2);
+    const double x2 = panda_COS(1, q3);
+    const double x3 = panda_SIN(1, q3);
     const double x4 = qd1*x0;
     const double x5 = qd1*x1;
     const double x6 = 0.00398335888393552*x4 + 0.0007689361029464*qd2 - 0.028124284712194955*x5;
@@ -60,8 +155,8 @@ void panda_inverse_dynamics(const double q[], const double qd[], const double qd
     const double x13 = x4*qd2;
     const double x14 = x13 - x1*qdd1;
     const double x15 = 0.0022610063699999997*x10 + 0.01026110182100817*qdd2 + 0.00850351162402155*x12 - 0.00398335888393552*x14 - x7 - x9;
-    const double x16 = cos(q4);
-    const double x17 = sin(q4);
+    const double x16 = panda_COS(2, q4);
+    const double x17 = panda_SIN(2, q4);
     const double x18 = x5 + qd3;
     const double x19 = qd2*x3;
     const double x20 = x4*x2;
@@ -91,8 +186,8 @@ void panda_inverse_dynamics(const double q[], const double qd[], const double qd
     const double x44 = 0.316*x43;
     const double x45 = -x42*x3 - x44*x2;
     const double x46 = -x26 - x32 + 0.214708623208*x45 + 0.05649492601407083*x35 - 0.008248333140675744*x37 - 0.005487648106562256*x38 + x33*x24;
-    const double x47 = cos(q5);
-    const double x48 = sin(q5);
+    const double x47 = panda_COS(3, q5);
+    const double x48 = panda_SIN(3, q5);
     const double x49 = qd4 - x24;
     const double x50 = x21*x16 + x18*x17;
     const double x51 = x18*x16 - x17*x21;
@@ -118,8 +213,8 @@ void panda_inverse_dynamics(const double q[], const double qd[], const double qd
     const double x71 = x38 + x70;
     const double x72 = x45 + 0.0825*x71;
     const double x73 = 0.0039053550262761003*x59 + 0.06767727025085991*x56 + 0.02771584317362585*x58 - 0.374644408005*x72 - 0.09850206933*x69 + x54*x51 - x53;
-    const double x74 = sin(q6);
-    const double x75 = cos(q6);
+    const double x74 = panda_SIN(4, q6);
+    const double x75 = panda_COS(4, q6);
     const double x76 = -x50*x48 - x49*x47;
     const double x77 = x51 + qd5;
     const double x78 = x50*x47 - x48*x49;
@@ -151,8 +246,8 @@ void panda_inverse_dynamics(const double q[], const double qd[], const double qd
     const double x104 = x59 + x92;
     const double x105 = x69 - x103 - 0.0825*x104;
     const double x106 = x81 + 0.03942757095803552*x83 + 0.047121686402*x100 + 0.05034347249*x105 - 0.0015152444733270301*x85 - 0.004600245517563105*x86;
-    const double x107 = sin(q7);
-    const double x108 = cos(q7);
+    const double x107 = panda_SIN(5, q7);
+    const double x108 = panda_COS(5, q7);
     const double x109 = x77*x75 - x74*x78;
     const double x110 = qd6 - x76;
     const double x111 = x78*x75 + x77*x74;
@@ -358,19 +453,33 @@ void panda_mass_matrix(const double q[], const double p[], double M[])
     const double q5 = q[4];
     const double q6 = q[5];
     const double q7 = q[6];
-    const double x0 = cos(q4);
-    const double x1 = sin(q4);
-    const double x2 = cos(q5);
-    const double x3 = sin(q6);
-    const double x4 = cos(q6);
-    const double x5 = sin(q7);
-    const double x6 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q5,
+        q6,
+        q7,
+        q2,
+        q3,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q4);
+    const double x1 = panda_SIN(0, q4);
+    const double x2 = panda_COS(1, q5);
+    const double x3 = panda_SIN(2, q6);
+    const double x4 = panda_COS(2, q6);
+    const double x5 = panda_SIN(3, q7);
+    const double x6 = panda_COS(3, q7);
     const double x7 = 0.0031274395439999996*x5 + 0.007735484874*x6;
     const double x8 = 0.16496755269500002 + x7;
     const double x9 = 0.068832705569*x3 + x8*x4;
     const double x10 = -0.014653732538 + x9;
     const double x11 = x10*x2;
-    const double x12 = sin(q5);
+    const double x12 = panda_SIN(1, q5);
     const double x13 = 0.007735484874*x5;
     const double x14 = 0.0031274395439999996*x6;
     const double x15 = x13 - x14;
@@ -432,8 +541,8 @@ void panda_mass_matrix(const double q[], const double p[], double M[])
     const double x71 = x70*x61 + x69*x63;
     const double x72 = 0.06736254418002012 + x44 + x71 + x27;
     const double x73 = 0.028124284712194955 + x72;
-    const double x74 = sin(q2);
-    const double x75 = cos(q2);
+    const double x74 = panda_SIN(4, q2);
+    const double x75 = panda_COS(4, q2);
     const double x76 = x75*x74;
     const double x77 = 2.0*x76;
     const double x78 = x20*x1 + x25*x0;
@@ -443,8 +552,8 @@ void panda_mass_matrix(const double q[], const double p[], double M[])
     const double x82 = 0.6372531400842897 + x48 + x59 + x45 + x28;
     const double x83 = 0.10199172388710612 + x82 + x27;
     const double x84 = x81 - x83;
-    const double x85 = cos(q3);
-    const double x86 = sin(q3);
+    const double x85 = panda_COS(5, q3);
+    const double x86 = panda_SIN(5, q3);
     const double x87 = x85*x86;
     const double x88 = 2.0*x87;
     const double x89 = -x10*x12 - x17*x2;
@@ -610,16 +719,30 @@ void panda_coriolis_matrix(const double q[], const double qd[], const double p[]
     const double qd5 = qd[4];
     const double qd6 = qd[5];
     const double qd7 = qd[6];
-    const double x0 = cos(q4);
-    const double x1 = sin(q4);
-    const double x2 = sin(q3);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q3,
+        q2,
+        q5,
+        q6,
+        q7,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q4);
+    const double x1 = panda_SIN(0, q4);
+    const double x2 = panda_SIN(1, q3);
     const double x3 = qd2*x2;
-    const double x4 = cos(q3);
-    const double x5 = sin(q2);
+    const double x4 = panda_COS(1, q3);
+    const double x5 = panda_SIN(2, q2);
     const double x6 = qd1*x5;
     const double x7 = x6*x4;
     const double x8 = x3 - x7;
-    const double x9 = cos(q2);
+    const double x9 = panda_COS(2, q2);
     const double x10 = qd1*x9;
     const double x11 = x10 + qd3;
     const double x12 = x11*x0 - x1*x8;
@@ -631,8 +754,8 @@ void panda_coriolis_matrix(const double q[], const double qd[], const double p[]
     const double x18 = 0.316*x13 + 0.316*x14;
     const double x19 = x18*x0 - x1*x17;
     const double x20 = 0.049251034665*x12 + 1.7939475*x19 - 0.1873222040025*x16;
-    const double x21 = cos(q5);
-    const double x22 = sin(q5);
+    const double x21 = panda_COS(3, q5);
+    const double x22 = panda_SIN(3, q5);
     const double x23 = x8*x0 + x11*x1;
     const double x24 = -x23*x22 - x16*x21;
     const double x25 = 0.023560843201*x24;
@@ -644,8 +767,8 @@ void panda_coriolis_matrix(const double q[], const double qd[], const double p[]
     const double x31 = x30 + 0.384*x23 + 0.0825*x12;
     const double x32 = x28*x21 - x22*x31;
     const double x33 = -x25 - x27 + 0.612973*x32;
-    const double x34 = sin(q6);
-    const double x35 = cos(q6);
+    const double x34 = panda_SIN(4, q6);
+    const double x35 = panda_COS(4, q6);
     const double x36 = x23*x21 - x22*x16;
     const double x37 = x26*x35 - x34*x36;
     const double x38 = qd6 - x24;
@@ -653,8 +776,8 @@ void panda_coriolis_matrix(const double q[], const double qd[], const double p[]
     const double x40 = x39 - 0.0825*x16;
     const double x41 = x32*x35 + x40*x34;
     const double x42 = 0.0117633784675*x38 + 0.8332775*x41 - 0.008763579467500001*x37;
-    const double x43 = sin(q7);
-    const double x44 = cos(q7);
+    const double x43 = panda_SIN(5, q7);
+    const double x44 = panda_COS(5, q7);
     const double x45 = x36*x35 + x26*x34;
     const double x46 = x38*x44 - x43*x45;
     const double x47 = qd7 - x37;
@@ -1326,10 +1449,24 @@ void panda_coriolis(const double q[], const double qd[], const double p[], doubl
     const double qd5 = qd[4];
     const double qd6 = qd[5];
     const double qd7 = qd[6];
-    const double x0 = sin(q2);
-    const double x1 = cos(q2);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_SIN(0, q2);
+    const double x1 = panda_COS(0, q2);
+    const double x2 = panda_COS(1, q3);
+    const double x3 = panda_SIN(1, q3);
     const double x4 = qd1*x1;
     const double x5 = x4*qd2;
     const double x6 = qd1*x0;
@@ -1339,8 +1476,8 @@ void panda_coriolis(const double q[], const double qd[], const double p[], doubl
     const double x10 = 0.026534991901690206*qd2 - 0.01026110182100817*x6 - 0.0007689361029464*x4;
     const double x11 = x10*x4;
     const double x12 = x9 + x11 + 0.00398335888393552*x7 + 0.00850351162402155*x5;
-    const double x13 = cos(q4);
-    const double x14 = sin(q4);
+    const double x13 = panda_COS(2, q4);
+    const double x14 = panda_SIN(2, q4);
     const double x15 = x4 + qd3;
     const double x16 = qd2*x3;
     const double x17 = x6*x2;
@@ -1366,8 +1503,8 @@ void panda_coriolis(const double q[], const double qd[], const double p[], doubl
     const double x37 = 0.632*x25;
     const double x38 = x36*x3 + x37;
     const double x39 = x31 + 0.214708623208*x38 - 0.040046415889728*x34;
-    const double x40 = cos(q5);
-    const double x41 = sin(q5);
+    const double x40 = panda_COS(3, q5);
+    const double x41 = panda_SIN(3, q5);
     const double x42 = qd4 - x21;
     const double x43 = x18*x13 + x15*x14;
     const double x44 = x15*x13 - x14*x18;
@@ -1397,8 +1534,8 @@ void panda_coriolis(const double q[], const double qd[], const double p[], doubl
     const double x68 = 0.0825*x67;
     const double x69 = x38 + x68;
     const double x70 = -x52 - 0.374644408005*x69 - 0.09850206933*x65;
-    const double x71 = sin(q6);
-    const double x72 = cos(q6);
+    const double x71 = panda_SIN(4, q6);
+    const double x72 = panda_COS(4, q6);
     const double x73 = -x43*x41 - x42*x40;
     const double x74 = x44 + qd5;
     const double x75 = x43*x40 - x41*x42;
@@ -1433,8 +1570,8 @@ void panda_coriolis(const double q[], const double qd[], const double p[], doubl
     const double x104 = x102 + 0.0825*x103;
     const double x105 = x65 - x104;
     const double x106 = x83 + 0.047121686402*x99 + 0.05034347249*x105;
-    const double x107 = sin(q7);
-    const double x108 = cos(q7);
+    const double x107 = panda_SIN(5, q7);
+    const double x108 = panda_COS(5, q7);
     const double x109 = x74*x72 - x71*x75;
     const double x110 = qd6 - x73;
     const double x111 = x75*x72 + x74*x71;
@@ -1664,21 +1801,35 @@ void panda_gravity(const double q[], const double p[], double G[])
     const double q5 = q[4];
     const double q6 = q[5];
     const double q7 = q[6];
-    const double x0 = cos(q3);
-    const double x1 = sin(q3);
-    const double x2 = cos(q4);
-    const double x3 = sin(q4);
-    const double x4 = cos(q5);
-    const double x5 = sin(q6);
-    const double x6 = cos(q6);
-    const double x7 = sin(q7);
-    const double x8 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        q2,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q3);
+    const double x1 = panda_SIN(0, q3);
+    const double x2 = panda_COS(1, q4);
+    const double x3 = panda_SIN(1, q4);
+    const double x4 = panda_COS(2, q5);
+    const double x5 = panda_SIN(3, q6);
+    const double x6 = panda_COS(3, q6);
+    const double x7 = panda_SIN(4, q7);
+    const double x8 = panda_COS(4, q7);
     const double x9 = 0.0031274395439999996*x7 + 0.007735484874*x8;
     const double x10 = 0.16496755269500002 + x9;
     const double x11 = 0.068832705569*x5 + x10*x6;
     const double x12 = -0.014653732538 + x11;
     const double x13 = x12*x4;
-    const double x14 = sin(q5);
+    const double x14 = panda_SIN(2, q5);
     const double x15 = 0.007735484874*x7;
     const double x16 = 0.0031274395439999996*x8;
     const double x17 = x15 - x16;
@@ -1702,9 +1853,9 @@ void panda_gravity(const double q[], const double p[], double G[])
     const double x35 = x22*x3 + x27*x2;
     const double x36 = -0.214708623208 + x35;
     const double x37 = -3.3190486667199997 - x36;
-    const double x38 = sin(q2);
+    const double x38 = panda_SIN(5, q2);
     const double x39 = 9.81*x38;
-    const double x40 = cos(q2);
+    const double x40 = panda_COS(5, q2);
     const double x41 = 9.81*x40;
     const double x42 = x39*x0;
     const double x43 = x39*x1;
@@ -1763,19 +1914,33 @@ void panda_forward_dynamics(const double q[], const double qd[], const double ta
     const double tau5 = tau[4];
     const double tau6 = tau[5];
     const double tau7 = tau[6];
-    const double x0 = cos(q4);
-    const double x1 = sin(q4);
-    const double x2 = cos(q5);
-    const double x3 = sin(q6);
-    const double x4 = cos(q6);
-    const double x5 = sin(q7);
-    const double x6 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q5,
+        q6,
+        q7,
+        q2,
+        q3,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q4);
+    const double x1 = panda_SIN(0, q4);
+    const double x2 = panda_COS(1, q5);
+    const double x3 = panda_SIN(2, q6);
+    const double x4 = panda_COS(2, q6);
+    const double x5 = panda_SIN(3, q7);
+    const double x6 = panda_COS(3, q7);
     const double x7 = 0.0031274395439999996*x5 + 0.007735484874*x6;
     const double x8 = 0.16496755269500002 + x7;
     const double x9 = 0.068832705569*x3 + x8*x4;
     const double x10 = -0.014653732538 + x9;
     const double x11 = x10*x2;
-    const double x12 = sin(q5);
+    const double x12 = panda_SIN(1, q5);
     const double x13 = 0.007735484874*x5;
     const double x14 = 0.0031274395439999996*x6;
     const double x15 = x13 - x14;
@@ -1837,8 +2002,8 @@ void panda_forward_dynamics(const double q[], const double qd[], const double ta
     const double x71 = x70*x61 + x69*x63;
     const double x72 = 0.06736254418002012 + x44 + x71 + x27;
     const double x73 = 0.028124284712194955 + x72;
-    const double x74 = sin(q2);
-    const double x75 = cos(q2);
+    const double x74 = panda_SIN(4, q2);
+    const double x75 = panda_COS(4, q2);
     const double x76 = x75*x74;
     const double x77 = 2.0*x76;
     const double x78 = x20*x1 + x25*x0;
@@ -1848,8 +2013,8 @@ void panda_forward_dynamics(const double q[], const double qd[], const double ta
     const double x82 = 0.6372531400842897 + x48 + x59 + x45 + x28;
     const double x83 = 0.10199172388710612 + x82 + x27;
     const double x84 = x81 - x83;
-    const double x85 = cos(q3);
-    const double x86 = sin(q3);
+    const double x85 = panda_COS(5, q3);
+    const double x86 = panda_SIN(5, q3);
     const double x87 = x85*x86;
     const double x88 = 2.0*x87;
     const double x89 = -x10*x12 - x17*x2;
@@ -2360,9 +2525,23 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
     const double qdd7 = qdd[6];
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
     const double x0 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x1 = sin(q2);
-    const double x2 = cos(q2);
+    const double x1 = panda_SIN(0, q2);
+    const double x2 = panda_COS(0, q2);
     const double x3 = 9.81*x1;
     const double x4 = 9.81*x2;
     const double x5 = x2*x3 - x1*x4;
@@ -2380,11 +2559,11 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
     const double x17 = -x1*qdd2 - x2*x15 - x6*x16;
     const double x18 = x1*x15 - x2*qdd2 - x8*x16;
     const double x19 = qd2*x16;
-    const double x20 = cos(q3);
+    const double x20 = panda_COS(1, q3);
     const double x21 = x6*x8;
     const double x22 = x21 - qdd2;
     const double x23 = -x3 - 0.316*x22;
-    const double x24 = sin(q3);
+    const double x24 = panda_SIN(1, q3);
     const double x25 = 0.316*x24;
     const double x26 = x10 - x9;
     const double x27 = x23*x20 - x26*x25;
@@ -2428,8 +2607,8 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
     const double x65 = x2*x56 + x35*x64 + x44*x59 - x32*x38;
     const double x66 = x2*x53 + x30*x38 + x36*x64 + x44*x61;
     const double x67 = x2*x38 + x44*x64;
-    const double x68 = cos(q4);
-    const double x69 = sin(q4);
+    const double x68 = panda_COS(2, q4);
+    const double x69 = panda_SIN(2, q4);
     const double x70 = x52 - x53;
     const double x71 = x42 + 0.0825*x70;
     const double x72 = x27 + 0.0825*x46;
@@ -2476,8 +2655,8 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
     const double x113 = x101*x84 + x81*x112 + x86*x107 - x30*x97;
     const double x114 = x93*x84 + x82*x112 + x86*x109 - x30*x88;
     const double x115 = x86*x112 - x30*x84;
-    const double x116 = cos(q5);
-    const double x117 = sin(q5);
+    const double x116 = panda_COS(3, q5);
+    const double x117 = panda_SIN(3, q5);
     const double x118 = x73 + 0.384*x95 - 0.0825*x92;
     const double x119 = 0.0825*x89;
     const double x120 = x75 + 0.384*x98 - x119;
@@ -2526,8 +2705,8 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
     const double x163 = x93*x147 + x151*x134 + x131*x162 + x136*x157;
     const double x164 = x93*x138 + x143*x134 + x132*x162 + x136*x159;
     const double x165 = x93*x134 + x136*x162;
-    const double x166 = cos(q6);
-    const double x167 = sin(q6);
+    const double x166 = panda_COS(4, q6);
+    const double x167 = panda_SIN(4, q6);
     const double x168 = x126*x166 + x127*x167;
     const double x169 = x127*x166 - x167*x126;
     const double x170 = x128*x166 + x129*x167;
@@ -2568,8 +2747,8 @@ void panda_regressor(const double q[], const double qd[], const double qdd[], co
     const double x205 = x193*x176 + x173*x204 + x178*x199 - x143*x189;
     const double x206 = x185*x176 + x174*x204 + x178*x201 - x143*x180;
     const double x207 = x178*x204 - x143*x176;
-    const double x208 = cos(q7);
-    const double x209 = sin(q7);
+    const double x208 = panda_COS(5, q7);
+    const double x209 = panda_SIN(5, q7);
     const double x210 = x168 + 0.088*x184;
     const double x211 = -x121 + 0.088*x181;
     const double x212 = x210*x208 + x211*x209;
@@ -3540,9 +3719,23 @@ void panda_base_regressor(const double q[], const double qd[], const double qdd[
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
     const double qdd7 = qdd[6];
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
     const double x0 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x1 = sin(q2);
-    const double x2 = cos(q2);
+    const double x1 = panda_SIN(0, q2);
+    const double x2 = panda_COS(0, q2);
     const double x3 = qd1*x1;
     const double x4 = x3*qd2;
     const double x5 = qd1*x2;
@@ -3556,13 +3749,13 @@ void panda_base_regressor(const double q[], const double qd[], const double qdd[
     const double x13 = -x1*qdd2 - x2*x11 - x3*x12;
     const double x14 = x1*x11 - x2*qdd2 - x5*x12;
     const double x15 = qd2*x12;
-    const double x16 = sin(q3);
+    const double x16 = panda_SIN(1, q3);
     const double x17 = x1*x16;
     const double x18 = 9.81*x1;
     const double x19 = x3*x5;
     const double x20 = x19 - qdd2;
     const double x21 = -x18 - 0.316*x20;
-    const double x22 = cos(q3);
+    const double x22 = panda_COS(1, q3);
     const double x23 = 0.316*x22;
     const double x24 = x7 - x6;
     const double x25 = -x24*x23 - x21*x16;
@@ -3599,8 +3792,8 @@ void panda_base_regressor(const double q[], const double qd[], const double qdd[
     const double x56 = x2*x50 + x26*x55 + x36*x49 - x40*x29;
     const double x57 = x2*x53 + x17*x29 + x27*x55 + x36*x52;
     const double x58 = x2*x29 + x36*x55;
-    const double x59 = cos(q4);
-    const double x60 = sin(q4);
+    const double x59 = panda_COS(2, q4);
+    const double x60 = panda_SIN(2, q4);
     const double x61 = x26*x59 + x36*x60;
     const double x62 = x36*x59 - x60*x26;
     const double x63 = x61*x62;
@@ -3642,8 +3835,8 @@ void panda_base_regressor(const double q[], const double qd[], const double qdd[
     const double x99 = x92*x64 + x61*x98 + x66*x94 - x17*x87;
     const double x100 = x79*x64 + x62*x98 + x66*x96 - x17*x68;
     const double x101 = x66*x98 - x17*x64;
-    const double x102 = cos(q5);
-    const double x103 = sin(q5);
+    const double x102 = panda_COS(3, q5);
+    const double x103 = panda_SIN(3, q5);
     const double x104 = x61*x102 - x103*x66;
     const double x105 = -x61*x103 - x66*x102;
     const double x106 = x104*x105;
@@ -3685,8 +3878,8 @@ void panda_base_regressor(const double q[], const double qd[], const double qdd[
     const double x142 = x79*x130 + x135*x107 + x104*x141 + x109*x137;
     const double x143 = x79*x111 + x121*x107 + x105*x141 + x109*x139;
     const double x144 = x79*x107 + x109*x141;
-    const double x145 = cos(q6);
-    const double x146 = sin(q6);
+    const double x145 = panda_COS(4, q6);
+    const double x146 = panda_SIN(4, q6);
     const double x147 = x104*x145 + x109*x146;
     const double x148 = x109*x145 - x146*x104;
     const double x149 = x147*x148;
@@ -3721,8 +3914,8 @@ void panda_base_regressor(const double q[], const double qd[], const double qdd[
     const double x178 = x171*x150 + x147*x177 + x152*x173 - x121*x166;
     const double x179 = x160*x150 + x148*x177 + x152*x175 - x121*x154;
     const double x180 = x152*x177 - x121*x150;
-    const double x181 = cos(q7);
-    const double x182 = sin(q7);
+    const double x181 = panda_COS(5, q7);
+    const double x182 = panda_SIN(5, q7);
     const double x183 = x147*x181 + x152*x182;
     const double x184 = x152*x181 - x182*x147;
     const double x185 = x183*x184;
@@ -4441,18 +4634,32 @@ void panda_inverse_dynamics_derivatives(const double q[], const double qd[], con
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
     const double qdd7 = qdd[6];
-    const double x0 = sin(q2);
-    const double x1 = cos(q2);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
-    const double x4 = cos(q4);
-    const double x5 = sin(q4);
-    const double x6 = cos(q5);
-    const double x7 = sin(q5);
-    const double x8 = sin(q6);
-    const double x9 = cos(q6);
-    const double x10 = sin(q7);
-    const double x11 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_SIN(0, q2);
+    const double x1 = panda_COS(0, q2);
+    const double x2 = panda_COS(1, q3);
+    const double x3 = panda_SIN(1, q3);
+    const double x4 = panda_COS(2, q4);
+    const double x5 = panda_SIN(2, q4);
+    const double x6 = panda_COS(3, q5);
+    const double x7 = panda_SIN(3, q5);
+    const double x8 = panda_SIN(4, q6);
+    const double x9 = panda_COS(4, q6);
+    const double x10 = panda_SIN(5, q7);
+    const double x11 = panda_COS(5, q7);
     const double x12 = qd2*x3;
     const double x13 = qd1*x0;
     const double x14 = x13*x2;
@@ -6531,19 +6738,33 @@ void panda_forward_dynamics_derivatives(const double q[], const double qd[], con
     const double tau5 = tau[4];
     const double tau6 = tau[5];
     const double tau7 = tau[6];
-    const double x0 = cos(q4);
-    const double x1 = sin(q4);
-    const double x2 = cos(q5);
-    const double x3 = sin(q6);
-    const double x4 = cos(q6);
-    const double x5 = sin(q7);
-    const double x6 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q5,
+        q6,
+        q7,
+        q2,
+        q3,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q4);
+    const double x1 = panda_SIN(0, q4);
+    const double x2 = panda_COS(1, q5);
+    const double x3 = panda_SIN(2, q6);
+    const double x4 = panda_COS(2, q6);
+    const double x5 = panda_SIN(3, q7);
+    const double x6 = panda_COS(3, q7);
     const double x7 = 0.0031274395439999996*x5 + 0.007735484874*x6;
     const double x8 = 0.16496755269500002 + x7;
     const double x9 = 0.068832705569*x3 + x8*x4;
     const double x10 = -0.014653732538 + x9;
     const double x11 = x10*x2;
-    const double x12 = sin(q5);
+    const double x12 = panda_SIN(1, q5);
     const double x13 = 0.007735484874*x5;
     const double x14 = 0.0031274395439999996*x6;
     const double x15 = x13 - x14;
@@ -6605,8 +6826,8 @@ void panda_forward_dynamics_derivatives(const double q[], const double qd[], con
     const double x71 = x70*x61 + x69*x63;
     const double x72 = 0.06736254418002012 + x44 + x71 + x27;
     const double x73 = 0.028124284712194955 + x72;
-    const double x74 = sin(q2);
-    const double x75 = cos(q2);
+    const double x74 = panda_SIN(4, q2);
+    const double x75 = panda_COS(4, q2);
     const double x76 = x75*x74;
     const double x77 = 2.0*x76;
     const double x78 = x20*x1 + x25*x0;
@@ -6616,8 +6837,8 @@ void panda_forward_dynamics_derivatives(const double q[], const double qd[], con
     const double x82 = 0.6372531400842897 + x48 + x59 + x45 + x28;
     const double x83 = 0.10199172388710612 + x82 + x27;
     const double x84 = x81 - x83;
-    const double x85 = cos(q3);
-    const double x86 = sin(q3);
+    const double x85 = panda_COS(5, q3);
+    const double x86 = panda_SIN(5, q3);
     const double x87 = x85*x86;
     const double x88 = 2.0*x87;
     const double x89 = -x10*x12 - x17*x2;
@@ -9010,19 +9231,33 @@ void panda_mass_matrix_inverse(const double q[], const double p[], double Minv[]
     const double q5 = q[4];
     const double q6 = q[5];
     const double q7 = q[6];
-    const double x0 = cos(q4);
-    const double x1 = sin(q4);
-    const double x2 = cos(q5);
-    const double x3 = sin(q6);
-    const double x4 = cos(q6);
-    const double x5 = sin(q7);
-    const double x6 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q5,
+        q6,
+        q7,
+        q2,
+        q3,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q4);
+    const double x1 = panda_SIN(0, q4);
+    const double x2 = panda_COS(1, q5);
+    const double x3 = panda_SIN(2, q6);
+    const double x4 = panda_COS(2, q6);
+    const double x5 = panda_SIN(3, q7);
+    const double x6 = panda_COS(3, q7);
     const double x7 = 0.0031274395439999996*x5 + 0.007735484874*x6;
     const double x8 = 0.16496755269500002 + x7;
     const double x9 = 0.068832705569*x3 + x8*x4;
     const double x10 = -0.014653732538 + x9;
     const double x11 = x10*x2;
-    const double x12 = sin(q5);
+    const double x12 = panda_SIN(1, q5);
     const double x13 = 0.007735484874*x5;
     const double x14 = 0.0031274395439999996*x6;
     const double x15 = x13 - x14;
@@ -9084,8 +9319,8 @@ void panda_mass_matrix_inverse(const double q[], const double p[], double Minv[]
     const double x71 = x70*x61 + x69*x63;
     const double x72 = 0.06736254418002012 + x44 + x71 + x27;
     const double x73 = 0.028124284712194955 + x72;
-    const double x74 = sin(q2);
-    const double x75 = cos(q2);
+    const double x74 = panda_SIN(4, q2);
+    const double x75 = panda_COS(4, q2);
     const double x76 = x75*x74;
     const double x77 = 2.0*x76;
     const double x78 = x20*x1 + x25*x0;
@@ -9095,8 +9330,8 @@ void panda_mass_matrix_inverse(const double q[], const double p[], double Minv[]
     const double x82 = 0.6372531400842897 + x48 + x59 + x45 + x28;
     const double x83 = 0.10199172388710612 + x82 + x27;
     const double x84 = x81 - x83;
-    const double x85 = cos(q3);
-    const double x86 = sin(q3);
+    const double x85 = panda_COS(5, q3);
+    const double x86 = panda_SIN(5, q3);
     const double x87 = x85*x86;
     const double x88 = 2.0*x87;
     const double x89 = -x10*x12 - x17*x2;
@@ -9370,19 +9605,33 @@ void panda_linearize(const double q[], const double qd[], const double tau[], co
     const double tau5 = tau[4];
     const double tau6 = tau[5];
     const double tau7 = tau[6];
-    const double x0 = cos(q4);
-    const double x1 = sin(q4);
-    const double x2 = cos(q5);
-    const double x3 = sin(q6);
-    const double x4 = cos(q6);
-    const double x5 = sin(q7);
-    const double x6 = cos(q7);
+#ifdef panda_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q5,
+        q6,
+        q7,
+        q2,
+        q3,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    panda_sincos(6, angle, sine, cosine);
+#endif
+    const double x0 = panda_COS(0, q4);
+    const double x1 = panda_SIN(0, q4);
+    const double x2 = panda_COS(1, q5);
+    const double x3 = panda_SIN(2, q6);
+    const double x4 = panda_COS(2, q6);
+    const double x5 = panda_SIN(3, q7);
+    const double x6 = panda_COS(3, q7);
     const double x7 = 0.0031274395439999996*x5 + 0.007735484874*x6;
     const double x8 = 0.16496755269500002 + x7;
     const double x9 = 0.068832705569*x3 + x8*x4;
     const double x10 = -0.014653732538 + x9;
     const double x11 = x10*x2;
-    const double x12 = sin(q5);
+    const double x12 = panda_SIN(1, q5);
     const double x13 = 0.007735484874*x5;
     const double x14 = 0.0031274395439999996*x6;
     const double x15 = x13 - x14;
@@ -9444,8 +9693,8 @@ void panda_linearize(const double q[], const double qd[], const double tau[], co
     const double x71 = x70*x61 + x69*x63;
     const double x72 = 0.06736254418002012 + x44 + x71 + x27;
     const double x73 = 0.028124284712194955 + x72;
-    const double x74 = sin(q2);
-    const double x75 = cos(q2);
+    const double x74 = panda_SIN(4, q2);
+    const double x75 = panda_COS(4, q2);
     const double x76 = x75*x74;
     const double x77 = 2.0*x76;
     const double x78 = x20*x1 + x25*x0;
@@ -9455,8 +9704,8 @@ void panda_linearize(const double q[], const double qd[], const double tau[], co
     const double x82 = 0.6372531400842897 + x48 + x59 + x45 + x28;
     const double x83 = 0.10199172388710612 + x82 + x27;
     const double x84 = x81 - x83;
-    const double x85 = cos(q3);
-    const double x86 = sin(q3);
+    const double x85 = panda_COS(5, q3);
+    const double x86 = panda_SIN(5, q3);
     const double x87 = x85*x86;
     const double x88 = 2.0*x87;
     const double x89 = -x10*x12 - x17*x2;

@@ -20,6 +20,87 @@
 
 #include <math.h>
 
+/*
+ * The sines and cosines: with AVX2 (gcc or clang -mavx2, or -march= a CPU that has it) each
+ * function fills an array with its angles and one call of puma560_sincos gives all their sines
+ * and cosines, which puma560_SIN(k, a) and puma560_COS(k, a) read; without AVX2 they are the C
+ * library's sin(a) and cos(a), called where they are used.
+ */
+#if defined(__AVX2__)
+#define puma560_SINCOS_VECTOR 1
+#define puma560_SIN(k, a) sine[k]
+#define puma560_COS(k, a) cosine[k]
+
+/*
+ * s[k] = sin(x[k]) and c[k] = cos(x[k]) for k < n; the arrays hold n rounded up to a multiple
+ * of 4, and the entries of x past n are finite (the callers pad with zeros). The angles
+ * go 4 at a time through straight-line code that the compiler turns into vector
+ * instructions: x is reduced by pi/2 in three parts (Cody and Waite, as fdlibm's medium case,
+ * the two roundings caught by TwoSum) and fdlibm's kernels give the sine and cosine on
+ * [-pi/4, pi/4]; within 1 ulp of the C library's sin and cos. |x| >= 2^19 pi/2, infinities
+ * and NaN go to the C library.
+ */
+static void puma560_sincos(int n, const double *restrict x, double *restrict s, double *restrict c)
+{
+    const double invpio2 = 6.36619772367581382433e-01, shift = 0x1.8p52, chop = 0x1.8p28;
+    const double pio2_1 = 1.57079632673412561417e+00, pio2_2 = 6.07710050630396597660e-11;
+    const double pio2_3 = 2.02226624871116645580e-21, pio2_3t = 8.47842766036889956997e-32;
+    const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03;
+    const double S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06;
+    const double S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+    const double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03;
+    const double C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07;
+    const double C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+    int b, j, k;
+    for (b = 0; b < n; b += 4) {
+        /* no branch in this loop: every select is between values already computed */
+        for (j = 0; j < 4; ++j) {
+            const double a = x[b + j];
+            /* fn = a / (pi/2) rounded to an integer; |fn| < 2^20, so fn times each 33-bit part
+               of pi/2 = pio2_1 + pio2_2 + pio2_3 + pio2_3t is exact */
+            const double fn = (a * invpio2 + shift) - shift;
+            const double r1 = a - fn * pio2_1;
+            const double p2 = fn * pio2_2, r2 = r1 - p2, b2 = r2 - r1;
+            const double e2 = (r1 - (r2 - b2)) - (p2 + b2);
+            const double p3 = fn * pio2_3, r3 = r2 - p3, b3 = r3 - r2;
+            const double e3 = (r2 - (r3 - b3)) - (p3 + b3);
+            const double tail = (e2 + e3) - fn * pio2_3t;
+            /* a - fn pi/2 = y0 + y1, |y0| <= pi/4 */
+            const double y0 = r3 + tail;
+            const double y1 = (r3 - y0) + tail;
+            const double z = y0 * y0, v = z * y0;
+            /* fdlibm's __kernel_sin(y0, y1, 1) */
+            const double rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+            const double ks = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * S1);
+            /* fdlibm's __kernel_cos(y0, y1): qx = 0 below 0.3, 0.28125 above 0.78125, else
+               |y0|/4 cut to its leading bits */
+            const double rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+            const double ay = fabs(y0);
+            const double big = ay > 0.78125, mid = ay >= 0.3;
+            const double qx = mid * ((1.0 - big) * ((0.25 * ay + chop) - chop) + big * 0.28125);
+            const double kc = (1.0 - qx) - ((0.5 * z - qx) - (z * rc - y0 * y1));
+            /* the quadrant f4 = fn mod 4 in 0 .. 3 */
+            const double m4 = fn - 4.0 * ((fn * 0.25 + shift) - shift);
+            const double f4 = m4 + 4.0 * (double)(m4 < 0.0);
+            const int odd = f4 == 1.0 || f4 == 3.0;
+            const double sv = odd ? kc : ks, cv = odd ? ks : kc;
+            /* sin a = a below 2^-27 (so that sin -0 = -0) */
+            s[b + j] = fabs(a) < 0x1p-27 ? a : (f4 >= 2.0 ? -sv : sv);
+            c[b + j] = (f4 == 1.0 || f4 == 2.0) ? -cv : cv;
+        }
+    }
+    for (k = 0; k < n; ++k) {
+        if (!(fabs(x[k]) < 823549.6)) { /* |x| >= 2^19 pi/2, infinite or NaN */
+            s[k] = sin(x[k]);
+            c[k] = cos(x[k]);
+        }
+    }
+}
+#else
+#define puma560_SIN(k, a) sin(a)
+#define puma560_COS(k, a) cos(a)
+#endif
+
 /* tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (434 operations: 230 multiplications, 188 additions, 0 divisions, 10 trigonometric calls, 6 other calls) */
 void puma560_inverse_dynamics(const double q[], const double qd[], const double qdd[], const double p[], double tau[])
 {
@@ -41,11 +122,25 @@ void puma560_inverse_dynamics(const double q[], const double qd[], const double 
     const double qdd4 = qdd[3];
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
     const double x0 = 5.8018217679508*qd1 + 24.7313845*((double)((qd1 > 0) - (qd1 < 0)));
-    const double x1 = sin(q2);
-    const double x2 = cos(q2);
-    const double x3 = cos(q3);
-    const double x4 = sin(q3);
+    const double x1 = puma560_SIN(0, q2);
+    const double x2 = puma560_COS(0, q2);
+    const double x3 = puma560_COS(1, q3);
+    const double x4 = puma560_SIN(1, q3);
     const double x5 = qd1*x2;
     const double x6 = x5*qd2;
     const double x7 = 0.015000000000000013*x6;
@@ -69,8 +164,8 @@ void puma560_inverse_dynamics(const double q[], const double qd[], const double 
     const double x25 = x6 + x8;
     const double x26 = 0.068*x24 + 0.006*x25 + x21;
     const double x27 = 0.13*x8 + 0.10439999999999999*x26 - 3.9585*x18 + x7;
-    const double x28 = cos(q4);
-    const double x29 = sin(q4);
+    const double x28 = puma560_COS(2, q4);
+    const double x29 = puma560_SIN(2, q4);
     const double x30 = x5*x3;
     const double x31 = x30 - x4*x9;
     const double x32 = qd2 + qd3;
@@ -102,8 +197,8 @@ void puma560_inverse_dynamics(const double q[], const double qd[], const double 
     const double x58 = x33 + x36;
     const double x59 = x57 + 0.07*x58 + x55;
     const double x60 = 0.066*x36 + 0.336*x59 - 0.06767999999999999*x52 + x34;
-    const double x61 = sin(q5);
-    const double x62 = cos(q5);
+    const double x61 = puma560_SIN(3, q5);
+    const double x62 = puma560_COS(3, q5);
     const double x63 = -x38*x29 - x32*x28;
     const double x64 = x31 + qd4;
     const double x65 = x63*x64;
@@ -126,8 +221,8 @@ void puma560_inverse_dynamics(const double q[], const double qd[], const double 
     const double x82 = x65 - x69;
     const double x83 = x81 + 0.019*x82;
     const double x84 = -x66 + 0.0018*x69 - 0.015579999999999998*x83;
-    const double x85 = cos(q6);
-    const double x86 = sin(q6);
+    const double x85 = puma560_COS(4, q6);
+    const double x86 = puma560_SIN(4, q6);
     const double x87 = qd5 - x63;
     const double x88 = 0.00010000000000000005*x87;
     const double x89 = x38*x28 - x29*x32;
@@ -253,18 +348,28 @@ void puma560_mass_matrix(const double q[], const double p[], double M[])
     const double q3 = q[2];
     const double q4 = q[3];
     const double q5 = q[4];
-    const double x0 = sin(q4);
-    const double x1 = sin(q5);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[4] = {
+        q4,
+        q5,
+        q3,
+        q2
+    };
+    double sine[4], cosine[4];
+    puma560_sincos(4, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q4);
+    const double x1 = puma560_SIN(1, q5);
     const double x2 = 0.0028799999999999997*x1;
     const double x3 = x2*x0;
     const double x4 = 0.06767999999999999 + x3;
     const double x5 = 0.3001*x4;
-    const double x6 = cos(q3);
-    const double x7 = sin(q3);
-    const double x8 = cos(q4);
+    const double x6 = puma560_COS(2, q3);
+    const double x7 = puma560_SIN(2, q3);
+    const double x8 = puma560_COS(0, q4);
     const double x9 = x2*x8;
     const double x10 = 0.025374999999999998 - x9;
-    const double x11 = cos(q5);
+    const double x11 = puma560_COS(1, q5);
     const double x12 = 0.0028799999999999997*x11;
     const double x13 = 0.015579999999999998 + x12;
     const double x14 = 0.87575 + x13;
@@ -292,8 +397,8 @@ void puma560_mass_matrix(const double q[], const double p[], double M[])
     const double x36 = x7*x7;
     const double x37 = x36*x28 + x35*x30;
     const double x38 = 2.769262117125 + x21 + x37 + x5 + x16;
-    const double x39 = sin(q2);
-    const double x40 = cos(q2);
+    const double x39 = puma560_SIN(3, q2);
+    const double x40 = puma560_COS(3, q2);
     const double x41 = x40*x39;
     const double x42 = 2.0*x41;
     const double x43 = 1.1674009151249998 + x27 - x37 + x5;
@@ -400,17 +505,31 @@ void puma560_coriolis_matrix(const double q[], const double qd[], const double p
     const double qd4 = qd[3];
     const double qd5 = qd[4];
     const double qd6 = qd[5];
-    const double x0 = cos(q2);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
+    const double x0 = puma560_COS(0, q2);
     const double x1 = qd1*x0;
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
+    const double x2 = puma560_COS(1, q3);
+    const double x3 = puma560_SIN(1, q3);
     const double x4 = x1*x3;
-    const double x5 = sin(q2);
+    const double x5 = puma560_SIN(0, q2);
     const double x6 = qd1*x5;
     const double x7 = x6*x2 + x4;
     const double x8 = 0.168*x7 - 1.03632*x1;
-    const double x9 = cos(q4);
-    const double x10 = sin(q4);
+    const double x9 = puma560_COS(2, q4);
+    const double x10 = puma560_SIN(2, q4);
     const double x11 = qd2 + qd3;
     const double x12 = -x7*x10 - x11*x9;
     const double x13 = x1*x2;
@@ -421,15 +540,15 @@ void puma560_coriolis_matrix(const double q[], const double qd[], const double p
     const double x18 = 0.4318*x7 - 0.0203*x17 - 0.4318*x1;
     const double x19 = x16*x9 - x18*x10;
     const double x20 = 0.41*x19 + 0.007789999999999999*x12;
-    const double x21 = sin(q5);
-    const double x22 = cos(q5);
+    const double x21 = puma560_SIN(3, q5);
+    const double x22 = puma560_COS(3, q5);
     const double x23 = x14*x2 - 0.15005*x4;
     const double x24 = x23 + 0.0203*x11;
     const double x25 = x24*x22 - x21*x19;
     const double x26 = 0.21500000000000002*x25;
     const double x27 = x19*x22 + x24*x21;
-    const double x28 = cos(q6);
-    const double x29 = sin(q6);
+    const double x28 = puma560_COS(4, q6);
+    const double x29 = puma560_SIN(4, q6);
     const double x30 = x7*x9 - x10*x11;
     const double x31 = x17 + qd4;
     const double x32 = x30*x22 + x31*x21;
@@ -810,10 +929,24 @@ void puma560_coriolis(const double q[], const double qd[], const double p[], dou
     const double qd4 = qd[3];
     const double qd5 = qd[4];
     const double qd6 = qd[5];
-    const double x0 = sin(q2);
-    const double x1 = cos(q2);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q2);
+    const double x1 = puma560_COS(0, q2);
+    const double x2 = puma560_COS(1, q3);
+    const double x3 = puma560_SIN(1, q3);
     const double x4 = qd1*x0;
     const double x5 = qd1*x1;
     const double x6 = x4*x5;
@@ -831,8 +964,8 @@ void puma560_coriolis(const double q[], const double qd[], const double p[], dou
     const double x18 = x17 + 0.136*x14 + 0.012*x12;
     const double x19 = x13 + 0.13*x12 + 0.10439999999999999*x18;
     const double x20 = x19 - 3.9585*x11;
-    const double x21 = cos(q4);
-    const double x22 = sin(q4);
+    const double x21 = puma560_COS(2, q4);
+    const double x22 = puma560_SIN(2, q4);
     const double x23 = x5*x2;
     const double x24 = x23 - x3*x4;
     const double x25 = qd2 + qd3;
@@ -862,8 +995,8 @@ void puma560_coriolis(const double q[], const double qd[], const double p[], dou
     const double x49 = x3*x48 + x2*x46;
     const double x50 = x45 + x49;
     const double x51 = x40 - 0.06767999999999999*x50;
-    const double x52 = cos(q5);
-    const double x53 = sin(q5);
+    const double x52 = puma560_COS(3, q5);
+    const double x53 = puma560_SIN(3, q5);
     const double x54 = x31*x21 - x22*x25;
     const double x55 = x24 + qd4;
     const double x56 = x54*x52 + x55*x53;
@@ -899,8 +1032,8 @@ void puma560_coriolis(const double q[], const double qd[], const double p[], dou
     const double x86 = -x85 - x81*x22;
     const double x87 = x86 + x75;
     const double x88 = -x73 - 0.015579999999999998*x87;
-    const double x89 = cos(q6);
-    const double x90 = sin(q6);
+    const double x89 = puma560_COS(4, q6);
+    const double x90 = puma560_SIN(4, q6);
     const double x91 = x55*x52 - x53*x54;
     const double x92 = x66*x91;
     const double x93 = x91*qd5;
@@ -1020,14 +1153,24 @@ void puma560_gravity(const double q[], const double p[], double G[])
     const double q3 = q[2];
     const double q4 = q[3];
     const double q5 = q[4];
-    const double x0 = cos(q3);
-    const double x1 = sin(q3);
-    const double x2 = cos(q4);
-    const double x3 = sin(q5);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[4] = {
+        q3,
+        q4,
+        q5,
+        q2
+    };
+    double sine[4], cosine[4];
+    puma560_sincos(4, angle, sine, cosine);
+#endif
+    const double x0 = puma560_COS(0, q3);
+    const double x1 = puma560_SIN(0, q3);
+    const double x2 = puma560_COS(1, q4);
+    const double x3 = puma560_SIN(2, q5);
     const double x4 = 0.0028799999999999997*x3;
     const double x5 = x4*x2;
     const double x6 = 0.025374999999999998 - x5;
-    const double x7 = cos(q5);
+    const double x7 = puma560_COS(2, q5);
     const double x8 = 0.0028799999999999997*x7;
     const double x9 = 0.015579999999999998 + x8;
     const double x10 = 0.87575 + x9;
@@ -1035,13 +1178,13 @@ void puma560_gravity(const double q[], const double p[], double G[])
     const double x12 = 3.79559 + x11;
     const double x13 = x6*x1 + x10*x0;
     const double x14 = 0.10439999999999999 + x13;
-    const double x15 = sin(q2);
+    const double x15 = puma560_SIN(3, q2);
     const double x16 = 9.81*x15;
-    const double x17 = cos(q2);
+    const double x17 = puma560_COS(3, q2);
     const double x18 = 9.81*x17;
     const double x19 = -x16*x0 - x18*x1;
     const double x20 = x16*x1 - x0*x18;
-    const double x21 = sin(q4);
+    const double x21 = puma560_SIN(1, q4);
     const double x22 = x19*x21;
     const double x23 = x19*x2;
     const double x24 = x20*x3 + x23*x7;
@@ -1098,18 +1241,32 @@ void puma560_forward_dynamics(const double q[], const double qd[], const double 
     const double tau4 = tau[3];
     const double tau5 = tau[4];
     const double tau6 = tau[5];
-    const double x0 = sin(q4);
-    const double x1 = sin(q5);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q4,
+        q5,
+        q3,
+        q2,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q4);
+    const double x1 = puma560_SIN(1, q5);
     const double x2 = 0.0028799999999999997*x1;
     const double x3 = x2*x0;
     const double x4 = 0.06767999999999999 + x3;
     const double x5 = 0.3001*x4;
-    const double x6 = cos(q3);
-    const double x7 = sin(q3);
-    const double x8 = cos(q4);
+    const double x6 = puma560_COS(2, q3);
+    const double x7 = puma560_SIN(2, q3);
+    const double x8 = puma560_COS(0, q4);
     const double x9 = x2*x8;
     const double x10 = 0.025374999999999998 - x9;
-    const double x11 = cos(q5);
+    const double x11 = puma560_COS(1, q5);
     const double x12 = 0.0028799999999999997*x11;
     const double x13 = 0.015579999999999998 + x12;
     const double x14 = 0.87575 + x13;
@@ -1137,8 +1294,8 @@ void puma560_forward_dynamics(const double q[], const double qd[], const double 
     const double x36 = x7*x7;
     const double x37 = x36*x28 + x35*x30;
     const double x38 = 2.769262117125 + x21 + x37 + x5 + x16;
-    const double x39 = sin(q2);
-    const double x40 = cos(q2);
+    const double x39 = puma560_SIN(3, q2);
+    const double x40 = puma560_COS(3, q2);
     const double x41 = x40*x39;
     const double x42 = 2.0*x41;
     const double x43 = 1.1674009151249998 + x27 - x37 + x5;
@@ -1237,8 +1394,8 @@ void puma560_forward_dynamics(const double q[], const double qd[], const double 
     const double x136 = -x129 - x135*x0;
     const double x137 = x136 + x125;
     const double x138 = -x123 - 0.015579999999999998*x137;
-    const double x139 = cos(q6);
-    const double x140 = sin(q6);
+    const double x139 = puma560_COS(4, q6);
+    const double x140 = puma560_SIN(4, q6);
     const double x141 = x105*x11 - x1*x104;
     const double x142 = x116*x141;
     const double x143 = x141*qd5;
@@ -1467,9 +1624,23 @@ void puma560_regressor(const double q[], const double qd[], const double qdd[], 
     const double qdd4 = qdd[3];
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
     const double x0 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x1 = sin(q2);
-    const double x2 = cos(q2);
+    const double x1 = puma560_SIN(0, q2);
+    const double x2 = puma560_COS(0, q2);
     const double x3 = 9.81*x1;
     const double x4 = 9.81*x2;
     const double x5 = x2*x3 - x1*x4;
@@ -1488,8 +1659,8 @@ void puma560_regressor(const double q[], const double qd[], const double qdd[], 
     const double x18 = x2*qdd2 + x8*x16 - x1*x15;
     const double x19 = qd2*x16;
     const double x20 = 0.4318*x2;
-    const double x21 = cos(q3);
-    const double x22 = sin(q3);
+    const double x21 = puma560_COS(1, q3);
+    const double x22 = puma560_SIN(1, q3);
     const double x23 = x7 + x12;
     const double x24 = x8*x8;
     const double x25 = -x24 - x15;
@@ -1545,8 +1716,8 @@ void puma560_regressor(const double q[], const double qd[], const double qdd[], 
     const double x75 = x65*x47 + x56*x54 + x44*x74;
     const double x76 = x56*x47 + x45*x74 - x54*x65;
     const double x77 = x49*x74;
-    const double x78 = cos(q4);
-    const double x79 = sin(q4);
+    const double x78 = puma560_COS(2, q4);
+    const double x79 = puma560_SIN(2, q4);
     const double x80 = x31 + 0.0203*x55 + 0.4318*x62;
     const double x81 = x36 + 0.0203*x52 + x61;
     const double x82 = -x80*x79 - x81*x78;
@@ -1592,8 +1763,8 @@ void puma560_regressor(const double q[], const double qd[], const double qdd[], 
     const double x122 = x56*x106 + x110*x93 + x90*x121 + x95*x116;
     const double x123 = x56*x97 + x91*x121 + x95*x118 - x102*x93;
     const double x124 = x56*x93 + x95*x121;
-    const double x125 = cos(q5);
-    const double x126 = sin(q5);
+    const double x125 = puma560_COS(3, q5);
+    const double x126 = puma560_SIN(3, q5);
     const double x127 = x87*x125 - x126*x86;
     const double x128 = x42*x125 - x126*x88;
     const double x129 = x128*x127;
@@ -1635,8 +1806,8 @@ void puma560_regressor(const double q[], const double qd[], const double qdd[], 
     const double x165 = x102*x149 + x153*x136 + x133*x164 + x138*x159;
     const double x166 = x102*x140 + x145*x136 + x134*x164 + x138*x161;
     const double x167 = x102*x136 + x138*x164;
-    const double x168 = cos(q6);
-    const double x169 = sin(q6);
+    const double x168 = puma560_COS(4, q6);
+    const double x169 = puma560_SIN(4, q6);
     const double x170 = x82*x169 + x130*x168;
     const double x171 = x82*x168 - x169*x130;
     const double x172 = x84*x169 + x131*x168;
@@ -2308,9 +2479,23 @@ void puma560_base_regressor(const double q[], const double qd[], const double qd
     const double qdd4 = qdd[3];
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
     const double x0 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x1 = sin(q2);
-    const double x2 = cos(q2);
+    const double x1 = puma560_SIN(0, q2);
+    const double x2 = puma560_COS(0, q2);
     const double x3 = qd1*x1;
     const double x4 = x3*qd2;
     const double x5 = qd1*x2;
@@ -2325,8 +2510,8 @@ void puma560_base_regressor(const double q[], const double qd[], const double qd
     const double x14 = x2*qdd2 + x5*x12 - x1*x11;
     const double x15 = qd2*x12;
     const double x16 = 0.4318*x2;
-    const double x17 = cos(q3);
-    const double x18 = sin(q3);
+    const double x17 = puma560_COS(1, q3);
+    const double x18 = puma560_SIN(1, q3);
     const double x19 = x3*x17 + x5*x18;
     const double x20 = x5*x17 - x18*x3;
     const double x21 = x19*x20;
@@ -2367,8 +2552,8 @@ void puma560_base_regressor(const double q[], const double qd[], const double qd
     const double x56 = x51*x22 + x38*x34 + x19*x55;
     const double x57 = x38*x22 + x20*x55 - x34*x51;
     const double x58 = x24*x55;
-    const double x59 = cos(q4);
-    const double x60 = sin(q4);
+    const double x59 = puma560_COS(2, q4);
+    const double x60 = puma560_SIN(2, q4);
     const double x61 = x19*x59 - x60*x24;
     const double x62 = -x19*x60 - x24*x59;
     const double x63 = x61*x62;
@@ -2418,8 +2603,8 @@ void puma560_base_regressor(const double q[], const double qd[], const double qd
     const double x107 = x38*x95 + x100*x64 + x61*x106 + x66*x102;
     const double x108 = x38*x68 + x62*x106 + x66*x104 - x88*x64;
     const double x109 = x38*x64 + x66*x106;
-    const double x110 = cos(q5);
-    const double x111 = sin(q5);
+    const double x110 = puma560_COS(3, q5);
+    const double x111 = puma560_SIN(3, q5);
     const double x112 = x61*x110 + x66*x111;
     const double x113 = x66*x110 - x111*x61;
     const double x114 = x112*x113;
@@ -2454,8 +2639,8 @@ void puma560_base_regressor(const double q[], const double qd[], const double qd
     const double x143 = x88*x131 + x136*x115 + x112*x142 + x117*x138;
     const double x144 = x88*x119 + x125*x115 + x113*x142 + x117*x140;
     const double x145 = x88*x115 + x117*x142;
-    const double x146 = cos(q6);
-    const double x147 = sin(q6);
+    const double x146 = puma560_COS(4, q6);
+    const double x147 = puma560_SIN(4, q6);
     const double x148 = x112*x146 - x147*x117;
     const double x149 = -x112*x147 - x117*x146;
     const double x150 = x148*x149;
@@ -2935,14 +3120,28 @@ void puma560_inverse_dynamics_derivatives(const double q[], const double qd[], c
     const double qdd4 = qdd[3];
     const double qdd5 = qdd[4];
     const double qdd6 = qdd[5];
-    const double x0 = sin(q2);
-    const double x1 = cos(q2);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
-    const double x4 = cos(q4);
-    const double x5 = sin(q4);
-    const double x6 = sin(q5);
-    const double x7 = cos(q5);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q2);
+    const double x1 = puma560_COS(0, q2);
+    const double x2 = puma560_COS(1, q3);
+    const double x3 = puma560_SIN(1, q3);
+    const double x4 = puma560_COS(2, q4);
+    const double x5 = puma560_SIN(2, q4);
+    const double x6 = puma560_SIN(3, q5);
+    const double x7 = puma560_COS(3, q5);
     const double x8 = qd1*x1;
     const double x9 = x8*x2;
     const double x10 = qd1*x0;
@@ -3001,8 +3200,8 @@ void puma560_inverse_dynamics_derivatives(const double q[], const double qd[], c
     const double x63 = x36 + x37;
     const double x64 = x62 + 0.0203*x63 + x61;
     const double x65 = x58*x7 + x64*x6;
-    const double x66 = cos(q6);
-    const double x67 = sin(q6);
+    const double x66 = puma560_COS(4, q6);
+    const double x67 = puma560_SIN(4, q6);
     const double x68 = -x39*x5 - x56*x4;
     const double x69 = x65*x66 + x68*x67;
     const double x70 = x35*x4;
@@ -4010,17 +4209,31 @@ void puma560_forward_dynamics_derivatives(const double q[], const double qd[], c
     const double tau4 = tau[3];
     const double tau5 = tau[4];
     const double tau6 = tau[5];
-    const double x0 = sin(q5);
-    const double x1 = cos(q5);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
-    const double x4 = cos(q2);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q5,
+        q3,
+        q2,
+        q4,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q5);
+    const double x1 = puma560_COS(0, q5);
+    const double x2 = puma560_COS(1, q3);
+    const double x3 = puma560_SIN(1, q3);
+    const double x4 = puma560_COS(2, q2);
     const double x5 = qd1*x4;
     const double x6 = x5*x3;
-    const double x7 = sin(q2);
+    const double x7 = puma560_SIN(2, q2);
     const double x8 = qd1*x7;
     const double x9 = x8*x2 + x6;
-    const double x10 = cos(q4);
+    const double x10 = puma560_COS(3, q4);
     const double x11 = x5*x2;
     const double x12 = x11 - x3*x8;
     const double x13 = x12*x10;
@@ -4028,7 +4241,7 @@ void puma560_forward_dynamics_derivatives(const double q[], const double qd[], c
     const double x15 = x14*qd5;
     const double x16 = x5*qd2;
     const double x17 = 0.0028799999999999997*x0;
-    const double x18 = sin(q4);
+    const double x18 = puma560_SIN(3, q4);
     const double x19 = x17*x18;
     const double x20 = 0.06767999999999999 + x19;
     const double x21 = 0.3001*x20;
@@ -4236,8 +4449,8 @@ void puma560_forward_dynamics_derivatives(const double q[], const double qd[], c
     const double x223 = -x219*x18 - x222*x10;
     const double x224 = x223 + 0.019*x214;
     const double x225 = -x213 + 0.0018*x204 - 0.015579999999999998*x224;
-    const double x226 = cos(q6);
-    const double x227 = sin(q6);
+    const double x226 = puma560_COS(4, q6);
+    const double x227 = puma560_SIN(4, q6);
     const double x228 = x197*x1 - x0*x196;
     const double x229 = x208*x228;
     const double x230 = x228*qd5;
@@ -5362,18 +5575,28 @@ void puma560_mass_matrix_inverse(const double q[], const double p[], double Minv
     const double q3 = q[2];
     const double q4 = q[3];
     const double q5 = q[4];
-    const double x0 = sin(q5);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[4] = {
+        q5,
+        q4,
+        q3,
+        q2
+    };
+    double sine[4], cosine[4];
+    puma560_sincos(4, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q5);
     const double x1 = 0.0028799999999999997*x0;
-    const double x2 = sin(q4);
+    const double x2 = puma560_SIN(1, q4);
     const double x3 = x1*x2;
     const double x4 = 0.06767999999999999 + x3;
     const double x5 = 0.3001*x4;
-    const double x6 = cos(q3);
-    const double x7 = sin(q3);
-    const double x8 = cos(q4);
+    const double x6 = puma560_COS(2, q3);
+    const double x7 = puma560_SIN(2, q3);
+    const double x8 = puma560_COS(1, q4);
     const double x9 = x1*x8;
     const double x10 = 0.025374999999999998 - x9;
-    const double x11 = cos(q5);
+    const double x11 = puma560_COS(0, q5);
     const double x12 = 0.0028799999999999997*x11;
     const double x13 = 0.015579999999999998 + x12;
     const double x14 = 0.87575 + x13;
@@ -5401,8 +5624,8 @@ void puma560_mass_matrix_inverse(const double q[], const double p[], double Minv
     const double x36 = x7*x7;
     const double x37 = x36*x28 + x35*x30;
     const double x38 = 2.769262117125 + x21 + x37 + x5 + x16;
-    const double x39 = sin(q2);
-    const double x40 = cos(q2);
+    const double x39 = puma560_SIN(3, q2);
+    const double x40 = puma560_COS(3, q2);
     const double x41 = x40*x39;
     const double x42 = 2.0*x41;
     const double x43 = 1.1674009151249998 + x27 - x37 + x5;
@@ -5587,17 +5810,31 @@ void puma560_linearize(const double q[], const double qd[], const double tau[], 
     const double tau4 = tau[3];
     const double tau5 = tau[4];
     const double tau6 = tau[5];
-    const double x0 = sin(q5);
-    const double x1 = cos(q5);
-    const double x2 = cos(q3);
-    const double x3 = sin(q3);
-    const double x4 = cos(q2);
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q5,
+        q3,
+        q2,
+        q4,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
+    const double x0 = puma560_SIN(0, q5);
+    const double x1 = puma560_COS(0, q5);
+    const double x2 = puma560_COS(1, q3);
+    const double x3 = puma560_SIN(1, q3);
+    const double x4 = puma560_COS(2, q2);
     const double x5 = qd1*x4;
     const double x6 = x5*x3;
-    const double x7 = sin(q2);
+    const double x7 = puma560_SIN(2, q2);
     const double x8 = qd1*x7;
     const double x9 = x8*x2 + x6;
-    const double x10 = cos(q4);
+    const double x10 = puma560_COS(3, q4);
     const double x11 = x5*x2;
     const double x12 = x11 - x3*x8;
     const double x13 = x12*x10;
@@ -5605,7 +5842,7 @@ void puma560_linearize(const double q[], const double qd[], const double tau[], 
     const double x15 = x14*qd5;
     const double x16 = x5*qd2;
     const double x17 = 0.0028799999999999997*x0;
-    const double x18 = sin(q4);
+    const double x18 = puma560_SIN(3, q4);
     const double x19 = x17*x18;
     const double x20 = 0.06767999999999999 + x19;
     const double x21 = 0.3001*x20;
@@ -5813,8 +6050,8 @@ void puma560_linearize(const double q[], const double qd[], const double tau[], 
     const double x223 = -x219*x18 - x222*x10;
     const double x224 = x223 + 0.019*x214;
     const double x225 = -x213 + 0.0018*x204 - 0.015579999999999998*x224;
-    const double x226 = cos(q6);
-    const double x227 = sin(q6);
+    const double x226 = puma560_COS(4, q6);
+    const double x227 = puma560_SIN(4, q6);
     const double x228 = x197*x1 - x0*x196;
     const double x229 = x208*x228;
     const double x230 = x228*qd5;

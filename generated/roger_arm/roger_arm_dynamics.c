@@ -20,6 +20,87 @@
 
 #include <math.h>
 
+/*
+ * The sines and cosines: with AVX2 (gcc or clang -mavx2, or -march= a CPU that has it) each
+ * function fills an array with its angles and one call of roger_arm_sincos gives all their sines
+ * and cosines, which roger_arm_SIN(k, a) and roger_arm_COS(k, a) read; without AVX2 they are the C
+ * library's sin(a) and cos(a), called where they are used.
+ */
+#if defined(__AVX2__)
+#define roger_arm_SINCOS_VECTOR 1
+#define roger_arm_SIN(k, a) sine[k]
+#define roger_arm_COS(k, a) cosine[k]
+
+/*
+ * s[k] = sin(x[k]) and c[k] = cos(x[k]) for k < n; the arrays hold n rounded up to a multiple
+ * of 4, and the entries of x past n are finite (the callers pad with zeros). The angles
+ * go 4 at a time through straight-line code that the compiler turns into vector
+ * instructions: x is reduced by pi/2 in three parts (Cody and Waite, as fdlibm's medium case,
+ * the two roundings caught by TwoSum) and fdlibm's kernels give the sine and cosine on
+ * [-pi/4, pi/4]; within 1 ulp of the C library's sin and cos. |x| >= 2^19 pi/2, infinities
+ * and NaN go to the C library.
+ */
+static void roger_arm_sincos(int n, const double *restrict x, double *restrict s, double *restrict c)
+{
+    const double invpio2 = 6.36619772367581382433e-01, shift = 0x1.8p52, chop = 0x1.8p28;
+    const double pio2_1 = 1.57079632673412561417e+00, pio2_2 = 6.07710050630396597660e-11;
+    const double pio2_3 = 2.02226624871116645580e-21, pio2_3t = 8.47842766036889956997e-32;
+    const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03;
+    const double S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06;
+    const double S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+    const double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03;
+    const double C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07;
+    const double C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+    int b, j, k;
+    for (b = 0; b < n; b += 4) {
+        /* no branch in this loop: every select is between values already computed */
+        for (j = 0; j < 4; ++j) {
+            const double a = x[b + j];
+            /* fn = a / (pi/2) rounded to an integer; |fn| < 2^20, so fn times each 33-bit part
+               of pi/2 = pio2_1 + pio2_2 + pio2_3 + pio2_3t is exact */
+            const double fn = (a * invpio2 + shift) - shift;
+            const double r1 = a - fn * pio2_1;
+            const double p2 = fn * pio2_2, r2 = r1 - p2, b2 = r2 - r1;
+            const double e2 = (r1 - (r2 - b2)) - (p2 + b2);
+            const double p3 = fn * pio2_3, r3 = r2 - p3, b3 = r3 - r2;
+            const double e3 = (r2 - (r3 - b3)) - (p3 + b3);
+            const double tail = (e2 + e3) - fn * pio2_3t;
+            /* a - fn pi/2 = y0 + y1, |y0| <= pi/4 */
+            const double y0 = r3 + tail;
+            const double y1 = (r3 - y0) + tail;
+            const double z = y0 * y0, v = z * y0;
+            /* fdlibm's __kernel_sin(y0, y1, 1) */
+            const double rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+            const double ks = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * S1);
+            /* fdlibm's __kernel_cos(y0, y1): qx = 0 below 0.3, 0.28125 above 0.78125, else
+               |y0|/4 cut to its leading bits */
+            const double rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+            const double ay = fabs(y0);
+            const double big = ay > 0.78125, mid = ay >= 0.3;
+            const double qx = mid * ((1.0 - big) * ((0.25 * ay + chop) - chop) + big * 0.28125);
+            const double kc = (1.0 - qx) - ((0.5 * z - qx) - (z * rc - y0 * y1));
+            /* the quadrant f4 = fn mod 4 in 0 .. 3 */
+            const double m4 = fn - 4.0 * ((fn * 0.25 + shift) - shift);
+            const double f4 = m4 + 4.0 * (double)(m4 < 0.0);
+            const int odd = f4 == 1.0 || f4 == 3.0;
+            const double sv = odd ? kc : ks, cv = odd ? ks : kc;
+            /* sin a = a below 2^-27 (so that sin -0 = -0) */
+            s[b + j] = fabs(a) < 0x1p-27 ? a : (f4 >= 2.0 ? -sv : sv);
+            c[b + j] = (f4 == 1.0 || f4 == 2.0) ? -cv : cv;
+        }
+    }
+    for (k = 0; k < n; ++k) {
+        if (!(fabs(x[k]) < 823549.6)) { /* |x| >= 2^19 pi/2, infinite or NaN */
+            s[k] = sin(x[k]);
+            c[k] = cos(x[k]);
+        }
+    }
+}
+#else
+#define roger_arm_SIN(k, a) sin(a)
+#define roger_arm_COS(k, a) cos(a)
+#endif
+
 /* tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (35 operations: 20 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 0 other calls) */
 void roger_arm_inverse_dynamics(const double q[], const double qd[], const double qdd[], const double p[], double tau[])
 {
@@ -34,16 +115,26 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = g*sin(q1);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q1,
+        q2,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
+    const double x0 = g*roger_arm_SIN(0, q1);
     const double x1 = x0 + l1*qdd1;
     const double x2 = x1*m1;
     const double x3 = x2*l1;
     const double x4 = qdd1 + qdd2;
-    const double x5 = cos(q2);
-    const double x6 = sin(q2);
+    const double x5 = roger_arm_COS(1, q2);
+    const double x6 = roger_arm_SIN(1, q2);
     const double x7 = qd1*qd1;
     const double x8 = x7*l1;
-    const double x9 = g*cos(q1);
+    const double x9 = g*roger_arm_COS(0, q1);
     const double x10 = -x8 - x9;
     const double x11 = -x10*x6;
     const double x12 = x1*x5 + x11;
@@ -71,9 +162,19 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(1, angle, sine, cosine);
+#endif
     const double x0 = l1*l1;
     const double x1 = l2*m2;
-    const double x2 = cos(q2);
+    const double x2 = roger_arm_COS(0, q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
     const double x5 = m2*l2*l2;
@@ -95,12 +196,22 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double l1 = p[roger_arm_P_l1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(1, angle, sine, cosine);
+#endif
     const double x0 = l2*m2;
-    const double x1 = sin(q2);
+    const double x1 = roger_arm_SIN(0, q2);
     const double x2 = l1*qd1;
     const double x3 = x1*x2;
     const double x4 = x0*x3;
-    const double x5 = cos(q2);
+    const double x5 = roger_arm_COS(0, q2);
     const double x6 = x3*m2;
     const double x7 = 0.5*x6;
     const double x8 = x5*x2;
@@ -129,13 +240,23 @@ void roger_arm_coriolis(const double q[], const double qd[], const double p[], d
     const double l1 = p[roger_arm_P_l1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = sin(q2);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(1, angle, sine, cosine);
+#endif
+    const double x0 = roger_arm_SIN(0, q2);
     const double x1 = qd1*qd1;
     const double x2 = x1*l1;
     const double x3 = x0*x2;
     const double x4 = x3*m2;
     const double x5 = x4*l2;
-    const double x6 = cos(q2);
+    const double x6 = roger_arm_COS(0, q2);
     const double x7 = qd1 + qd2;
     const double x8 = x7*x7;
     const double x9 = x8*l2;
@@ -158,15 +279,25 @@ void roger_arm_gravity(const double q[], const double p[], double G[])
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        q1,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
     const double x0 = l2*m2;
-    const double x1 = sin(q2);
+    const double x1 = roger_arm_SIN(0, q2);
     const double x2 = x0*x1;
     const double x3 = l1*m1;
-    const double x4 = cos(q2);
+    const double x4 = roger_arm_COS(0, q2);
     const double x5 = x0*x4;
     const double x6 = x5 + x3 + l1*m2;
-    const double x7 = g*cos(q1);
-    const double x8 = g*sin(q1);
+    const double x7 = g*roger_arm_COS(1, q1);
+    const double x8 = g*roger_arm_SIN(1, q1);
     const double x9 = x8*x4;
     const double x10 = -x9 - x7*x1;
     G[0] = x2*x7 + x6*x8;
@@ -196,23 +327,33 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        q1,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
     const double x0 = l1*l1;
     const double x1 = l2*m2;
-    const double x2 = cos(q2);
+    const double x2 = roger_arm_COS(0, q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
     const double x5 = m2*l2*l2;
     const double x6 = m1*x0;
     const double x7 = x5 + x6 + m2*x0 + 2.0*x4;
     const double x8 = 1.0/x7;
-    const double x9 = g*sin(q1);
+    const double x9 = g*roger_arm_SIN(1, q1);
     const double x10 = x9*m1;
     const double x11 = x10*l1;
     const double x12 = x9*x2;
-    const double x13 = sin(q2);
+    const double x13 = roger_arm_SIN(0, q2);
     const double x14 = qd1*qd1;
     const double x15 = x14*l1;
-    const double x16 = g*cos(q1);
+    const double x16 = g*roger_arm_COS(1, q1);
     const double x17 = -x15 - x16;
     const double x18 = -x17*x13;
     const double x19 = x12 + x18;
@@ -250,14 +391,24 @@ void roger_arm_regressor(const double q[], const double qd[], const double qdd[]
     const double qdd2 = qdd[1];
     const double g = p[roger_arm_P_g];
     const double l1 = p[roger_arm_P_l1];
-    const double x0 = g*sin(q1);
-    const double x1 = g*cos(q1);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q1,
+        q2,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
+    const double x0 = g*roger_arm_SIN(0, q1);
+    const double x1 = g*roger_arm_COS(0, q1);
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
     const double x3 = x0 + l1*qdd1;
-    const double x4 = sin(q2);
+    const double x4 = roger_arm_SIN(1, q2);
     const double x5 = qd1*qd1;
     const double x6 = -x1 - x5*l1;
-    const double x7 = cos(q2);
+    const double x7 = roger_arm_COS(1, q2);
     const double x8 = x3*x4 + x6*x7;
     const double x9 = x3*x7 - x4*x6;
     const double x10 = l1*x4;
@@ -334,17 +485,27 @@ void roger_arm_base_regressor(const double q[], const double qd[], const double 
     const double qdd2 = qdd[1];
     const double g = p[roger_arm_P_g];
     const double l1 = p[roger_arm_P_l1];
-    const double x0 = g*sin(q1);
-    const double x1 = g*cos(q1);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q1,
+        q2,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
+    const double x0 = g*roger_arm_SIN(0, q1);
+    const double x1 = g*roger_arm_COS(0, q1);
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
     const double x3 = qd1 + qd2;
     const double x4 = x3*x3;
     const double x5 = qdd1 + qdd2;
     const double x6 = x0 + l1*qdd1;
-    const double x7 = sin(q2);
+    const double x7 = roger_arm_SIN(1, q2);
     const double x8 = qd1*qd1;
     const double x9 = -x1 - x8*l1;
-    const double x10 = cos(q2);
+    const double x10 = roger_arm_COS(1, q2);
     const double x11 = x6*x10 - x7*x9;
     const double x12 = l1*x7;
     const double x13 = l1*x10;
@@ -390,12 +551,22 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = g*cos(q1);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q1,
+        q2,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
+    const double x0 = g*roger_arm_COS(0, q1);
     const double x1 = x0*m1;
     const double x2 = x1*l1;
-    const double x3 = cos(q2);
-    const double x4 = sin(q2);
-    const double x5 = g*sin(q1);
+    const double x3 = roger_arm_COS(1, q2);
+    const double x4 = roger_arm_SIN(1, q2);
+    const double x5 = g*roger_arm_SIN(0, q1);
     const double x6 = x5*x4;
     const double x7 = x0*x3 - x6;
     const double x8 = x7*m2;
@@ -469,11 +640,21 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = cos(q2);
-    const double x1 = sin(q2);
-    const double x2 = g*sin(q1);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        q1,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
+    const double x0 = roger_arm_COS(0, q2);
+    const double x1 = roger_arm_SIN(0, q2);
+    const double x2 = g*roger_arm_SIN(1, q1);
     const double x3 = x2*x1;
-    const double x4 = g*cos(q1);
+    const double x4 = g*roger_arm_COS(1, q1);
     const double x5 = x4*x0 - x3;
     const double x6 = x5*m2;
     const double x7 = x6*l2;
@@ -581,9 +762,19 @@ void roger_arm_mass_matrix_inverse(const double q[], const double p[], double Mi
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(1, angle, sine, cosine);
+#endif
     const double x0 = l1*l1;
     const double x1 = l2*m2;
-    const double x2 = cos(q2);
+    const double x2 = roger_arm_COS(0, q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
     const double x5 = m2*l2*l2;
@@ -616,11 +807,21 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double m1 = p[roger_arm_P_m1];
     const double l2 = p[roger_arm_P_l2];
     const double m2 = p[roger_arm_P_m2];
-    const double x0 = cos(q2);
-    const double x1 = sin(q2);
-    const double x2 = g*sin(q1);
+#ifdef roger_arm_SINCOS_VECTOR
+    const double angle[4] = {
+        q2,
+        q1,
+        0.0,
+        0.0
+    };
+    double sine[4], cosine[4];
+    roger_arm_sincos(2, angle, sine, cosine);
+#endif
+    const double x0 = roger_arm_COS(0, q2);
+    const double x1 = roger_arm_SIN(0, q2);
+    const double x2 = g*roger_arm_SIN(1, q1);
     const double x3 = x2*x1;
-    const double x4 = g*cos(q1);
+    const double x4 = g*roger_arm_COS(1, q1);
     const double x5 = x4*x0 - x3;
     const double x6 = x5*m2;
     const double x7 = x6*l2;

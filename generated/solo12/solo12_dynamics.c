@@ -20,6 +20,87 @@
 
 #include <math.h>
 
+/*
+ * The sines and cosines: with AVX2 (gcc or clang -mavx2, or -march= a CPU that has it) each
+ * function fills an array with its angles and one call of solo12_sincos gives all their sines
+ * and cosines, which solo12_SIN(k, a) and solo12_COS(k, a) read; without AVX2 they are the C
+ * library's sin(a) and cos(a), called where they are used.
+ */
+#if defined(__AVX2__)
+#define solo12_SINCOS_VECTOR 1
+#define solo12_SIN(k, a) sine[k]
+#define solo12_COS(k, a) cosine[k]
+
+/*
+ * s[k] = sin(x[k]) and c[k] = cos(x[k]) for k < n; the arrays hold n rounded up to a multiple
+ * of 4, and the entries of x past n are finite (the callers pad with zeros). The angles
+ * go 4 at a time through straight-line code that the compiler turns into vector
+ * instructions: x is reduced by pi/2 in three parts (Cody and Waite, as fdlibm's medium case,
+ * the two roundings caught by TwoSum) and fdlibm's kernels give the sine and cosine on
+ * [-pi/4, pi/4]; within 1 ulp of the C library's sin and cos. |x| >= 2^19 pi/2, infinities
+ * and NaN go to the C library.
+ */
+static void solo12_sincos(int n, const double *restrict x, double *restrict s, double *restrict c)
+{
+    const double invpio2 = 6.36619772367581382433e-01, shift = 0x1.8p52, chop = 0x1.8p28;
+    const double pio2_1 = 1.57079632673412561417e+00, pio2_2 = 6.07710050630396597660e-11;
+    const double pio2_3 = 2.02226624871116645580e-21, pio2_3t = 8.47842766036889956997e-32;
+    const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03;
+    const double S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06;
+    const double S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+    const double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03;
+    const double C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07;
+    const double C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+    int b, j, k;
+    for (b = 0; b < n; b += 4) {
+        /* no branch in this loop: every select is between values already computed */
+        for (j = 0; j < 4; ++j) {
+            const double a = x[b + j];
+            /* fn = a / (pi/2) rounded to an integer; |fn| < 2^20, so fn times each 33-bit part
+               of pi/2 = pio2_1 + pio2_2 + pio2_3 + pio2_3t is exact */
+            const double fn = (a * invpio2 + shift) - shift;
+            const double r1 = a - fn * pio2_1;
+            const double p2 = fn * pio2_2, r2 = r1 - p2, b2 = r2 - r1;
+            const double e2 = (r1 - (r2 - b2)) - (p2 + b2);
+            const double p3 = fn * pio2_3, r3 = r2 - p3, b3 = r3 - r2;
+            const double e3 = (r2 - (r3 - b3)) - (p3 + b3);
+            const double tail = (e2 + e3) - fn * pio2_3t;
+            /* a - fn pi/2 = y0 + y1, |y0| <= pi/4 */
+            const double y0 = r3 + tail;
+            const double y1 = (r3 - y0) + tail;
+            const double z = y0 * y0, v = z * y0;
+            /* fdlibm's __kernel_sin(y0, y1, 1) */
+            const double rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+            const double ks = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * S1);
+            /* fdlibm's __kernel_cos(y0, y1): qx = 0 below 0.3, 0.28125 above 0.78125, else
+               |y0|/4 cut to its leading bits */
+            const double rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+            const double ay = fabs(y0);
+            const double big = ay > 0.78125, mid = ay >= 0.3;
+            const double qx = mid * ((1.0 - big) * ((0.25 * ay + chop) - chop) + big * 0.28125);
+            const double kc = (1.0 - qx) - ((0.5 * z - qx) - (z * rc - y0 * y1));
+            /* the quadrant f4 = fn mod 4 in 0 .. 3 */
+            const double m4 = fn - 4.0 * ((fn * 0.25 + shift) - shift);
+            const double f4 = m4 + 4.0 * (double)(m4 < 0.0);
+            const int odd = f4 == 1.0 || f4 == 3.0;
+            const double sv = odd ? kc : ks, cv = odd ? ks : kc;
+            /* sin a = a below 2^-27 (so that sin -0 = -0) */
+            s[b + j] = fabs(a) < 0x1p-27 ? a : (f4 >= 2.0 ? -sv : sv);
+            c[b + j] = (f4 == 1.0 || f4 == 2.0) ? -cv : cv;
+        }
+    }
+    for (k = 0; k < n; ++k) {
+        if (!(fabs(x[k]) < 823549.6)) { /* |x| >= 2^19 pi/2, infinite or NaN */
+            s[k] = sin(x[k]);
+            c[k] = cos(x[k]);
+        }
+    }
+}
+#else
+#define solo12_SIN(k, a) sin(a)
+#define solo12_COS(k, a) cos(a)
+#endif
+
 /* tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (948 operations: 516 multiplications, 408 additions, 0 divisions, 24 trigonometric calls, 0 other calls) */
 void solo12_inverse_dynamics(const double q[], const double qd[], const double qdd[], const double p[], double tau[])
 {
@@ -60,13 +141,31 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double qdd10 = qdd[9];
     const double qdd11 = qdd[10];
     const double qdd12 = qdd[11];
-    const double x0 = cos(q2);
-    const double x1 = sin(q2);
-    const double x2 = 9.81*cos(q1);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q2,
+        q1,
+        q3,
+        q5,
+        q4,
+        q6,
+        q8,
+        q7,
+        q9,
+        q11,
+        q10,
+        q12
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q2);
+    const double x1 = solo12_SIN(0, q2);
+    const double x2 = 9.81*solo12_COS(1, q1);
     const double x3 = 0.0014853845*x2;
     const double x4 = x3 + 4.5093845000000035e-05*qdd1;
-    const double x5 = sin(q3);
-    const double x6 = cos(q3);
+    const double x5 = solo12_SIN(2, q3);
+    const double x6 = solo12_COS(2, q3);
     const double x7 = qd1*x1;
     const double x8 = qd1*x0;
     const double x9 = 0.0013320948074879001*qd2 + 0.0002730308797879413*x7 - 3.959544277738894e-08*x8;
@@ -74,7 +173,7 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x11 = 0.0002730308797879413*qd2 + 1.609852873477455e-07*x8 + 8.590521094399056e-05*x7;
     const double x12 = qd1*qd1;
     const double x13 = 0.014*x12;
-    const double x14 = 9.81*sin(q1);
+    const double x14 = 9.81*solo12_SIN(1, q1);
     const double x15 = x14 - x13;
     const double x16 = -x10 + 0.01169101578415*x15 + x11*qd2;
     const double x17 = x7*qd2;
@@ -157,13 +256,13 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x94 = x93*x24 - x43*x24;
     const double x95 = x94 + 3.3497340042275575e-05*x61 + 0.0005426192213171668*x59 - 0.0038482516772413004*x62;
     const double x96 = x92 + x95 - 0.16*x79;
-    const double x97 = cos(q5);
-    const double x98 = sin(q5);
-    const double x99 = 9.81*cos(q4);
+    const double x97 = solo12_COS(3, q5);
+    const double x98 = solo12_SIN(3, q5);
+    const double x99 = 9.81*solo12_COS(4, q4);
     const double x100 = -0.0014853845*x99;
     const double x101 = 4.5093845000000035e-05*qdd4 + x100;
-    const double x102 = sin(q6);
-    const double x103 = cos(q6);
+    const double x102 = solo12_SIN(5, q6);
+    const double x103 = solo12_COS(5, q6);
     const double x104 = qd4*x98;
     const double x105 = qd4*x97;
     const double x106 = 0.0013320948074879001*qd5 - 3.959544277738894e-08*x105 - 0.0002730308797879413*x104;
@@ -171,7 +270,7 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x108 = x106*x104 - x107*qd5;
     const double x109 = qd4*qd4;
     const double x110 = 0.014*x109;
-    const double x111 = 9.81*sin(q4);
+    const double x111 = 9.81*solo12_SIN(4, q4);
     const double x112 = x111 + x110;
     const double x113 = -0.01169101578415*x112;
     const double x114 = x104*qd5;
@@ -253,13 +352,13 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x190 = x140*x121 - 0.0005446477058047094*x121*x123;
     const double x191 = -x190 + 0.0005426192213171668*x156 - 3.3497340042275575e-05*x158 - 0.0038482516772413004*x159;
     const double x192 = x189 + x191 - 0.16*x176;
-    const double x193 = cos(q8);
-    const double x194 = sin(q8);
-    const double x195 = 9.81*cos(q7);
+    const double x193 = solo12_COS(6, q8);
+    const double x194 = solo12_SIN(6, q8);
+    const double x195 = 9.81*solo12_COS(7, q7);
     const double x196 = 0.0014853845*x195;
     const double x197 = x196 + 4.5093845000000035e-05*qdd7;
-    const double x198 = sin(q9);
-    const double x199 = cos(q9);
+    const double x198 = solo12_SIN(8, q9);
+    const double x199 = solo12_COS(8, q9);
     const double x200 = qd7*x194;
     const double x201 = qd7*x193;
     const double x202 = 0.0013320948074879001*qd8 + 0.0002730308797879413*x200 - 3.959544277738894e-08*x201;
@@ -267,7 +366,7 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x204 = 0.0002730308797879413*qd8 + 1.609852873477455e-07*x201 + 8.590521094399056e-05*x200;
     const double x205 = qd7*qd7;
     const double x206 = 0.014*x205;
-    const double x207 = 9.81*sin(q7);
+    const double x207 = 9.81*solo12_SIN(7, q7);
     const double x208 = x207 - x206;
     const double x209 = -x203 + 0.01169101578415*x208 + x204*qd8;
     const double x210 = x200*qd8;
@@ -350,13 +449,13 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x287 = x286*x217 - x236*x217;
     const double x288 = x287 + 3.3497340042275575e-05*x254 + 0.0005426192213171668*x252 - 0.0038482516772413004*x255;
     const double x289 = x285 + x288 - 0.16*x272;
-    const double x290 = cos(q11);
-    const double x291 = sin(q11);
-    const double x292 = 9.81*cos(q10);
+    const double x290 = solo12_COS(9, q11);
+    const double x291 = solo12_SIN(9, q11);
+    const double x292 = 9.81*solo12_COS(10, q10);
     const double x293 = -0.0014853845*x292;
     const double x294 = 4.5093845000000035e-05*qdd10 + x293;
-    const double x295 = sin(q12);
-    const double x296 = cos(q12);
+    const double x295 = solo12_SIN(11, q12);
+    const double x296 = solo12_COS(11, q12);
     const double x297 = qd10*x291;
     const double x298 = qd10*x290;
     const double x299 = 0.0013320948074879001*qd11 - 3.959544277738894e-08*x298 - 0.0002730308797879413*x297;
@@ -364,7 +463,7 @@ void solo12_inverse_dynamics(const double q[], const double qd[], const double q
     const double x301 = x299*x297 - x300*qd11;
     const double x302 = qd10*qd10;
     const double x303 = 0.014*x302;
-    const double x304 = 9.81*sin(q10);
+    const double x304 = 9.81*solo12_SIN(10, q10);
     const double x305 = x304 + x303;
     const double x306 = -0.01169101578415*x305;
     const double x307 = x297*qd11;
@@ -472,15 +571,29 @@ void solo12_mass_matrix(const double q[], const double p[], double M[])
     const double q9 = q[8];
     const double q11 = q[10];
     const double q12 = q[11];
-    const double x0 = cos(q3);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[8] = {
+        q3,
+        q2,
+        q6,
+        q5,
+        q9,
+        q8,
+        q12,
+        q11
+    };
+    double sine[8], cosine[8];
+    solo12_sincos(8, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q3);
     const double x1 = 0.0038482516772413004*x0;
     const double x2 = 0.32*x1;
-    const double x3 = sin(q3);
+    const double x3 = solo12_SIN(0, q3);
     const double x4 = x3*x3;
     const double x5 = 0.0005396092213171668*x4;
     const double x6 = 0.0029700831576528162 + x2 - x5;
-    const double x7 = cos(q2);
-    const double x8 = sin(q2);
+    const double x7 = solo12_COS(1, q2);
+    const double x8 = solo12_SIN(1, q2);
     const double x9 = x7*x8;
     const double x10 = 2.0*x9;
     const double x11 = 0.0038482516772413004*x3;
@@ -502,15 +615,15 @@ void solo12_mass_matrix(const double q[], const double p[], double M[])
     const double x27 = 0.014*x26 + x18*x7 + x20*x8;
     const double x28 = 0.0028381974208050668 + x2;
     const double x29 = 0.0005426192213171668 + 0.16*x1;
-    const double x30 = cos(q6);
+    const double x30 = solo12_COS(2, q6);
     const double x31 = 0.0038482516772413004*x30;
     const double x32 = 0.32*x31;
-    const double x33 = sin(q6);
+    const double x33 = solo12_SIN(2, q6);
     const double x34 = x33*x33;
     const double x35 = 0.0005396092213171668*x34;
     const double x36 = 0.0029700831576528162 + x32 - x35;
-    const double x37 = cos(q5);
-    const double x38 = sin(q5);
+    const double x37 = solo12_COS(3, q5);
+    const double x38 = solo12_SIN(3, q5);
     const double x39 = x37*x38;
     const double x40 = 2.0*x39;
     const double x41 = 0.0038482516772413004*x33;
@@ -532,15 +645,15 @@ void solo12_mass_matrix(const double q[], const double p[], double M[])
     const double x57 = -0.014*x56 - x48*x37 - x50*x38;
     const double x58 = 0.0028381974208050668 + x32;
     const double x59 = 0.0005426192213171668 + 0.16*x31;
-    const double x60 = cos(q9);
+    const double x60 = solo12_COS(4, q9);
     const double x61 = 0.0038482516772413004*x60;
     const double x62 = 0.32*x61;
-    const double x63 = sin(q9);
+    const double x63 = solo12_SIN(4, q9);
     const double x64 = x63*x63;
     const double x65 = 0.0005396092213171668*x64;
     const double x66 = 0.0029700831576528162 + x62 - x65;
-    const double x67 = cos(q8);
-    const double x68 = sin(q8);
+    const double x67 = solo12_COS(5, q8);
+    const double x68 = solo12_SIN(5, q8);
     const double x69 = x67*x68;
     const double x70 = 2.0*x69;
     const double x71 = 0.0038482516772413004*x63;
@@ -562,15 +675,15 @@ void solo12_mass_matrix(const double q[], const double p[], double M[])
     const double x87 = 0.014*x86 + x78*x67 + x80*x68;
     const double x88 = 0.0028381974208050668 + x62;
     const double x89 = 0.0005426192213171668 + 0.16*x61;
-    const double x90 = cos(q12);
+    const double x90 = solo12_COS(6, q12);
     const double x91 = 0.0038482516772413004*x90;
     const double x92 = 0.32*x91;
-    const double x93 = sin(q12);
+    const double x93 = solo12_SIN(6, q12);
     const double x94 = x93*x93;
     const double x95 = 0.0005396092213171668*x94;
     const double x96 = 0.0029700831576528162 + x92 - x95;
-    const double x97 = cos(q11);
-    const double x98 = sin(q11);
+    const double x97 = solo12_COS(7, q11);
+    const double x98 = solo12_SIN(7, q11);
     const double x99 = x97*x98;
     const double x100 = 2.0*x99;
     const double x101 = 0.0038482516772413004*x93;
@@ -762,11 +875,25 @@ void solo12_coriolis_matrix(const double q[], const double qd[], const double p[
     const double qd10 = qd[9];
     const double qd11 = qd[10];
     const double qd12 = qd[11];
-    const double x0 = cos(q2);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q5,
+        q6,
+        q8,
+        q9,
+        q11,
+        q12
+    };
+    double sine[8], cosine[8];
+    solo12_sincos(8, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q2);
     const double x1 = qd1*x0;
-    const double x2 = sin(q3);
-    const double x3 = cos(q3);
-    const double x4 = sin(q2);
+    const double x2 = solo12_SIN(1, q3);
+    const double x3 = solo12_COS(1, q3);
+    const double x4 = solo12_SIN(0, q2);
     const double x5 = qd1*x4;
     const double x6 = x3*x1 - x2*x5;
     const double x7 = 0.0030108856000000002*x1 + 0.0019241258386206502*x6;
@@ -888,11 +1015,11 @@ void solo12_coriolis_matrix(const double q[], const double qd[], const double p[
     const double x123 = x121*x3 - x120*x2;
     const double x124 = x122*x0 + x123*x4;
     const double x125 = -x114 + x51*x15 + x112*x1 - x55*x13 - x110*x5;
-    const double x126 = cos(q5);
+    const double x126 = solo12_COS(2, q5);
     const double x127 = qd4*x126;
-    const double x128 = sin(q6);
-    const double x129 = cos(q6);
-    const double x130 = sin(q5);
+    const double x128 = solo12_SIN(3, q6);
+    const double x129 = solo12_COS(3, q6);
+    const double x130 = solo12_SIN(2, q5);
     const double x131 = qd4*x130;
     const double x132 = x129*x127 - x128*x131;
     const double x133 = 0.0030108856000000002*x127 + 0.0019241258386206502*x132;
@@ -1015,11 +1142,11 @@ void solo12_coriolis_matrix(const double q[], const double qd[], const double p[
     const double x250 = x248*x129 - x247*x128;
     const double x251 = x249*x126 + x250*x130;
     const double x252 = x241 + x181*x139 + x237*x131 - x177*x141 - x239*x127;
-    const double x253 = cos(q8);
+    const double x253 = solo12_COS(4, q8);
     const double x254 = qd7*x253;
-    const double x255 = sin(q9);
-    const double x256 = cos(q9);
-    const double x257 = sin(q8);
+    const double x255 = solo12_SIN(5, q9);
+    const double x256 = solo12_COS(5, q9);
+    const double x257 = solo12_SIN(4, q8);
     const double x258 = qd7*x257;
     const double x259 = x256*x254 - x258*x255;
     const double x260 = 0.0030108856000000002*x254 + 0.0019241258386206502*x259;
@@ -1141,11 +1268,11 @@ void solo12_coriolis_matrix(const double q[], const double qd[], const double p[
     const double x376 = x374*x256 - x373*x255;
     const double x377 = x375*x253 + x376*x257;
     const double x378 = -x367 + x304*x268 + x365*x254 - x308*x266 - x363*x258;
-    const double x379 = cos(q11);
+    const double x379 = solo12_COS(6, q11);
     const double x380 = qd10*x379;
-    const double x381 = sin(q12);
-    const double x382 = cos(q12);
-    const double x383 = sin(q11);
+    const double x381 = solo12_SIN(7, q12);
+    const double x382 = solo12_COS(7, q12);
+    const double x383 = solo12_SIN(6, q11);
     const double x384 = qd10*x383;
     const double x385 = x382*x380 - x381*x384;
     const double x386 = 0.0030108856000000002*x380 + 0.0019241258386206502*x385;
@@ -1438,10 +1565,24 @@ void solo12_coriolis(const double q[], const double qd[], const double p[], doub
     const double qd10 = qd[9];
     const double qd11 = qd[10];
     const double qd12 = qd[11];
-    const double x0 = cos(q2);
-    const double x1 = sin(q2);
-    const double x2 = sin(q3);
-    const double x3 = cos(q3);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q5,
+        q6,
+        q8,
+        q9,
+        q11,
+        q12
+    };
+    double sine[8], cosine[8];
+    solo12_sincos(8, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q2);
+    const double x1 = solo12_SIN(0, q2);
+    const double x2 = solo12_SIN(1, q3);
+    const double x3 = solo12_COS(1, q3);
     const double x4 = qd1*x0;
     const double x5 = x4*qd2;
     const double x6 = qd1*x1;
@@ -1524,10 +1665,10 @@ void solo12_coriolis(const double q[], const double qd[], const double p[], doub
     const double x83 = x82 + 3.3497340042275575e-05*x48;
     const double x84 = x83 - 0.0038482516772413004*x50;
     const double x85 = x84 + x80 - 0.16*x68;
-    const double x86 = cos(q5);
-    const double x87 = sin(q5);
-    const double x88 = sin(q6);
-    const double x89 = cos(q6);
+    const double x86 = solo12_COS(2, q5);
+    const double x87 = solo12_SIN(2, q5);
+    const double x88 = solo12_SIN(3, q6);
+    const double x89 = solo12_COS(3, q6);
     const double x90 = qd4*x87;
     const double x91 = x90*qd5;
     const double x92 = qd4*x86;
@@ -1609,10 +1750,10 @@ void solo12_coriolis(const double q[], const double qd[], const double p[], doub
     const double x168 = x167 + 3.3497340042275575e-05*x134;
     const double x169 = -x168 - 0.0038482516772413004*x136;
     const double x170 = x169 + x166 - 0.16*x154;
-    const double x171 = cos(q8);
-    const double x172 = sin(q8);
-    const double x173 = sin(q9);
-    const double x174 = cos(q9);
+    const double x171 = solo12_COS(4, q8);
+    const double x172 = solo12_SIN(4, q8);
+    const double x173 = solo12_SIN(5, q9);
+    const double x174 = solo12_COS(5, q9);
     const double x175 = qd7*x171;
     const double x176 = x175*qd8;
     const double x177 = qd7*x172;
@@ -1695,10 +1836,10 @@ void solo12_coriolis(const double q[], const double qd[], const double p[], doub
     const double x254 = x253 + 3.3497340042275575e-05*x219;
     const double x255 = x254 - 0.0038482516772413004*x221;
     const double x256 = x255 + x251 - 0.16*x239;
-    const double x257 = cos(q11);
-    const double x258 = sin(q11);
-    const double x259 = sin(q12);
-    const double x260 = cos(q12);
+    const double x257 = solo12_COS(6, q11);
+    const double x258 = solo12_SIN(6, q11);
+    const double x259 = solo12_SIN(7, q12);
+    const double x260 = solo12_COS(7, q12);
     const double x261 = qd10*x258;
     const double x262 = x261*qd11;
     const double x263 = qd10*x257;
@@ -1810,59 +1951,77 @@ void solo12_gravity(const double q[], const double p[], double G[])
     const double q10 = q[9];
     const double q11 = q[10];
     const double q12 = q[11];
-    const double x0 = cos(q2);
-    const double x1 = sin(q2);
-    const double x2 = sin(q3);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q2,
+        q3,
+        q1,
+        q5,
+        q6,
+        q4,
+        q8,
+        q9,
+        q7,
+        q11,
+        q12,
+        q10
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q2);
+    const double x1 = solo12_SIN(0, q2);
+    const double x2 = solo12_SIN(1, q3);
     const double x3 = 0.0038482516772413004*x2;
     const double x4 = 2.0453744564999998e-06 - x3;
-    const double x5 = cos(q3);
+    const double x5 = solo12_COS(1, q3);
     const double x6 = 0.0038482516772413004*x5;
     const double x7 = -0.01771278698415 - x6;
     const double x8 = x7*x0 - x4*x1;
-    const double x9 = 9.81*sin(q1);
-    const double x10 = 9.81*cos(q1);
+    const double x9 = 9.81*solo12_SIN(2, q1);
+    const double x10 = 9.81*solo12_COS(2, q1);
     const double x11 = x10*x1;
     const double x12 = x10*x0;
     const double x13 = x11*x5 + x12*x2;
-    const double x14 = cos(q5);
-    const double x15 = sin(q5);
-    const double x16 = sin(q6);
+    const double x14 = solo12_COS(3, q5);
+    const double x15 = solo12_SIN(3, q5);
+    const double x16 = solo12_SIN(4, q6);
     const double x17 = 0.0038482516772413004*x16;
     const double x18 = -2.0453744564999998e-06 - x17;
-    const double x19 = cos(q6);
+    const double x19 = solo12_COS(4, q6);
     const double x20 = 0.0038482516772413004*x19;
     const double x21 = -0.01771278698415 - x20;
     const double x22 = x21*x14 - x18*x15;
-    const double x23 = 9.81*sin(q4);
-    const double x24 = 9.81*cos(q4);
+    const double x23 = 9.81*solo12_SIN(5, q4);
+    const double x24 = 9.81*solo12_COS(5, q4);
     const double x25 = x24*x15;
     const double x26 = x24*x14;
     const double x27 = x25*x19 + x26*x16;
-    const double x28 = cos(q8);
-    const double x29 = sin(q8);
-    const double x30 = sin(q9);
+    const double x28 = solo12_COS(6, q8);
+    const double x29 = solo12_SIN(6, q8);
+    const double x30 = solo12_SIN(7, q9);
     const double x31 = 0.0038482516772413004*x30;
     const double x32 = 2.0453744564999998e-06 - x31;
-    const double x33 = cos(q9);
+    const double x33 = solo12_COS(7, q9);
     const double x34 = 0.0038482516772413004*x33;
     const double x35 = -0.01771278698415 - x34;
     const double x36 = x35*x28 - x32*x29;
-    const double x37 = 9.81*sin(q7);
-    const double x38 = 9.81*cos(q7);
+    const double x37 = 9.81*solo12_SIN(8, q7);
+    const double x38 = 9.81*solo12_COS(8, q7);
     const double x39 = x38*x29;
     const double x40 = x38*x28;
     const double x41 = x39*x33 + x40*x30;
-    const double x42 = cos(q11);
-    const double x43 = sin(q11);
-    const double x44 = sin(q12);
+    const double x42 = solo12_COS(9, q11);
+    const double x43 = solo12_SIN(9, q11);
+    const double x44 = solo12_SIN(10, q12);
     const double x45 = 0.0038482516772413004*x44;
     const double x46 = -2.0453744564999998e-06 - x45;
-    const double x47 = cos(q12);
+    const double x47 = solo12_COS(10, q12);
     const double x48 = 0.0038482516772413004*x47;
     const double x49 = -0.01771278698415 - x48;
     const double x50 = x49*x42 - x46*x43;
-    const double x51 = 9.81*sin(q10);
-    const double x52 = 9.81*cos(q10);
+    const double x51 = 9.81*solo12_SIN(11, q10);
+    const double x52 = 9.81*solo12_COS(11, q10);
     const double x53 = x52*x43;
     const double x54 = x52*x42;
     const double x55 = x53*x47 + x54*x44;
@@ -1939,15 +2098,33 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double tau10 = tau[9];
     const double tau11 = tau[10];
     const double tau12 = tau[11];
-    const double x0 = cos(q3);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q3,
+        q2,
+        q1,
+        q6,
+        q5,
+        q4,
+        q9,
+        q8,
+        q7,
+        q12,
+        q11,
+        q10
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q3);
     const double x1 = 0.0038482516772413004*x0;
     const double x2 = 0.32*x1;
-    const double x3 = sin(q3);
+    const double x3 = solo12_SIN(0, q3);
     const double x4 = x3*x3;
     const double x5 = 0.0005396092213171668*x4;
     const double x6 = 0.0029700831576528162 + x2 - x5;
-    const double x7 = cos(q2);
-    const double x8 = sin(q2);
+    const double x7 = solo12_COS(1, q2);
+    const double x8 = solo12_SIN(1, q2);
     const double x9 = x7*x8;
     const double x10 = 2.0*x9;
     const double x11 = 0.0038482516772413004*x3;
@@ -1989,7 +2166,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x47 = x42 + 3.3497340042275575e-05*x46;
     const double x48 = x35*x36;
     const double x49 = 0.16*x48;
-    const double x50 = 9.81*cos(q1);
+    const double x50 = 9.81*solo12_COS(2, q1);
     const double x51 = x50*x8;
     const double x52 = -x49 - x51;
     const double x53 = x35*x35;
@@ -2009,7 +2186,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x67 = 0.0002730308797879413*qd2 + 1.609852873477455e-07*x35 + 8.590521094399056e-05*x36;
     const double x68 = qd1*qd1;
     const double x69 = 0.014*x68;
-    const double x70 = 9.81*sin(q1);
+    const double x70 = 9.81*solo12_SIN(2, q1);
     const double x71 = x70 - x69;
     const double x72 = -x66 + 0.01169101578415*x71 + x67*qd2;
     const double x73 = x72 - x64 + 1.609852873477455e-07*x44 + 0.0028754860404784995*x57;
@@ -2078,15 +2255,15 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x136 = x135/x34;
     const double x137 = x134*x25 - x33*x136;
     const double x138 = 1842.9129686423128*x61 - x26*x137 - 1842.9129686423128*x21*x136;
-    const double x139 = cos(q6);
+    const double x139 = solo12_COS(3, q6);
     const double x140 = 0.0038482516772413004*x139;
     const double x141 = 0.32*x140;
-    const double x142 = sin(q6);
+    const double x142 = solo12_SIN(3, q6);
     const double x143 = x142*x142;
     const double x144 = 0.0005396092213171668*x143;
     const double x145 = 0.0029700831576528162 + x141 - x144;
-    const double x146 = cos(q5);
-    const double x147 = sin(q5);
+    const double x146 = solo12_COS(4, q5);
+    const double x147 = solo12_SIN(4, q5);
     const double x148 = x146*x147;
     const double x149 = 2.0*x148;
     const double x150 = 0.0038482516772413004*x142;
@@ -2127,7 +2304,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x185 = x180 + 3.3497340042275575e-05*x184;
     const double x186 = x174*x175;
     const double x187 = 0.16*x186;
-    const double x188 = 9.81*cos(q4);
+    const double x188 = 9.81*solo12_COS(5, q4);
     const double x189 = x188*x147;
     const double x190 = -x187 - x189;
     const double x191 = x174*x174;
@@ -2147,7 +2324,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x205 = x204 + 0.001386899962102278*x181 + 1.609852873477455e-07*x182;
     const double x206 = qd4*qd4;
     const double x207 = 0.014*x206;
-    const double x208 = 9.81*sin(q4);
+    const double x208 = 9.81*solo12_SIN(5, q4);
     const double x209 = x208 + x207;
     const double x210 = -0.01169101578415*x209;
     const double x211 = -x205 - x210 - 0.0028754860404784995*x195;
@@ -2216,15 +2393,15 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x274 = x273/x173;
     const double x275 = x272*x164 - x172*x274;
     const double x276 = 1842.9129686423128*x199 - x165*x275 - 1842.9129686423128*x160*x274;
-    const double x277 = cos(q9);
+    const double x277 = solo12_COS(6, q9);
     const double x278 = 0.0038482516772413004*x277;
     const double x279 = 0.32*x278;
-    const double x280 = sin(q9);
+    const double x280 = solo12_SIN(6, q9);
     const double x281 = x280*x280;
     const double x282 = 0.0005396092213171668*x281;
     const double x283 = 0.0029700831576528162 + x279 - x282;
-    const double x284 = cos(q8);
-    const double x285 = sin(q8);
+    const double x284 = solo12_COS(7, q8);
+    const double x285 = solo12_SIN(7, q8);
     const double x286 = x284*x285;
     const double x287 = 2.0*x286;
     const double x288 = 0.0038482516772413004*x280;
@@ -2266,7 +2443,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x324 = x319 + 3.3497340042275575e-05*x323;
     const double x325 = x312*x313;
     const double x326 = 0.16*x325;
-    const double x327 = 9.81*cos(q7);
+    const double x327 = 9.81*solo12_COS(8, q7);
     const double x328 = x327*x285;
     const double x329 = -x326 - x328;
     const double x330 = x312*x312;
@@ -2286,7 +2463,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x344 = 0.0002730308797879413*qd8 + 1.609852873477455e-07*x312 + 8.590521094399056e-05*x313;
     const double x345 = qd7*qd7;
     const double x346 = 0.014*x345;
-    const double x347 = 9.81*sin(q7);
+    const double x347 = 9.81*solo12_SIN(8, q7);
     const double x348 = x347 - x346;
     const double x349 = -x343 + 0.01169101578415*x348 + x344*qd8;
     const double x350 = x349 - x341 + 1.609852873477455e-07*x321 + 0.0028754860404784995*x334;
@@ -2355,15 +2532,15 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x413 = x412/x311;
     const double x414 = x411*x302 - x310*x413;
     const double x415 = 1842.9129686423128*x338 - x303*x414 - 1842.9129686423128*x298*x413;
-    const double x416 = cos(q12);
+    const double x416 = solo12_COS(9, q12);
     const double x417 = 0.0038482516772413004*x416;
     const double x418 = 0.32*x417;
-    const double x419 = sin(q12);
+    const double x419 = solo12_SIN(9, q12);
     const double x420 = x419*x419;
     const double x421 = 0.0005396092213171668*x420;
     const double x422 = 0.0029700831576528162 + x418 - x421;
-    const double x423 = cos(q11);
-    const double x424 = sin(q11);
+    const double x423 = solo12_COS(10, q11);
+    const double x424 = solo12_SIN(10, q11);
     const double x425 = x423*x424;
     const double x426 = 2.0*x425;
     const double x427 = 0.0038482516772413004*x419;
@@ -2404,7 +2581,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x462 = x457 + 3.3497340042275575e-05*x461;
     const double x463 = x451*x452;
     const double x464 = 0.16*x463;
-    const double x465 = 9.81*cos(q10);
+    const double x465 = 9.81*solo12_COS(11, q10);
     const double x466 = x465*x424;
     const double x467 = -x464 - x466;
     const double x468 = x451*x451;
@@ -2424,7 +2601,7 @@ void solo12_forward_dynamics(const double q[], const double qd[], const double t
     const double x482 = x481 + 0.001386899962102278*x458 + 1.609852873477455e-07*x459;
     const double x483 = qd10*qd10;
     const double x484 = 0.014*x483;
-    const double x485 = 9.81*sin(q10);
+    const double x485 = 9.81*solo12_SIN(11, q10);
     const double x486 = x485 + x484;
     const double x487 = -0.01169101578415*x486;
     const double x488 = -x482 - x487 - 0.0028754860404784995*x472;
@@ -2547,13 +2724,31 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double qdd10 = qdd[9];
     const double qdd11 = qdd[10];
     const double qdd12 = qdd[11];
-    const double x0 = 9.81*cos(q1);
-    const double x1 = 9.81*sin(q1);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q1,
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        q8,
+        q9,
+        q10,
+        q11,
+        q12
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = 9.81*solo12_COS(0, q1);
+    const double x1 = 9.81*solo12_SIN(0, q1);
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x3 = sin(q2);
+    const double x3 = solo12_SIN(1, q2);
     const double x4 = x0 + 0.014*qdd1;
     const double x5 = x4*x3;
-    const double x6 = cos(q2);
+    const double x6 = solo12_COS(1, q2);
     const double x7 = x4*x6;
     const double x8 = 0.014*x3;
     const double x9 = 0.014*x6;
@@ -2587,8 +2782,8 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x37 = x6*x17 + x3*qdd2 + x14*x33;
     const double x38 = x6*x24 + x3*x22;
     const double x39 = 0.16*x6;
-    const double x40 = cos(q3);
-    const double x41 = sin(q3);
+    const double x40 = solo12_COS(2, q3);
+    const double x41 = solo12_SIN(2, q3);
     const double x42 = -x5 + 0.03745*x23 - 0.16*x28;
     const double x43 = x7 + 0.03745*x26 - 0.16*x30;
     const double x44 = x42*x40 - x41*x43;
@@ -2648,13 +2843,13 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x98 = x64 - x72;
     const double x99 = x57 - x56;
     const double x100 = ((double)((qd3 > 0) - (qd3 < 0)));
-    const double x101 = 9.81*cos(q4);
-    const double x102 = 9.81*sin(q4);
+    const double x101 = 9.81*solo12_COS(3, q4);
+    const double x102 = 9.81*solo12_SIN(3, q4);
     const double x103 = ((double)((qd4 > 0) - (qd4 < 0)));
-    const double x104 = sin(q5);
+    const double x104 = solo12_SIN(4, q5);
     const double x105 = x101 - 0.014*qdd4;
     const double x106 = x105*x104;
-    const double x107 = cos(q5);
+    const double x107 = solo12_COS(4, q5);
     const double x108 = x105*x107;
     const double x109 = 0.014*x104;
     const double x110 = 0.014*x107;
@@ -2688,8 +2883,8 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x138 = x118*x107 + x104*qdd5 + x115*x134;
     const double x139 = x125*x107 + x104*x123;
     const double x140 = 0.16*x107;
-    const double x141 = cos(q6);
-    const double x142 = sin(q6);
+    const double x141 = solo12_COS(5, q6);
+    const double x142 = solo12_SIN(5, q6);
     const double x143 = -x106 - 0.03745*x124 - 0.16*x129;
     const double x144 = x108 - 0.03745*x127 - 0.16*x131;
     const double x145 = x143*x141 - x144*x142;
@@ -2749,13 +2944,13 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x199 = x165 - x173;
     const double x200 = x158 - x157;
     const double x201 = ((double)((qd6 > 0) - (qd6 < 0)));
-    const double x202 = 9.81*cos(q7);
-    const double x203 = 9.81*sin(q7);
+    const double x202 = 9.81*solo12_COS(6, q7);
+    const double x203 = 9.81*solo12_SIN(6, q7);
     const double x204 = ((double)((qd7 > 0) - (qd7 < 0)));
-    const double x205 = sin(q8);
+    const double x205 = solo12_SIN(7, q8);
     const double x206 = x202 + 0.014*qdd7;
     const double x207 = x206*x205;
-    const double x208 = cos(q8);
+    const double x208 = solo12_COS(7, q8);
     const double x209 = x206*x208;
     const double x210 = 0.014*x205;
     const double x211 = 0.014*x208;
@@ -2789,8 +2984,8 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x239 = x219*x208 + x205*qdd8 + x216*x235;
     const double x240 = x226*x208 + x205*x224;
     const double x241 = 0.16*x208;
-    const double x242 = cos(q9);
-    const double x243 = sin(q9);
+    const double x242 = solo12_COS(8, q9);
+    const double x243 = solo12_SIN(8, q9);
     const double x244 = -x207 + 0.03745*x225 - 0.16*x230;
     const double x245 = x209 + 0.03745*x228 - 0.16*x232;
     const double x246 = x244*x242 - x243*x245;
@@ -2850,13 +3045,13 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x300 = x266 - x274;
     const double x301 = x259 - x258;
     const double x302 = ((double)((qd9 > 0) - (qd9 < 0)));
-    const double x303 = 9.81*cos(q10);
-    const double x304 = 9.81*sin(q10);
+    const double x303 = 9.81*solo12_COS(9, q10);
+    const double x304 = 9.81*solo12_SIN(9, q10);
     const double x305 = ((double)((qd10 > 0) - (qd10 < 0)));
-    const double x306 = sin(q11);
+    const double x306 = solo12_SIN(10, q11);
     const double x307 = x303 - 0.014*qdd10;
     const double x308 = x307*x306;
-    const double x309 = cos(q11);
+    const double x309 = solo12_COS(10, q11);
     const double x310 = x307*x309;
     const double x311 = 0.014*x306;
     const double x312 = 0.014*x309;
@@ -2890,8 +3085,8 @@ void solo12_regressor(const double q[], const double qd[], const double qdd[], c
     const double x340 = x309*x320 + x306*qdd11 + x317*x336;
     const double x341 = x309*x327 + x306*x325;
     const double x342 = 0.16*x309;
-    const double x343 = cos(q12);
-    const double x344 = sin(q12);
+    const double x343 = solo12_COS(11, q12);
+    const double x344 = solo12_SIN(11, q12);
     const double x345 = -x308 - 0.03745*x326 - 0.16*x331;
     const double x346 = x310 - 0.03745*x329 - 0.16*x333;
     const double x347 = x345*x343 - x344*x346;
@@ -4865,13 +5060,31 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double qdd10 = qdd[9];
     const double qdd11 = qdd[10];
     const double qdd12 = qdd[11];
-    const double x0 = 9.81*cos(q1);
-    const double x1 = 9.81*sin(q1);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q1,
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        q7,
+        q8,
+        q9,
+        q10,
+        q11,
+        q12
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = 9.81*solo12_COS(0, q1);
+    const double x1 = 9.81*solo12_SIN(0, q1);
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x3 = sin(q2);
+    const double x3 = solo12_SIN(1, q2);
     const double x4 = qd1*qd1;
     const double x5 = x1 - 0.014*x4;
-    const double x6 = cos(q2);
+    const double x6 = solo12_COS(1, q2);
     const double x7 = qd1*x6;
     const double x8 = qd1*x3;
     const double x9 = x7*x8;
@@ -4897,8 +5110,8 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x29 = x6*x21 + x6*x28 + x3*x23 - x3*x22;
     const double x30 = x6*x11 + x3*qdd2 + x8*x25;
     const double x31 = 0.16*x6;
-    const double x32 = cos(q3);
-    const double x33 = sin(q3);
+    const double x32 = solo12_COS(2, q3);
+    const double x33 = solo12_SIN(2, q3);
     const double x34 = x7*x32 - x33*x8;
     const double x35 = qd2 + qd3;
     const double x36 = x34*x35;
@@ -4955,13 +5168,13 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x87 = x47 - x59;
     const double x88 = x37 - x36;
     const double x89 = ((double)((qd3 > 0) - (qd3 < 0)));
-    const double x90 = 9.81*cos(q4);
-    const double x91 = 9.81*sin(q4);
+    const double x90 = 9.81*solo12_COS(3, q4);
+    const double x91 = 9.81*solo12_SIN(3, q4);
     const double x92 = ((double)((qd4 > 0) - (qd4 < 0)));
-    const double x93 = sin(q5);
+    const double x93 = solo12_SIN(4, q5);
     const double x94 = qd4*qd4;
     const double x95 = x91 + 0.014*x94;
-    const double x96 = cos(q5);
+    const double x96 = solo12_COS(4, q5);
     const double x97 = qd4*x96;
     const double x98 = qd4*x93;
     const double x99 = x97*x98;
@@ -4987,8 +5200,8 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x119 = x111*x96 + x96*x118 + x93*x113 - x112*x93;
     const double x120 = x101*x96 + x93*qdd5 + x98*x115;
     const double x121 = 0.16*x96;
-    const double x122 = cos(q6);
-    const double x123 = sin(q6);
+    const double x122 = solo12_COS(5, q6);
+    const double x123 = solo12_SIN(5, q6);
     const double x124 = x97*x122 - x123*x98;
     const double x125 = qd5 + qd6;
     const double x126 = x124*x125;
@@ -5045,13 +5258,13 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x177 = x137 - x149;
     const double x178 = x127 - x126;
     const double x179 = ((double)((qd6 > 0) - (qd6 < 0)));
-    const double x180 = 9.81*cos(q7);
-    const double x181 = 9.81*sin(q7);
+    const double x180 = 9.81*solo12_COS(6, q7);
+    const double x181 = 9.81*solo12_SIN(6, q7);
     const double x182 = ((double)((qd7 > 0) - (qd7 < 0)));
-    const double x183 = sin(q8);
+    const double x183 = solo12_SIN(7, q8);
     const double x184 = qd7*qd7;
     const double x185 = x181 - 0.014*x184;
-    const double x186 = cos(q8);
+    const double x186 = solo12_COS(7, q8);
     const double x187 = qd7*x186;
     const double x188 = qd7*x183;
     const double x189 = x187*x188;
@@ -5077,8 +5290,8 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x209 = x201*x186 + x186*x208 + x183*x203 - x202*x183;
     const double x210 = x191*x186 + x183*qdd8 + x188*x205;
     const double x211 = 0.16*x186;
-    const double x212 = cos(q9);
-    const double x213 = sin(q9);
+    const double x212 = solo12_COS(8, q9);
+    const double x213 = solo12_SIN(8, q9);
     const double x214 = x187*x212 - x213*x188;
     const double x215 = qd8 + qd9;
     const double x216 = x214*x215;
@@ -5135,13 +5348,13 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x267 = x227 - x239;
     const double x268 = x217 - x216;
     const double x269 = ((double)((qd9 > 0) - (qd9 < 0)));
-    const double x270 = 9.81*cos(q10);
-    const double x271 = 9.81*sin(q10);
+    const double x270 = 9.81*solo12_COS(9, q10);
+    const double x271 = 9.81*solo12_SIN(9, q10);
     const double x272 = ((double)((qd10 > 0) - (qd10 < 0)));
-    const double x273 = sin(q11);
+    const double x273 = solo12_SIN(10, q11);
     const double x274 = qd10*qd10;
     const double x275 = x271 + 0.014*x274;
-    const double x276 = cos(q11);
+    const double x276 = solo12_COS(10, q11);
     const double x277 = qd10*x276;
     const double x278 = qd10*x273;
     const double x279 = x277*x278;
@@ -5167,8 +5380,8 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     const double x299 = x276*x291 + x276*x298 + x273*x293 - x273*x292;
     const double x300 = x276*x281 + x273*qdd11 + x278*x295;
     const double x301 = 0.16*x276;
-    const double x302 = cos(q12);
-    const double x303 = sin(q12);
+    const double x302 = solo12_COS(11, q12);
+    const double x303 = solo12_SIN(11, q12);
     const double x304 = x277*x302 - x303*x278;
     const double x305 = qd11 + qd12;
     const double x306 = x304*x305;
@@ -6419,16 +6632,34 @@ void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], co
     const double qdd10 = qdd[9];
     const double qdd11 = qdd[10];
     const double qdd12 = qdd[11];
-    const double x0 = sin(q2);
-    const double x1 = cos(q2);
-    const double x2 = 9.81*sin(q1);
-    const double x3 = sin(q3);
-    const double x4 = cos(q3);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q2,
+        q1,
+        q3,
+        q5,
+        q4,
+        q6,
+        q8,
+        q7,
+        q9,
+        q11,
+        q10,
+        q12
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = solo12_SIN(0, q2);
+    const double x1 = solo12_COS(0, q2);
+    const double x2 = 9.81*solo12_SIN(1, q1);
+    const double x3 = solo12_SIN(2, q3);
+    const double x4 = solo12_COS(2, q3);
     const double x5 = x2*x0;
     const double x6 = x2*x1;
     const double x7 = x5*x4 + x6*x3;
     const double x8 = 0.0002972952667644*x7;
-    const double x9 = 9.81*cos(q1);
+    const double x9 = 9.81*solo12_COS(1, q1);
     const double x10 = 0.01169101578415*x9 - 0.0028754860404784995*x6;
     const double x11 = x5*x3 - x4*x6;
     const double x12 = 0.0002972952667644*x11 + 0.0038482516772413004*x9;
@@ -6618,16 +6849,16 @@ void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], co
     const double x196 = x192 + x195 - 0.16*x153;
     const double x197 = x194 + 3.3497340042275575e-05*x176 + 0.0038482516772413004*x61;
     const double x198 = x197 - 0.16*x184;
-    const double x199 = sin(q5);
-    const double x200 = cos(q5);
-    const double x201 = 9.81*sin(q4);
-    const double x202 = sin(q6);
-    const double x203 = cos(q6);
+    const double x199 = solo12_SIN(3, q5);
+    const double x200 = solo12_COS(3, q5);
+    const double x201 = 9.81*solo12_SIN(4, q4);
+    const double x202 = solo12_SIN(5, q6);
+    const double x203 = solo12_COS(5, q6);
     const double x204 = x201*x199;
     const double x205 = x201*x200;
     const double x206 = x204*x203 + x205*x202;
     const double x207 = 0.0002972952667644*x206;
-    const double x208 = 9.81*cos(q4);
+    const double x208 = 9.81*solo12_COS(4, q4);
     const double x209 = 0.0028754860404784995*x205 + 0.01169101578415*x208;
     const double x210 = x204*x202 - x203*x205;
     const double x211 = 0.0038482516772413004*x208 - 0.0002972952667644*x210;
@@ -6818,16 +7049,16 @@ void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], co
     const double x396 = x393 + x395 - 0.16*x353;
     const double x397 = -x394 + 0.0038482516772413004*x259 - 3.3497340042275575e-05*x377;
     const double x398 = x397 - 0.16*x385;
-    const double x399 = sin(q8);
-    const double x400 = cos(q8);
-    const double x401 = 9.81*sin(q7);
-    const double x402 = sin(q9);
-    const double x403 = cos(q9);
+    const double x399 = solo12_SIN(6, q8);
+    const double x400 = solo12_COS(6, q8);
+    const double x401 = 9.81*solo12_SIN(7, q7);
+    const double x402 = solo12_SIN(8, q9);
+    const double x403 = solo12_COS(8, q9);
     const double x404 = x401*x399;
     const double x405 = x401*x400;
     const double x406 = x404*x403 + x405*x402;
     const double x407 = 0.0002972952667644*x406;
-    const double x408 = 9.81*cos(q7);
+    const double x408 = 9.81*solo12_COS(7, q7);
     const double x409 = 0.01169101578415*x408 - 0.0028754860404784995*x405;
     const double x410 = x404*x402 - x403*x405;
     const double x411 = 0.0002972952667644*x410 + 0.0038482516772413004*x408;
@@ -7017,16 +7248,16 @@ void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], co
     const double x595 = x591 + x594 - 0.16*x552;
     const double x596 = x593 + 3.3497340042275575e-05*x575 + 0.0038482516772413004*x460;
     const double x597 = x596 - 0.16*x583;
-    const double x598 = sin(q11);
-    const double x599 = cos(q11);
-    const double x600 = 9.81*sin(q10);
-    const double x601 = sin(q12);
-    const double x602 = cos(q12);
+    const double x598 = solo12_SIN(9, q11);
+    const double x599 = solo12_COS(9, q11);
+    const double x600 = 9.81*solo12_SIN(10, q10);
+    const double x601 = solo12_SIN(11, q12);
+    const double x602 = solo12_COS(11, q12);
     const double x603 = x600*x598;
     const double x604 = x600*x599;
     const double x605 = x603*x602 + x604*x601;
     const double x606 = 0.0002972952667644*x605;
-    const double x607 = 9.81*cos(q10);
+    const double x607 = 9.81*solo12_COS(10, q10);
     const double x608 = 0.0028754860404784995*x604 + 0.01169101578415*x607;
     const double x609 = x603*x601 - x602*x604;
     const double x610 = 0.0038482516772413004*x607 - 0.0002972952667644*x609;
@@ -8039,12 +8270,30 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double tau10 = tau[9];
     const double tau11 = tau[10];
     const double tau12 = tau[11];
-    const double x0 = sin(q3);
-    const double x1 = cos(q3);
-    const double x2 = sin(q2);
-    const double x3 = 9.81*sin(q1);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q3,
+        q2,
+        q1,
+        q6,
+        q5,
+        q4,
+        q9,
+        q8,
+        q7,
+        q12,
+        q11,
+        q10
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = solo12_SIN(0, q3);
+    const double x1 = solo12_COS(0, q3);
+    const double x2 = solo12_SIN(1, q2);
+    const double x3 = 9.81*solo12_SIN(2, q1);
     const double x4 = x3*x2;
-    const double x5 = cos(q2);
+    const double x5 = solo12_COS(1, q2);
     const double x6 = x3*x5;
     const double x7 = x4*x1 + x6*x0;
     const double x8 = 0.0038482516772413004*x7;
@@ -8055,7 +8304,7 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x13 = x10*x7 + x11*x12;
     const double x14 = x9 - x8 - 0.16*x13;
     const double x15 = 0.0002972952667644*x7;
-    const double x16 = 9.81*cos(q1);
+    const double x16 = 9.81*solo12_COS(2, q1);
     const double x17 = 0.01169101578415*x16 - 0.0028754860404784995*x6;
     const double x18 = 0.0002972952667644*x12 + 0.0038482516772413004*x16;
     const double x19 = x10*x12 - x11*x7;
@@ -8325,12 +8574,12 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x283 = -x186*x14 - x61*x26 + 0.0038482516772413004*x196*x7;
     const double x284 = -x165*x196 - x183*x186 - x260*x61;
     const double x285 = -x263*x196 - x269*x186 - x278*x61;
-    const double x286 = sin(q6);
-    const double x287 = cos(q6);
-    const double x288 = sin(q5);
-    const double x289 = 9.81*sin(q4);
+    const double x286 = solo12_SIN(3, q6);
+    const double x287 = solo12_COS(3, q6);
+    const double x288 = solo12_SIN(4, q5);
+    const double x289 = 9.81*solo12_SIN(5, q4);
     const double x290 = x289*x288;
-    const double x291 = cos(q5);
+    const double x291 = solo12_COS(4, q5);
     const double x292 = x289*x291;
     const double x293 = x290*x287 + x292*x286;
     const double x294 = 0.0038482516772413004*x293;
@@ -8341,7 +8590,7 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x299 = x296*x293 + x297*x298;
     const double x300 = x295 - x294 - 0.16*x299;
     const double x301 = 0.0002972952667644*x293;
-    const double x302 = 9.81*cos(q4);
+    const double x302 = 9.81*solo12_COS(5, q4);
     const double x303 = 0.0028754860404784995*x292 + 0.01169101578415*x302;
     const double x304 = 0.0038482516772413004*x302 - 0.0002972952667644*x298;
     const double x305 = x296*x298 - x297*x293;
@@ -8612,12 +8861,12 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x570 = -x472*x300 - x347*x312 + 0.0038482516772413004*x481*x293;
     const double x571 = -x451*x481 - x469*x472 - x546*x347;
     const double x572 = -x549*x481 - x555*x472 - x565*x347;
-    const double x573 = sin(q9);
-    const double x574 = cos(q9);
-    const double x575 = sin(q8);
-    const double x576 = 9.81*sin(q7);
+    const double x573 = solo12_SIN(6, q9);
+    const double x574 = solo12_COS(6, q9);
+    const double x575 = solo12_SIN(7, q8);
+    const double x576 = 9.81*solo12_SIN(8, q7);
     const double x577 = x576*x575;
-    const double x578 = cos(q8);
+    const double x578 = solo12_COS(7, q8);
     const double x579 = x576*x578;
     const double x580 = x577*x574 + x579*x573;
     const double x581 = 0.0038482516772413004*x580;
@@ -8628,7 +8877,7 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x586 = x583*x580 + x584*x585;
     const double x587 = x582 - x581 - 0.16*x586;
     const double x588 = 0.0002972952667644*x580;
-    const double x589 = 9.81*cos(q7);
+    const double x589 = 9.81*solo12_COS(8, q7);
     const double x590 = 0.01169101578415*x589 - 0.0028754860404784995*x579;
     const double x591 = 0.0002972952667644*x585 + 0.0038482516772413004*x589;
     const double x592 = x583*x585 - x584*x580;
@@ -8898,12 +9147,12 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x856 = -x759*x587 - x634*x599 + 0.0038482516772413004*x769*x580;
     const double x857 = -x738*x769 - x756*x759 - x833*x634;
     const double x858 = -x836*x769 - x842*x759 - x851*x634;
-    const double x859 = sin(q12);
-    const double x860 = cos(q12);
-    const double x861 = sin(q11);
-    const double x862 = 9.81*sin(q10);
+    const double x859 = solo12_SIN(9, q12);
+    const double x860 = solo12_COS(9, q12);
+    const double x861 = solo12_SIN(10, q11);
+    const double x862 = 9.81*solo12_SIN(11, q10);
     const double x863 = x862*x861;
-    const double x864 = cos(q11);
+    const double x864 = solo12_COS(10, q11);
     const double x865 = x862*x864;
     const double x866 = x863*x860 + x865*x859;
     const double x867 = 0.0038482516772413004*x866;
@@ -8914,7 +9163,7 @@ void solo12_forward_dynamics_derivatives(const double q[], const double qd[], co
     const double x872 = x869*x866 + x870*x871;
     const double x873 = x868 - x867 - 0.16*x872;
     const double x874 = 0.0002972952667644*x866;
-    const double x875 = 9.81*cos(q10);
+    const double x875 = 9.81*solo12_COS(11, q10);
     const double x876 = 0.0028754860404784995*x865 + 0.01169101578415*x875;
     const double x877 = 0.0038482516772413004*x875 - 0.0002972952667644*x871;
     const double x878 = x869*x871 - x870*x866;
@@ -10087,15 +10336,29 @@ void solo12_mass_matrix_inverse(const double q[], const double p[], double Minv[
     const double q9 = q[8];
     const double q11 = q[10];
     const double q12 = q[11];
-    const double x0 = cos(q3);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[8] = {
+        q3,
+        q2,
+        q6,
+        q5,
+        q9,
+        q8,
+        q12,
+        q11
+    };
+    double sine[8], cosine[8];
+    solo12_sincos(8, angle, sine, cosine);
+#endif
+    const double x0 = solo12_COS(0, q3);
     const double x1 = 0.0038482516772413004*x0;
     const double x2 = 0.32*x1;
-    const double x3 = sin(q3);
+    const double x3 = solo12_SIN(0, q3);
     const double x4 = x3*x3;
     const double x5 = 0.0005396092213171668*x4;
     const double x6 = 0.0029700831576528162 + x2 - x5;
-    const double x7 = sin(q2);
-    const double x8 = cos(q2);
+    const double x7 = solo12_SIN(1, q2);
+    const double x8 = solo12_COS(1, q2);
     const double x9 = x8*x7;
     const double x10 = 2.0*x9;
     const double x11 = 0.0038482516772413004*x3;
@@ -10131,15 +10394,15 @@ void solo12_mass_matrix_inverse(const double q[], const double p[], double Minv[
     const double x41 = x25*x37;
     const double x42 = -x41 - x33*x39;
     const double x43 = 1842.9129686423128 + x38*x39 + x37*x41;
-    const double x44 = cos(q6);
+    const double x44 = solo12_COS(2, q6);
     const double x45 = 0.0038482516772413004*x44;
     const double x46 = 0.32*x45;
-    const double x47 = sin(q6);
+    const double x47 = solo12_SIN(2, q6);
     const double x48 = x47*x47;
     const double x49 = 0.0005396092213171668*x48;
     const double x50 = 0.0029700831576528162 + x46 - x49;
-    const double x51 = sin(q5);
-    const double x52 = cos(q5);
+    const double x51 = solo12_SIN(3, q5);
+    const double x52 = solo12_COS(3, q5);
     const double x53 = x52*x51;
     const double x54 = 2.0*x53;
     const double x55 = 0.0038482516772413004*x47;
@@ -10175,15 +10438,15 @@ void solo12_mass_matrix_inverse(const double q[], const double p[], double Minv[
     const double x85 = x69*x81;
     const double x86 = -x85 - x77*x83;
     const double x87 = 1842.9129686423128 + x82*x83 + x81*x85;
-    const double x88 = cos(q9);
+    const double x88 = solo12_COS(4, q9);
     const double x89 = 0.0038482516772413004*x88;
     const double x90 = 0.32*x89;
-    const double x91 = sin(q9);
+    const double x91 = solo12_SIN(4, q9);
     const double x92 = x91*x91;
     const double x93 = 0.0005396092213171668*x92;
     const double x94 = 0.0029700831576528162 + x90 - x93;
-    const double x95 = sin(q8);
-    const double x96 = cos(q8);
+    const double x95 = solo12_SIN(5, q8);
+    const double x96 = solo12_COS(5, q8);
     const double x97 = x96*x95;
     const double x98 = 2.0*x97;
     const double x99 = 0.0038482516772413004*x91;
@@ -10219,15 +10482,15 @@ void solo12_mass_matrix_inverse(const double q[], const double p[], double Minv[
     const double x129 = x113*x125;
     const double x130 = -x129 - x121*x127;
     const double x131 = 1842.9129686423128 + x126*x127 + x125*x129;
-    const double x132 = cos(q12);
+    const double x132 = solo12_COS(6, q12);
     const double x133 = 0.0038482516772413004*x132;
     const double x134 = 0.32*x133;
-    const double x135 = sin(q12);
+    const double x135 = solo12_SIN(6, q12);
     const double x136 = x135*x135;
     const double x137 = 0.0005396092213171668*x136;
     const double x138 = 0.0029700831576528162 + x134 - x137;
-    const double x139 = sin(q11);
-    const double x140 = cos(q11);
+    const double x139 = solo12_SIN(7, q11);
+    const double x140 = solo12_COS(7, q11);
     const double x141 = x140*x139;
     const double x142 = 2.0*x141;
     const double x143 = 0.0038482516772413004*x135;
@@ -10449,12 +10712,30 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double tau10 = tau[9];
     const double tau11 = tau[10];
     const double tau12 = tau[11];
-    const double x0 = sin(q3);
-    const double x1 = cos(q3);
-    const double x2 = sin(q2);
-    const double x3 = 9.81*sin(q1);
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q3,
+        q2,
+        q1,
+        q6,
+        q5,
+        q4,
+        q9,
+        q8,
+        q7,
+        q12,
+        q11,
+        q10
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
+    const double x0 = solo12_SIN(0, q3);
+    const double x1 = solo12_COS(0, q3);
+    const double x2 = solo12_SIN(1, q2);
+    const double x3 = 9.81*solo12_SIN(2, q1);
     const double x4 = x3*x2;
-    const double x5 = cos(q2);
+    const double x5 = solo12_COS(1, q2);
     const double x6 = x3*x5;
     const double x7 = x4*x1 + x6*x0;
     const double x8 = 0.0038482516772413004*x7;
@@ -10465,7 +10746,7 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x13 = x10*x7 + x11*x12;
     const double x14 = x9 - x8 - 0.16*x13;
     const double x15 = 0.0002972952667644*x7;
-    const double x16 = 9.81*cos(q1);
+    const double x16 = 9.81*solo12_COS(2, q1);
     const double x17 = 0.01169101578415*x16 - 0.0028754860404784995*x6;
     const double x18 = 0.0002972952667644*x12 + 0.0038482516772413004*x16;
     const double x19 = x10*x12 - x11*x7;
@@ -10848,12 +11129,12 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x396 = -x298*x196 - x327*x61 - x387*x186;
     const double x397 = -x357*x196 - x364*x61 - x389*x186;
     const double x398 = -x370*x196 - x381*x61 - x391*x186;
-    const double x399 = sin(q6);
-    const double x400 = cos(q6);
-    const double x401 = sin(q5);
-    const double x402 = 9.81*sin(q4);
+    const double x399 = solo12_SIN(3, q6);
+    const double x400 = solo12_COS(3, q6);
+    const double x401 = solo12_SIN(4, q5);
+    const double x402 = 9.81*solo12_SIN(5, q4);
     const double x403 = x402*x401;
-    const double x404 = cos(q5);
+    const double x404 = solo12_COS(4, q5);
     const double x405 = x402*x404;
     const double x406 = x403*x400 + x405*x399;
     const double x407 = 0.0038482516772413004*x406;
@@ -10864,7 +11145,7 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x412 = x409*x406 + x410*x411;
     const double x413 = x408 - x407 - 0.16*x412;
     const double x414 = 0.0002972952667644*x406;
-    const double x415 = 9.81*cos(q4);
+    const double x415 = 9.81*solo12_COS(5, q4);
     const double x416 = 0.0028754860404784995*x405 + 0.01169101578415*x415;
     const double x417 = 0.0038482516772413004*x415 - 0.0002972952667644*x411;
     const double x418 = x409*x411 - x410*x406;
@@ -11250,12 +11531,12 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x798 = -x698*x594 - x727*x460 - x789*x585;
     const double x799 = -x759*x594 - x766*x460 - x791*x585;
     const double x800 = -x772*x594 - x783*x460 - x793*x585;
-    const double x801 = sin(q9);
-    const double x802 = cos(q9);
-    const double x803 = sin(q8);
-    const double x804 = 9.81*sin(q7);
+    const double x801 = solo12_SIN(6, q9);
+    const double x802 = solo12_COS(6, q9);
+    const double x803 = solo12_SIN(7, q8);
+    const double x804 = 9.81*solo12_SIN(8, q7);
     const double x805 = x804*x803;
-    const double x806 = cos(q8);
+    const double x806 = solo12_COS(7, q8);
     const double x807 = x804*x806;
     const double x808 = x805*x802 + x807*x801;
     const double x809 = 0.0038482516772413004*x808;
@@ -11266,7 +11547,7 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x814 = x811*x808 + x812*x813;
     const double x815 = x810 - x809 - 0.16*x814;
     const double x816 = 0.0002972952667644*x808;
-    const double x817 = 9.81*cos(q7);
+    const double x817 = 9.81*solo12_COS(8, q7);
     const double x818 = 0.01169101578415*x817 - 0.0028754860404784995*x807;
     const double x819 = 0.0002972952667644*x813 + 0.0038482516772413004*x817;
     const double x820 = x811*x813 - x812*x808;
@@ -11649,12 +11930,12 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x1197 = -x1099*x997 - x1128*x862 - x1188*x987;
     const double x1198 = -x1158*x997 - x1165*x862 - x1190*x987;
     const double x1199 = -x1171*x997 - x1182*x862 - x1192*x987;
-    const double x1200 = sin(q12);
-    const double x1201 = cos(q12);
-    const double x1202 = sin(q11);
-    const double x1203 = 9.81*sin(q10);
+    const double x1200 = solo12_SIN(9, q12);
+    const double x1201 = solo12_COS(9, q12);
+    const double x1202 = solo12_SIN(10, q11);
+    const double x1203 = 9.81*solo12_SIN(11, q10);
     const double x1204 = x1203*x1202;
-    const double x1205 = cos(q11);
+    const double x1205 = solo12_COS(10, q11);
     const double x1206 = x1203*x1205;
     const double x1207 = x1204*x1201 + x1206*x1200;
     const double x1208 = 0.0038482516772413004*x1207;
@@ -11665,7 +11946,7 @@ void solo12_linearize(const double q[], const double qd[], const double tau[], c
     const double x1213 = x1210*x1207 + x1211*x1212;
     const double x1214 = x1209 - x1208 - 0.16*x1213;
     const double x1215 = 0.0002972952667644*x1207;
-    const double x1216 = 9.81*cos(q10);
+    const double x1216 = 9.81*solo12_COS(11, q10);
     const double x1217 = 0.0028754860404784995*x1206 + 0.01169101578415*x1216;
     const double x1218 = 0.0038482516772413004*x1216 - 0.0002972952667644*x1212;
     const double x1219 = x1210*x1212 - x1211*x1207;

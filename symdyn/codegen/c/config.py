@@ -99,6 +99,10 @@ class CNames:
     locals: dict[sp.Symbol, str]  # input symbol -> C local name
     param_macro: dict[sp.Symbol, str]  # parameter symbol -> its index macro
     dims: dict[str, str]  # size name of an output (symdyn.codegen.functions.DIMS) -> C expression
+    # the sines and cosines (symdyn.codegen.c.sincos): "helper" (the static function computing
+    # them for an array of angles), the macros "sin", "cos" (reading them) and "vector" (defined
+    # when the helper is used), the locals "angle", "sine" and "cosine" (the arrays)
+    sincos: dict[str, str]
 
 
 def _aliases(written: list[str], taken: set[str]) -> tuple[tuple[str, str], ...]:
@@ -127,13 +131,21 @@ def c_names(ctx: RenderContext) -> CNames:
     """The file, macro, function and local names for one robot (deterministic, collision-free).
 
     Joint symbols keep their names (q1, qd2, ...); a parameter whose name is reserved, taken
-    or looks like a temporary gets `_` then `_1`, `_2`, ... appended.
+    or looks like a temporary gets `_` then `_1`, `_2`, ... appended, and so do the arrays of
+    angles, sines and cosines (`angle`, `sine`, `cosine`) when a parameter has their name.
     """
     name = ctx.name
     params = tuple(ctx.dynamics.params)
     ndof, nparam = f"{name}_NDOF", f"{name}_NPARAM"
     param_macros = tuple((f"{name}_P_{p}", k) for k, p in enumerate(params))
     functions = {f.name: f"{name}_{f.name}" for f in ctx.functions}
+    sincos = {
+        "helper": f"{name}_sincos",
+        "sin": f"{name}_SIN",
+        "cos": f"{name}_COS",
+        "vector": f"{name}_SINCOS_VECTOR",
+    }
+    assert not set(sincos.values()) & set(functions.values()), "a generated function has the sines' name"
     guard = f"{name.upper()}_DYNAMICS_H"
     column_dims = {r.dims[1] for f in ctx.functions for r in f.results} & {"nstd", "nbase"}
     written = (
@@ -141,7 +153,7 @@ def c_names(ctx: RenderContext) -> CNames:
         + [m for m, _ in param_macros]
         + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
     )
-    taken = set(written) | set(functions.values()) | {guard}
+    taken = set(written) | set(functions.values()) | {guard} | set(sincos.values())
     aliases = _aliases(written, taken)
 
     joint_symbols = _joint_symbols(ctx)
@@ -162,6 +174,8 @@ def c_names(ctx: RenderContext) -> CNames:
     for p in params:
         local_names[p] = free_name(str(p), reserved | used, TEMPORARY)
         used.add(local_names[p])
+    for array in ("angle", "sine", "cosine"):
+        sincos[array] = free_name(array, reserved | used, TEMPORARY)
     param_macro = {p: m for p, (m, _) in zip(params, param_macros, strict=True)}
     return CNames(
         header_file=f"{name}_dynamics.h",
@@ -176,4 +190,5 @@ def c_names(ctx: RenderContext) -> CNames:
         locals=local_names,
         param_macro=param_macro,
         dims={"1": "1", "n": ndof, "2n": f"(2*{ndof})", "nstd": f"{name}_NSTD", "nbase": f"{name}_NBASE"},
+        sincos=sincos,
     )

@@ -35,12 +35,17 @@ ADD, MUL, UNARY, ATOM = 1, 3, 4, 5
 class CPrinter(TreePrinter):
     """SymPy expression -> C99 expression text for one floating type ("double" or "float").
 
-    `names` maps every symbol that may appear (input locals, temporaries) to its C name.
+    `names` maps every symbol that may appear (input locals, temporaries) to its C name;
+    `calls` maps calls computed beforehand (sin(a), cos(a): symdyn.codegen.c.sincos) to the C
+    text that reads their value.
     """
 
-    def __init__(self, names: dict[sp.Symbol, str], precision: str = "double"):
+    def __init__(
+        self, names: dict[sp.Symbol, str], precision: str = "double", calls: dict[sp.Expr, str] | None = None
+    ):
         self.names = names
         self.config = CConfig(precision)
+        self.calls = calls or {}
 
     # numbers
     def literal(self, value: float) -> str:
@@ -73,6 +78,8 @@ class CPrinter(TreePrinter):
         return self._number(e)
 
     def _call(self, e: sp.Expr) -> tuple[str, int]:
+        if e in self.calls:
+            return self.calls[e], ATOM
         if isinstance(e, sp.sign):
             x = self._print(e.args[0])[0]
             return f"(({self.config.real})(({x} > 0) - ({x} < 0)))", ATOM

@@ -21,6 +21,7 @@ from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .printer import CPrinter
+from .sincos import BLOCK, gather
 
 __all__ = ["render", "render_context", "TOOLS"]
 
@@ -29,6 +30,32 @@ JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
 TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
+
+
+def _sincos_view(
+    ctx: RenderContext, names: CNames, spec: FunctionSpec, symbol_names: dict
+) -> tuple[CPrinter, list, dict | None]:
+    """The printer of a function's code, the temporaries it keeps, and its angles as data.
+
+    In double precision sin(a) and cos(a) become NAME_SIN(k, a) and NAME_COS(k, a) over the
+    function's k-th angle a (symdyn.codegen.c.sincos): entry k of the arrays NAME_sincos fills
+    when the compiler targets AVX2, else sin(a) and cos(a) (templates/c/sincos.c.j2). The
+    angles are printed with the C library's calls (an angle may itself hold a sine) and padded
+    with zeros to the arrays' size. Under --precision float every call stays sinf or cosf.
+    """
+    plain = CPrinter(symbol_names, ctx.precision)
+    if ctx.precision != "double":
+        return plain, list(spec.temporaries), None
+    trig = gather(spec.temporaries, spec.outputs)
+    temporaries = [(s, e) for s, e in spec.temporaries if s in trig.live]
+    angles = [plain.doprint(a) for a in trig.angles]
+    macros = (names.sincos["sin"], names.sincos["cos"])
+    calls = {call: f"{macros[which]}({k}, {angles[k]})" for call, (which, k) in trig.calls.items()}
+    printer = CPrinter(symbol_names, ctx.precision, calls)
+    if not angles:
+        return printer, temporaries, None
+    padding = ["0.0"] * (trig.size - len(angles))
+    return printer, temporaries, {"count": len(angles), "size": trig.size, "angles": angles + padding}
 
 
 def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
@@ -41,7 +68,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
                 "(or no C name); rename the parameter"
             )
         symbol_names[sym] = sym.name
-    printer = CPrinter(symbol_names, ctx.precision)
+    printer, temporaries, sincos = _sincos_view(ctx, names, spec, symbol_names)
     used_symbols = spec.free_symbols
     inputs, unused, reads = [], [], []
     for inp in spec.inputs:
@@ -79,13 +106,15 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         "width": max(len(a) for a in [*(inp.name for inp in spec.inputs), *(r.name for r in spec.results)]),
         "unused": unused,
         "reads": reads,
-        "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in spec.temporaries],
+        "sincos": sincos,
+        "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in temporaries],
     }
 
 
 def render_context(ctx: RenderContext) -> dict:
     """Everything templates/c/ needs for the robot of `ctx`: names, numbers and printed expressions."""
     names = c_names(ctx)
+    functions = [_function_view(ctx, names, spec) for spec in ctx.functions]
     return {
         "name": ctx.name,
         "real": CConfig(ctx.precision).real,
@@ -100,8 +129,9 @@ def render_context(ctx: RenderContext) -> dict:
         "param_pattern": names.param_pattern,
         "param_macros": list(names.param_macros),
         "aliases": list(names.aliases),
-        "functions": [_function_view(ctx, names, spec) for spec in ctx.functions],
+        "functions": functions,
         "column_sizes": _column_sizes(ctx, names),
+        "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
     }
 
 
