@@ -108,7 +108,7 @@ def render_all(root: Path) -> dict[str, dict[str, str | bytes]]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for name in EXAMPLES:
-            out[name] = render(example_robot(root, name), targets=tuple(TARGETS))
+            out[name] = render(example_robot(root, name), targets=tuple(TARGETS), functions=("all",))
     return out
 
 

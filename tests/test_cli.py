@@ -168,6 +168,30 @@ def test_generate_default_targets_are_c_and_casadi(tmp_path):
     assert not any(n.endswith(".tex") or n.endswith("_numpy.py") for n in names)
 
 
+def _declared(header: Path) -> list[str]:
+    return re.findall(r"^void (\w+)\(", header.read_text(), re.M)
+
+
+def test_generate_builds_the_dynamics_group_unless_told_all(tmp_path, capsys):
+    """Without --functions: the seven functions of tau = M qdd + V + G + F and forward dynamics;
+    --functions all: every function generated/ holds (written by symdyn.regenerate)."""
+    robot = str(EXAMPLES / "roger_arm.yaml")
+    assert main(["generate", robot, "--target", "c", "--out", str(tmp_path / "default")]) == 0
+    assert (
+        main(["generate", robot, "--target", "c", "--functions", "all", "--out", str(tmp_path / "all")]) == 0
+    )
+    seven = ("inverse_dynamics", "mass_matrix", "coriolis_matrix", "coriolis", "gravity", "friction")
+    seven += ("forward_dynamics",)
+    assert _declared(tmp_path / "default" / "roger_arm_dynamics.h") == [f"roger_arm_{n}" for n in seven]
+    committed = _declared(ROOT / "generated" / "roger_arm" / "roger_arm_dynamics.h")
+    assert len(committed) > len(seven) and "roger_arm_regressor" in committed
+    assert _declared(tmp_path / "all" / "roger_arm_dynamics.h") == committed
+    with pytest.raises(SystemExit) as refused:
+        main(["generate", robot, "--functions", "dynamic", "--out", str(tmp_path / "x")])
+    assert refused.value.code == 2
+    assert "invalid choice" in capsys.readouterr().err
+
+
 def _subcommands(parser):
     return next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction").choices
 

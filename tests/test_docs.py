@@ -302,6 +302,75 @@ def test_site_builds_strictly(tmp_path: Path, block_env: dict[str, str]):
     api = (site / "python-api" / "index.html").read_text(encoding="utf-8")
     for name in ("symdyn.derive", "symdyn.Dynamics", "symdyn.generate", "symdyn.SymdynError"):
         assert name in api, f"the API reference lacks {name}"
+    internal = re.findall(r'id="(symdyn\.[\w.]*NumericModel\.(?:R0|p0|axis))"', api)
+    assert not internal, f"the API reference lists internal attributes: {internal}"
+    assert offline_problems(site) == []
+    for page in MATH_PAGES:
+        html = (site / page.removesuffix(".md").removesuffix("index") / "index.html").read_text(
+            encoding="utf-8"
+        )
+        assert 'class="arithmatex"' in html, f"{page}: no typeset math"
+        for asset in KATEX_ASSETS:
+            assert re.search(rf'(src|href)="(\.\./)*{re.escape(asset)}"', html), (
+                f"{page} does not load {asset}"
+            )
+
+
+# --------------------------------------------------------------------------- math, offline
+
+#: The vendored KaTeX (docs/assets/katex/) and the script that typesets pymdownx.arithmatex's output.
+KATEX_ASSETS = (
+    "assets/katex/katex.min.css",
+    "assets/katex/katex.min.js",
+    "assets/katex/contrib/auto-render.min.js",
+    "assets/katex-init.js",
+)
+#: Pages whose equations are typeset (a sample: every page with an equation has them).
+MATH_PAGES = ("index.md", "lecture.md", "generated-code.md", "tutorials/embedded-c.md")
+EXTERNAL = re.compile(
+    r"<(?:script|link|img|iframe)\b[^>]*\b(?:src|href)=[\"'](?:https?:)?//[^\"']*[\"'][^>]*>"
+    r"|@import\s+(?:url\()?[\"']?(?:https?:)?//|url\([\"']?(?:https?:)?//",
+    re.I,
+)
+
+
+def offline_problems(site: Path) -> list[str]:
+    """What a built site would load from outside (scripts, style sheets, fonts, pictures; plain
+    links to other sites are fine), and the vendored KaTeX fonts it lacks."""
+    problems = []
+    for path in sorted(site.rglob("*")):
+        if path.suffix in (".html", ".css", ".js") and path.is_file():
+            text = path.read_text(encoding="utf-8", errors="replace")
+            if path.suffix == ".js":  # scripts: only the loaders of style sheets and scripts
+                text = "\n".join(re.findall(r"@import[^;]*|url\([^)]*\)", text))
+            problems += [f"{path.relative_to(site)}: {m.group(0)[:100]}" for m in EXTERNAL.finditer(text)]
+    css = site / "assets" / "katex" / "katex.min.css"
+    if not css.is_file():
+        return [*problems, "assets/katex/katex.min.css is missing"]
+    fonts = re.findall(r"url\((fonts/[^)]+\.woff2)\)", css.read_text(encoding="utf-8"))
+    problems += [f"assets/katex/{f} is missing" for f in fonts if not (css.parent / f).is_file()]
+    return problems + ([] if fonts else ["katex.min.css names no woff2 font"])
+
+
+def test_the_offline_check_finds_what_it_looks_for(tmp_path: Path):
+    """offline_problems itself, on a small site: a CDN script, style sheet and font are found."""
+    (tmp_path / "assets" / "katex" / "fonts").mkdir(parents=True)
+    (tmp_path / "assets" / "katex" / "katex.min.css").write_text("a{src:url(fonts/K.woff2)}")
+    (tmp_path / "assets" / "katex" / "fonts" / "K.woff2").write_bytes(b"")
+    page = '<a href="https://example.org">a link</a><script src="assets/x.js"></script>'
+    (tmp_path / "index.html").write_text(page)
+    assert offline_problems(tmp_path) == []
+    (tmp_path / "cdn.html").write_text('<script defer src="https://cdn.example/katex.js"></script>')
+    (tmp_path / "style.html").write_text('<link rel="stylesheet" href="//fonts.example/css">')
+    (tmp_path / "font.css").write_text("@font-face{src:url(https://fonts.example/a.woff2)}")
+    (tmp_path / "assets" / "katex" / "fonts" / "K.woff2").unlink()
+    found = offline_problems(tmp_path)
+    assert [p.split(":")[0] for p in found] == [
+        "cdn.html",
+        "font.css",
+        "style.html",
+        "assets/katex/fonts/K.woff2 is missing",
+    ]
 
 
 # --------------------------------------------------------------------------- the command line page

@@ -1,6 +1,6 @@
 """Trajectory optimisation of the Franka Panda with CasADi's Opti, IPOPT and symdyn's derivatives.
 
-The generated CasADi module (symdyn generate examples/panda.yaml --target casadi) gives
+The generated CasADi module (symdyn generate examples/panda.yaml --target casadi --functions all) gives
 forward_dynamics and forward_dynamics_derivatives. `with_derivatives` wraps the first as a
 casadi.Function whose Jacobian is the second (CasADi's `custom_jacobian`): IPOPT then takes
 dqdd/dq, dqdd/dqd and M^-1 from symdyn's code instead of differentiating the expression graph,

@@ -185,9 +185,11 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--functions",
         nargs="+",
-        choices=("dynamics", "regressor", "tip_wrench", "derivatives"),
-        help="only these groups of functions (default: all): dynamics (the seven of tau = M qdd + V + G + F "
-        "and forward dynamics), regressor, tip_wrench (product-of-exponentials robots), derivatives",
+        choices=("dynamics", "regressor", "tip_wrench", "derivatives", "all"),
+        default=["dynamics"],
+        help="the groups of functions to build (default: dynamics, the seven of tau = M qdd + V + G + F "
+        "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives; "
+        "all: every group",
     )
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
     g.add_argument(

@@ -56,7 +56,7 @@ def context(
 ) -> RenderContext:
     """Derive the robot and build the target-independent function specs (from the pruned
     configuration-space form when `prune` is given, symdyn.codegen.pruned; only the groups of
-    symdyn.codegen.functions.GROUPS named in `functions`, when given)."""
+    symdyn.codegen.functions.GROUPS named in `functions`, when given; None or "all": every group)."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
     dyn = derive(robot, method=method, simplify=False)
@@ -65,14 +65,20 @@ def context(
         from .pruned import pruned_dynamics
 
         dyn, notes = pruned_dynamics(dyn, prune)
-    if functions is not None:
-        unknown = sorted(set(functions) - set(GROUPS))
-        if unknown or not functions:
-            raise SymdynError(
-                f"unknown function group(s) {', '.join(unknown) or '(none given)'} (one or more of "
-                f"{', '.join(GROUPS)})"
-            )
-    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, functions)), precision, notes)
+    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, _groups(functions))), precision, notes)
+
+
+def _groups(functions: Sequence[str] | None) -> Sequence[str] | None:
+    """The groups of GROUPS that `functions` names (None, or a name "all" among them: every group)."""
+    if functions is None or "all" in functions:
+        return None
+    unknown = sorted(set(functions) - set(GROUPS))
+    if unknown or not functions:
+        raise SymdynError(
+            f"unknown function group(s) {', '.join(unknown) or '(none given)'} (one or more of "
+            f"{', '.join(GROUPS)}, or all)"
+        )
+    return functions
 
 
 def render(
@@ -100,11 +106,15 @@ def generate(
     force: bool = False,
     method: str = "newton-euler",
     prune: float | None = None,
-    functions: Sequence[str] | None = None,
+    functions: Sequence[str] = ("dynamics",),
 ) -> list[Path]:
-    """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir
-    (`prune`: from the significance-pruned model, symdyn.codegen.pruned; `functions`: only these
-    groups of symdyn.codegen.functions.GROUPS, e.g. ("dynamics",) for the seven functions)."""
+    """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir.
+
+    `functions` names the groups of symdyn.codegen.functions.GROUPS to build: by default
+    ("dynamics",), the seven functions of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) and forward
+    dynamics; ("all",) builds every group (the regressors, the derivatives, tip_wrench_torque).
+    `prune`: from the significance-pruned model, symdyn.codegen.pruned.
+    """
     if not isinstance(robot, Robot):
         from ..parsers import load
 
