@@ -123,7 +123,7 @@ def _warn_massless(reader: UrdfReader, tree: UrdfTree, parts: list[tuple[str, Tr
             f"yet it carries joint {joints} at a distance; the URDF specification allows this, but in "
             "the middle of a chain it is almost always a forgotten <inertial>",
             SymdynWarning,
-            stacklevel=4,
+            stacklevel=5,
         )
 
 
