@@ -225,6 +225,8 @@ def test_steps_with_null_entries():
     )
     with pytest.raises(SymdynError, match="no answer entry given"):
         check_answers(craig, {"steps": {2: {"omega": None}}})
+    with pytest.raises(SymdynError, match="no answer entry given"):
+        check_answers(craig, {"steps": {1: None}})
 
 
 def test_one_entry_at_a_state(roger):

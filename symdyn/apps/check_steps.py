@@ -9,8 +9,8 @@
 
 The quantities are those of symdyn.apps.steps: for Newton-Euler omega, omegadot, vdot,
 vdotC, F, N, f, n (3 entries each, in link i's body frame {i}) and tau; for Lagrange T, U
-(per link), dL_dqd, ddt_dL_dqd, dL_dq and tau (per joint), one entry each; `null` (an entry or
-a whole quantity) is not checked. Every entry is
+(per link), dL_dqd, ddt_dL_dqd, dL_dq and tau (per joint), one entry each; `null` (an entry, a
+quantity or a whole link) is not checked. Every entry is
 compared with symdyn's step like a final answer (symdyn.apps.check passes its parser and
 comparison in, so this module needs nothing from it); the first
 step that differs, in the order the recursion computes them, is reported.
@@ -62,6 +62,8 @@ def _parse(raw: object, robot: Robot, method: str, file: str | None, entry: Entr
     out = {}
     for key, quantities in raw.items():
         i = _link_number(key, robot, file)
+        if quantities is None:  # a link left out: nothing of it is checked
+            continue
         if not isinstance(quantities, Mapping):
             raise SymdynError("expected a mapping of quantities", file=file, field=f"steps.{key}")
         for name, value in quantities.items():
