@@ -35,7 +35,7 @@ def _rational_data(x):
 def _robots():
     import yaml
 
-    from symdyn.parsers.robot_file import load_robot, robot_from_data
+    from symdyn.parsers import load_robot, robot_from_data
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from robots import puma560_symbolic

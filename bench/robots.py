@@ -138,7 +138,7 @@ def puma560_symbolic() -> tuple[Robot, str]:
     base = None
     if PUMA_FILE.exists():
         try:
-            from symdyn.parsers.robot_file import load_robot
+            from symdyn.parsers import load_robot
         except ImportError:
             load_robot = None
         if load_robot is not None:

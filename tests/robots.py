@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 from symdyn.dynamics import derive
 from symdyn.errors import SymdynWarning
 from symdyn.model.robot import Friction, Link, Motor, Robot
-from symdyn.parsers.robot_file import load_robot, robot_from_data
+from symdyn.parsers import load_robot, robot_from_data
 from symdyn.rnea import forward_kinematics as rnea_poses
 from symdyn.spatial.transform import Transform
 

@@ -42,8 +42,8 @@ def test_answers_file_holds_the_lecture(roger):
     m1, m2, l1, l2, g, q1, q2 = sp.symbols("m1 m2 l1 l2 g q1 q2")
     parsed = load_answers(ANSWERS, roger)
     assert set(parsed) == {"M", "V", "G"}
-    assert sp.expand(parsed["M"][1, 1] - m2 * l2**2) == 0
-    assert sp.expand(parsed["G"][1] - m2 * g * l2 * sp.sin(q1 + q2)) == 0
+    assert sp.expand(parsed["M"][2, 2] - m2 * l2**2) == 0
+    assert sp.expand(parsed["G"][(2,)] - m2 * g * l2 * sp.sin(q1 + q2)) == 0
 
 
 @pytest.mark.parametrize("method", ["newton-euler", "lagrange"])
@@ -132,6 +132,13 @@ def test_one_joint_robot_accepts_scalars():
         ({"G": ["0"]}, "list of 2 entries"),
         ({"X": [0, 0]}, "unknown key"),
         ({}, "no answers"),
+        ({"M": [[None, None], [None, None]]}, "no answer entry given: every entry is null (not checked)"),
+        ({"M": [None, None], "G": None}, "no answer entry given"),
+        ({"M": [[None, None]]}, "list of 2 rows of 2 entries (null for a row or entry not checked)"),
+        ({"M[3,1]": "0"}, "no such entry: M has the entries M[i,j], i and j in 1..2"),
+        ({"G[1,1]": "0"}, "no such entry: G has the entries G[i], i in 1..2"),
+        ({"M": [[None, None], [None, 0]], "M[2,2]": "0"}, "field 'M[2,2]': entry given twice"),
+        ({"M[x]": "0"}, "unknown key(s) M[x]"),
         ({"G": ["c2", 0]}, "unknown name(s) c2"),
         ({"G": ["q3", 0]}, "unknown name(s) q3"),
         ({"G": ["__import__('os').system('true')", 0]}, "not allowed"),
@@ -154,3 +161,81 @@ def test_cli_bad_file_one_line(tmp_path, monkeypatch, capsys):
     assert err.startswith("symdyn: error: ") and "invalid YAML" in err and err.count("\n") == 1
     assert run_cli(["check", ROGER, tmp_path / "missing.yaml"], monkeypatch) == 1
     assert capsys.readouterr().err.startswith("symdyn: error: ")
+
+
+#: M[2,2] of the lecture's arm (slide 18), right and wrong, as a student who derived only it
+M22, M22_WRONG = "m2*l2**2", "m2*l2"
+
+
+@pytest.mark.parametrize(
+    "answers",
+    [{"M": [[None, None], [None, M22]]}, {"M": [None, [None, M22]]}, {"M[2,2]": M22}, {"M[2, 2]": M22}],
+    ids=["nulls", "null row", "entry key", "entry key with a space"],
+)
+def test_one_entry_checked(roger, answers):
+    report = check_answers(roger, answers)
+    assert report.ok and [r.label for r in report.results] == ["M[2,2]"] and report.entries == 4
+    assert (
+        report.summary()
+        == "roger_arm: 1 of 4 entries of M checked (the others null); it matches (all symbolically)"
+    )
+
+
+def test_one_entry_wrong(roger, tmp_path, capsys):
+    report = check_answers(roger, {"M[2,2]": M22_WRONG, "G": [None, "m2*g*l2*sin(q1 + q2)"]})
+    assert not report.ok and [r.label for r in report.differing] == ["M[2,2]"]
+    assert (
+        report.summary() == "roger_arm: 2 of 6 entries of M, G checked (the others null); 1 differs (M[2,2])"
+    )
+    answers = tmp_path / "one.yaml"
+    answers.write_text(f"M:\n  - [null, null]\n  - [null, {M22_WRONG}]\n")
+    assert run_cli(["check", ROGER, answers]) == 1
+    out = capsys.readouterr().out
+    assert out == (
+        "M[2,2]: expected l2**2*m2, got l2*m2\n"
+        "roger_arm: 1 of 4 entries of M checked (the others null); 1 differs (M[2,2])\n"
+    )
+
+
+def test_no_entry_at_all(roger, tmp_path, capsys):
+    answers = tmp_path / "none.yaml"
+    answers.write_text("M: [[null, null], [null, null]]\nG: [null, null]\n")
+    assert run_cli(["check", ROGER, answers]) == 1
+    assert capsys.readouterr().err == (
+        f"symdyn: error: {answers}: no answer entry given: "
+        "every entry is null (not checked); give at least one\n"
+    )
+
+
+def test_steps_with_null_entries():
+    """Craig's omega_2 = (0, 0, qd1 + qd2) (example 6.6), its third entry alone, right and wrong."""
+    craig = load_robot(EXAMPLES / "craig_two_link.yaml")
+    report = check_answers(craig, {"steps": {2: {"omega": [None, None, "qd1 + qd2"]}}})
+    assert report.ok and [r.label for r in report.results] == ["omega_2[3]"]
+    assert (
+        report.summary()
+        == "craig_two_link: 1 of 3 entries of 1 step checked (the others null); it matches (all symbolically)"
+    )
+    report = check_answers(
+        craig, {"steps": {2: {"omega": [None, None, "qd1 - qd2"], "f": None}}, "M[1,1]": None}
+    )
+    assert not report.ok and report.first_step.startswith("omega_2 (outward iteration, link 2")
+    assert report.summary().endswith(
+        "1 of 10 entries of 2 steps, M checked (the others null); 1 differs (omega_2[3])"
+    )
+    with pytest.raises(SymdynError, match="no answer entry given"):
+        check_answers(craig, {"steps": {2: {"omega": None}}})
+    with pytest.raises(SymdynError, match="no answer entry given"):
+        check_answers(craig, {"steps": {1: None}})
+
+
+def test_one_entry_at_a_state(roger):
+    """M[2,2] = m2 l2^2 (slide 18) at m2 = 2, l2 = 0.5: 0.5, whatever q."""
+    at = {"q": [0.3, -1.2], "m1": 1.0, "m2": 2.0, "l1": 0.7, "l2": 0.5, "g": 9.81}
+    report = check_answers(roger, {"at": at, "M": [[None, None], [None, 0.5]]})
+    assert report.ok and [r.label for r in report.results] == ["M[2,2]"]
+    assert (
+        report.summary()
+        == "roger_arm: 1 of 4 entries of M checked (the others null); it matches (at the given state)"
+    )
+    assert not check_answers(roger, {"at": at, "M[2,2]": 0.25}).ok

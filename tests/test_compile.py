@@ -25,7 +25,7 @@ from symdyn.apps.control import ComputedTorque, Reference, track
 from symdyn.apps.simulate import simulate
 from symdyn.cli.main import main
 from symdyn.codegen import functions as fn
-from symdyn.errors import SymdynWarning
+from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.rnea import forward_dynamics as oracle_forward
 
 PLANAR = Path(__file__).resolve().parent.parent / "examples" / "planar_3r.yaml"
@@ -306,3 +306,24 @@ def test_a_warm_simulate_imports_no_sympy(tmp_path, temporary_cache):
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_a_missing_or_unknown_parameter_is_named():
+    """The missing and the unknown names are named, with the robot's free parameters: from the
+    Robot (Robot.param_values, a cache miss) and from the cache entry alone (a hit)."""
+    robot = example("roger_arm")
+    names = [str(p) for p in robot.params]
+    full = {n: 0.5 for n in names}
+    assert compile(robot, full).param_names == tuple(names)  # the entry exists: the calls below hit it
+    missing = {n: v for n, v in full.items() if n != "l2"}
+    unknown = f"unknown parameter(s) l3 (free parameters of robot 'roger_arm': {', '.join(names)})"
+    for bind in (lambda p: compile(robot, p), robot.param_values):
+        with pytest.raises(SymdynError) as info:
+            bind(missing)
+        assert str(info.value).endswith("no value for parameter(s) l2")
+        with pytest.raises(SymdynError) as info:
+            bind({**missing, "l3": 1.0})
+        assert str(info.value).endswith(f"{unknown}; no value for parameter(s) l2")
+        with pytest.raises(SymdynError) as info:
+            bind({**full, "l3": 1.0})
+        assert str(info.value).endswith(unknown)

@@ -84,3 +84,48 @@ def test_no_private_name_crosses_a_module(path, parts):
     for node in ast.walk(tree):
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in modules:
             assert not node.attr.startswith("_"), f"{'.'.join(parts)} uses {node.value.id}.{node.attr}"
+
+
+def _module_of(target: tuple[str, ...], name: str) -> tuple[str, ...]:
+    """The module `from <target> import <name>` loads: the submodule `name` when there is one."""
+    sub = PACKAGE.joinpath(*target, name)
+    if sub.with_suffix(".py").is_file() or (sub / "__init__.py").is_file():
+        return (*target, name)
+    return target
+
+
+def _import_graph() -> dict[tuple[str, ...], set[tuple[str, ...]]]:
+    """Module -> the symdyn modules it imports (relative imports anywhere in it, lazy ones too,
+    within a floor or across); a package is its __init__, named by the package's parts."""
+    graph = {}
+    for path, parts in _modules():
+        module = parts[:-1] if parts[-1] == "__init__" else parts
+        edges = graph.setdefault(module, set())
+        for target, names in _imports(path, parts):
+            if target:  # the package root (`from .. import __version__`) re-exports, lazily
+                edges.update(_module_of(target, name) for name in names)
+        edges.discard(module)
+    return graph
+
+
+def test_no_import_cycle():
+    """No chain of imports leads from a module back to itself (depth-first search for a back edge)."""
+    graph = _import_graph()
+    assert ("codegen", "functions") in graph and ("codegen", "function_rows") in graph[
+        ("codegen", "functions")
+    ]
+    state: dict[tuple[str, ...], int] = {}  # 1: on the current path, 2: done
+
+    def visit(module, path):
+        state[module] = 1
+        for target in sorted(graph.get(module, ())):
+            assert state.get(target) != 1, "import cycle: " + " -> ".join(
+                ".".join(m) for m in (*path[path.index(target) :], target)
+            )
+            if target not in state:
+                visit(target, [*path, target])
+        state[module] = 2
+
+    for module in sorted(graph):
+        if module not in state:
+            visit(module, [module])

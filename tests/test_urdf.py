@@ -639,6 +639,63 @@ def test_plausibility_only_for_links_that_move(tmp_path):
         load_urdf(tmp_path / "odd.urdf")
 
 
+def _massless_warnings(path: Path, **kw) -> list[str]:
+    """The messages of the massless-link warnings that loading `path` gives (the others pass)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robot = load_urdf(path, **kw)
+    assert robot.n >= 1
+    return [str(w.message) for w in caught if "has no <inertial>" in str(w.message)]
+
+
+def test_massless_link_in_the_middle_of_a_chain_warns(tmp_path):
+    """l2 has no <inertial> yet carries j3 0.3 m from its joint: a forgotten <inertial>."""
+    text = (DATA / "bad_missing_inertial.urdf").read_text()
+    leaf = tmp_path / "leaf.xml"  # l2 is the last link: massless, but nothing hangs from it
+    leaf.write_text(text)
+    assert _massless_warnings(leaf) == []
+    chain = tmp_path / "chain.xml"
+    l3 = (
+        '<link name="l3"><inertial><mass value="1"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>'
+    )
+    j3 = (
+        '<joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>'
+        '<origin xyz="0.3 0 0"/><axis xyz="0 0 1"/></joint>'
+    )
+    chain.write_text(text.replace("</robot>", l3 + j3 + "</robot>"))
+    (message,) = _massless_warnings(chain)
+    assert message.startswith(
+        f"{chain}: link 3 (l2): has no <inertial>, so it is massless, yet it carries joint 'j3'"
+    )
+    assert message.endswith("it is almost always a forgotten <inertial>")
+    # the chain from the base to l2 does not carry j3: no warning
+    assert _massless_warnings(chain, tip="l2") == []
+    # the same links with j3 at l2's origin (a universal joint built from two revolute ones): no warning
+    at_origin = tmp_path / "universal.urdf"
+    at_origin.write_text(
+        chain.read_text().replace(
+            '<origin xyz="0.3 0 0"/><axis xyz="0 0 1"/></joint></robot>',
+            '<axis xyz="1 0 0"/></joint></robot>',
+        )
+    )
+    assert at_origin.read_text() != chain.read_text()
+    assert _massless_warnings(at_origin) == []
+    # a massless frame fixed to a link with mass carries the next joint: no warning either
+    framed = tmp_path / "framed.urdf"
+    frame = (
+        '<link name="tool"/><joint name="mount" type="fixed"><parent link="l1"/><child link="tool"/>'
+        '<origin xyz="0.3 0 0"/></joint>'
+    )
+    framed.write_text(
+        text.replace("</robot>", frame + "</robot>").replace(
+            '<parent link="l1"/><child link="l2"/><origin xyz="0.3 0 0"/>',
+            '<parent link="tool"/><child link="l2"/>',
+        )
+    )
+    assert _massless_warnings(framed) == []
+
+
 # --------------------------------------------------------------------------- errors
 
 BAD = [
@@ -679,7 +736,7 @@ BAD = [
         None,
         "<xacro:property> is a xacro macro: expand the file with xacro first",
     ),
-    ("bad_root.urdf", None, None, None, "the top element must be <robot>, not <sdf>"),
+    ("bad_root.urdf", None, None, None, "an XML file whose top element is <sdf>: symdyn reads URDF"),
 ]
 
 
@@ -701,8 +758,11 @@ def test_file_errors(tmp_path):
     with pytest.raises(SymdynError, match="is a directory"):
         load_urdf(tmp_path)
     (tmp_path / "empty.urdf").write_text("")
-    with pytest.raises(SymdynError, match="invalid XML at line 1"):
+    with pytest.raises(SymdynError, match="not a URDF: the file does not start with an XML element"):
         load_urdf(tmp_path / "empty.urdf")
+    (tmp_path / "doc.urdf").write_text("<?xml version='1.0'?>\n<!-- a comment -->\n<robot")
+    with pytest.raises(SymdynError, match="invalid XML at line 3"):
+        load_urdf(tmp_path / "doc.urdf")
     (tmp_path / "nolinks.urdf").write_text('<robot name="x"/>')
     with pytest.raises(SymdynError, match="the robot has no <link>"):
         load_urdf(tmp_path / "nolinks.urdf")

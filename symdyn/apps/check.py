@@ -11,7 +11,11 @@ qdd1..:
 M and C are n x n lists of rows, the others lists of n entries (a 1-joint robot
 may give a single entry). Entries are numbers or strings parsed by symdyn's
 safe parser (never evaluated as code). Parameters that have a value in the
-robot file are replaced by that value.
+robot file are replaced by that value. `null` (an entry, a row or a whole
+quantity) means "not checked", and a single entry may be given on its own with
+a key such as `M[2,2]` or `G[1]` (indices from 1); at least one entry must be
+given. The report says how many of the entries of the quantities given were
+checked.
 
 Each entry is compared with symdyn's closed form: first symbolically (the
 expanded difference, without floating-point rounding noise below 1e-12 of the
@@ -25,6 +29,7 @@ simplification counts as matching numerically.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,6 +55,7 @@ __all__ = [
     "load_answers",
     "parse_answers",
     "answer_entry",
+    "entry_count",
     "compare_entry",
     "check_answers",
 ]
@@ -61,6 +67,11 @@ RTOL = 1e-9
 SIMPLIFY_MAX_OPS = 400  # larger differences are judged numerically only
 #: the key of answers for the derivation's intermediate steps (symdyn.apps.check_steps)
 STEPS_KEY = "steps"
+#: a key giving one entry on its own: M[2,2], G[1]
+_ENTRY_KEY = re.compile(r"(\w+)\[\s*(\d+)\s*(?:,\s*(\d+)\s*)?\]")
+
+
+_NOTHING_GIVEN = "no answer entry given: every entry is null (not checked); give at least one"
 
 
 def _entry_label(name: str, index: tuple[int, ...]) -> str:
@@ -72,48 +83,95 @@ def _parse_entry(value: object, file: str | None, label: str) -> sp.Expr:
     return parse_expression(value, file=file, field=label, allow_joint_symbols=True)
 
 
-def parse_answers(data: object, robot: Robot, file: str | None = None) -> dict[str, sp.Matrix]:
-    """The answers of a mapping (e.g. read from YAML) as SymPy matrices over the robot's symbols."""
+def _entry_key(key: object) -> tuple[str, tuple[int, ...]] | None:
+    """(quantity, 1-based index) of a key naming one entry, such as M[2,2] or G[1]; None otherwise."""
+    m = _ENTRY_KEY.fullmatch(key) if isinstance(key, str) else None
+    if m is None or m.group(1) not in QUANTITIES:
+        return None
+    return m.group(1), tuple(int(g) for g in m.groups()[1:] if g is not None)
+
+
+def _cells(name: str, raw: object, n: int, file: str | None) -> list[tuple[tuple[int, ...], object]]:
+    """(1-based index, value) of every entry of quantity `name` as written (None: not checked)."""
+    if raw is None:
+        return []
+    if name in MATRICES:
+        if n == 1 and not isinstance(raw, list):
+            raw = [[raw]]
+        ok = (
+            isinstance(raw, list)
+            and len(raw) == n
+            and all(r is None or (isinstance(r, list) and len(r) == n) for r in raw)
+        )
+        if not ok:
+            raise SymdynError(
+                f"{name} must be a list of {n} rows of {n} entries (null for a row or entry not checked)",
+                file=file,
+                field=name,
+            )
+        return [((i + 1, j + 1), raw[i][j]) for i in range(n) if raw[i] is not None for j in range(n)]
+    if n == 1 and not isinstance(raw, list):
+        raw = [raw]
+    if not (isinstance(raw, list) and len(raw) == n):
+        raise SymdynError(
+            f"{name} must be a list of {n} entries (null for one not checked)", file=file, field=name
+        )
+    return [((i + 1,), raw[i]) for i in range(n)]
+
+
+def entry_count(name: str, n: int) -> int:
+    """How many entries quantity `name` has for n joints (n x n for M and C, n for the others)."""
+    return n * n if name in MATRICES else n
+
+
+def parse_answers(
+    data: object, robot: Robot, file: str | None = None
+) -> dict[str, dict[tuple[int, ...], sp.Expr]]:
+    """The answers of a mapping (e.g. read from YAML): quantity -> {1-based index: expression over
+    the robot's symbols} for the entries given, row-major (entries that are null are left out)."""
     if not isinstance(data, Mapping):
         kind = "empty file" if data is None else type(data).__name__
         raise SymdynError(f"expected a mapping of M, C, V, G, F, tau to answers, got {kind}", file=file)
-    unknown = [str(k) for k in data if k not in (*QUANTITIES, STEPS_KEY, AT_KEY, TOLERANCE_KEY)]
+    keys = (*QUANTITIES, STEPS_KEY, AT_KEY, TOLERANCE_KEY)
+    unknown = [str(k) for k in data if k not in keys and _entry_key(k) is None]
     if unknown:
         raise SymdynError(
-            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)} and {STEPS_KEY}, "
-            f"or numbers {AT_KEY} a state with a {TOLERANCE_KEY})",
+            f"unknown key(s) {', '.join(unknown)} (answers may give {', '.join(QUANTITIES)}, single entries "
+            f"such as M[1,2] and {STEPS_KEY}, or numbers {AT_KEY} a state with a {TOLERANCE_KEY})",
             file=file,
         )
     if not data:
         raise SymdynError(f"no answers given (any of M, C, V, G, F, tau, {STEPS_KEY})", file=file)
     n = robot.n
-    out: dict[str, sp.Matrix] = {}
+    given: dict[str, dict[tuple[int, ...], object]] = {}
     for name in QUANTITIES:
-        if name not in data:
+        if name in data:
+            given[name] = dict(_cells(name, data[name], n, file))
+    for key, value in data.items():
+        entry = _entry_key(key)
+        if entry is None:
             continue
-        raw = data[name]
-        if name in MATRICES:
-            if n == 1 and not isinstance(raw, list):
-                raw = [[raw]]
-            ok = (
-                isinstance(raw, list)
-                and len(raw) == n
-                and all(isinstance(r, list) and len(r) == n for r in raw)
+        name, index = entry
+        shape = (n, n) if name in MATRICES else (n,)
+        if len(index) != len(shape) or not all(1 <= i <= n for i in index):
+            where = f"[i,j], i and j in 1..{n}" if name in MATRICES else f"[i], i in 1..{n}"
+            raise SymdynError(
+                f"no such entry: {name} has the entries {name}{where}", file=file, field=str(key)
             )
-            if not ok:
-                raise SymdynError(f"{name} must be a list of {n} rows of {n} entries", file=file, field=name)
-            cells = [((i + 1, j + 1), raw[i][j]) for i in range(n) for j in range(n)]
-            shape = (n, n)
-        else:
-            if n == 1 and not isinstance(raw, list):
-                raw = [raw]
-            if not (isinstance(raw, list) and len(raw) == n):
-                raise SymdynError(f"{name} must be a list of {n} entries", file=file, field=name)
-            cells = [((i + 1,), raw[i]) for i in range(n)]
-            shape = (n, 1)
-        entries = [answer_entry(value, robot, file, _entry_label(name, index)) for index, value in cells]
-        out[name] = sp.Matrix(*shape, entries)
-    return out
+        entries = given.setdefault(name, {})
+        if entries.get(index) is not None and value is not None:
+            raise SymdynError(f"entry given twice (also in {name})", file=file, field=str(key))
+        if value is not None:
+            entries[index] = value
+    return {
+        name: {
+            index: answer_entry(value, robot, file, _entry_label(name, index))
+            for index, value in sorted(given[name].items())
+            if value is not None
+        }
+        for name in QUANTITIES
+        if name in given
+    }
 
 
 def answer_entry(value: object, robot: Robot, file: str | None, label: str) -> sp.Expr:
@@ -152,7 +210,7 @@ def read_answers(path: str | os.PathLike) -> object:
         raise SymdynError(f"invalid YAML{where}: {problem}", file=str(p)) from None
 
 
-def load_answers(path: str | os.PathLike, robot: Robot) -> dict[str, sp.Matrix]:
+def load_answers(path: str | os.PathLike, robot: Robot) -> dict[str, dict[tuple[int, ...], sp.Expr]]:
     """Read an answers file (YAML, safe loader) for `robot`."""
     return parse_answers(read_answers(path), robot, str(Path(path)))
 
@@ -192,6 +250,11 @@ class CheckReport:
     results: list[EntryResult] = field(default_factory=list)
     #: the first step of the recursion (in the order it is computed) whose answer differs
     first_step: str | None = None
+    #: the entries of the quantities and steps the answers give, checked or not (null)
+    entries: int = 0
+    #: the quantities the answers give (M, G, ...) and how many steps, checked or not
+    given: tuple[str, ...] = ()
+    steps_given: int = 0
 
     @property
     def ok(self) -> bool:
@@ -202,25 +265,29 @@ class CheckReport:
         return [r for r in self.results if not r.ok]
 
     def summary(self) -> str:
+        """One line: how many entries were checked, of how many, and whether they all match."""
         total = len(self.results)
-        steps = len({r.quantity for r in self.results if r.quantity not in QUANTITIES})
-        finals = [q for q in dict.fromkeys(r.quantity for r in self.results) if q in QUANTITIES]
-        names = ", ".join([f"{steps} step{'s' * (steps != 1)}"] * bool(steps) + finals)
+        steps = self.steps_given
+        names = ", ".join([f"{steps} step{'s' * (steps != 1)}"] * bool(steps) + list(self.given))
+        partial = f"{total} of {self.entries} entries of {names} checked (the others null); "
         if self.ok:
             numeric = sum(r.status == "numeric" for r in self.results)
             if any(r.status == "at the state" for r in self.results):
+                how = "at the given state"
+            elif not numeric:
+                how = "all symbolically"
+            else:
+                how = f"{total - numeric} symbolically, {numeric} numerically at {self.samples} random points"
+            if total < self.entries:
+                return f"{self.robot}: {partial}{'it matches' if total == 1 else 'all match'} ({how})"
+            if how == "at the given state":
                 return f"{self.robot}: all {total} entries of {names} match at the given state"
-            how = (
-                "all symbolically"
-                if not numeric
-                else f"{total - numeric} symbolically, {numeric} numerically at {self.samples} random points"
-            )
             return f"{self.robot}: all {total} entries of {names} match ({how})"
         bad = self.differing
-        return (
-            f"{self.robot}: {len(bad)} of {total} entries of {names} differ "
-            f"({', '.join(r.label for r in bad)})"
-        )
+        labels = ", ".join(r.label for r in bad)
+        if total < self.entries:
+            return f"{self.robot}: {partial}{len(bad)} differ{'s' * (len(bad) == 1)} ({labels})"
+        return f"{self.robot}: {len(bad)} of {total} entries of {names} differ ({labels})"
 
     def text(self, verbose: bool = False) -> str:
         lines = []
@@ -304,6 +371,10 @@ def check_answers(
         ]
     )
     report = CheckReport(robot.name, method, samples)
+    report.entries = sum(entry_count(name, n) for name in parsed)
+    report.given = tuple(parsed)
+    if STEPS_KEY not in data and not any(parsed.values()):
+        raise SymdynError(_NOTHING_GIVEN, file=file)
     if AT_KEY in data:
         if STEPS_KEY in data:
             raise SymdynError(f"{STEPS_KEY} are checked symbolically: leave out {AT_KEY}", file=file)
@@ -311,7 +382,7 @@ def check_answers(
         report.results = [EntryResult(*r) for r in at]
         return report
     if STEPS_KEY in data:
-        steps, report.first_step = check_steps(
+        steps, report.first_step, sizes = check_steps(
             robot,
             data[STEPS_KEY],
             method,
@@ -320,10 +391,13 @@ def check_answers(
             lambda e, g: compare_entry(e, g, symbols, points),
         )
         report.results = [EntryResult(*s) for s in steps]
+        report.entries += sum(sizes)
+        report.steps_given = len(sizes)
     for name, got in parsed.items():
         expected = dyn.closed_form(name)
-        for k in range(len(got)):
-            index = (k // n + 1, k % n + 1) if name in MATRICES else (k + 1,)
-            e, g = expected[k], got[k]
+        for index, g in got.items():
+            e = expected[index[0] - 1, index[1] - 1] if name in MATRICES else expected[index[0] - 1]
             report.results.append(EntryResult(name, index, e, g, compare_entry(e, g, symbols, points)))
+    if not report.results:
+        raise SymdynError(_NOTHING_GIVEN, file=file)
     return report

@@ -61,9 +61,14 @@ def _is_number(x: object) -> bool:
 
 
 def compare_at_state(
-    dyn: Dynamics, parsed: dict[str, sp.Matrix], raw: object, tolerance: object, file: str | None
+    dyn: Dynamics,
+    parsed: dict[str, dict[tuple[int, ...], sp.Expr]],
+    raw: object,
+    tolerance: object,
+    file: str | None,
 ) -> list[tuple[str, tuple[int, ...], sp.Expr, sp.Expr, str]]:
-    """(quantity, index, symdyn's number, the answer, status) per entry, at the state of `raw`."""
+    """(quantity, index, symdyn's number, the answer, status) per entry given (`parsed`: quantity ->
+    {1-based index: answer}, symdyn.apps.check.parse_answers), at the state of `raw`."""
     (q, qd, qdd), params = read_state(raw, dyn, file)
     if tolerance is not None and not (_is_number(tolerance) and tolerance > 0):
         raise SymdynError("expected a positive number", file=file, field=TOLERANCE_KEY)
@@ -76,11 +81,10 @@ def compare_at_state(
     state.update({p: params[str(p)] for p in dyn.params})
     out = []
     for name, got in parsed.items():
-        expected = np.ravel(dyn.evaluate(name, q, qd, qdd, [params[str(p)] for p in dyn.params]))
-        for k in range(len(got)):
-            index = (k // dyn.n + 1, k % dyn.n + 1) if name in ("M", "C") else (k + 1,)
-            e = float(expected[k])
-            g = sp.sympify(got[k]).xreplace(state)
+        expected = np.atleast_1d(dyn.evaluate(name, q, qd, qdd, [params[str(p)] for p in dyn.params]))
+        for index, answer in got.items():
+            e = float(expected[tuple(i - 1 for i in index)])
+            g = sp.sympify(answer).xreplace(state)
             allowed = tolerance if tolerance is not None else RELATIVE * max(1.0, abs(e))
             ok = g.is_number and abs(float(g) - e) <= allowed
             out.append((name, index, sp.Float(e, 12), g, "at the state" if ok else "differs"))

@@ -9,7 +9,8 @@
 
 The quantities are those of symdyn.apps.steps: for Newton-Euler omega, omegadot, vdot,
 vdotC, F, N, f, n (3 entries each, in link i's body frame {i}) and tau; for Lagrange T, U
-(per link), dL_dqd, ddt_dL_dqd, dL_dq and tau (per joint), one entry each. Every entry is
+(per link), dL_dqd, ddt_dL_dqd, dL_dq and tau (per joint), one entry each; `null` (an entry, a
+quantity or a whole link) is not checked. Every entry is
 compared with symdyn's step like a final answer (symdyn.apps.check passes its parser and
 comparison in, so this module needs nothing from it); the first
 step that differs, in the order the recursion computes them, is reported.
@@ -54,13 +55,15 @@ Entry = Callable[[object, str], sp.Expr]
 
 
 def _parse(raw: object, robot: Robot, method: str, file: str | None, entry: Entry) -> dict:
-    """(quantity, link) -> the answer (3x1 for a vector, 1x1 for a scalar)."""
+    """(quantity, link) -> the answer's entries (3 for a vector, 1 for a scalar; None: not checked)."""
     allowed = NEWTON_EULER_STEPS if method == "newton-euler" else LAGRANGE_STEPS
     if not isinstance(raw, Mapping) or not raw:
         raise SymdynError("steps: expected a mapping of links to their quantities", file=file, field="steps")
     out = {}
     for key, quantities in raw.items():
         i = _link_number(key, robot, file)
+        if quantities is None:  # a link left out: nothing of it is checked
+            continue
         if not isinstance(quantities, Mapping):
             raise SymdynError("expected a mapping of quantities", file=file, field=f"steps.{key}")
         for name, value in quantities.items():
@@ -72,10 +75,12 @@ def _parse(raw: object, robot: Robot, method: str, file: str | None, entry: Entr
                     field=where,
                 )
             size = 3 if method == "newton-euler" and name != "tau" else 1
-            values = value if isinstance(value, list) else [value]
+            values = [None] * size if value is None else value if isinstance(value, list) else [value]
             if len(values) != size:
                 raise SymdynError(f"expected {size} entries, got {len(values)}", file=file, field=where)
-            out[(name, i)] = sp.Matrix([entry(v, f"{where}[{k + 1}]") for k, v in enumerate(values)])
+            out[(name, i)] = [
+                None if v is None else entry(v, f"{where}[{k + 1}]") for k, v in enumerate(values)
+            ]
     return out
 
 
@@ -86,7 +91,7 @@ def check_steps(
     file: str | None,
     entry: Entry,
     compare: Callable[[sp.Expr, sp.Expr], str],
-) -> tuple[list[tuple[str, tuple[int, ...], sp.Expr, sp.Expr, str]], str | None]:
+) -> tuple[list[tuple[str, tuple[int, ...], sp.Expr, sp.Expr, str]], str | None, list[int]]:
     """Compare the step answers `raw` with symdyn's steps, in the order they are computed.
 
     Args:
@@ -94,8 +99,9 @@ def check_steps(
         compare: judges one entry, compare(expected, got) -> "symbolic", "numeric" or "differs".
 
     Returns:
-        (quantity, index, expected, got, status) per entry, and the first differing step in
-        words (None when all match).
+        (quantity, index, expected, got, status) per entry given (null entries are not checked),
+        the first differing step in words (None when all match), and the number of entries of
+        each step given, checked or not.
     """
     answers = _parse(raw, robot, method, file, entry)
     results = []
@@ -105,6 +111,8 @@ def check_steps(
         if got is None:
             continue
         for k in range(len(got)):
+            if got[k] is None:
+                continue
             status = compare(step.value[k], got[k])
             index = (k + 1,) if len(got) > 1 else ()
             expected = simplify_entry(step.value[k]) if status == "differs" else step.value[k]  # to print
@@ -113,4 +121,4 @@ def check_steps(
                 where = f"link {step.link}" if step.phase != "joint" else f"joint {step.link}"
                 frame = f", frame {step.frame}" if step.frame else ""
                 first = f"{step.name}_{step.link} ({_PHASES[step.phase]}, {where}{frame})"
-    return results, first
+    return results, first, [len(got) for got in answers.values()]

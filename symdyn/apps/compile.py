@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SymdynError, SymdynWarning
+from ..model.parameter_names import parameter_names_problem
 from . import cache
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
@@ -172,7 +173,8 @@ def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamic
 
 
 def _bind(names: list[str], robot, params) -> np.ndarray | None:
-    """The parameter vector in `names` order (None when there are none)."""
+    """The parameter vector in `names` order (None when there are none); `robot` is the Robot, or
+    the RobotInfo of a cache hit."""
     if robot is not None and not isinstance(robot, RobotInfo):
         values = robot.param_values(params) if robot.params else {}
         by_name = {str(k): v for k, v in values.items()}
@@ -184,9 +186,9 @@ def _bind(names: list[str], robot, params) -> np.ndarray | None:
         by_name = {}
     elif isinstance(params, Mapping):
         by_name = {str(k): float(v) for k, v in params.items()}
-        wrong = sorted(set(by_name) ^ set(names))
-        if wrong:
-            raise SymdynError(f"parameters: expected values for {', '.join(names)}; got {', '.join(by_name)}")
+        problem = parameter_names_problem(by_name, names, robot.name)
+        if problem:
+            raise SymdynError(f"parameters: {problem}")
     else:
         given = [float(v) for v in params]
         if len(given) != len(names):
@@ -216,7 +218,7 @@ class CompiledDynamics:
         info = meta["robot"]
         self.robot = robot if robot is not None else RobotInfo(info["name"], info["n"], tuple(info["params"]))
         self.param_names = tuple(info["params"])
-        self.p = _bind(info["params"], robot, params)
+        self.p = _bind(info["params"], self.robot, params)
         self._entry = entry
         self._module = None
         self.functions = tuple(f["name"] for f in meta["functions"])

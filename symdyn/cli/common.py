@@ -12,14 +12,17 @@ METHODS = ("newton-euler", "lagrange")
 
 
 def load_robot_argument(args: argparse.Namespace):
-    """A robot from a robot file, or from a URDF file (by its .urdf suffix) with --base/--tip."""
+    """A robot from a robot file, or from a URDF file with --base/--tip: recognised by its content
+    (symdyn.parsers.loading), whatever its name."""
     from ..parsers import load
 
     return load(args.robot, base=args.base, tip=args.tip)
 
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("robot", help="robot file (YAML or JSON) or URDF file (.urdf)")
+    parser.add_argument(
+        "robot", help="robot file (YAML or JSON) or URDF file, recognised by its content, whatever its name"
+    )
     parser.add_argument("--base", help="URDF: the link the robot hangs from (default: the root link)")
     parser.add_argument(
         "--tip",

@@ -28,7 +28,7 @@ import sympy as sp
 
 from ..algorithms.derivatives import effort_jacobians, elimination_order, ldlt_inverse, matmul, substitute
 from ..dynamics import Dynamics
-from .functions import FunctionRow, Inputs, Output, joint_matrix_output
+from .function_rows import FunctionRow, Inputs, Output, joint_matrix_output
 
 __all__ = ["derivative_rows", "DERIVATIVE_FUNCTION_NAMES"]
 

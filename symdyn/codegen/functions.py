@@ -29,14 +29,25 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import sympy as sp
 
 from ..dynamics import QUANTITIES, Dynamics
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
-from ..symbolic.simplify import Eliminated, OpCount, eliminate_many
+from ..symbolic.simplify import eliminate_many
+from .derivative_functions import derivative_rows
+from .function_rows import (
+    DIMS,
+    FunctionRow,
+    FunctionSpec,
+    Input,
+    Inputs,
+    Output,
+    joint_matrix_output,
+    vector_output,
+)
+from .regressor_functions import regressor_rows
 from .tip_wrench import TIP_WRENCH_DOC, TIP_WRENCH_FUNCTION, tip_wrench_exprs, tip_wrench_symbols
 
 __all__ = [
@@ -65,147 +76,6 @@ FUNCTION_NAMES = (
     "regressor",
     "base_regressor",
 )
-
-
-@dataclass(frozen=True)
-class Input:
-    """A vector argument: its name in the generated code and its symbols."""
-
-    name: str
-    symbols: tuple[sp.Symbol, ...]
-
-
-#: Size names of the outputs (Output.dims): "1" for a vector's columns, "n" for the joints, "2n"
-#: for the state x = (q, qd); a target spells each as its own expression (C: a macro), and a
-#: family of functions that needs another size adds the name and every target's spelling.
-DIMS = ("1", "n", "2n", "nstd", "nbase")
-
-
-@dataclass(frozen=True)
-class Output:
-    """One output array of a generated function: its argument name, shape and meaning.
-
-    `dims` names the two sizes for the targets (see DIMS); a vector has dims (rows, "1") and
-    a matrix is stored row-major, entry [i*cols + j] being row i, column j.
-    """
-
-    name: str
-    rows: int
-    cols: int
-    doc: str
-    dims: tuple[str, str]
-
-    @property
-    def size(self) -> int:
-        return self.rows * self.cols
-
-    @property
-    def matrix(self) -> bool:
-        """A matrix even when it has one column (M of a one-joint robot is 1 x 1)."""
-        return self.dims[1] != "1"
-
-
-def vector_output(name: str, n: int, doc: str) -> Output:
-    """An n x 1 output over the joints (tau, V, G, F, qdd)."""
-    return Output(name, n, 1, doc, ("n", "1"))
-
-
-def joint_matrix_output(name: str, n: int, doc: str) -> Output:
-    """An n x n output over the joints, row-major (M, C, derivatives by q or qd)."""
-    return Output(name, n, n, doc, ("n", "n"))
-
-
-@dataclass(frozen=True)
-class FunctionSpec:
-    """One generated function: inputs, one or more output arrays, and the code computing them.
-
-    `code.outputs` holds every output's row-major entries, the outputs one after the other in
-    the order of `results` (the order of the arguments); `entries(result)` is one output's part.
-    """
-
-    name: str
-    doc: str
-    inputs: tuple[Input, ...]
-    results: tuple[Output, ...]
-    code: Eliminated
-
-    def __post_init__(self) -> None:
-        assert len(self.code.outputs) == sum(r.size for r in self.results), f"{self.name}: output sizes"
-
-    @property
-    def ops(self) -> OpCount:
-        return self.code.ops
-
-    @property
-    def temporaries(self):
-        return self.code.temporaries
-
-    @property
-    def outputs(self):
-        """Every entry of every output, in argument order (see `entries`)."""
-        return self.code.outputs
-
-    def entries(self, result: Output) -> list:
-        """The row-major entries of one of this function's outputs."""
-        start = 0
-        for r in self.results:
-            if r is result:
-                return list(self.code.outputs[start : start + r.size])
-            start += r.size
-        raise KeyError(f"{result.name} is not an output of {self.name}")
-
-    @property
-    def free_symbols(self) -> set[sp.Symbol]:
-        """Every symbol the temporaries and outputs read (input symbols and temporaries)."""
-        return set().union(
-            *(e.free_symbols for _, e in self.code.temporaries),
-            *(sp.sympify(e).free_symbols for e in self.code.outputs),
-        )
-
-
-@dataclass(frozen=True)
-class FunctionRow:
-    """A function before elimination: what `build_functions` turns into a FunctionSpec.
-
-    `exprs` are the outputs' row-major entries over the program's intermediates (in the order
-    of `results`); `steps` the assignments they need beyond the dynamics' own program. Rows of
-    one `cse` group share a CSE pass; a family in a group of its own cannot change the code of
-    the others.
-    """
-
-    name: str
-    doc: str
-    inputs: tuple[Input, ...]
-    results: tuple[Output, ...]
-    exprs: tuple[sp.Expr, ...]
-    steps: tuple = ()
-    cse: str = ""
-
-
-@dataclass(frozen=True)
-class Inputs:
-    """The input vectors every function family draws from: q, qd, qdd, tau and p."""
-
-    q: Input
-    qd: Input
-    qdd: Input
-    tau: Input
-    p: Input
-
-    @classmethod
-    def of(cls, dyn: Dynamics) -> Inputs:
-        n = dyn.n
-        return cls(
-            Input("q", tuple(dyn.q)),
-            Input("qd", tuple(dyn.qd)),
-            Input("qdd", tuple(dyn.qdd)),
-            Input("tau", tuple(sp.Symbol(f"tau{i + 1}") for i in range(n))),
-            Input("p", tuple(dyn.params)),
-        )
-
-    @property
-    def symbols(self) -> tuple[sp.Symbol, ...]:
-        return (*self.q.symbols, *self.qd.symbols, *self.qdd.symbols, *self.tau.symbols, *self.p.symbols)
 
 
 def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
@@ -307,12 +177,10 @@ _OUTPUT_DOCS = {
 }
 
 
-# The families in modules of their own build on the names above (each sets its rows' CSE group).
-from .derivative_functions import derivative_rows  # noqa: E402
-from .regressor_functions import regressor_rows  # noqa: E402
-
 #: The families of generated functions, in the order of the generated files: each maps a derived
-#: robot and the input vectors to its FunctionRows (a new family is one module and one entry here).
+#: robot and the input vectors to its FunctionRows (a new family is one module and one entry here;
+#: the families in modules of their own build on symdyn.codegen.function_rows, never on this
+#: module, so that codegen has no import cycle).
 
 FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     dynamics_rows,

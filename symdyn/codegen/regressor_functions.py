@@ -17,7 +17,7 @@ import sympy as sp
 from ..dynamics import Dynamics
 from ..errors import SymdynError, SymdynWarning
 from ..model.parameters import standard_parameters
-from .functions import FunctionRow, Inputs, Output
+from .function_rows import FunctionRow, Inputs, Output
 
 __all__ = ["regressor_rows", "columns", "base_definitions"]
 

@@ -285,4 +285,4 @@ def check_inertia(
             stacklevel=2,
         )
     if m == 0 and scale > 0:
-        warnings.warn(f"{prefix}mass is zero but the inertia tensor is not", SymdynWarning, stacklevel=2)
+        warnings.warn(f"{prefix}mass is zero but the inertia tensor is not zero", SymdynWarning, stacklevel=2)

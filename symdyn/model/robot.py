@@ -36,6 +36,7 @@ import sympy as sp
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
 from .limits import check_limits
+from .parameter_names import parameter_names_problem
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
@@ -309,15 +310,9 @@ class Robot:
         if isinstance(params, Mapping):
             by_name = {str(k): v for k, v in params.items()}
             names = [str(p) for p in self.params]
-            unknown = [k for k in by_name if k not in names]
-            if unknown:
-                raise SymdynError(
-                    f"{prefix}unknown parameter(s) {', '.join(unknown)} (free parameters of robot "
-                    f"'{self.name}': {self._listing()})"
-                )
-            missing = [k for k in names if k not in by_name]
-            if missing:
-                raise SymdynError(f"{prefix}no value for parameter(s) {', '.join(missing)}")
+            problem = parameter_names_problem(by_name, names, self.name)
+            if problem:
+                raise SymdynError(prefix + problem)
             given = [by_name[k] for k in names]
         else:
             given = None if isinstance(params, (str, bytes)) else _listed(params)

@@ -25,8 +25,6 @@ relative to the frame of the link's parent.
 
 from __future__ import annotations
 
-import os
-
 import sympy as sp
 
 from ..errors import SymdynError
@@ -37,23 +35,23 @@ from .dh import dh_link, to_body
 from .poe_file import PoeFileReader
 from .robot_fields import LinkData, RobotFileReader
 from .robot_tree import link_mimics, link_parents
-from .source import read_source
 from .yaml_text import parse_text
 
-__all__ = ["load_robot", "robot_from_data"]
+__all__ = ["robot_from_bytes", "robot_from_data"]
 
 #: Largest resolved parameter value (nodes of its expression tree / bits of a number).
 _MAX_NODES = 20000
 _MAX_BITS = 8192
 
 
-def load_robot(path: str | os.PathLike) -> Robot:
-    """Read a robot description file (YAML or JSON) and return the `Robot`.
+def robot_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
+    """The `Robot` of a robot description file's bytes (YAML or JSON; `file` names it in messages,
+    `digest` is their sha256, symdyn.parsers.source.read_source).
 
     Raises SymdynError (naming file, link and field) for any bad input; warns
-    with SymdynWarning for implausible inertial data.
+    with SymdynWarning for implausible inertial data. symdyn.parsers.loading.load_robot
+    reads the file and sends it here or to the URDF reader, by its content.
     """
-    file, raw, digest = read_source(path, "robot file")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -14,7 +14,7 @@ from xml.parsers import expat
 
 from ..errors import SymdynError
 
-__all__ = ["Element", "parse_xml"]
+__all__ = ["Element", "looks_like_xml", "parse_xml"]
 
 
 @dataclass
@@ -28,6 +28,13 @@ class Element:
 
     def all(self, tag: str) -> list[Element]:
         return [c for c in self.children if c.tag == tag]
+
+
+def looks_like_xml(raw: bytes) -> bool:
+    """Whether the bytes start, after a UTF-8 byte order mark and white space, with '<': an XML
+    document (a declaration, a comment or the root element). No YAML or JSON robot file can start
+    so: its top level is a mapping, and '<' starts no YAML mapping."""
+    return raw.removeprefix(b"\xef\xbb\xbf").lstrip(b" \t\r\n").startswith(b"<")
 
 
 class _RefusedError(Exception):

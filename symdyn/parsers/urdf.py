@@ -18,7 +18,10 @@ a symdyn body frame unchanged (`Link.frame` is the identity):
   of mass average, and each inertia tensor is rotated into the body axes and moved
   to the common centre of mass by the parallel-axis theorem
   (symdyn.parsers.urdf_merge). The inertial <origin> (xyz and rpy) is honoured; a
-  link without <inertial> is massless, as the URDF specification allows;
+  link without <inertial> is massless, as the URDF specification allows, with a
+  SymdynWarning when its whole body is (no link fixed to it has one either) and it
+  carries a joint away from its frame: in the middle of a chain, a massless link is
+  almost always a mistake;
 * a <mimic joint= multiplier= offset=> makes the link's `mimic`: q = multiplier *
   q_master + offset with master an independent loaded joint (a mimic of a mimic is
   composed; symdyn.parsers.urdf_mimic). The master may come later in joint order;
@@ -63,20 +66,22 @@ symdyn.parsers.urdf_mimic (mimic joints) and this one (the assembly into a Robot
 from __future__ import annotations
 
 import os
+import warnings
 
 import sympy as sp
 
-from ..errors import SymdynError
+from ..errors import SymdynError, SymdynWarning, location
 from ..model.inertia import check_inertia
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Mimic, Robot
-from .safe_xml import parse_xml
+from ..spatial.transform import Transform
+from .safe_xml import looks_like_xml, parse_xml
 from .source import MAX_BYTES, read_source
 from .urdf_elements import MOVABLE, UrdfJoint, UrdfReader, numeric, urdf_robot_name
 from .urdf_merge import body_parts, merge_inertials
 from .urdf_mimic import mimic_error, resolve_mimic
 from .urdf_tree import UrdfTree, link_name
 
-__all__ = ["load_urdf", "urdf_robot_name", "MAX_BYTES"]
+__all__ = ["load_urdf", "urdf_from_bytes", "urdf_robot_name", "MAX_BYTES"]
 
 
 def _check_inertials(reader: UrdfReader, names: list[str]) -> None:
@@ -91,6 +96,35 @@ def _check_inertials(reader: UrdfReader, names: list[str]) -> None:
                 link_index=link.index,
                 link_name=link.name,
             )
+
+
+def _warn_massless(reader: UrdfReader, tree: UrdfTree, parts: list[tuple[str, Transform]]) -> None:
+    """A SymdynWarning when a moving body (its link and the links fixed to it, `parts`: name and
+    body_T_link) has no <inertial> at all yet carries a joint away from its frame: a massless link in
+    the middle of a chain. The URDF specification allows it, but it is almost always a mistake.
+
+    Not warned: a frame link without <inertial> fixed to a body that has one (a tool or camera
+    frame), and a massless link whose child joints sit at its origin (the intermediate links of a
+    spherical or universal joint built from revolute ones)."""
+    names = {name for name, _ in parts}
+    if any(reader.links[name].inertial is not None for name in names):
+        return
+    away = [
+        j.name
+        for name, T in parts
+        for j in tree.children[name]
+        if j.child not in names and any(x.is_zero is not True for x in (T @ j.origin).p)
+    ]
+    if away:
+        link = reader.links[parts[0][0]]
+        joints = ", ".join(f"'{name}'" for name in away)
+        warnings.warn(
+            f"{location(reader.file, link.index, link.name)}: has no <inertial>, so it is massless, "
+            f"yet it carries joint {joints} at a distance; the URDF specification allows this, but in "
+            "the middle of a chain it is almost always a forgotten <inertial>",
+            SymdynWarning,
+            stacklevel=5,
+        )
 
 
 def _refuse_unmodelled(
@@ -166,6 +200,7 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
         parent = -1 if carrier is None else index[carrier.name]
         parts = body_parts(tree, j.child, index)
         _check_inertials(reader, [name for name, _ in parts])
+        _warn_massless(reader, tree, parts)
         mass, com, inertia = merge_inertials(
             [(reader.links[n].inertial, T) for n, T in parts if reader.links[n].inertial is not None]
         )
@@ -201,11 +236,23 @@ def load_urdf(path: str | os.PathLike, base: str | None = None, tip: str | None 
     the whole tree; see the module documentation). Raises SymdynError naming file,
     link and field for bad input; warns with SymdynWarning for implausible inertial
     data of the links used. The robot's name is the URDF name made a C identifier.
+    `symdyn.load_robot` reads a URDF too (it recognises one by its content).
     """
     file, raw, digest = read_source(path, "URDF file")
+    return urdf_from_bytes(raw, file, digest, base, tip)
+
+
+def urdf_from_bytes(raw: bytes, file: str, digest: str, base: str | None, tip: str | None) -> Robot:
+    """The `Robot` of a URDF file's bytes (`file` names it in messages, `digest` is their sha256)."""
     for what, value in (("base", base), ("tip", tip)):
         if value is not None and not isinstance(value, str):
             raise SymdynError(f"{what} must be a link name, not {value!r}", file=file)
+    if not looks_like_xml(raw):
+        raise SymdynError(
+            "not a URDF: the file does not start with an XML element ('<'); "
+            "a robot file (YAML or JSON) is read by symdyn.load_robot",
+            file=file,
+        )
     reader = UrdfReader(file)
     reader.read(parse_xml(raw, file))
     return _build(reader, digest, base, tip)

@@ -186,8 +186,16 @@ class UrdfReader:
 
     # -- the document
     def read(self, root: Element) -> None:
+        if root.tag == "mujoco":
+            raise self.error(
+                "an MJCF file (top element <mujoco>): symdyn does not read MJCF yet; "
+                "it reads URDF (top element <robot>) and robot files (YAML or JSON)"
+            )
         if root.tag != "robot":
-            raise self.error(f"the top element must be <robot>, not <{root.tag}>", line=root.line)
+            raise self.error(
+                f"an XML file whose top element is <{root.tag}>: symdyn reads URDF (top element "
+                "<robot>) and robot files (YAML or JSON)"
+            )
         self._refuse_xacro(root)
         if "name" not in root.attrib:
             raise self.error("<robot> needs the attribute 'name'", field="robot.name", line=root.line)
