@@ -45,11 +45,12 @@ def _placement(reader, entries: dict, field: str) -> Transform:
     rpy = entries.get("rpy")
     if rpy is None:
         return Transform.from_translation(p)
-    angles = reader.vector(rpy, f"{field}.rpy")
-    snapped = [
-        snap_angle(a, file=reader.file, field=f"{field}.rpy.{k}")
-        for a, k in zip(angles, ("r", "p", "y"), strict=True)
-    ]
+    if not (isinstance(rpy, list) and len(rpy) == 3):
+        reader.vector(rpy, f"{field}.rpy")  # raises, saying what was expected
+    snapped = []
+    for a, k in zip(rpy, ("r", "p", "y"), strict=True):
+        where = f"{field}.rpy.{k}"
+        snapped.append(snap_angle(reader.expr(a, where), file=reader.file, field=where))
     return Transform(rpy_matrix(*snapped), sp.ImmutableMatrix(3, 1, list(p)))
 
 
