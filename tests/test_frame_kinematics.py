@@ -9,7 +9,7 @@ from functools import cache
 
 import numpy as np
 import pytest
-from robots import EXAMPLES_DIR, example, y_robot
+from robots import EXAMPLES_DIR, example, rpy, y_robot
 from scipy.linalg import logm
 
 import symdyn
@@ -276,28 +276,13 @@ def test_operational_space_identities(name, frame, axes):
 # --------------------------------------------------------------------------- the model and bad input
 
 
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def _ry(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def _rz(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
 def test_frames_are_written_in_the_link_frame_and_the_base_places_the_robot():
     dyn = hung_dynamics()
     r = dyn.robot
     q = _state(r, 3)[0]
     link = frame_state(r, "l3", q).pose
     T = np.eye(4)
-    T[:3, :3] = _rz(1.2) @ _ry(-0.4) @ _rx(0.1)
+    T[:3, :3] = rpy(0.1, -0.4, 1.2)
     T[:3, 3] = [0.01, 0.02, 0.15]
     np.testing.assert_allclose(dyn.frame_pose("tool", q), link @ T, atol=TOL)
     base = dyn.frame_pose("camera", q)

@@ -55,10 +55,10 @@ def check_frame_names(robot_name: str, link_names: Iterable[str], frames: Iterab
         seen[f.name] = "another frame"
 
 
-def unknown_frame(name: object, names: Iterable[str], where: str) -> SymdynError:
+def unknown_frame(name: object, names: Iterable[str], where: str, file: str | None = None) -> SymdynError:
     """The error for a frame name that is not among `names`, naming the near matches."""
     names = list(names)
     close = difflib.get_close_matches(str(name), names, n=3)
     hint = f" (did you mean {', '.join(repr(c) for c in close)}?)" if close else ""
     listed = ", ".join(names[:12]) + (", ..." if len(names) > 12 else "")
-    return SymdynError(f"{where}: unknown frame {name!r}{hint}; the frames: {listed}")
+    return SymdynError(f"{where}: unknown frame {name!r}{hint}; the frames: {listed}", file=file)

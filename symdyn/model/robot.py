@@ -210,7 +210,7 @@ class Robot:
         for f in self.frames:
             if f.name == name:
                 return f
-        raise unknown_frame(name, self.frame_names, f"{where}: robot '{self.name}'")
+        raise unknown_frame(name, self.frame_names, f"{where}: robot '{self.name}'", self.source)
 
     @cached_property
     def n(self) -> int:
