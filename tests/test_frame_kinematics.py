@@ -19,7 +19,7 @@ from symdyn.rnea_frames import center_of_mass, frame_state
 
 TOL = 1e-9
 URDFS = {
-    "panda": ("panda_description/urdf/panda.urdf", ("panda_hand", "panda_link8")),
+    "panda": ("panda_description/urdf/panda.urdf", ("panda_hand", "panda_link8", "panda_rightfinger")),
     "ur5": ("ur_description/urdf/ur5_robot.urdf", ("tool0",)),
     "solo12": ("solo_description/robots/solo12.urdf", ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")),
 }
@@ -336,3 +336,20 @@ def test_an_unknown_frame_names_the_near_matches():
         dyn.operational_space_inertia("tool", [0, 0, 0], axes="x,w")
     with pytest.raises(SymdynError, match="reference must be"):
         dyn.frame_jacobian("tool", "body")
+
+
+def test_poe_end_effector_is_a_frame_in_files_and_from_python():
+    mr = pytest.importorskip("modern_robotics")
+    robot = example("mr_ur5")
+    assert robot.frame("end_effector").link == robot.nb - 1
+    M01 = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0.5], [0, 0, 0, 1]])
+    M12 = np.array([[1, 0, 0, 0.3], [0, 1, 0, 0], [0, 0, 1, 0.1], [0, 0, 0, 1]])
+    S = np.array([[0, 0, 1, 0, 0, 0]]).T
+    built = symdyn.robot_from_poe([M01, M12], [np.diag([0.1, 0.1, 0.1, 1, 1, 1])], S)
+    q = [0.7]
+    T = mr.FKinSpace(M01 @ M12, S, q)
+    np.testing.assert_allclose(frame_state(built, "end_effector", q).pose, T, atol=TOL)
+    raw = __import__("yaml").safe_load((EXAMPLES_DIR / "mr_ur5.yaml").read_text())
+    raw["frames"] = [{"name": "end_effector", "link": "wrist_3_link"}]
+    with pytest.raises(SymdynError, match="'end_effector' is PoE's end-effector frame"):
+        symdyn.robot_from_data(raw, "ur5.yaml")
