@@ -199,3 +199,11 @@ def test_an_unknown_frame_is_one_line_and_nothing_is_printed(capsys, tmp_path):
     assert out == ""
     assert err.strip().endswith("unknown frame 'tol' (did you mean 'tool'?); the frames: l1, l2, tool")
     assert err.count("\n") == 1 and str(path) in err
+
+
+def test_frames_do_not_combine_with_steps(capsys, tmp_path):
+    path = tmp_path / "framed.yaml"
+    path.write_text(FRAMED)
+    assert main(["derive", str(path), "--frames", "tool", "--steps"]) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and "--frames" in err and "--steps" in err

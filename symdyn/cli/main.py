@@ -77,6 +77,10 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    if args.frames is not None and (args.steps or args.at):
+        raise SymdynError(
+            "derive: --frames prints the frames after the equations of motion, not with --steps"
+        )
     if args.steps or args.at:
         from .steps import cmd_derive_steps
 
