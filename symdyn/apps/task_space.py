@@ -27,7 +27,6 @@ if TYPE_CHECKING:
 __all__ = ["TASK_AXES", "parse_axes", "default_axes", "task_jacobian", "joint_vector"]
 
 
-
 def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
     """Task axes from "x,y" or a sequence of names among x, y, z, rx, ry, rz (None: default)."""
     if axes is None:
