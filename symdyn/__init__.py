@@ -26,6 +26,7 @@ if TYPE_CHECKING:  # what the names below are, for type checkers and the API ref
     from .codegen import generate
     from .dynamics import Dynamics, derive
     from .model import inertia
+    from .model.frames import Frame
     from .model.parameters import standard_parameters
     from .model.robot import Link, Robot
     from .parsers import load_robot, load_urdf, robot_from_data, robot_from_poe
@@ -42,6 +43,7 @@ _LAZY = {
     "derive": (".dynamics", "derive"),
     "standard_parameters": (".model.parameters", "standard_parameters"),
     "Link": (".model.robot", "Link"),
+    "Frame": (".model.frames", "Frame"),
     "Robot": (".model.robot", "Robot"),
     "load_robot": (".parsers", "load_robot"),
     "load_urdf": (".parsers", "load_urdf"),
@@ -87,6 +89,7 @@ __all__ = [
     "compile",
     "Dynamics",
     "Link",
+    "Frame",
     "Robot",
     "SymdynError",
     "SymdynWarning",

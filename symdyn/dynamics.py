@@ -48,9 +48,11 @@ from .algorithms.configuration_space import ConfigurationSpace, configuration_sp
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
+from .algorithms.frame_kinematics import FrameKinematics
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
+from .algorithms.operational_space import operational_space, task_rows
 from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
@@ -138,6 +140,7 @@ class Dynamics:
     _compiled: dict[str, object] = field(default_factory=dict, repr=False)
     _linear: dict[str, object] = field(default_factory=dict, repr=False)
     _configuration: ConfigurationSpace | None = field(default=None, repr=False)
+    _frames: FrameKinematics | None = field(default=None, repr=False)
 
     @property
     def n(self) -> int:
@@ -348,6 +351,108 @@ class Dynamics:
         self.robot.param_values(params, where)
         robot = self.robot.numeric(params)
         return np.asarray(tip_wrench_torque(robot, F, [float(x) for x in q]), dtype=float)[:, 0]
+
+    # -- frames and task space (docs/frames.md; symdyn.algorithms.frame_kinematics)
+    @property
+    def frames(self) -> FrameKinematics:
+        """The frame quantities over named intermediates of a copy of `program` (intermediates
+        `_F...`), shared by the methods below."""
+        if self._frames is None:
+            self._frames = FrameKinematics(self.robot, list(self.q), list(self.qd), self.program.copy("F"))
+        return self._frames
+
+    def _frame_value(self, key: tuple, m: sp.Matrix, q, qd, params, where: str):
+        """m's closed form (q None) or its numbers at (q, qd, params) (lambdified once per key)."""
+        if q is None:
+            entries = self.frames.program.expand(list(m))
+            if self.simplified:
+                entries = [simplify_entry(e) for e in entries]
+            return sp.ImmutableMatrix(m.rows, m.cols, entries)
+        f = self._compiled.get(key)
+        if f is None:
+            steps = self.frames.program.needed(list(m))
+            args = [list(self.q), list(self.qd), list(self.params)]
+            f = sp.lambdify(args, sp.Matrix(m), modules="numpy", cse=lambda exprs: (steps, exprs))
+            self._compiled[key] = f
+        vq = self.robot.joint_values(q, "q", where)
+        vqd = self.robot.joint_values(qd, "qd", where)
+        values = self.robot.param_values(params, where)
+        out = np.asarray(f(vq, vqd, [values[s] for s in self.params]), dtype=float).reshape(m.shape)
+        return out[:, 0] if m.cols == 1 else out
+
+    def frame_pose(self, frame: str, q=None, params=None):
+        """world_T_F (4 x 4) of frame `frame` (a link's or one of Robot.frames): closed form over
+        q with q None, else an array at q."""
+        m = self.frames.pose(frame)
+        return self._frame_value(("pose", frame), m, q, None, params, "Dynamics.frame_pose")
+
+    def frame_jacobian(self, frame: str, reference: str = "world", q=None, params=None):
+        """J (6 x n), rows v_x v_y v_z w_x w_y w_z, of F's origin: world-aligned ("world",
+        Pinocchio's LOCAL_WORLD_ALIGNED) or in F's own axes ("local", LOCAL)."""
+        if reference not in ("world", "local"):
+            raise SymdynError(
+                f"Dynamics.frame_jacobian: reference must be 'world' or 'local', got {reference!r}"
+            )
+        m = self.frames.jacobian(frame, reference)
+        return self._frame_value((reference, frame), m, q, None, params, "Dynamics.frame_jacobian")
+
+    def frame_jacobian_dot_qd(self, frame: str, q=None, qd=None, params=None):
+        """Jdot qd (6): F's origin's classical acceleration and F's angular acceleration at
+        qdd = 0, world-aligned (Pinocchio's getFrameClassicalAcceleration, LOCAL_WORLD_ALIGNED)."""
+        m = self.frames.jacobian_dot_qd(frame)
+        return self._frame_value(("drift", frame), m, q, qd, params, "Dynamics.frame_jacobian_dot_qd")
+
+    def com(self, q=None, params=None):
+        """The centre of mass c(q) (3), world frame."""
+        return self._frame_value(("com",), self.frames.com(), q, None, params, "Dynamics.com")
+
+    def com_jacobian(self, q=None, params=None):
+        """Jc (3 x n), world frame: dc/dt = Jc qd."""
+        return self._frame_value(
+            ("Jc",), self.frames.com_jacobian(), q, None, params, "Dynamics.com_jacobian"
+        )
+
+    def com_jacobian_dot_qd(self, q=None, qd=None, params=None):
+        """Jc_dot qd (3), world frame: the centre of mass's acceleration at qdd = 0."""
+        m = self.frames.com_jacobian_dot_qd()
+        return self._frame_value(("Jcd",), m, q, qd, params, "Dynamics.com_jacobian_dot_qd")
+
+    def _operational(self, frame: str, axes, where: str):
+        rows = task_rows(axes, where)
+        key = ("os", frame, rows)
+        if key not in self._compiled:
+            fk = self.frames
+            J = fk.jacobian(frame, "world")
+            os = operational_space(
+                self.compact["M"],
+                J.extract(list(rows), list(range(self.n))),
+                self.compact["bias"],
+                fk.jacobian_dot_qd(frame).extract(list(rows), [0]),
+                self.robot.is_chain,
+                fk.program,
+            )
+            self._compiled[key] = os
+        return key, self._compiled[key]
+
+    def operational_space_inertia(self, frame: str, q, axes=None, params=None) -> np.ndarray:
+        """Lambda = (J M^-1 J^T)^-1 (k x k) at q, J the world-aligned Jacobian's rows `axes`
+        (any of x, y, z, rx, ry, rz; default all six); symdyn.algorithms.operational_space."""
+        key, os = self._operational(frame, axes, "Dynamics.operational_space_inertia")
+        return self._frame_value(
+            (*key, "L"), os.inertia, q, None, params, "Dynamics.operational_space_inertia"
+        )
+
+    def operational_space_bias(self, frame: str, q, qd=None, axes=None, params=None) -> np.ndarray:
+        """mu + p = Lambda (J M^-1 (V + G + F) - Jdot qd) (k) at (q, qd)."""
+        key, os = self._operational(frame, axes, "Dynamics.operational_space_bias")
+        return self._frame_value((*key, "b"), os.bias, q, qd, params, "Dynamics.operational_space_bias")
+
+    def dynamically_consistent_inverse(self, frame: str, q, axes=None, params=None) -> np.ndarray:
+        """Jbar = M^-1 J^T Lambda (n x k) at q."""
+        key, os = self._operational(frame, axes, "Dynamics.dynamically_consistent_inverse")
+        return self._frame_value(
+            (*key, "B"), os.inverse, q, None, params, "Dynamics.dynamically_consistent_inverse"
+        )
 
     def __repr__(self) -> str:
         """One line: robot, joints, method and free parameters (the robot's table: `table()`)."""

@@ -125,7 +125,7 @@ class LumpedConstants:
 
 
 def _geometry_symbols(robot: Robot) -> set:
-    out = set(robot.gravity.free_symbols)
+    out = set(robot.base_gravity.free_symbols)
     for link in robot.links:
         out |= link.placement.R.free_symbols | link.placement.p.free_symbols | link.axis.free_symbols
         if link.mimic is not None:

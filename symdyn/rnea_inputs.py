@@ -38,7 +38,11 @@ class NumericModel:
     `axis` (nb,3) in the body frame; `mass` (nb,); `com` (nb,3) body frame;
     `inertia` (nb,3,3) about the centre of mass; `spatial_inertia` (nb,6,6) about
     the body origin; `viscous`, `coulomb`, `reflected` (nb,) friction and
-    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame; `parent` (nb,) int,
+    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame (the robot's world gravity
+    turned by the base rotation, base_R_world g); `base_R`, `base_p` (3,3), (3,) the base frame
+    in the world; `frame_link` (nf,) int and `frame_R`, `frame_p` (nf,3,3), (nf,3): the link
+    (-1: base) and placement in its body frame of every frame (`frame_names`: the links' names,
+    then Robot.frames'); `parent` (nb,) int,
     lambda(i) with -1 for the base (parents before children); `coordinate` (nb,) int, the
     independent coordinate each body's joint follows, with `multiplier` and `offset` (nb,)
     (q_i = multiplier_i q[coordinate_i] + offset_i); `selection` (nb, n) the matrix S of
@@ -57,6 +61,12 @@ class NumericModel:
     coulomb: np.ndarray
     reflected: np.ndarray
     gravity: np.ndarray
+    base_R: np.ndarray
+    base_p: np.ndarray
+    frame_link: np.ndarray
+    frame_R: np.ndarray
+    frame_p: np.ndarray
+    frame_names: tuple[str, ...]
     parent: np.ndarray
     coordinate: np.ndarray
     multiplier: np.ndarray
@@ -155,11 +165,20 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
     )
     selection = np.zeros((n, r.n))
     selection[np.arange(n), coordinate] = multiplier
+    base_R = _floats(r.base.R, (3, 3), "base.rpy")
+    frames = [(i, lk.name, lk.frame) for i, lk in enumerate(links)] + [
+        (f.link, f.name, f.placement) for f in r.frames
+    ]
+    frame_R = np.array([_floats(T.R, (3, 3), f"frame {name}") for _, name, T in frames]).reshape(-1, 3, 3)
+    frame_p = np.array([_floats(T.p, (3,), f"frame {name}") for _, name, T in frames]).reshape(-1, 3)
     return NumericModel(
         revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
         R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
         spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
-        gravity=_floats(r.gravity, (3,), "gravity"), parent=np.array(r.parents, dtype=int).reshape(n),
+        gravity=base_R.T @ _floats(r.gravity, (3,), "gravity"), base_R=base_R,
+        base_p=_floats(r.base.p, (3,), "base.xyz"), frame_link=np.array([k for k, _, _ in frames], dtype=int),
+        frame_R=frame_R, frame_p=frame_p, frame_names=tuple(name for _, name, _ in frames),
+        parent=np.array(r.parents, dtype=int).reshape(n),
         coordinate=coordinate, multiplier=multiplier.reshape(n), offset=offset.reshape(n),
         selection=selection, names=tuple(lk.name for lk in links), name=r.name,
     )  # fmt: skip

@@ -283,6 +283,26 @@ def assert_matrix_zero(A: sp.Matrix, n: int, what: str = "") -> None:
 # --------------------------------------------------------------------------- random robots
 
 
+def rx(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def ry(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def rz(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def rpy(r, p, y):
+    """URDF's fixed-axis roll, pitch, yaw, written out with NumPy."""
+    return rz(y) @ ry(p) @ rx(r)
+
+
 def rotation(rng: np.random.Generator) -> np.ndarray:
     """A uniformly random rotation matrix (from a random unit quaternion)."""
     w, x, y, z = (qu := rng.normal(size=4)) / np.linalg.norm(qu)

@@ -149,3 +149,61 @@ def test_an_unreadable_form_falls_back_to_the_expansion_and_compact(monkeypatch,
     assert "printing --form compact" in captured.err and "B[" not in captured.out
     assert main(["derive", str(path), "--form", "configuration"]) == 0
     assert "B[" in capsys.readouterr().out
+
+
+FRAMED = """
+name: framed
+base: {xyz: [0.1, 0, 2], rpy: [pi, 0, 0.2]}
+links:
+  - {name: l1, joint: revolute, a: 0.4, alpha: pi/2, mass: 1, com: [-0.2, 0, 0]}
+  - {name: l2, joint: revolute, a: 0.3, mass: 1, com: [-0.1, 0, 0]}
+frames:
+  - {name: tool, link: l2, xyz: [0, 0.05, 0.1], rpy: [0.3, 0, 0]}
+"""
+
+
+@pytest.mark.parametrize("fmt", ["text", "json"])
+def test_frames_print_each_pose_and_jacobian_entry(capsys, tmp_path, fmt):
+    from symdyn.rnea_frames import frame_state
+
+    path = tmp_path / "framed.yaml"
+    path.write_text(FRAMED)
+    out = _run(capsys, str(path), "--frames", "tool,l1", "--format", fmt, "--simplify", "no")
+    robot = __import__("symdyn").load_robot(path)
+    q, _ = _state(2, seed=4)
+    for name in ("tool", "l1"):
+        if fmt == "json":
+            frame = json.loads(out)["frames"][name]
+            T, J = (
+                np.array([[_subs(sp.sympify(e), q, q) for e in row] for row in frame[k]])
+                for k in ("pose", "jacobian")
+            )
+        else:
+            entries = _assignments(out)
+            T = np.array(
+                [[_subs(entries[f"T_{name}[{i},{j}]"], q, q) for j in range(1, 5)] for i in range(1, 5)]
+            )
+            J = np.array(
+                [[_subs(entries[f"J_{name}[{i},{j}]"], q, q) for j in range(1, 3)] for i in range(1, 7)]
+            )
+        want = frame_state(robot, name, q)
+        np.testing.assert_allclose(T.astype(float), want.pose, atol=1e-12)
+        np.testing.assert_allclose(J.astype(float), want.jacobian, atol=1e-12)
+
+
+def test_an_unknown_frame_is_one_line_and_nothing_is_printed(capsys, tmp_path):
+    path = tmp_path / "framed.yaml"
+    path.write_text(FRAMED)
+    assert main(["derive", str(path), "--frames", "tol"]) == 1
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.strip().endswith("unknown frame 'tol' (did you mean 'tool'?); the frames: l1, l2, tool")
+    assert err.count("\n") == 1 and str(path) in err
+
+
+def test_frames_do_not_combine_with_steps(capsys, tmp_path):
+    path = tmp_path / "framed.yaml"
+    path.write_text(FRAMED)
+    assert main(["derive", str(path), "--frames", "tool", "--steps"]) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and "--frames" in err and "--steps" in err

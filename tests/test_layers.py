@@ -53,7 +53,9 @@ def _imports(path: Path, parts: tuple[str, ...]):
 def _floor(parts: tuple[str, ...]) -> str:
     if parts[0] == "lumped":  # works on a Dynamics, as dynamics does
         return "dynamics"
-    return "rnea" if parts[0] in ("rnea_inputs", "rnea_spatial", "rnea_regressor") else parts[0]  # the oracle
+    return (
+        "rnea" if parts[0] in ("rnea_inputs", "rnea_spatial", "rnea_regressor", "rnea_frames") else parts[0]
+    )  # the oracle
 
 
 @pytest.mark.parametrize(

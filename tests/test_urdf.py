@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from cbuild import build_dynamics, compilers
-from robots import assert_close, mat, random_state, vec
+from robots import assert_close, mat, random_state, rpy, rx, ry, rz, vec
 
 import symdyn.codegen
 from symdyn import inertia as si
@@ -45,26 +45,6 @@ G = 9.81
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def rx(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def ry(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def rz(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
-def rpy(r, p, y):
-    """URDF's fixed-axis roll, pitch, yaw, written out with NumPy."""
-    return rz(y) @ ry(p) @ rx(r)
 
 
 def rodrigues(axis, q):

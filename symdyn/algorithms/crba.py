@@ -180,7 +180,7 @@ def gravity_composite(
     Returns:
         nb expressions (the bodies' joints) over the program's intermediates.
     """
-    g_base = v3.vec(robot.gravity)
+    g_base = v3.vec(robot.base_gravity)
     g: list[v3.Vec] = []  # g_k, frame k
     G: list[sp.Expr] = []
     for k, link in enumerate(robot.links):

@@ -58,7 +58,7 @@ def lagrange(robot: Robot, q: sp.Matrix, qd: sp.Matrix, program: Program) -> dic
     poses = forward_kinematics(robot, list(q), program)
     M = sp.zeros(n, n)
     P = sp.S.Zero
-    g = sp.Matrix(robot.gravity)
+    g = sp.Matrix(robot.base_gravity)
     for i, link in enumerate(robot.links):
         J = body_point_jacobian(robot, i, list(link.com), list(q), program)
         Jv = J[:3, :].applyfunc(lambda x, i=i: program.let(x, f"Jv{i + 1}_"))

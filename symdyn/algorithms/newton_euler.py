@@ -170,7 +170,7 @@ def newton_euler(
     parents = robot.parents
     frames = rotations if rotations is not None else joint_frames(robot, q)
     zero = v3.ZERO3
-    vd_0 = program.let_vector(v3.neg(v3.vec(robot.gravity)), f"{tag}g") if gravity else zero
+    vd_0 = program.let_vector(v3.neg(v3.vec(robot.base_gravity)), f"{tag}g") if gravity else zero
     base = LinkAcceleration(zero, zero, vd_0)
     motions: list[LinkAcceleration] = []  # of link i, in frame i
     Ws: list[v3.Mat] = []

@@ -99,7 +99,7 @@ def body_regressor(
     nb = robot.nb
     parents = robot.parents
     frames = rotations if rotations is not None else joint_frames(robot, q_b)
-    vd_0 = program.let_vector(v3.neg(v3.vec(robot.gravity)), "Tg")
+    vd_0 = program.let_vector(v3.neg(v3.vec(robot.base_gravity)), "Tg")
     base = LinkAcceleration(v3.ZERO3, v3.ZERO3, vd_0)
     motions: list[LinkAcceleration] = []
     Ws: list[v3.Mat] = []

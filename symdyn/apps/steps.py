@@ -100,7 +100,7 @@ def _vec(x) -> sp.Matrix:
 
 
 def _newton_euler(robot: Robot, q, qd, qdd) -> list[Step]:
-    g = _vec(robot.gravity)
+    g = _vec(robot.base_gravity)
     zero = sp.zeros(3, 1)
     frames, out = [], []
     motion: list[tuple[sp.Matrix, sp.Matrix, sp.Matrix]] = []
@@ -153,7 +153,7 @@ def _newton_euler(robot: Robot, q, qd, qdd) -> list[Step]:
 def _lagrange(robot: Robot, q, qd, qdd) -> list[Step]:
     qs, qds, _ = joint_symbols(robot.n)  # differentiate by symbols, substitute the state after
     poses = forward_kinematics(robot, list(qs))
-    g = _vec(robot.gravity)
+    g = _vec(robot.base_gravity)
     out, L = [], sp.S.Zero
     for i, link in enumerate(robot.links):
         J = point_jacobian(robot, i, list(link.com), poses=poses)

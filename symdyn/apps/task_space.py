@@ -1,9 +1,9 @@
 """The task space of the end-effector: its axes, and its Jacobian J with the bias Jdot qd as numbers.
 
-J is the geometric Jacobian of the origin of the last convention frame, in the
-base frame (`symdyn.algorithms.kinematics.end_effector_jacobian`), rows x, y, z
-(linear) and rx, ry, rz (angular); a task picks some of these rows. Jdot qd is
-exact: the symbolic time derivative of J, sum_j dJ/dq_j qd_j, times qd.
+J is the geometric Jacobian of the origin of the last convention frame (the last link's frame),
+in the base frame, rows x, y, z (linear) and rx, ry, rz (angular); a task picks some of these
+rows. J and Jdot qd come from symdyn.algorithms.frame_kinematics (the drift by its outward
+recursion at qdd = 0), over named intermediates.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..algorithms.operational_space import TASK_AXES
 from ..errors import SymdynError
 from .compile import CompiledDynamics
 
@@ -24,8 +25,6 @@ if TYPE_CHECKING:
     from ..model.robot import Robot
 
 __all__ = ["TASK_AXES", "parse_axes", "default_axes", "task_jacobian", "joint_vector"]
-
-TASK_AXES = ("x", "y", "z", "rx", "ry", "rz")
 
 
 def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
@@ -47,19 +46,23 @@ def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
 @lru_cache(maxsize=32)
 def _kinematics(robot: Robot):
     """(f(q, qd, p) -> (J 6xn, Jdot qd 6), the linear rows not identically zero, free params)."""
+    from dataclasses import replace
+
     import sympy as sp
 
-    from ..algorithms.kinematics import end_effector_jacobian
+    from ..algorithms.frame_kinematics import FrameKinematics
     from ..model.symbols import joint_symbols
+    from ..spatial.transform import Transform
+    from ..symbolic.program import Program
 
     r = robot.resolved()
     q, qd, _ = joint_symbols(r.n)
-    J = end_effector_jacobian(r, list(q))
-    Jdot = sp.zeros(*J.shape)
-    for j in range(r.n):
-        Jdot += J.diff(q[j]) * qd[j]
-    bias = Jdot * qd
-    f = sp.lambdify([list(q), list(qd), list(r.params)], [J, bias], modules="numpy", cse=True)
+    fk = FrameKinematics(replace(r, base=Transform.identity()), list(q), list(qd), Program())
+    tip = r.links[-1].name
+    J, bias = fk.jacobian(tip), fk.jacobian_dot_qd(tip)
+    steps = fk.program.needed([*J, *bias])
+    args = [list(q), list(qd), list(r.params)]
+    f = sp.lambdify(args, [J, bias], modules="numpy", cse=lambda exprs: (steps, exprs))
     live = tuple(TASK_AXES[i] for i in range(3) if any(x != 0 for x in J[i, :]))
     return f, live, tuple(str(p) for p in r.params)
 

@@ -11,7 +11,8 @@
   form), M, C, V, G, F.
 
 JSON always has the keys M, C, V, G, F, and B and Csq in the configuration form; every
-expression string parses with sympy.sympify.
+expression string parses with sympy.sympify. With `--frames F1,F2` each frame's pose world_T_F
+and world-aligned Jacobian follow (symdyn.algorithms.frame_kinematics; JSON key "frames").
 """
 
 from __future__ import annotations
@@ -23,11 +24,22 @@ import sympy as sp
 
 from ..algorithms.configuration_space import pair_columns
 from ..dynamics import Dynamics
+from ..errors import SymdynError
 from ..lumped import lumped_constants
 from ..symbolic.simplify import count_ops, eliminate
 from ..symbolic.trig_text import number_text
 
-__all__ = ["FORMS", "derive_text", "derive_json", "configuration_entries", "prune_summary"]
+__all__ = [
+    "FORMS",
+    "derive_text",
+    "derive_json",
+    "configuration_entries",
+    "prune_summary",
+    "frame_names",
+    "frames_text",
+    "frames_json",
+    "frames_latex",
+]
 
 FORMS = ("configuration", "compact", "expanded")
 PRINTED = ("M", "C", "V", "G", "F")
@@ -308,4 +320,76 @@ def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
         abbreviations.append(f"${nt.names[ph]} = \\{'sin' if kind == 's' else 'cos'}({angle})$")
     if abbreviations:
         out.insert(1, "Abbreviations: " + ", ".join(abbreviations) + ".")
+    return "\n".join(out) + "\n"
+
+
+def frame_names(dyn: Dynamics, text: str | None) -> list[str]:
+    """The frames of `--frames F1,F2` (None: none), each checked to exist (Robot.frame)."""
+    if text is None:
+        return []
+    names = list(dict.fromkeys(a.strip() for a in text.split(",") if a.strip()))
+    if not names:
+        raise SymdynError("--frames: no frame given (a link's name or one of the robot's frames)")
+    for name in names:
+        dyn.robot.frame(name, "--frames")
+    return names
+
+
+def _frame_link(dyn: Dynamics, name: str) -> str:
+    k = dyn.robot.frame(name).link
+    return "the base" if k < 0 else f"link {k + 1} ({dyn.robot.links[k].name})"
+
+
+def frames_text(dyn: Dynamics, names: list[str]) -> str:
+    """Each frame's pose world_T_F (T[i,j], 4 x 4) and world-aligned Jacobian (J[i,j], 6 x n,
+    rows v_x v_y v_z w_x w_y w_z), closed forms, one entry per line as M is printed."""
+    lines = []
+    for name in names:
+        lines += [
+            "",
+            f"# frame {name} on {_frame_link(dyn, name)}: pose world_T_F, Jacobian J world-aligned at "
+            "F's origin (rows v_x v_y v_z w_x w_y w_z)",
+        ]
+        for label, m in (("T", dyn.frame_pose(name)), ("J", dyn.frame_jacobian(name))):
+            lines += [
+                f"{label}_{name}[{i + 1},{j + 1}] = {sp.sstr(m[i, j])}"
+                for i in range(m.rows)
+                for j in range(m.cols)
+            ]
+    return "\n".join(lines) + "\n"
+
+
+def frames_json(dyn: Dynamics, names: list[str]) -> dict:
+    """{frame: {link, pose (4 x 4), jacobian (6 x n)}}, entries as SymPy strings."""
+    return {
+        name: {
+            "link": dyn.robot.frame(name).link + 1,
+            "pose": _nested(dyn.frame_pose(name), False),
+            "jacobian": _nested(dyn.frame_jacobian(name), False),
+        }
+        for name in names
+    }
+
+
+def frames_latex(dyn: Dynamics, names: list[str]) -> str:
+    """One align* per frame: the entries of T (world_T_F) and J (world-aligned), in LaTeX."""
+    symbols = {}
+    for head, v in (("q", dyn.q), ("\\dot{q}", dyn.qd)):
+        symbols.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})
+    out = []
+    for name in names:
+        tex = re.sub(r"([_#%&{}$])", r"\\\1", name)
+        rows = []
+        for label, m in (("T", dyn.frame_pose(name)), ("J", dyn.frame_jacobian(name))):
+            head = f"{label}^{{\\mathrm{{{tex}}}}}"
+            rows += [
+                f"{head}_{{{i + 1},{j + 1}}} &= {sp.latex(m[i, j], symbol_names=symbols)}"
+                for i in range(m.rows)
+                for j in range(m.cols)
+            ]
+        out.append(
+            f"% frame {name}: pose world_T_F and world-aligned Jacobian\n\\begin{{align*}}\n"
+            + " \\\\\n".join(rows)
+            + "\n\\end{align*}"
+        )
     return "\n".join(out) + "\n"

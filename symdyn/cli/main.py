@@ -77,6 +77,10 @@ def _derive_latex(dyn) -> str:
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
+    if args.frames is not None and (args.steps or args.at):
+        raise SymdynError(
+            "derive: --frames prints the frames after the equations of motion, not with --steps"
+        )
     if args.steps or args.at:
         from .steps import cmd_derive_steps
 
@@ -88,6 +92,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
     robot = load_robot_argument(args)
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
+    frames = out.frame_names(dyn, args.frames)
     if args.form is None:
         args.form = "configuration"
         if not dyn.configuration_space.readable:
@@ -110,6 +115,12 @@ def cmd_derive(args: argparse.Namespace) -> int:
         text = out.derive_text(dyn, args.form, args.lumped, pruned)
     else:
         text = {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
+    if frames and args.format == "json":
+        doc = json.loads(text)
+        doc["frames"] = out.frames_json(dyn, frames)
+        text = json.dumps(doc, indent=2) + "\n"
+    elif frames:
+        text += (out.frames_latex if args.format == "latex" else out.frames_text)(dyn, frames)
     sys.stdout.write(text)
     return 0
 
@@ -163,6 +174,12 @@ def _derive_arguments(d: argparse.ArgumentParser) -> None:
         type=float,
         metavar="REL",
         help="drop terms below REL of their entry's largest value over the joint ranges (AKB's 1%% model)",
+    )
+    d.add_argument(
+        "--frames",
+        metavar="F1,F2",
+        help="also print each frame's pose world_T_F and world-aligned Jacobian (a link's name or "
+        "one of the robot's frames; docs/frames.md)",
     )
     d.add_argument(
         "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"

@@ -35,12 +35,13 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from .frames import Frame, check_frame_names, unknown_frame
 from .limits import check_limits
 from .parameter_names import parameter_names_problem
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
-__all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "JOINT_TYPES", "DEFAULT_GRAVITY"]
+__all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "Frame", "JOINT_TYPES", "DEFAULT_GRAVITY"]
 
 JOINT_TYPES = ("revolute", "prismatic")
 #: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
@@ -146,8 +147,10 @@ class Robot:
 
     `values` holds the parameters the file gave values for (symbol -> SymPy
     number or expression); `params` the free parameter symbols (no value), in
-    order of first appearance in the file. Gravity is the gravitational
-    acceleration in the base frame.
+    order of first appearance in the file. `base` = world_T_base places the base frame in
+    the world (identity: the base frame is the world frame) and `gravity` is the gravitational
+    acceleration in the world frame; `base_gravity` is it in the base frame, what the dynamics
+    use. `frames` are the named frames besides the links' own (symdyn.model.frames).
     """
 
     name: str
@@ -158,11 +161,14 @@ class Robot:
     source: str | None = None
     source_sha256: str | None = None
     convention: str = "standard"
+    frames: tuple[Frame, ...] = ()
+    base: Transform = field(default_factory=Transform.identity)
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
         if problem:
             raise SymdynError(f"robot '{self.name}': {problem}")
+        check_frame_names(self.name, [link.name for link in self.links], self.frames, self.nb)
         for i, link in enumerate(self.links):
             m = link.mimic
             if m is None:
@@ -181,6 +187,31 @@ class Robot:
         return robot_table(self)
 
     __str__ = __repr__
+
+    @property
+    def base_gravity(self) -> sp.ImmutableMatrix:
+        """g in the base frame, base_R_world g (`gravity` itself when the base is not rotated)."""
+        R = self.base.R
+        return self.gravity if sp.eye(3) == R else sp.ImmutableMatrix(R.T * self.gravity)
+
+    @property
+    def frame_names(self) -> tuple[str, ...]:
+        """Every frame's name: the links' (in order), then the other frames'."""
+        return tuple(link.name for link in self.links) + tuple(f.name for f in self.frames)
+
+    def frame(self, name: str, where: str = "frame") -> Frame:
+        """The frame named `name`: a link's (its convention frame, `Link.frame`) or one of `frames`.
+
+        Raises:
+            SymdynError: an unknown name, naming the near matches.
+        """
+        for i, link in enumerate(self.links):
+            if link.name == name:
+                return Frame(name, i, link.frame)
+        for f in self.frames:
+            if f.name == name:
+                return f
+        raise unknown_frame(name, self.frame_names, f"{where}: robot '{self.name}'", self.source)
 
     @cached_property
     def n(self) -> int:
@@ -374,5 +405,7 @@ class Robot:
             self,
             links=tuple(link.subs(mapping) for link in self.links),
             gravity=self.gravity.xreplace(mapping),
+            frames=tuple(f.subs(mapping) for f in self.frames),
+            base=self.base.subs(mapping),
             **changes,
         )

@@ -30,6 +30,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..model.expressions import is_c_identifier
+from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import Link, Robot
 from ..spatial.transform import Transform
@@ -212,7 +213,8 @@ def robot_from_poe(Mlist, Glist, Slist, gravity=(0, 0, -9.81), name: str = "poe_
 
     Args:
         Mlist: n+1 homogeneous 4x4 matrices M_{i-1,i}: the home centre-of-mass frame {i} of
-            link i in frame {i-1}; the last one is the end-effector frame {n+1} in {n}.
+            link i in frame {i-1}; the last one is the end-effector frame {n+1} in {n}, which
+            becomes the frame `end_effector` (symdyn.model.frames).
         Glist: n 6x6 spatial inertias G_i = [[I_i, 0], [0, m_i 1]] in frame {i} (angular first).
         Slist: a 6 x n matrix whose columns are the space-frame screw axes S_i = [omega; v].
         gravity: gravitational acceleration in the space frame (MR's g).
@@ -252,4 +254,7 @@ def robot_from_poe(Mlist, Glist, Slist, gravity=(0, 0, -9.81), name: str = "poe_
     entries = [x for lk in links for x in (*lk.M.R, *lk.M.p, *lk.G, *lk.S)] + [*end.R, *end.p, *g]
     for x in entries:
         symbols.update(dict.fromkeys(sorted(x.free_symbols, key=str)))
-    return Robot(name=name, links=tuple(built), gravity=g, params=tuple(symbols), convention="poe")
+    ee = Frame("end_effector", len(built) - 1, built[-1].frame)
+    return Robot(
+        name=name, links=tuple(built), gravity=g, params=tuple(symbols), convention="poe", frames=(ee,)
+    )

@@ -7,7 +7,7 @@
         spatial_inertia: [Ixx, Iyy, Izz, m, m, m]   # the diagonal of G_i, or its 6 rows
         screw: [wx, wy, wz, vx, vy, vz]              # S_i, space frame
         limits: [lower, upper]                       # optional: the joint's range (rad or m)
-    end_effector: {position: [...], rotation: [...]}  # M_{n,n+1}
+    end_effector: {position: [...], rotation: [...]}  # M_{n,n+1}: the frame `end_effector`
 
 The top-level keys name, gravity and parameters are read as in every robot file
 (symdyn.parsers.robot_fields); the links are turned into the general model by
@@ -26,7 +26,7 @@ from .robot_fields import LINK_NAME, LinkData, RobotFileReader
 
 __all__ = ["POE_TOP_KEYS", "POE_LINK_KEYS", "FRAME_KEYS", "PoeFileReader"]
 
-POE_TOP_KEYS = ("name", "convention", "gravity", "parameters", "links", "end_effector")
+POE_TOP_KEYS = ("name", "convention", "gravity", "base", "parameters", "links", "end_effector", "frames")
 POE_LINK_KEYS = ("name", "frame", "spatial_inertia", "screw", "limits")
 FRAME_KEYS = ("position", "rotation")
 
@@ -39,6 +39,7 @@ class PoeFileReader(RobotFileReader):
         self.convention = "poe"
         self.poe: list[PoeLink] = []
         self.end_effector = Transform.identity()
+        self.end_effector_given = False
 
     def read(self, data: object) -> None:
         if isinstance(data, dict):
@@ -56,6 +57,7 @@ class PoeFileReader(RobotFileReader):
 
     def _read_end_effector(self, value: object) -> None:
         self.end_effector = self.frame(value, "end_effector", None)
+        self.end_effector_given = True
 
     def frame(self, value: object, field: str, link: LinkData | None) -> Transform:
         """{position: [x, y, z], rotation: 3 rows of 3} (either may be left out: 0, identity)."""

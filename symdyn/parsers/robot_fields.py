@@ -22,7 +22,9 @@ from ..model.angles import snap_angle
 from ..model.expressions import check_parameter_name, is_c_identifier, parse_expression_names
 from ..model.limits import check_limits
 from ..model.robot import JOINT_TYPES
+from ..spatial.transform import Transform
 from .dh import CONVENTIONS
+from .frame_fields import FrameData, read_base, read_frames
 from .source import did_you_mean
 
 __all__ = [
@@ -36,7 +38,7 @@ __all__ = [
     "RobotFileReader",
 ]
 
-TOP_KEYS = ("name", "convention", "gravity", "parameters", "links")
+TOP_KEYS = ("name", "convention", "gravity", "base", "parameters", "links", "frames")
 LINK_KEYS = (
     "name",
     "parent",
@@ -104,6 +106,8 @@ class RobotFileReader:
         self.convention = "standard"
         self.gravity: tuple[sp.Expr, ...] | None = None
         self.links: list[LinkData] = []
+        self.base = Transform.identity()
+        self.frames: list[FrameData] = []
 
     # -- helpers
     def error(self, message: str, *, link: LinkData | None = None, field: str | None = None):
@@ -207,6 +211,12 @@ class RobotFileReader:
 
     def _read_gravity(self, value: object) -> None:
         self.gravity = self.vector(value, "gravity")
+
+    def _read_base(self, value: object) -> None:
+        self.base = read_base(self, value)
+
+    def _read_frames(self, value: object) -> None:
+        self.frames = read_frames(self, value, _LINK_NAME)
 
     def _read_parameters(self, value: object) -> None:
         if value is None:

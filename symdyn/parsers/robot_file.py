@@ -28,10 +28,12 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import SymdynError
+from ..model.frames import Frame
 from ..model.inertia import check_inertia, tensor_from_components
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
+from .frame_fields import model_frames
 from .poe_file import PoeFileReader
 from .robot_fields import LinkData, RobotFileReader
 from .robot_tree import link_mimics, link_parents
@@ -159,6 +161,11 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
     if gravity is None:
         gravity = DEFAULT_GRAVITY
     assert reader.name is not None
+    frames = model_frames(reader, reader.frames, links)
+    if isinstance(reader, PoeFileReader) and reader.end_effector_given:
+        if any(f.name == "end_effector" for f in frames) or any(lk.name == "end_effector" for lk in links):
+            raise reader.error("the name 'end_effector' is PoE's end-effector frame", field="frames")
+        frames = (Frame("end_effector", len(links) - 1, links[-1].frame), *frames)
     return Robot(
         name=reader.name,
         links=tuple(links),
@@ -168,6 +175,8 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
         source=file,
         source_sha256=digest,
         convention=reader.convention,
+        frames=frames,
+        base=reader.base,
     )
 
 

@@ -25,6 +25,9 @@ a symdyn body frame unchanged (`Link.frame` is the identity):
 * a <mimic joint= multiplier= offset=> makes the link's `mimic`: q = multiplier *
   q_master + offset with master an independent loaded joint (a mimic of a mimic is
   composed; symdyn.parsers.urdf_mimic). The master may come later in joint order;
+* every link merged into a body, or fixed to the base link, keeps its frame under its own
+  name (`Robot.frames`, symdyn.model.frames; the base link and the links fixed to it are
+  frames on the base), as Pinocchio keeps BODY frames;
 * the base link and everything rigidly fixed to it is the ground: its mass does
   not enter the dynamics; links that are not below the base are ignored. The whole
   file must be well formed (XML, numbers, one tree), but inertial data is checked
@@ -71,6 +74,7 @@ import warnings
 import sympy as sp
 
 from ..errors import SymdynError, SymdynWarning, location
+from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Mimic, Robot
 from ..spatial.transform import Transform
@@ -195,10 +199,12 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
     index = {j.name: i for i, j in enumerate(loaded)}
 
     links: list[Link] = []
+    frames = [Frame(name, -1, T) for name, T in _fixed_parts(tree, base)]
     for i, j in enumerate(loaded):
         carrier, fixed = tree.carrier(j, index, base)
         parent = -1 if carrier is None else index[carrier.name]
         parts = body_parts(tree, j.child, index)
+        frames += [Frame(name, i, T) for name, T in parts[1:]]
         _check_inertials(reader, [name for name, _ in parts])
         _warn_massless(reader, tree, parts)
         mass, com, inertia = merge_inertials(
@@ -226,7 +232,19 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
         source=reader.file,
         source_sha256=digest,
         convention="urdf",
+        frames=tuple(frames),
     )
+
+
+def _fixed_parts(tree: UrdfTree, base: str) -> list:
+    """(link, base_T_link) of the base link and the links fixed to it (fixed joints only): the
+    frames of the ground."""
+    parts, stack = [], [(base, Transform.identity())]
+    while stack:
+        name, T = stack.pop()
+        parts.append((name, T))
+        stack += [(j.child, T @ j.origin) for j in reversed(tree.children[name]) if j.type == "fixed"]
+    return parts
 
 
 def load_urdf(path: str | os.PathLike, base: str | None = None, tip: str | None = None) -> Robot:
