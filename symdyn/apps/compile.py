@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SymdynError, SymdynWarning
+from ..loading import load_module
 from . import cache
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
@@ -268,11 +269,9 @@ class CompiledDynamics:
             except cache.CorruptEntryError:  # changed since it was built: build the entry again
                 self._entry = self._rebuild()
                 path = self._entry.file(name)
-            module = types.ModuleType(path.stem)
-            module.__file__ = str(path)
-            # symdyn's own output for this robot, verified against the cache manifest's digest
-            exec(compile_source(path), module.__dict__)
-            self._module = module
+            # symdyn's own output for this robot, verified against the cache manifest's digest,
+            # imported from its file (never exec'd from a string)
+            self._module = load_module(path, path.stem)
         return self._module
 
     def derived_entry(self, kind: str, build: Callable) -> cache.Entry:
@@ -292,13 +291,6 @@ class CompiledDynamics:
     def __repr__(self) -> str:
         names = ", ".join(self.functions)
         return f"<CompiledDynamics {self.robot.name}: {self.n} joints, {self.backend}, {names}>"
-
-
-def compile_source(path: Path):
-    """The code object of a generated Python file."""
-    import builtins
-
-    return builtins.compile(path.read_text(encoding="utf-8"), str(path), "exec")
 
 
 def _warn_fallback() -> None:
