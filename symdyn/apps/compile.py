@@ -34,6 +34,7 @@ import numpy as np
 from ..errors import SymdynError, SymdynWarning
 from ..loading import load_module
 from . import cache
+from .singular import guarded
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
 
@@ -164,6 +165,10 @@ def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamic
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
+    if robot.params:  # the values pass the robot file's physical checks (mass >= 0, ...)
+        from ..model.physical import check_values
+
+        check_values(robot, robot.param_values(params, "symdyn.compile"), "symdyn.compile")
     from ..codegen.functions import FAMILIES
 
     families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
@@ -226,7 +231,7 @@ class CompiledDynamics:
         if self._library is None:
             _warn_fallback()
             for f in meta["functions"]:
-                setattr(self, f["name"], _numpy_method(self, f["name"]))
+                setattr(self, f["name"], guarded(self, f["name"], _numpy_method(self, f["name"])))
         return self
 
     def __getattr__(self, name: str):
@@ -237,7 +242,7 @@ class CompiledDynamics:
         ffi, lib = _load_library(self._library, entry.meta["functions"])
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
-            setattr(self, f["name"], _c_method(ffi, lib, f, p_ptr))
+            setattr(self, f["name"], guarded(self, f["name"], _c_method(ffi, lib, f, p_ptr)))
         return self.__dict__[name]
 
     @property
