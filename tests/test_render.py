@@ -149,3 +149,37 @@ def test_robot_names_must_be_identifiers(evil_robot, name, tmp_path):
     with pytest.raises(SymdynError, match="not a valid C identifier"):
         generate(replace(evil_robot, name=name), targets=["python"], out_dir=tmp_path)
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("name", ['x"); import os; ("', "a b", "p*/", "λ"])
+def test_parameter_names_must_be_identifiers(name, tmp_path):
+    """A Robot built in Python may hold any symbol; generated code names its parameters."""
+    from dataclasses import replace
+
+    import sympy as sp
+
+    robot = load(ROOT / "examples" / "roger_arm.yaml")
+    renamed = replace(robot, params=(sp.Symbol(name), *robot.params[1:]))
+    with pytest.raises(SymdynError, match="not valid C identifiers"):
+        generate(renamed, targets=["python"], out_dir=tmp_path)
+    assert not any(tmp_path.iterdir())
+
+
+def test_link_names_never_reach_generated_code(evil_robot, tmp_path, monkeypatch):
+    """Link names (a URDF's or a robot file's `name`, any text) are not written into any file."""
+    from dataclasses import replace
+
+    monkeypatch.chdir(tmp_path)
+    names = ["a */ int pwned; /*", 'b\nimport os; os.system("touch pwned")\n#']
+    robot = replace(
+        evil_robot,
+        links=tuple(replace(link, name=name) for link, name in zip(evil_robot.links, names, strict=True)),
+    )
+    paths = generate(
+        robot, targets=["c", "python", "matlab", "latex"], out_dir=tmp_path / "out", functions=["dynamics"]
+    )
+    for path in paths:
+        text = path.read_text(encoding="utf-8")
+        assert "pwned" not in text.replace('os.system("touch pwned")\\n', ""), path.name
+    load_module(next(p for p in paths if p.name.endswith("_numpy.py")), "links_numpy")
+    assert not (tmp_path / "pwned").exists()

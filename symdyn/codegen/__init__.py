@@ -65,6 +65,13 @@ def context(
             f"robot name {robot.name!r} is not a valid C identifier (letters, digits and underscores, "
             "not starting with a digit, not a C keyword): it names the generated files and functions"
         )
+    bad = [str(p) for p in robot.params if not is_c_identifier(str(p))]
+    if bad:
+        raise SymdynError(
+            f"robot '{robot.name}': parameter name(s) {', '.join(map(repr, bad))} are not valid C "
+            "identifiers (letters, digits and underscores, not starting with a digit, not a C keyword): "
+            "they name the generated code's parameters"
+        )
     dyn = derive(robot, method=method, simplify=False)
     notes: tuple[str, ...] = ()
     if prune is not None:
