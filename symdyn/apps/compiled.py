@@ -16,7 +16,6 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from ..errors import SymdynError
-from ..model.physical import check_values
 from .compile import CompiledDynamics
 
 if TYPE_CHECKING:
@@ -32,6 +31,8 @@ def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
     wrote as an expression of another parameter keeps the number it had.
     """
     import sympy as sp
+
+    from ..model.physical import check_values  # here: a warm run from the cache imports no SymPy
 
     if not values:
         return robot
