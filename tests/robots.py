@@ -545,3 +545,17 @@ def regressor_oracle(dyn, q, qd, qdd, params=None) -> dict[str, np.ndarray]:
 
     Y = regressor(dyn.robot, q, qd, qdd, params)
     return {"regressor": Y, "base_regressor": Y[..., list(dyn.linear_compact()[1].columns)]}
+
+
+# --------------------------------------------------------------------------- processes
+
+
+def dead_pid() -> int:
+    """The id of a process that has exited (for the tests of leftovers of killed runs)."""
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True
+    )
+    return int(done.stdout)

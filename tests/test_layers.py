@@ -1,8 +1,8 @@
 """The package's floors: each imports only lower ones, and no private name crosses a module.
 
-Floors, lowest first (symdyn/__init__.py): errors; spatial and symbolic; model; parsers,
-algorithms and the numeric oracle rnea (with rnea_inputs); dynamics (with lumped, the lumped
-constants of a derivation); codegen; apps; cli; regenerate. A module
+Floors, lowest first (symdyn/__init__.py): errors (with loading and leftovers); spatial and
+symbolic; model; parsers, algorithms and the numeric oracle rnea (with rnea_inputs); dynamics
+(with lumped, the lumped constants of a derivation); codegen; apps; cli; regenerate. A module
 may import its own floor and any lower one; `__version__` may come from the package root.
 """
 
@@ -53,6 +53,8 @@ def _imports(path: Path, parts: tuple[str, ...]):
 def _floor(parts: tuple[str, ...]) -> str:
     if parts[0] == "lumped":  # works on a Dynamics, as dynamics does
         return "dynamics"
+    if parts[0] in ("loading", "leftovers"):  # helpers of codegen and apps that use only errors
+        return "errors"
     return (
         "rnea" if parts[0] in ("rnea_inputs", "rnea_spatial", "rnea_regressor", "rnea_frames") else parts[0]
     )  # the oracle

@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ..dynamics import derive
 from ..errors import SymdynError
+from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
 from .functions import FUNCTION_NAMES, GROUPS, build_functions
 from .output import write_files
@@ -59,6 +60,18 @@ def context(
     symdyn.codegen.functions.GROUPS named in `functions`, when given; None or "all": every group)."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
+    if not is_c_identifier(robot.name):
+        raise SymdynError(
+            f"robot name {robot.name!r} is not a valid C identifier (letters, digits and underscores, "
+            "not starting with a digit, not a C keyword): it names the generated files and functions"
+        )
+    bad = [str(p) for p in robot.params if not is_c_identifier(str(p))]
+    if bad:
+        raise SymdynError(
+            f"robot '{robot.name}': parameter name(s) {', '.join(map(repr, bad))} are not valid C "
+            "identifiers (letters, digits and underscores, not starting with a digit, not a C keyword): "
+            "they name the generated code's parameters"
+        )
     dyn = derive(robot, method=method, simplify=False)
     notes: tuple[str, ...] = ()
     if prune is not None:

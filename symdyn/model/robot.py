@@ -362,6 +362,8 @@ class Robot:
                 values[p] = float(v)
             except (TypeError, ValueError):
                 raise SymdynError(f"{prefix}parameter {p} must be a number, got {v!r}") from None
+            if not np.isfinite(values[p]):
+                raise SymdynError(f"{prefix}parameter {p} must be finite, got {v!r}")
         return values
 
     def _listing(self) -> str:

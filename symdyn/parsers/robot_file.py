@@ -27,9 +27,10 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..errors import SymdynError
+from ..errors import SymdynError, link_fields
 from ..model.frames import Frame
-from ..model.inertia import check_inertia, tensor_from_components
+from ..model.inertia import tensor_from_components
+from ..model.physical import check_link_numbers
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
@@ -118,33 +119,22 @@ def _check_size(expr: sp.Expr, reader: RobotFileReader, field: str) -> None:
         raise reader.error(f"value is not finite after substituting parameters ({expr})", field=field)
 
 
-def _number(expr: sp.Expr) -> float | None:
-    """A float if `expr` has no free symbols, else None."""
-    if expr.free_symbols:
-        return None
-    try:
-        return float(expr)
-    except TypeError:
-        return None
-
-
 def _check_link_numbers(
     reader: RobotFileReader, link: LinkData, tensor: sp.ImmutableMatrix, subs: dict
 ) -> None:
     """Refuse impossible numbers of a link (`tensor`: its inertia as written) once parameters have values."""
-    mass = link.mass.xreplace(subs)
-    check_inertia(mass, tensor.xreplace(subs), file=reader.file, link_index=link.index, link_name=link.name)
-    for fld, value in (
-        ("friction.viscous", link.viscous),
-        ("friction.coulomb", link.coulomb),
-        ("motor.inertia", link.motor_inertia),
-    ):
-        x = _number(value.xreplace(subs))
-        if x is not None and x < 0:
-            raise reader.error(f"must not be negative (got {x:g})", link=link, field=fld)
-    x = _number(link.gear_ratio.xreplace(subs))
-    if x is not None and x == 0:
-        raise reader.error("gear ratio must not be zero", link=link, field="motor.gear_ratio")
+    check_link_numbers(
+        link.mass.xreplace(subs),
+        tensor.xreplace(subs),
+        {
+            "friction.viscous": link.viscous.xreplace(subs),
+            "friction.coulomb": link.coulomb.xreplace(subs),
+            "motor.inertia": link.motor_inertia.xreplace(subs),
+        },
+        link.gear_ratio.xreplace(subs),
+        file=reader.file,
+        **link_fields(link),
+    )
 
 
 def _build(data: object, file: str | None, digest: str | None) -> Robot:
