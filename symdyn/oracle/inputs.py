@@ -16,7 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import SymdynError
+from ..errors import SymdynError
 
 __all__ = [
     "NumericModel",
