@@ -159,4 +159,4 @@ def test_the_cycle_finder_finds_cycles():
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"d"}, "e": {"a"}}
     assert _cycles(graph) == {("a", "b", "c"), ("d",)}
     assert _cycles({"a": {"b"}, "b": set()}) == set()
-    assert {"errors", "oracle.inputs"} <= _import_graph()["oracle.rnea"]  # edges are found
+    assert {"errors", "oracle.inputs"} <= _import_graph()["oracle.singular"]  # edges are found

@@ -391,7 +391,9 @@ def test_every_public_function_checks_its_arguments(name):
         assert np.shape(call(robot, batch, P_ARM))[0] == 3  # one result per state
 
 
-@pytest.mark.parametrize("module", ["oracle/rnea", "oracle/inputs", "oracle/spatial", "rnea"])
+@pytest.mark.parametrize(
+    "module", ["oracle/rnea", "oracle/inputs", "oracle/spatial", "oracle/singular", "rnea"]
+)
 def test_oracle_is_independent_of_symbolic_derivation(module):
     """The oracle (symdyn/oracle: rnea.py, its input side inputs.py and its spatial kinematics
     spatial.py) and its public entry symdyn/rnea.py import NumPy, the error type and the
@@ -411,6 +413,7 @@ def test_oracle_is_independent_of_symbolic_derivation(module):
         "numpy",
         "errors",
         "inputs",
+        "singular",
         "spatial",
         "oracle.rnea",  # symdyn/rnea.py re-exports it
         "sys",  # the callable-module hook that makes symdyn.rnea(...) a function too

@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..dynamics import derive
-from ..errors import SymdynError
+from ..dynamics import SINGULAR_M, derive
+from ..errors import SymdynError, SymdynWarning
 from ..model.robot import Robot
 from .functions import FUNCTION_NAMES, GROUPS, build_functions
 from .output import write_files
@@ -59,7 +61,9 @@ def context(
     symdyn.codegen.functions.GROUPS named in `functions`, when given)."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
-    dyn = derive(robot, method=method, simplify=False)
+    with warnings.catch_warnings():  # build_functions says it again, with the functions left out
+        warnings.filterwarnings("ignore", f"robot '.*': {re.escape(SINGULAR_M)}", SymdynWarning)
+        dyn = derive(robot, method=method, simplify=False)
     notes: tuple[str, ...] = ()
     if prune is not None:
         from .pruned import pruned_dynamics

@@ -42,7 +42,8 @@ class NumericModel:
     lambda(i) with -1 for the base (parents before children); `coordinate` (nb,) int, the
     independent coordinate each body's joint follows, with `multiplier` and `offset` (nb,)
     (q_i = multiplier_i q[coordinate_i] + offset_i); `selection` (nb, n) the matrix S of
-    qd_b = S qd; `names` the links' names and `name` the robot's, for messages.
+    qd_b = S qd; `own` (n,) int, per coordinate the link whose joint it is (not a mimic);
+    `names` the links' names and `name` the robot's, for messages.
     """
 
     revolute: np.ndarray
@@ -62,6 +63,7 @@ class NumericModel:
     multiplier: np.ndarray
     offset: np.ndarray
     selection: np.ndarray
+    own: np.ndarray
     names: tuple[str, ...]
     name: str
 
@@ -161,7 +163,8 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
         spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
         gravity=_floats(r.gravity, (3,), "gravity"), parent=np.array(r.parents, dtype=int).reshape(n),
         coordinate=coordinate, multiplier=multiplier.reshape(n), offset=offset.reshape(n),
-        selection=selection, names=tuple(lk.name for lk in links), name=r.name,
+        selection=selection, own=np.array([i for i, lk in enumerate(links) if lk.mimic is None], dtype=int),
+        names=tuple(lk.name for lk in links), name=r.name,
     )  # fmt: skip
 
 

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SymdynError
 from .inputs import (
     NumericModel,
     body_positions,
@@ -38,6 +37,7 @@ from .inputs import (
     numeric_model,
     project,
 )
+from .singular import check_invertible
 from .spatial import crm, joint_poses, motion_transforms, mv, subspaces
 
 __all__ = [
@@ -223,22 +223,6 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
     return _out(project(mdl, mdl.viscous * qd_b + mdl.coulomb * np.sign(qd_b)), single)
 
 
-def _check_invertible(mdl: NumericModel, M: np.ndarray, where: str) -> None:
-    """Raise when a diagonal entry of M (N, n, n) is exactly zero: that joint moves no mass or
-    inertia (M positive semi-definite, so its whole row is zero) and M cannot be inverted."""
-    idle = np.flatnonzero(np.any(np.diagonal(M, axis1=-2, axis2=-1) == 0.0, axis=0))
-    if idle.size:
-        names = ", ".join(
-            f"'{mdl.names[i]}' (link {i + 1})"
-            for i in range(mdl.nb)
-            if mdl.coordinate[i] in set(idle.tolist())
-        )
-        raise SymdynError(
-            f"{where}: robot '{mdl.name}': M(q) is singular: joint(s) {names} move no mass or inertia "
-            "(their subtrees have zero mass and inertia and they have no rotor inertia)"
-        )
-
-
 def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
     """qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (numpy.linalg.solve, joint space).
 
@@ -253,15 +237,16 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
         qdd, (n,) or (N, n).
 
     Raises:
-        SymdynError: bad arguments (see `rnea`), or M(q) singular because a joint moves no
-            mass or inertia (named in the message).
+        SymdynError: bad arguments (see `rnea`), or M(q) singular (symdyn.oracle.singular: a
+            pivot of M = L D L^T vanishes), naming the joint and why: it moves no mass or
+            inertia, or only mass on its own axis, or only as the joints before it do.
     """
     mdl, (q, qd, tau), single = checked_inputs(
         "forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau)
     )
     h = _rnea(mdl, q, qd, np.zeros_like(q), True, True)
     M = _mass_matrix(mdl, q)
-    _check_invertible(mdl, M, "forward_dynamics")
+    check_invertible(mdl, M, "forward_dynamics")
     return _out(np.linalg.solve(M, (tau - h)[..., None])[..., 0], single)
 
 
