@@ -540,8 +540,8 @@ def branch_pairs(parents) -> list[tuple[int, int]]:
 
 def regressor_oracle(dyn, q, qd, qdd, params=None) -> dict[str, np.ndarray]:
     """The generated regressor functions' expected values from the oracle's numeric regressor
-    (symdyn.rnea_regressor): Y, and its columns of the base parameters for Y_b (one state or a batch)."""
-    from symdyn.rnea_regressor import regressor
+    (symdyn.oracle.regressor): Y, and its columns of the base parameters for Y_b (one state or a batch)."""
+    from symdyn.oracle.regressor import regressor
 
     Y = regressor(dyn.robot, q, qd, qdd, params)
     return {"regressor": Y, "base_regressor": Y[..., list(dyn.linear_compact()[1].columns)]}

@@ -1,7 +1,7 @@
 """The symbolic regressor (symdyn.algorithms.regressor, `Dynamics.regressor`), judged by independent routes.
 
 At random states the compact Y of the derivation (over its intermediates) must equal the oracle's
-numeric regressor symdyn.rnea_regressor entry by entry and give Y pi = tau of the numeric RNEA
+numeric regressor symdyn.oracle.regressor entry by entry and give Y pi = tau of the numeric RNEA
 symdyn.rnea (friction and rotor inertia included) with pi the standard parameters, to 1e-10
 relative: every example robot (standard and modified DH, prismatic joints, free parameters),
 random DH and general robots, URDF files, trees and mimic joints. On the two-link arm of the
@@ -34,7 +34,7 @@ from robots import (
 import symdyn
 from symdyn.model.parameters import numeric_parameters, standard_parameters
 from symdyn.model.robot import Mimic
-from symdyn.rnea_regressor import regressor as oracle_regressor
+from symdyn.oracle.regressor import regressor as oracle_regressor
 
 URDF_DIR = Path(__file__).resolve().parent / "data" / "urdf"
 URDFS = ("axes", "branch", "cartesian", "fixed_offset", "rpy_chain", "tree", "two_link")

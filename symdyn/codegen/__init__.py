@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..dynamics import derive
-from ..errors import SymdynError
+from ..dynamics import SINGULAR_M, derive
+from ..errors import SymdynError, SymdynWarning
 from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
 from .functions import FUNCTION_NAMES, GROUPS, build_functions
@@ -72,7 +74,9 @@ def context(
             "identifiers (letters, digits and underscores, not starting with a digit, not a C keyword): "
             "they name the generated code's parameters"
         )
-    dyn = derive(robot, method=method, simplify=False)
+    with warnings.catch_warnings():  # build_functions says it again, with the functions left out
+        warnings.filterwarnings("ignore", f"robot '.*': {re.escape(SINGULAR_M)}", SymdynWarning)
+        dyn = derive(robot, method=method, simplify=False)
     notes: tuple[str, ...] = ()
     if prune is not None:
         from .pruned import pruned_dynamics

@@ -9,7 +9,7 @@ frame i, I = I_c + m (c^T c 1 - c c^T) (parallel-axis theorem; I_c about the cen
 `Link.inertia`; off-diagonal entries are the tensor's, minus the product-of-inertia integrals);
 then the joint's 3: Ia_i = gear_ratio^2 J_m (reflected rotor inertia), fv_i (viscous friction),
 fc_i (Coulomb friction). The equations of motion are linear in this vector,
-tau = Y(q, qd, qdd) pi (symdyn.rnea_regressor; Atkeson, An and Hollerbach 1986).
+tau = Y(q, qd, qdd) pi (symdyn.oracle.regressor; Atkeson, An and Hollerbach 1986).
 """
 
 from __future__ import annotations

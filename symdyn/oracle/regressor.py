@@ -17,15 +17,15 @@ order is symdyn.model.parameters (Pinocchio's `toDynamicParameters`, then Ia, fv
 As symdyn.rnea, this runs on the nb bodies at q_b = S q + o, qd_b = S qd, qdd_b = S qdd and
 projects the rows with S^T (mimic joints), gravity entering as the base acceleration [0; -g].
 It shares no code with the symbolic derivation: the spatial kinematics are the oracle's own
-(symdyn.rnea_spatial) and the model comes from `symdyn.rnea_inputs`.
+(symdyn.oracle.spatial) and the model comes from `symdyn.oracle.inputs`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .rnea_inputs import NumericModel, body_positions, body_rates, checked_inputs, project, skew
-from .rnea_spatial import crm, joint_poses, motion_transforms, mv, subspaces
+from .inputs import NumericModel, body_positions, body_rates, checked_inputs, project, skew
+from .spatial import crm, joint_poses, motion_transforms, mv, subspaces
 
 __all__ = ["regressor", "PER_BODY"]
 

@@ -1,4 +1,4 @@
-"""The oracle's regressor (symdyn.rnea_regressor): tau = Y(q, qd, qdd) pi, judged by independent routes.
+"""The oracle's regressor (symdyn.oracle.regressor): tau = Y(q, qd, qdd) pi, judged by independent routes.
 
 Y @ pi, with pi the standard parameters of symdyn.standard_parameters (read from the model's
 fields), must equal the numeric RNEA symdyn.rnea (which builds each body's spatial inertia from
@@ -39,9 +39,9 @@ import symdyn
 from symdyn.errors import SymdynError
 from symdyn.model.parameters import numeric_parameters
 from symdyn.model.robot import Mimic
-from symdyn.rnea_regressor import regressor
+from symdyn.oracle.regressor import regressor
 
-rr = importlib.import_module("symdyn.rnea_regressor")
+rr = importlib.import_module("symdyn.oracle.regressor")
 URDF_DIR = Path(__file__).resolve().parent / "data" / "urdf"
 URDFS = ("axes", "branch", "cartesian", "fixed_offset", "rpy_chain", "tree", "two_link")
 ROBOT_DATA = {
@@ -146,7 +146,7 @@ def test_regressor_is_independent_of_the_symbolic_code():
     nodes = list(ast.walk(ast.parse(source)))
     modules = {n.module for n in nodes if isinstance(n, ast.ImportFrom)}
     modules |= {a.name for n in nodes if isinstance(n, ast.Import) for a in n.names}
-    assert modules <= {"__future__", "numpy", "rnea_inputs", "rnea_spatial"}
+    assert modules <= {"__future__", "numpy", "inputs", "spatial"}
     assert "sympy" not in source
 
 

@@ -16,7 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import SymdynError
+from ..errors import SymdynError
 
 __all__ = [
     "NumericModel",
@@ -46,7 +46,8 @@ class NumericModel:
     lambda(i) with -1 for the base (parents before children); `coordinate` (nb,) int, the
     independent coordinate each body's joint follows, with `multiplier` and `offset` (nb,)
     (q_i = multiplier_i q[coordinate_i] + offset_i); `selection` (nb, n) the matrix S of
-    qd_b = S qd; `names` the links' names and `name` the robot's, for messages.
+    qd_b = S qd; `own` (n,) int, per coordinate the link whose joint it is (not a mimic);
+    `names` the links' names and `name` the robot's, for messages.
     """
 
     revolute: np.ndarray
@@ -72,6 +73,7 @@ class NumericModel:
     multiplier: np.ndarray
     offset: np.ndarray
     selection: np.ndarray
+    own: np.ndarray
     names: tuple[str, ...]
     name: str
 
@@ -180,7 +182,8 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
         frame_R=frame_R, frame_p=frame_p, frame_names=tuple(name for _, name, _ in frames),
         parent=np.array(r.parents, dtype=int).reshape(n),
         coordinate=coordinate, multiplier=multiplier.reshape(n), offset=offset.reshape(n),
-        selection=selection, names=tuple(lk.name for lk in links), name=r.name,
+        selection=selection, own=np.array([i for i, lk in enumerate(links) if lk.mimic is None], dtype=int),
+        names=tuple(lk.name for lk in links), name=r.name,
     )  # fmt: skip
 
 
