@@ -101,7 +101,7 @@ def generated(request, tmp_path_factory):
     robot = CASES[case][0](tmp)
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")
-        written = symdyn.generate(robot, targets=tuple(TARGETS), out_dir=tmp / "out")
+        written = symdyn.generate(robot, targets=tuple(TARGETS), out_dir=tmp / "out", functions=("all",))
     assert written
     return case, robot, tmp / "out", symdyn_warnings(record)
 
