@@ -35,6 +35,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from .friction import Friction
 from .limits import check_limits
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
@@ -44,14 +45,6 @@ __all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "JOINT_TYPES", "DEFAUL
 JOINT_TYPES = ("revolute", "prismatic")
 #: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
 DEFAULT_GRAVITY = (sp.Integer(0), sp.Integer(0), sp.Float(-9.81))
-
-
-@dataclass(frozen=True)
-class Friction:
-    """Joint friction F_i = viscous * qd_i + coulomb * sign(qd_i) (slide 16)."""
-
-    viscous: sp.Expr = sp.S.Zero
-    coulomb: sp.Expr = sp.S.Zero
 
 
 @dataclass(frozen=True)
@@ -102,10 +95,7 @@ class Link:
             mass=sp.sympify(self.mass).xreplace(x),
             com=self.com.xreplace(x),
             inertia=self.inertia.xreplace(x),
-            friction=Friction(
-                sp.sympify(self.friction.viscous).xreplace(x),
-                sp.sympify(self.friction.coulomb).xreplace(x),
-            ),
+            friction=self.friction.subs(x),
             motor=Motor(
                 sp.sympify(self.motor.inertia).xreplace(x),
                 sp.sympify(self.motor.gear_ratio).xreplace(x),

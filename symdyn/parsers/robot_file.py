@@ -134,14 +134,16 @@ def _check_link_numbers(
     """Refuse impossible numbers of a link (`tensor`: its inertia as written) once parameters have values."""
     mass = link.mass.xreplace(subs)
     check_inertia(mass, tensor.xreplace(subs), file=reader.file, link_index=link.index, link_name=link.name)
-    for fld, value in (
-        ("friction.viscous", link.viscous),
-        ("friction.coulomb", link.coulomb),
-        ("motor.inertia", link.motor_inertia),
-    ):
+    coulomb = (
+        [("friction.coulomb", link.coulomb)]
+        if link.coulomb_minus is None
+        else [("friction.coulomb.plus", link.coulomb), ("friction.coulomb.minus", link.coulomb_minus)]
+    )
+    for fld, value in (("friction.viscous", link.viscous), *coulomb, ("motor.inertia", link.motor_inertia)):
         x = _number(value.xreplace(subs))
         if x is not None and x < 0:
-            raise reader.error(f"must not be negative (got {x:g})", link=link, field=fld)
+            hint = " (a magnitude: the Robotics Toolbox's Tc- without its sign)" if "minus" in fld else ""
+            raise reader.error(f"must not be negative (got {x:g}){hint}", link=link, field=fld)
     x = _number(link.gear_ratio.xreplace(subs))
     if x is not None and x == 0:
         raise reader.error("gear ratio must not be zero", link=link, field="motor.gear_ratio")
@@ -196,7 +198,7 @@ def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
                 mass=ld.mass,
                 com=com,
                 inertia=inertia,
-                friction=Friction(ld.viscous, ld.coulomb),
+                friction=Friction(ld.viscous, ld.coulomb, ld.coulomb_minus),
                 motor=Motor(ld.motor_inertia, ld.gear_ratio),
                 frame=frame,
                 parent=None if parents[i] == i - 1 else parents[i],
