@@ -84,7 +84,7 @@ def _body_regressor(
         Y[:, i, PER_BODY * i + 11] = qd_b[:, i]
         if mdl.asymmetric[i]:  # H(qd) for fcp, -H(-qd) for fcn (after the 13 nb columns)
             Y[:, i, PER_BODY * i + 12] = qd_b[:, i] > 0
-            Y[:, i, PER_BODY * nb + np.count_nonzero(mdl.asymmetric[:i])] = -(qd_b[:, i] < 0)
+            Y[:, i, PER_BODY * nb + np.count_nonzero(mdl.asymmetric[:i])] = -1.0 * (qd_b[:, i] < 0)
         else:
             Y[:, i, PER_BODY * i + 12] = np.sign(qd_b[:, i])
     return Y
