@@ -33,6 +33,10 @@ class Friction:
     coulomb: sp.Expr = sp.S.Zero
     coulomb_minus: sp.Expr | None = None
 
+    def __repr__(self) -> str:
+        minus = "" if self.coulomb_minus is None else f", coulomb_minus={self.coulomb_minus!r}"
+        return f"Friction(viscous={self.viscous!r}, coulomb={self.coulomb!r}{minus})"
+
     @property
     def asymmetric(self) -> bool:
         """Whether the Coulomb friction has a magnitude of its own for each direction."""

@@ -321,7 +321,7 @@ class RobotFileReader:
         if len(coulomb) != 2:
             raise self.error(
                 "expected one number (symmetric) or a list of 2 numbers or expressions [c_plus, c_minus] "
-                f"(magnitudes for positive and negative joint rates), got {len(coulomb)} entries",
+                f"(magnitudes for positive and negative joint rates), got {_count(len(coulomb))}",
                 link=link,
                 field="friction.coulomb",
             )
@@ -368,6 +368,10 @@ class RobotFileReader:
             if k != "joint":
                 factors[k] = self.expr(v, f"mimic.{k}", link)
         link.mimic = (joint, factors["multiplier"], factors["offset"])
+
+
+def _count(k: int) -> str:
+    return f"{k} entry" if k == 1 else f"{k} entries"
 
 
 def _kind(value: object) -> str:

@@ -142,7 +142,11 @@ def _check_link_numbers(
     for fld, value in (("friction.viscous", link.viscous), *coulomb, ("motor.inertia", link.motor_inertia)):
         x = _number(value.xreplace(subs))
         if x is not None and x < 0:
-            hint = " (a magnitude: the Robotics Toolbox's Tc- without its sign)" if "minus" in fld else ""
+            hint = (
+                ": c_minus is a magnitude, write the Robotics Toolbox's Tc- without its sign"
+                if "minus" in fld
+                else ""
+            )
             raise reader.error(f"must not be negative (got {x:g}){hint}", link=link, field=fld)
     x = _number(link.gear_ratio.xreplace(subs))
     if x is not None and x == 0:
