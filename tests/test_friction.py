@@ -23,6 +23,7 @@ from robots import (
 )
 
 from symdyn.model.friction import Friction
+from symdyn.parsers import robot_from_data
 
 rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 x = sp.Symbol("x", real=True)
@@ -81,3 +82,34 @@ def test_both_routes_match_the_oracle_at_rates_of_both_signs_and_at_rest(method)
         np.testing.assert_allclose(
             dyn.evaluate("tau", q, qd, qdd, ASYMMETRIC_PARAMS), want, rtol=1e-10, atol=1e-12
         )
+
+
+def test_a_mimic_joint_takes_the_magnitude_of_its_own_direction():
+    """Link b follows link a with multiplier -2, so it moves backwards when a moves forwards:
+    F_1 = (0.1 qd + c_a) - 2 (0.2 (-2 qd) - c-_b) at qd > 0, by hand 0.4 + 1.02 = 1.42 at qd = 1,
+    and -0.6 - 2.2 = -2.8 at qd = -1 (b's rate +2: 0.4 + 0.7); 0 at rest. Both routes and the
+    oracle agree, tau included."""
+    link = {"joint": "revolute", "a": 0.5, "mass": 1, "com": [-0.25, 0, 0]}
+    link["inertia"] = {"ixx": 0.01, "iyy": 0.02, "izz": 0.02}
+    data = {
+        "name": "mimic_friction",
+        "links": [
+            dict(link, name="a", friction={"viscous": 0.1, "coulomb": [0.3, 0.5]}),
+            dict(
+                link,
+                name="b",
+                friction={"viscous": 0.2, "coulomb": [0.7, 0.11]},
+                mimic={"joint": "a", "multiplier": -2},
+            ),
+        ],
+    }
+    robot = robot_from_data(data)
+    q, qdd = np.array([0.3]), np.array([0.2])
+    for method in ("newton-euler", "lagrange"):
+        dyn = derived_robot(robot, method)
+        for qd, want in ((1.0, 1.42), (-1.0, -2.8), (0.0, 0.0)):
+            assert dyn.evaluate("F", q, [qd], qdd)[0] == pytest.approx(want, abs=1e-14)
+            assert rn.friction_torque(robot, [qd])[0] == pytest.approx(want, abs=1e-14)
+            np.testing.assert_allclose(
+                dyn.evaluate("tau", q, [qd], qdd), rn.rnea(robot, q, [qd], qdd), atol=1e-13
+            )
