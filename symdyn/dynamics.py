@@ -81,7 +81,9 @@ def _check_quantity(name, where: str) -> str:
 
 
 def friction_vector(robot: Robot, qd) -> sp.Matrix:
-    """F_i = viscous_i qd_i + coulomb_i sign(qd_i) (Grupen (2015), slide 16).
+    """F_i = viscous_i qd_i + coulomb_i sign(qd_i) (Grupen (2015), slide 16), or with
+    direction-dependent Coulomb friction viscous_i qd_i + c+_i H(qd_i) - c-_i H(-qd_i), H the
+    Heaviside step with H(0) = 0 (`symdyn.model.robot.Friction`).
 
     Per body at its joint rate qd_b = S qd; a mimic joint's friction is projected onto
     the coordinate it follows, F = S^T F_b(qd_b).
@@ -96,10 +98,7 @@ def friction_vector(robot: Robot, qd) -> sp.Matrix:
     if len(qd) != robot.n:
         raise SymdynError(f"friction_vector: qd has length {len(qd)}, expected {robot.n} (one per joint)")
     rates = robot.body_rates(list(qd))
-    F_b = [
-        link.friction.viscous * rate + link.friction.coulomb * sp.sign(rate)
-        for link, rate in zip(robot.links, rates, strict=True)
-    ]
+    F_b = [link.friction.effort(rate) for link, rate in zip(robot.links, rates, strict=True)]
     if robot.n == robot.nb:
         return sp.Matrix(F_b)
     F = [sp.S.Zero] * robot.n

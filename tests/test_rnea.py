@@ -14,9 +14,13 @@ import numpy as np
 import pytest
 import sympy as sp
 from robots import (
+    ASYMMETRIC_PARAMS,
     ZERO3,
     Z,
+    asymmetric_friction,
     branch_pairs,
+    friction_closed_form,
+    friction_states,
     mat,
     roger_arm_robot,
     rotation,
@@ -451,3 +455,20 @@ def test_tree_batch_equals_loop():
     for k in range(4):
         np.testing.assert_allclose(tau[k], rn.rnea(robot, q[k], qd[k], qdd[k]), atol=1e-12)
         np.testing.assert_allclose(rn.mass_matrix(robot, q)[k], rn.mass_matrix(robot, q[k]))
+
+
+def test_direction_dependent_coulomb_friction():
+    """friction_torque and rnea's friction part are c+ at qd > 0, -c- at qd < 0 and 0 at rest,
+    plus the viscous term (hand-written closed form), at single states and in a batch."""
+    robot = asymmetric_friction()
+    q, qd, qdd, _ = friction_states()
+    want = friction_closed_form(qd)
+    np.testing.assert_allclose(rn.friction_torque(robot, qd, ASYMMETRIC_PARAMS), want, rtol=0, atol=1e-15)
+    for k in range(len(qd)):
+        np.testing.assert_allclose(
+            rn.friction_torque(robot, qd[k], ASYMMETRIC_PARAMS), want[k], rtol=0, atol=1e-15
+        )
+    diff = rn.rnea(robot, q, qd, qdd, ASYMMETRIC_PARAMS) - rn.rnea(
+        robot, q, qd, qdd, ASYMMETRIC_PARAMS, friction=False
+    )
+    np.testing.assert_allclose(diff, want, rtol=0, atol=1e-12)

@@ -103,13 +103,16 @@ def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """The six functions of tau = M qdd + V + G + F and its terms (slide 16), over `dyn.program`."""
     n = dyn.n
     c = dyn.compact
+    friction = "F(qd) = viscous qd + coulomb sign(qd)"
+    if any(link.friction.asymmetric for link in dyn.robot.links):
+        friction += ", or c+ [qd > 0] - c- [qd < 0] per direction"
     table = [
         ("inverse_dynamics", "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)", (x.q, x.qd, x.qdd, x.p), "tau"),
         ("mass_matrix", "M(q), row-major n x n", (x.q, x.p), "M"),
         ("coriolis_matrix", "C(q, qd) from Christoffel symbols, row-major; C qd = V", (x.q, x.qd, x.p), "C"),
         ("coriolis", "V(q, qd) = C(q, qd) qd", (x.q, x.qd, x.p), "V"),
         ("gravity", "G(q)", (x.q, x.p), "G"),
-        ("friction", "F(qd) = viscous qd + coulomb sign(qd)", (x.qd, x.p), "F"),
+        ("friction", friction, (x.qd, x.p), "F"),
     ]
     rows = []
     for name, doc, inputs, out in table:

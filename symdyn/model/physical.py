@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import sympy as sp
 
 from ..errors import SymdynError
+from .friction import coulomb_fields
 from .inertia import check_inertia
 
 if TYPE_CHECKING:
@@ -54,7 +55,12 @@ def check_link_numbers(
     for field, value in nonnegative.items():
         x = _number(value)
         if x is not None and x < 0:
-            raise SymdynError(f"must not be negative (got {x:g})", field=field, **where)
+            hint = (
+                ": c_minus is a magnitude, write the Robotics Toolbox's Tc- without its sign"
+                if field.endswith("minus")
+                else ""
+            )
+            raise SymdynError(f"must not be negative (got {x:g}){hint}", field=field, **where)
     x = _number(gear_ratio)
     if x is not None and x == 0:
         raise SymdynError("gear ratio must not be zero", field="motor.gear_ratio", **where)
@@ -87,7 +93,10 @@ def check_values(robot: Robot, values: Mapping[sp.Symbol, float], where: str = "
                 link.inertia.xreplace(mapping),
                 {
                     "friction.viscous": sp.sympify(link.friction.viscous).xreplace(mapping),
-                    "friction.coulomb": sp.sympify(link.friction.coulomb).xreplace(mapping),
+                    **{
+                        k: sp.sympify(v).xreplace(mapping)
+                        for k, v in coulomb_fields(link.friction.coulomb, link.friction.coulomb_minus).items()
+                    },
                     "motor.inertia": sp.sympify(link.motor.inertia).xreplace(mapping),
                 },
                 sp.sympify(link.motor.gear_ratio).xreplace(mapping),
@@ -125,7 +134,7 @@ def _symbols(link, field: str | None = None) -> set:
         "mass": link.mass,
         "inertia": link.inertia,
         "friction.viscous": link.friction.viscous,
-        "friction.coulomb": link.friction.coulomb,
+        **coulomb_fields(link.friction.coulomb, link.friction.coulomb_minus),
         "motor.inertia": link.motor.inertia,
         "motor.gear_ratio": link.motor.gear_ratio,
     }

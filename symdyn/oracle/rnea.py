@@ -93,13 +93,19 @@ def _body_rnea(mdl: NumericModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
     return tau
 
 
+def _friction(mdl, qd_b: np.ndarray) -> np.ndarray:
+    """The bodies' friction efforts at their rates qd_b (N, nb): viscous qd + coulomb [qd > 0]
+    - coulomb_minus [qd < 0] (= coulomb sign(qd) when the two magnitudes are the same)."""
+    return mdl.viscous * qd_b + mdl.coulomb * (qd_b > 0) - mdl.coulomb_minus * (qd_b < 0)
+
+
 def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
     """tau (N, n) for independent q, qd, qdd (N, n): the bodies' efforts, with rotor inertia and
     friction at the bodies' rates, projected by S^T; see `rnea`."""
     q_b, qd_b, qdd_b = body_positions(mdl, q), body_rates(mdl, qd), body_rates(mdl, qdd)
     tau = _body_rnea(mdl, q_b, qd_b, qdd_b, g_on) + mdl.reflected * qdd_b
     if f_on:
-        tau += mdl.viscous * qd_b + mdl.coulomb * np.sign(qd_b)
+        tau += _friction(mdl, qd_b)
     return project(mdl, tau)
 
 
@@ -207,7 +213,8 @@ def bias_torque(robot, q, qd, params=None) -> np.ndarray:
 
 
 def friction_torque(robot, qd, params=None) -> np.ndarray:
-    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0), per body at
+    """F(qd)_i = viscous_i qd_i + coulomb_i sign(qd_i) (joint space; sign(0) = 0; with
+    direction-dependent friction + coulomb_i for qd_i > 0, - coulomb_minus_i for qd_i < 0), per body at
     qd_b = S qd and projected, S^T F_b, for mimic joints.
 
     Args:
@@ -220,7 +227,7 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
     """
     mdl, (qd,), single = checked_inputs("friction_torque", robot, params, ("qd", qd))
     qd_b = body_rates(mdl, qd)
-    return _out(project(mdl, mdl.viscous * qd_b + mdl.coulomb * np.sign(qd_b)), single)
+    return _out(project(mdl, _friction(mdl, qd_b)), single)
 
 
 def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:

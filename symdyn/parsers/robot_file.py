@@ -29,6 +29,7 @@ import sympy as sp
 
 from ..errors import SymdynError, link_fields
 from ..model.frames import Frame
+from ..model.friction import coulomb_fields
 from ..model.inertia import tensor_from_components
 from ..model.physical import check_link_numbers
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
@@ -128,7 +129,7 @@ def _check_link_numbers(
         tensor.xreplace(subs),
         {
             "friction.viscous": link.viscous.xreplace(subs),
-            "friction.coulomb": link.coulomb.xreplace(subs),
+            **{k: v.xreplace(subs) for k, v in coulomb_fields(link.coulomb, link.coulomb_minus).items()},
             "motor.inertia": link.motor_inertia.xreplace(subs),
         },
         link.gear_ratio.xreplace(subs),
@@ -193,7 +194,7 @@ def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
                 mass=ld.mass,
                 com=com,
                 inertia=inertia,
-                friction=Friction(ld.viscous, ld.coulomb),
+                friction=Friction(ld.viscous, ld.coulomb, ld.coulomb_minus),
                 motor=Motor(ld.motor_inertia, ld.gear_ratio),
                 frame=frame,
                 parent=None if parents[i] == i - 1 else parents[i],
