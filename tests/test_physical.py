@@ -12,7 +12,7 @@ import math
 
 import pytest
 import yaml
-from robots import EXAMPLES_DIR
+from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction
 
 import symdyn
 from symdyn.apps.compiled import with_parameters
@@ -86,6 +86,16 @@ def test_inertia_and_friction_checked_at_run_time():
         with_parameters(robot, {"m2": 1.0, "b2": 0.1, "Izz2": -0.01})
     with pytest.raises(SymdynError, match=r"parameter b2 = -0\.1: .*friction\.viscous.*must not be negative"):
         with_parameters(robot, {"m2": 1.0, "b2": -0.1, "Izz2": 0.01})
+
+
+def test_direction_dependent_coulomb_magnitudes_checked_at_run_time():
+    """Both magnitudes of asymmetric Coulomb friction given at run time pass the file's check:
+    a negative c_minus (the Robotics Toolbox's signed Tc-) is refused with its field named."""
+    robot = asymmetric_friction()
+    assert not with_parameters(robot, ASYMMETRIC_PARAMS).params
+    for name, field in (("cp3", "friction.coulomb.plus"), ("cm3", "friction.coulomb.minus")):
+        with pytest.raises(SymdynError, match=rf"parameter {name} = -0\.3: .*{field}.*must not be negative"):
+            with_parameters(robot, {**ASYMMETRIC_PARAMS, name: -0.3})
 
 
 def test_file_values_overridden_at_run_time_are_checked():
