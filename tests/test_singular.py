@@ -174,6 +174,9 @@ def test_compiled_c_of_the_two_link_arm(tmp_path):
     q, qd, qdd = np.array([0.3, -1.1]), np.array([0.4, 0.9]), np.array([-0.7, 0.2])
     assert_close(fast.inverse_dynamics(q, qd, qdd), symdyn.rnea(robot, q, qd, qdd))
     assert_close(fast.mass_matrix(q), rn.mass_matrix(robot, q))
+    assert not hasattr(fast, "linearize")  # left out: an AttributeError, and a SymdynError saying why
+    with pytest.raises(SymdynError, match=r"forward_dynamics was not generated: M\(q\) is singular"):
+        fast.forward_dynamics(q, qd, qdd)
 
 
 @pytest.mark.parametrize("case", CASES)

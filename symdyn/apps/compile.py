@@ -35,7 +35,7 @@ from ..errors import SymdynError, SymdynWarning
 from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
 from . import cache
-from .singular import guarded
+from .singular import INVERTING, NotGeneratedError, guarded
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
 
@@ -239,6 +239,8 @@ class CompiledDynamics:
     def __getattr__(self, name: str):
         """The C methods, bound on first use (cffi parses the declarations then: ~0.1 s)."""
         entry = self.__dict__.get("_entry")
+        if entry is not None and name in INVERTING and name not in self.__dict__.get("functions", ()):
+            raise NotGeneratedError(self.robot.name, name)
         if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
             raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
         ffi, lib = _load_library(self._library, entry.meta["functions"])

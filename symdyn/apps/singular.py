@@ -18,12 +18,24 @@ import numpy as np
 
 from ..errors import SymdynError
 
-__all__ = ["INVERTING", "guarded"]
+__all__ = ["INVERTING", "NotGeneratedError", "guarded"]
 
 #: The generated functions that solve with or invert M (docs/generated-code.md).
 INVERTING = frozenset(
     {"forward_dynamics", "forward_dynamics_derivatives", "mass_matrix_inverse", "linearize"}
 )
+
+
+class NotGeneratedError(SymdynError, AttributeError):
+    """A function that inverts M asked of a robot whose M is singular by construction, so that
+    symdyn.codegen left it out (an AttributeError too, so that hasattr() answers False)."""
+
+    def __init__(self, robot_name: str, name: str) -> None:
+        super().__init__(
+            f"robot '{robot_name}': {name} was not generated: M(q) is singular by construction "
+            "(the warning given when the robot was compiled names the joint), so the functions "
+            "that invert M are left out"
+        )
 
 
 def _finite(a: np.ndarray) -> bool:
