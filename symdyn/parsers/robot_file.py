@@ -226,11 +226,10 @@ def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
     for i, ld in enumerate(reader.links):
         for key in ("alpha", "theta", "gamma"):
             if getattr(ld, key).free_symbols:  # a parameter's value may make it a constant like pi**2/4
-                value = constant_angle(
-                    getattr(ld, key).xreplace(subs), file=reader.file, **link_fields(ld), field=key
-                )
-                if value.is_Float:
-                    setattr(ld, key, value)
+                value = getattr(ld, key).xreplace(subs)
+                double = constant_angle(value, file=reader.file, **link_fields(ld), field=key)
+                if double is not value:
+                    setattr(ld, key, double)
         tensor = tensor_from_components(ld.inertia)
         _check_link_numbers(reader, ld, tensor, subs)
         prev = frames[parents[i]] if parents[i] >= 0 else Transform.identity()
