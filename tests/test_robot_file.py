@@ -7,6 +7,7 @@ import hashlib
 import importlib
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 import sympy as sp
 import yaml
+from timebound import refused
 
 import symdyn.codegen
 from symdyn.apps.compiled import CompiledDynamics
@@ -737,3 +739,42 @@ def test_a_negative_coulomb_magnitude_from_a_parameter_value_is_refused():
     err = info.value
     assert (err.link_index, err.link_name, err.field) == (3, "wrist", "friction.coulomb.minus")
     assert "must not be negative (got -0.2)" in str(err) and "\n" not in str(err)
+
+
+# -- hostile input: powers completed by parameter values, constant angles (issue 21)
+
+
+@pytest.mark.parametrize(
+    "parameters, mass, message",
+    [
+        ({}, "((((x+1)**64)**64)**64)", r"field 'mass': exponent 262144 of '\(x \+ 1\)\*\*262144'"),
+        ({"x": 3}, "(((((x**64)**64)**64)**64)**64)", "field 'mass': exponent 1073741824"),
+        ({"e": "9**9"}, "m*b**e", r"field 'mass': exponent 387420489 in 'b\*\*e' is larger than 64"),
+        (
+            {"a1": 3, "a2": "a1**64", "a3": "a2**64"},
+            "a3",
+            r"field 'parameters.a3': number 'a2\*\*64' is too large",
+        ),
+        ({"a1": "y**8", "a2": "a1**8", "a3": "a2**8"}, "a3", r"field 'parameters.a3': exponent 512"),
+    ],
+)
+def test_powers_merged_or_completed_by_values_are_refused_quickly(
+    tmp_path, capsys, parameters, mass, message
+):
+    """The command exits 1 with one line within 10 s (before: it hung in SymPy)."""
+    data = _one_link(mass=mass)
+    data["parameters"] = parameters
+    path = tmp_path / "tower.yaml"
+    path.write_text(yaml.safe_dump(data))
+    line = refused(capsys, "derive", path)
+    assert re.search(message, line), line
+
+
+def test_an_angle_that_a_parameter_makes_constant_is_evaluated_to_a_double():
+    """alpha: x with x: pi*pi/4 is used as the double nearest to pi**2/4, like alpha: pi/2*pi/2."""
+    data = _one_link(alpha="x")
+    data["parameters"] = {"x": "pi*pi/4"}
+    via_parameter = robot_from_data(data, "data")
+    written = robot_from_data(_one_link(alpha=2.4674011002723395), "data")
+    assert via_parameter.links[1].frame.R == written.links[1].frame.R
+    assert not via_parameter.resolved().links[1].frame.R.has(sp.pi)
