@@ -32,8 +32,8 @@ from symdyn.rnea import gravity_torque, mass_matrix
 
 pin = pytest.importorskip("pinocchio", reason="the test extra installs pin (Pinocchio)")
 
-#: the published files' own oddities, which symdyn reports while loading them (tests/test_urdf.py
-#: and tests/test_angles.py assert these warnings): not the subject of the sweep
+#: the published files' own oddities, which symdyn reports while loading them (tests/test_inertia.py,
+#: test_angles.py and test_urdf.py assert these warnings): not the subject of the sweep
 pytestmark = [
     pytest.mark.filterwarnings(f"ignore:{message}:symdyn.errors.SymdynWarning")
     for message in (
