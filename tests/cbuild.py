@@ -9,6 +9,12 @@ A small helper shared by the tests of generated C:
 Compilation uses the C contract's strict flags (`STRICT_FLAGS`, with -Werror; docs/generated-code.md), so
 a warning is a failure. `compile_shared` and `compile_program` raise
 `CompileError` with the compiler's messages.
+
+Builds are unoptimised by default (`TEST_OPT`, -O0): the tests that use them are about the values
+the code computes, which do not depend on the optimisation level (no -ffast-math), and gcc -O2 takes
+about ten times longer than -O0 on a large generated file (the Panda's: 8.4 s against 0.7 s).
+The warnings only the optimiser finds are checked by tests/test_c_target.py's -O2 strict builds
+(test_optimised_strict_build); the sanitizers (SANITIZE_FLAGS) work unoptimised as well.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ import numpy as np
 __all__ = [
     "STRICT_FLAGS",
     "SANITIZE_FLAGS",
+    "TEST_OPT",
     "CompileError",
     "compilers",
     "write_files",
@@ -43,6 +50,8 @@ SANITIZE_FLAGS = (
     "-fno-omit-frame-pointer",
     "-g",
 )
+#: the optimisation level of the tests' builds (see the module's docstring)
+TEST_OPT = "-O0"
 
 
 class CompileError(RuntimeError):
@@ -80,7 +89,7 @@ def compile_shared(
     sources: Iterable[str | os.PathLike],
     output: str | os.PathLike,
     compiler: str = "gcc",
-    opt: str = "-O2",
+    opt: str = TEST_OPT,
     flags: Sequence[str] = STRICT_FLAGS,
     extra: Sequence[str] = (),
 ) -> Path:
@@ -92,7 +101,7 @@ def compile_program(
     sources: Iterable[str | os.PathLike],
     output: str | os.PathLike,
     compiler: str = "gcc",
-    opt: str = "-O1",
+    opt: str = TEST_OPT,
     flags: Sequence[str] = STRICT_FLAGS,
     extra: Sequence[str] = (),
 ) -> Path:
@@ -202,7 +211,7 @@ def build_dynamics(
     name: str,
     precision: str = "double",
     compiler: str = "gcc",
-    opt: str = "-O2",
+    opt: str = TEST_OPT,
     extra: Sequence[str] = (),
 ) -> CDynamics:
     """Write the C target's files, compile NAME_dynamics.c to a shared library and load it

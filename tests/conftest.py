@@ -33,9 +33,19 @@ def pytest_runtest_makereport(item, call):
 
 @pytest.fixture(autouse=True, scope="session")
 def _temporary_symdyn_cache(tmp_path_factory):
-    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.cache)."""
+    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.cache).
+
+    Under pytest-xdist the workers share one folder (in the run's common temporary root), so a
+    library one worker compiled is a cache hit for the others: the cache's writes are atomic and
+    it is safe under concurrent builds (tests of the cache itself use folders of their own).
+    """
     old = os.environ.get("SYMDYN_CACHE_DIR")
-    os.environ["SYMDYN_CACHE_DIR"] = str(tmp_path_factory.mktemp("symdyn-cache"))
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        folder = tmp_path_factory.getbasetemp().parent / "symdyn-cache"
+        folder.mkdir(exist_ok=True)
+    else:
+        folder = tmp_path_factory.mktemp("symdyn-cache")
+    os.environ["SYMDYN_CACHE_DIR"] = str(folder)
     yield
     if old is None:
         os.environ.pop("SYMDYN_CACHE_DIR", None)

@@ -246,8 +246,11 @@ def _rational(x):
 
 
 def rational_example(name: str) -> Robot:
-    """An example file with every decimal number read as the exact rational it denotes."""
-    return robot_from_data(_rational(raw_example(name)), source=f"{name} (rational)")
+    """An example file with every decimal number read as the exact rational it denotes (its
+    published-data warnings silenced, as in `example`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SymdynWarning)
+        return robot_from_data(_rational(raw_example(name)), source=f"{name} (rational)")
 
 
 def trig_zero(expr: sp.Expr, n: int) -> bool:

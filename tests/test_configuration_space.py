@@ -10,7 +10,15 @@ from fractions import Fraction
 import numpy as np
 import pytest
 import sympy as sp
-from robots import EXAMPLE_NAMES, example, random_params, random_state, rational_example, solo_robot, y_robot
+from robots import (
+    EXAMPLE_NAMES,
+    derived,
+    random_params,
+    random_state,
+    rational_example,
+    solo_robot,
+    y_robot,
+)
 from test_mimic import CASES as MIMIC_CASES
 
 from symdyn import rnea
@@ -61,7 +69,7 @@ def test_routes_give_identical_strings_exact_data(name):
 
 @pytest.mark.parametrize("name", EXAMPLE_NAMES)
 def test_routes_agree_float_data(name):
-    a, b = _both(example(name))
+    a, b = (derived(name, m) for m in ("newton-euler", "lagrange"))  # example(name), session-cached
     _assert_same_terms(a, b, exact=False, what=name)
 
 
@@ -95,8 +103,7 @@ def _value(dyn, name: str, q, values) -> np.ndarray:
 
 @pytest.mark.parametrize("name", [*EXAMPLE_NAMES, "ytree", "mimic_chain"])
 def test_values_equal_the_oracle(name):
-    robot = TREES[name]() if name in TREES else example(name)
-    dyn = derive(robot, simplify=False)
+    dyn = derive(TREES[name](), simplify=False) if name in TREES else derived(name, "newton-euler")
     small = dyn.configuration_space.readable  # the Panda: V and C would be the recursion expanded
     if small:
         args = [list(dyn.q), list(dyn.qd), list(dyn.params)]

@@ -86,8 +86,9 @@ def test_same_input_same_output():
 def test_operation_counts_match_sympy_cse(name):
     """Over everything the seven generated functions compute: within 1 % of sympy.cse."""
     dyn = derived(name, "newton-euler")
-    outputs = [e for f in build_functions(dyn) for e in f.outputs]
-    steps = [a for f in build_functions(dyn) for a in f.temporaries]
+    functions = build_functions(dyn)
+    outputs = [e for f in functions for e in f.outputs]
+    steps = [a for f in functions for a in f.temporaries]
     exprs = [e for _, e in steps]
     ours = count_ops(*fast_cse(exprs + outputs, "t"))
     theirs = count_ops(*sp.cse(exprs + outputs, symbols=sp.numbered_symbols("t"), order="none"))

@@ -92,7 +92,7 @@ def test_the_robots_are_a_tree_and_a_mimic_robot(generated):
 @pytest.mark.skipif(not compilers(), reason="no C compiler")
 def test_c(generated, tmp_path):
     robot, files, _ = generated
-    lib = build_dynamics(files, tmp_path, robot.name, opt="-O1")
+    lib = build_dynamics(files, tmp_path, robot.name)
     assert lib.n == robot.n
     for q, qd, qdd, tau in _states(robot, 1):
         want = _expected(robot, q, qd, qdd, tau)
@@ -131,8 +131,7 @@ def test_c_under_the_sanitizers(generated, tmp_path):
         [driver, out / f"{name}_dynamics.c"],
         tmp_path / "driver",
         "gcc",
-        "-O1",
-        (*STRICT_FLAGS, *SANITIZE_FLAGS, f"-I{out}"),
+        flags=(*STRICT_FLAGS, *SANITIZE_FLAGS, f"-I{out}"),
     )
     run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120, cwd=out)
     assert run.returncode == 0, run.stderr

@@ -778,7 +778,7 @@ def test_generated_c_of_a_urdf_robot(tmp_path, rng):
     files = symdyn.codegen.render(robot, targets=("c",))
     assert set(files) == {"branch_dynamics.h", "branch_dynamics.c"}
     assert "branch.urdf (sha256 " + robot.source_sha256 in files["branch_dynamics.c"]
-    lib = build_dynamics(files, tmp_path, "branch", opt="-O1")
+    lib = build_dynamics(files, tmp_path, "branch")
     for _ in range(3):
         q, qd, qdd = random_state(robot, rng)
         assert_close(lib.inverse_dynamics(q, qd, qdd), rnea(robot, q, qd, qdd))
@@ -1000,7 +1000,7 @@ def test_real_robot_generated_c_matches_rnea(name, tmp_path, rng):
     files = c_target.render(ctx)
     assert set(files) == {f"{robot.name}_dynamics.h", f"{robot.name}_dynamics.c"}
     assert f"void {robot.name}_inverse_dynamics(" in files[f"{robot.name}_dynamics.h"]
-    lib = build_dynamics(files, tmp_path, robot.name, opt="-O1")
+    lib = build_dynamics(files, tmp_path, robot.name)
     for _ in range(3):
         q, qd, qdd = random_state(robot, rng)
         assert_close(lib.inverse_dynamics(q, qd, qdd), rnea(robot, q, qd, qdd))
