@@ -9,7 +9,6 @@ the generated function: frame F's functions are named after identifier(F).
 
 from __future__ import annotations
 
-from ..codegen.frame_functions import identifier
 from ..errors import SymdynError
 
 __all__ = ["FrameMethods"]
@@ -25,6 +24,8 @@ class FrameMethods:
         raise NotImplementedError  # CompiledDynamics defines it
 
     def _function(self, frame: str, suffix: str, axes=None):
+        from ..codegen.frame_functions import identifier  # not at import: a warm run loads no SymPy
+
         group = "operational_space" if suffix.startswith("operational") else "kinematics"
         return self.frame_functions(frame, group, axes).function(f"{identifier(frame)}_{suffix}")
 
