@@ -7,6 +7,7 @@ qdd = 0), J and Jdot qd. One derivation per robot (cached), one Octave run for e
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import importlib.util
 import shutil
 import subprocess
@@ -29,6 +30,7 @@ from symdyn.codegen import matlab as matlab_target
 from symdyn.codegen import python as numpy_target
 from symdyn.codegen.frame_functions import choose_frames, identifier
 from symdyn.errors import SymdynError
+from symdyn.model.frames import Frame
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import mass_matrix, rnea
 from symdyn.rnea_frames import center_of_mass, frame_state
@@ -330,3 +332,22 @@ def test_bad_frames_and_task_axes_write_nothing(tmp_path, extra, message):
 def test_frames_without_a_frame_group_is_an_error():
     with pytest.raises(SymdynError, match="name them in --functions"):
         context(example("roger_arm"), functions=("dynamics",), frames="forearm")
+
+
+@pytest.mark.skipif(not compilers(), reason="no C compiler")
+def test_a_frame_name_reaches_generated_code_only_sanitised(tmp_path):
+    """A frame named with comment ends, quotes, a backslash and a newline: C compiles under -Werror,
+    the NumPy module imports, and the name appears in no file but as its `?` spelling."""
+    name = 'tip*/ "1%\\\nx'  # robot files refuse such names; a Robot built in Python may have them
+    base = example("roger_arm")
+    r = dataclasses.replace(base, frames=(Frame(name, 1, base.links[1].frame),))
+    rendered = symdyn.codegen.render(
+        r, targets=("c", "python", "matlab", "latex"), functions=GROUPS, frames=[name], task_axes="x,y"
+    )
+    assert "tip____1___x_pose" in rendered["roger_arm_numpy.py"]
+    for file, text in rendered.items():
+        assert "*/ " not in text.replace("/* ", "").replace(" */", "") and name not in text, file
+    paths = write_files(rendered, tmp_path)
+    compile_shared([p for p in paths if p.suffix == ".c"], tmp_path / "lib.so")
+    spec = importlib.util.spec_from_file_location("odd_frame", tmp_path / "roger_arm_numpy.py")
+    spec.loader.exec_module(importlib.util.module_from_spec(spec))

@@ -19,7 +19,9 @@ __all__ = ["frames_latex"]
 
 
 def _tex(text: str) -> str:
-    return re.sub(r"([_#%&{}$^~\\])", r"\\\1", text)
+    """Text for LaTeX's text mode: a comment-safe name (comment_text) with `^`, `~` as `?`, and
+    `_ # & { } $` escaped."""
+    return re.sub(r"([_#%&{}$])", r"\\\1", re.sub(r"[\^~\\]", "?", comment_text(text)))
 
 
 def frames_latex(ctx: RenderContext) -> str:
