@@ -24,6 +24,7 @@ compiler the methods are the generated NumPy module's, with one warning.
 from __future__ import annotations
 
 import dataclasses
+import json
 import types
 import warnings
 from collections.abc import Callable, Mapping
@@ -156,6 +157,7 @@ def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: 
     self = CompiledDynamics._from_entry(entry, robot, params)
     self._source = ({**key_parts, "method": method}, make_robot)
     self._build_frames = lambda robot, folder, frames: _build(robot, method, options, frames)(folder)
+    self._options = options
 
     def rebuild() -> cache.Entry:
         return cache.get_or_build(key, _build(robot if robot is not None else make_robot(), method, options))
@@ -328,8 +330,8 @@ class CompiledDynamics(FrameMethods):
         key = (frame, group, task)
         if key not in self._frame_libraries:
             options = {"functions": (group,), "frames": [frame], "task_axes": task}
-            entry = self.derived_entry(
-                f"frames {frame!r} {group} {task}",
+            entry = self.derived_entry(  # keyed by the compiler options too, as the robot's own entry
+                json.dumps({"frame": frame, "group": group, "axes": task, **self._options}, sort_keys=True),
                 lambda robot, folder: self._build_frames(robot, folder, options),
             )
             self._frame_libraries[key] = CompiledDynamics._from_entry(entry, self.robot, self._params)
