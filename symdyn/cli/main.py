@@ -139,6 +139,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
         method=args.method,
         prune=args.prune,
         functions=args.functions,
+        frames=args.frames,
+        task_axes=args.task_axes,
     )
     for p in paths:
         print(p)
@@ -202,11 +204,30 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--functions",
         nargs="+",
-        choices=("dynamics", "regressor", "tip_wrench", "derivatives", "all"),
+        choices=(
+            "dynamics",
+            "regressor",
+            "tip_wrench",
+            "derivatives",
+            "kinematics",
+            "operational_space",
+            "all",
+        ),
         default=["dynamics"],
         help="the groups of functions to build (default: dynamics, the seven of tau = M qdd + V + G + F "
-        "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives; "
-        "all: every group",
+        "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives, "
+        "kinematics and operational_space (per frame, see --frames); all: every group",
+    )
+    g.add_argument(
+        "--frames",
+        metavar="F1,F2,...",
+        help="the frames of the kinematics and operational_space groups (default: every leaf link "
+        "and every frame the robot file names or the URDF keeps; docs/generated-code.md)",
+    )
+    g.add_argument(
+        "--task-axes",
+        metavar="AXES",
+        help="the rows of operational_space, any of x,y,z,rx,ry,rz (default: all six)",
     )
     g.add_argument("--force", action="store_true", help="overwrite files symdyn did not generate")
     g.add_argument(

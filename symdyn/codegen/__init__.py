@@ -23,7 +23,8 @@ from ..dynamics import SINGULAR_M, derive
 from ..errors import SymdynError, SymdynWarning
 from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
-from .functions import FUNCTION_NAMES, GROUPS, build_functions
+from .frame_functions import choose_frames
+from .functions import FRAME_GROUPS, FUNCTION_NAMES, GROUPS, build_functions
 from .output import write_files
 from .render import PRECISIONS, RenderContext
 
@@ -56,10 +57,15 @@ def context(
     method: str = "newton-euler",
     prune: float | None = None,
     functions: Sequence[str] | None = None,
+    frames: Sequence[str] | str | None = None,
+    task_axes: Sequence[str] | str | None = None,
 ) -> RenderContext:
     """Derive the robot and build the target-independent function specs (from the pruned
     configuration-space form when `prune` is given, symdyn.codegen.pruned; only the groups of
-    symdyn.codegen.functions.GROUPS named in `functions`, when given; None or "all": every group)."""
+    symdyn.codegen.functions.GROUPS named in `functions`, when given; None: every group but the
+    frame groups; "all": every group). The frame groups (kinematics, operational_space) are built
+    for `frames` (names or "F1,F2"; None: the default frames) and `task_axes`
+    (symdyn.codegen.frame_functions.choose_frames), which are checked before anything is derived."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
     if not is_c_identifier(robot.name):
@@ -74,6 +80,15 @@ def context(
             "identifiers (letters, digits and underscores, not starting with a digit, not a C keyword): "
             "they name the generated code's parameters"
         )
+    groups = _groups(functions)
+    choice = None
+    if groups is not None and set(groups) & set(FRAME_GROUPS):
+        choice = choose_frames(robot, frames, task_axes)
+    elif frames is not None or task_axes is not None:
+        raise SymdynError(
+            "--frames and --task-axes choose the frames of the kinematics and operational_space "
+            "function groups: name them in --functions"
+        )
     with warnings.catch_warnings():  # build_functions says it again, with the functions left out
         warnings.filterwarnings("ignore", f"robot '.*': {re.escape(SINGULAR_M)}", SymdynWarning)
         dyn = derive(robot, method=method, simplify=False)
@@ -82,13 +97,16 @@ def context(
         from .pruned import pruned_dynamics
 
         dyn, notes = pruned_dynamics(dyn, prune)
-    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, _groups(functions))), precision, notes)
+    specs = tuple(build_functions(dyn, groups, choice))
+    return RenderContext(dyn.robot, dyn, specs, precision, notes, choice.frames if choice else ())
 
 
 def _groups(functions: Sequence[str] | None) -> Sequence[str] | None:
     """The groups of GROUPS that `functions` names (None, or a name "all" among them: every group)."""
-    if functions is None or "all" in functions:
+    if functions is None:
         return None
+    if "all" in functions:
+        return list(GROUPS)
     unknown = sorted(set(functions) - set(GROUPS))
     if unknown or not functions:
         raise SymdynError(
@@ -105,10 +123,12 @@ def render(
     method: str = "newton-euler",
     prune: float | None = None,
     functions: Sequence[str] | None = None,
+    frames: Sequence[str] | str | None = None,
+    task_axes: Sequence[str] | str | None = None,
 ) -> dict[str, str | bytes]:
     """All files of the requested targets, in memory (name -> content)."""
     modules = [_target_module(t) for t in dict.fromkeys(targets)]
-    ctx = context(robot, precision, method, prune, functions)
+    ctx = context(robot, precision, method, prune, functions, frames, task_axes)
     files: dict[str, str | bytes] = {}
     for module in modules:
         files.update(module.render(ctx))
@@ -124,17 +144,22 @@ def generate(
     method: str = "newton-euler",
     prune: float | None = None,
     functions: Sequence[str] = ("dynamics",),
+    frames: Sequence[str] | str | None = None,
+    task_axes: Sequence[str] | str | None = None,
 ) -> list[Path]:
     """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir.
 
     `functions` names the groups of symdyn.codegen.functions.GROUPS to build: by default
     ("dynamics",), the seven functions of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) and forward
-    dynamics; ("all",) builds every group (the regressors, the derivatives, tip_wrench_torque).
+    dynamics; ("all",) builds every group (the regressors, the derivatives, tip_wrench_torque,
+    and the frame groups kinematics and operational_space). The frame groups are built for
+    `frames` (frame names, or "F1,F2"; None: every leaf link and every frame of Robot.frames) and,
+    for operational_space, the rows `task_axes` ("x,y,z"; None: all six), docs/generated-code.md.
     `prune`: from the significance-pruned model, symdyn.codegen.pruned.
     """
     if not isinstance(robot, Robot):
         from ..parsers import load
 
         robot = load(robot)
-    files = render(robot, targets, precision, method, prune, functions)
+    files = render(robot, targets, precision, method, prune, functions, frames, task_axes)
     return write_files(out_dir, files, force=force)

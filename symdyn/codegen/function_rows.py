@@ -10,11 +10,13 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..algorithms.operational_space import TASK_AXES
 from ..dynamics import Dynamics
 from ..symbolic.simplify import Eliminated, OpCount
 
 __all__ = [
     "DIMS",
+    "FrameChoice",
     "FunctionRow",
     "FunctionSpec",
     "Input",
@@ -34,9 +36,11 @@ class Input:
 
 
 #: Size names of the outputs (Output.dims): "1" for a vector's columns, "n" for the joints, "2n"
-#: for the state x = (q, qd); a target spells each as its own expression (C: a macro), and a
-#: family of functions that needs another size adds the name and every target's spelling.
-DIMS = ("1", "n", "2n", "nstd", "nbase")
+#: for the state x = (q, qd), "3", "4", "6" fixed sizes, "k" the task axes of the
+#: operational-space functions (symdyn.codegen.frame_functions); a target spells each as its own
+#: expression (C: a macro), and a family of functions that needs another size adds the name and
+#: every target's spelling.
+DIMS = ("1", "n", "2n", "nstd", "nbase", "3", "4", "6", "k")
 
 
 @dataclass(frozen=True)
@@ -141,6 +145,21 @@ class FunctionRow:
 
 
 @dataclass(frozen=True)
+class FrameChoice:
+    """The frames of the generated frame functions and the task axes of the operational space.
+
+    `frames`: (name, identifier, link description) per frame, in order; `rows`: the world-aligned
+    Jacobian rows of the task axes (0-5)."""
+
+    frames: tuple[tuple[str, str, str], ...] = ()
+    rows: tuple[int, ...] = tuple(range(6))
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        return tuple(TASK_AXES[r] for r in self.rows)
+
+
+@dataclass(frozen=True)
 class Inputs:
     """The input vectors every function family draws from: q, qd, qdd, tau and p."""
 
@@ -149,9 +168,11 @@ class Inputs:
     qdd: Input
     tau: Input
     p: Input
+    #: the frames and task axes of the frame functions (symdyn.codegen.frame_functions)
+    frames: FrameChoice = FrameChoice()
 
     @classmethod
-    def of(cls, dyn: Dynamics) -> Inputs:
+    def of(cls, dyn: Dynamics, frames: FrameChoice | None = None) -> Inputs:
         n = dyn.n
         return cls(
             Input("q", tuple(dyn.q)),
@@ -159,6 +180,7 @@ class Inputs:
             Input("qdd", tuple(dyn.qdd)),
             Input("tau", tuple(sp.Symbol(f"tau{i + 1}") for i in range(n))),
             Input("p", tuple(dyn.params)),
+            frames or FrameChoice(),
         )
 
     @property

@@ -38,8 +38,10 @@ from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
+from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
 from .function_rows import (
     DIMS,
+    FrameChoice,
     FunctionRow,
     FunctionSpec,
     Input,
@@ -60,6 +62,7 @@ __all__ = [
     "DIMS",
     "FAMILIES",
     "GROUPS",
+    "FRAME_GROUPS",
     "build_functions",
     "vector_output",
     "joint_matrix_output",
@@ -177,6 +180,8 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     regressor_rows,
     tip_wrench_rows,
     derivative_rows,
+    kinematics_rows,
+    operational_space_rows,
 )
 
 
@@ -184,6 +189,7 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
 INVERTING: dict[Callable[[Dynamics, Inputs], list[FunctionRow]], tuple[str, ...]] = {
     forward_dynamics_rows: ("forward_dynamics",),
     derivative_rows: DERIVATIVE_FUNCTION_NAMES[1:],
+    operational_space_rows: ("operational_space_inertia", "operational_space_bias"),
 }
 
 
@@ -207,26 +213,40 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
     "regressor": (regressor_rows,),
     "tip_wrench": (tip_wrench_rows,),
     "derivatives": (derivative_rows,),
+    "kinematics": (kinematics_rows,),
+    "operational_space": (operational_space_rows,),
 }
 
+#: The groups built per frame (symdyn.codegen.frame_functions): only when named, never by default.
+FRAME_GROUPS = ("kinematics", "operational_space")
 
-def build_functions(dyn: Dynamics, groups: Sequence[str] | None = None) -> list[FunctionSpec]:
+
+def build_functions(
+    dyn: Dynamics, groups: Sequence[str] | None = None, frames: FrameChoice | None = None
+) -> list[FunctionSpec]:
     """The generated functions of a derived robot, one CSE pass per `FunctionRow.cse` group.
 
     All of FAMILIES' rows: the seven of docs/generated-code.md, or six without forward_dynamics
     (and one SymdynWarning naming what is left out) when M is singular by construction (see the
     module docstring), then
     regressor and base_regressor (symdyn.codegen.regressor_functions), tip_wrench_torque for
-    product-of-exponentials robots, and the derivatives (symdyn.codegen.derivative_functions).
+    product-of-exponentials robots, and the derivatives (symdyn.codegen.derivative_functions);
+    the frame groups (FRAME_GROUPS: kinematics, operational_space; symdyn.codegen.frame_functions)
+    only when `groups` names them, for the frames and task axes of `frames` (None: the default
+    frames, symdyn.codegen.frame_functions.choose_frames).
     The regressor and the derivatives add intermediates to `dyn.program`; each family has a pass
     of its own so that it cannot change the other functions' temporaries. `groups` (names of
-    GROUPS; all by default) keeps only those families: their code is the same as in a full build.
+    GROUPS; all but FRAME_GROUPS by default) keeps only those families: their code is the same
+    as in a full build.
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
-    x = Inputs.of(dyn)
-    chosen = None if groups is None else {b for g in groups for b in GROUPS[g]}
-    families = [family for family in FAMILIES if chosen is None or family in chosen]
+    per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
+    chosen = set(FAMILIES) - per_frame if groups is None else {b for g in groups for b in GROUPS[g]}
+    if frames is None and chosen & per_frame:
+        frames = choose_frames(dyn.robot)
+    x = Inputs.of(dyn, frames)
+    families = [family for family in FAMILIES if family in chosen]
     _warn_singular(dyn, families)
     rows = [row for family in families for row in family(dyn, x)]
     names = [row.name for row in rows]

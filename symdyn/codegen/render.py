@@ -42,6 +42,8 @@ class RenderContext:
     precision: str = "double"
     #: extra header lines (what `generate --prune` dropped and the bound it guarantees)
     notes: tuple[str, ...] = ()
+    #: (name, identifier, link) of each frame of the frame functions (symdyn.codegen.frame_functions)
+    frames: tuple[tuple[str, str, str], ...] = ()
 
     @property
     def name(self) -> str:

@@ -127,6 +127,11 @@ def _joint_symbols(ctx: RenderContext) -> list[sp.Symbol]:
     return symbols
 
 
+def _task_size(ctx: RenderContext) -> int:
+    """k, the rows of the operational-space functions' outputs (size name "k"; 6 without them)."""
+    return next((r.rows for f in ctx.functions for r in f.results if r.dims[0] == "k"), 6)
+
+
 def c_names(ctx: RenderContext) -> CNames:
     """The file, macro, function and local names for one robot (deterministic, collision-free).
 
@@ -152,6 +157,7 @@ def c_names(ctx: RenderContext) -> CNames:
         [ndof, nparam]
         + [m for m, _ in param_macros]
         + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
+        + ([f"{name}_NFRAMES"] if ctx.frames else [])
     )
     taken = set(written) | set(functions.values()) | {guard} | set(sincos.values())
     aliases = _aliases(written, taken)
@@ -189,6 +195,14 @@ def c_names(ctx: RenderContext) -> CNames:
         functions=functions,
         locals=local_names,
         param_macro=param_macro,
-        dims={"1": "1", "n": ndof, "2n": f"(2*{ndof})", "nstd": f"{name}_NSTD", "nbase": f"{name}_NBASE"},
+        dims={
+            "1": "1",
+            "n": ndof,
+            "2n": f"(2*{ndof})",
+            "nstd": f"{name}_NSTD",
+            "nbase": f"{name}_NBASE",
+            **{d: d for d in ("3", "4", "6")},
+            "k": str(_task_size(ctx)),
+        },
         sincos=sincos,
     )

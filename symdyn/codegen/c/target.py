@@ -16,6 +16,7 @@ templates/c/*.j2.
 from __future__ import annotations
 
 from ...errors import SymdynError
+from ..frame_functions import comment_text
 from ..functions import FunctionSpec
 from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
@@ -131,6 +132,7 @@ def render_context(ctx: RenderContext) -> dict:
         "aliases": list(names.aliases),
         "functions": functions,
         "column_sizes": _column_sizes(ctx, names),
+        "frames": [(comment_text(name), ident, link) for name, ident, link in ctx.frames],
         "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
     }
 

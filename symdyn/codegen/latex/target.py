@@ -28,6 +28,7 @@ from ...dynamics import AUTO_SIMPLIFY_MAX_JOINTS, Dynamics
 from ...symbolic.simplify import eliminate
 from ..render import RenderContext, environment, header_lines
 from .base_parameters import base_parameters_latex
+from .frames import frames_latex
 from .notation import MATRIX_WIDTH, Notation, escape_text, width
 
 __all__ = ["render", "latex_document_body", "dynamics_latex", "file_name", "AMSMATH_NOTE", "TOOLS"]
@@ -149,6 +150,7 @@ def render(ctx: RenderContext) -> dict[str, str]:
     body = latex_document_body(ctx.dynamics)
     if any(f.name == "base_regressor" for f in ctx.functions):
         body += base_parameters_latex(ctx.dynamics)
+    body += frames_latex(ctx)
     text = (
         environment()
         .get_template("latex/dynamics.tex.j2")

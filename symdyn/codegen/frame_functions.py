@@ -1,0 +1,261 @@
+"""The generated frame functions (docs/generated-code.md): kinematics and operational space.
+
+For each chosen frame F (`FrameChoice`), with F's name made an identifier ID (`identifier`):
+
+    ID_pose(q, p, T)                            T = world_T_F, 4 x 4
+    ID_jacobian(q, p, J)                        6 x n, world-aligned at F's origin
+    ID_jacobian_local(q, p, J)                  6 x n, in F's own axes
+    ID_jacobian_dot_qd(q, qd, p, a)             Jdot qd (6) at qdd = 0, world-aligned
+    ID_operational_space_inertia(q, p, Lambda)  (J M^-1 J^T)^-1, k x k
+    ID_operational_space_bias(q, qd, p, mu)     mu + p = Lambda (J M^-1 (V + G + F) - Jdot qd), k
+
+and once per robot com(q, p, c), com_jacobian(q, p, Jc), com_jacobian_dot_qd(q, qd, p, a)
+(world frame). Rows of J are v_x v_y v_z w_x w_y w_z; the operational-space functions use the
+world-aligned rows the task axes choose (symdyn.algorithms.operational_space.TASK_AXES, all six
+by default, k of them). The quantities are symdyn.algorithms.frame_kinematics' and
+symdyn.algorithms.operational_space's, over named intermediates written into copies of
+`dyn.program` (the derivation is not changed); both inverses are unrolled L D L^T
+factorisations, without square roots.
+
+The default frames are every leaf link of the tree (a link no other link hangs from) followed
+by every frame of Robot.frames (a URDF's merged fixed links, a robot file's `frames:`, PoE's
+end_effector), each once.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Sequence
+
+import sympy as sp
+
+from ..algorithms.frame_kinematics import FrameKinematics
+from ..algorithms.operational_space import operational_space, task_rows
+from ..dynamics import Dynamics
+from ..errors import SymdynError, SymdynWarning
+from ..model.robot import Robot
+from ..symbolic.program import Program
+from .function_rows import FrameChoice, FunctionRow, Inputs, Output
+
+__all__ = [
+    "FrameChoice",
+    "choose_frames",
+    "identifier",
+    "comment_text",
+    "default_frames",
+    "kinematics_rows",
+    "operational_space_rows",
+    "COM_FUNCTIONS",
+    "FRAME_SUFFIXES",
+    "frame_function_names",
+]
+
+#: The centre-of-mass functions of the kinematics group (an identifier must not shadow them).
+COM_FUNCTIONS = ("com", "com_jacobian", "com_jacobian_dot_qd")
+
+
+#: The functions of each frame, ID_<suffix> (module docstring).
+FRAME_SUFFIXES = (
+    "pose",
+    "jacobian",
+    "jacobian_local",
+    "jacobian_dot_qd",
+    "operational_space_inertia",
+    "operational_space_bias",
+)
+
+
+def frame_function_names(frames: tuple[tuple[str, str, str], ...]) -> set[str]:
+    """The names every frame function of FrameChoice.frames `frames` may have, and COM_FUNCTIONS."""
+    return {f"{ident}_{s}" for _, ident, _ in frames for s in FRAME_SUFFIXES} | set(COM_FUNCTIONS)
+
+
+def identifier(name: str) -> str:
+    """A frame name as a C identifier: characters outside [A-Za-z0-9_] become `_`, and a name
+    that then starts with a digit gets a leading `_` (so that it names a Python function too)."""
+    ident = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return "_" + ident if ident[:1].isdigit() or not ident else ident
+
+
+def comment_text(name: str) -> str:
+    """A name safe inside any target's comments and docstrings: every character but letters,
+    digits, spaces and ``_.:+()#@=,;<>[]|~!?^&/-`` becomes `?` (no newline, `*/`, `%`, quote or
+    backslash survives)."""
+    return re.sub(r"[^A-Za-z0-9_ .:+()#@=,;<>\[\]|~!?^&/-]", "?", name)
+
+
+def default_frames(robot: Robot) -> list[str]:
+    """Every leaf link (no child), then every frame of Robot.frames (module docstring)."""
+    parents = set(robot.parents)
+    return [link.name for i, link in enumerate(robot.links) if i not in parents] + [
+        f.name for f in robot.frames
+    ]
+
+
+def _link_text(robot: Robot, link: int) -> str:
+    return "the base" if link < 0 else f"link {link + 1} ({comment_text(robot.links[link].name)})"
+
+
+def choose_frames(robot: Robot, frames: Sequence[str] | str | None = None, task_axes=None) -> FrameChoice:
+    """The FrameChoice of `frames` (names, or "F1,F2"; None: the default frames) and `task_axes`
+    ("x,y,z", names of TASK_AXES, or None: all six).
+
+    Raises:
+        SymdynError: an unknown frame (naming the near matches), no frame, two frames with one
+            identifier, a frame whose identifier is `com`, or an unknown task axis.
+    """
+    rows = task_rows(task_axes, "--task-axes")
+    if isinstance(frames, str):
+        frames = [a.strip() for a in frames.split(",") if a.strip()]
+    names = list(dict.fromkeys(default_frames(robot) if frames is None else frames))
+    if not names:
+        raise SymdynError(f"--frames: robot '{robot.name}': no frame given")
+    table, seen = [], {}
+    for name in names:
+        link = robot.frame(name, "--frames").link
+        ident = identifier(name)
+        if ident in seen:
+            raise SymdynError(
+                f"--frames: robot '{robot.name}': frames {seen[ident]!r} and {name!r} both become the "
+                f"identifier '{ident}' in generated code; choose one of them"
+            )
+        if ident == "com":
+            raise SymdynError(
+                f"--frames: robot '{robot.name}': frame {name!r} would become the identifier 'com', "
+                "whose functions are the centre of mass's; leave it out of --frames"
+            )
+        seen[ident] = name
+        table.append((name, ident, _link_text(robot, link)))
+    return FrameChoice(tuple(table), rows)
+
+
+def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
+    return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
+
+
+def _with_steps(rows: list[tuple], prog: Program, first: int, cse: str) -> list[FunctionRow]:
+    """FunctionRows of one CSE group, the first carrying every step after `first` in `prog` that
+    the rows need (build_functions gathers the rows' steps into one program)."""
+    if not rows:
+        return []
+    new = {s for s, _ in prog.assignments[first:]}
+    steps = [a for a in prog.needed([e for row in rows for e in row[4]]) if a[0] in new]
+    carried = [tuple(steps)] + [()] * (len(rows) - 1)
+    return [FunctionRow(*row, s, cse=cse) for row, s in zip(rows, carried, strict=True)]
+
+
+def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """pose, jacobian, jacobian_local and jacobian_dot_qd of each chosen frame, then the centre
+    of mass's three functions (module docstring)."""
+    n = dyn.n
+    prog = dyn.program.copy("K")
+    first = len(prog.assignments)
+    fk = FrameKinematics(dyn.robot, list(dyn.q), list(dyn.qd), prog)
+    rows: list[tuple] = []
+    for name, ident, link in x.frames.frames:
+        on = f"of frame {comment_text(name)} on {link}"
+        rows += [
+            (
+                f"{ident}_pose",
+                f"world_T_F {on}, row-major 4 x 4",
+                (x.q, x.p),
+                (Output("T", 4, 4, "pose world_T_F: rotation and origin of F in the world", ("4", "4")),),
+                _entries(fk.pose(name)),
+            ),
+            (
+                f"{ident}_jacobian",
+                f"Jacobian {on}, world-aligned at F's origin, rows v_x v_y v_z w_x w_y w_z",
+                (x.q, x.p),
+                (Output("J", 6, n, "world-aligned Jacobian", ("6", "n")),),
+                _entries(fk.jacobian(name, "world")),
+            ),
+            (
+                f"{ident}_jacobian_local",
+                f"Jacobian {on}, in F's own axes, rows v_x v_y v_z w_x w_y w_z",
+                (x.q, x.p),
+                (Output("J", 6, n, "Jacobian in F's own axes", ("6", "n")),),
+                _entries(fk.jacobian(name, "local")),
+            ),
+            (
+                f"{ident}_jacobian_dot_qd",
+                f"Jdot qd {on} at qdd = 0, world-aligned: classical acceleration of F's origin, "
+                "then F's angular acceleration",
+                (x.q, x.qd, x.p),
+                (Output("a", 6, 1, "Jdot qd: linear then angular acceleration at qdd = 0", ("6", "1")),),
+                _entries(fk.jacobian_dot_qd(name)),
+            ),
+        ]
+    rows += [
+        (
+            "com",
+            "the centre of mass c(q), world frame",
+            (x.q, x.p),
+            (Output("c", 3, 1, "centre of mass in the world", ("3", "1")),),
+            _entries(fk.com()),
+        ),
+        (
+            "com_jacobian",
+            "Jc(q) with dc/dt = Jc qd, world frame",
+            (x.q, x.p),
+            (Output("Jc", 3, n, "centre-of-mass Jacobian", ("3", "n")),),
+            _entries(fk.com_jacobian()),
+        ),
+        (
+            "com_jacobian_dot_qd",
+            "Jc_dot qd: the centre of mass's acceleration at qdd = 0, world frame",
+            (x.q, x.qd, x.p),
+            (Output("a", 3, 1, "Jc_dot qd", ("3", "1")),),
+            _entries(fk.com_jacobian_dot_qd()),
+        ),
+    ]
+    return _with_steps(rows, prog, first, "kinematics")
+
+
+def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
+    """operational_space_inertia and operational_space_bias of each chosen frame over the task
+    axes' rows of its world-aligned Jacobian (module docstring)."""
+    n = dyn.n
+    c = dyn.compact
+    prog = dyn.program.copy("O")
+    first = len(prog.assignments)
+    fk = FrameKinematics(dyn.robot, list(dyn.q), list(dyn.qd), prog)
+    keep = list(x.frames.rows)
+    k = len(keep)
+    axes = ", ".join(x.frames.axes)
+    rows: list[tuple] = []
+    if dyn.singular_joints:
+        return []  # M is singular by construction (build_functions warns)
+    for name, ident, link in x.frames.frames:
+        J = fk.jacobian(name, "world").extract(keep, list(range(n)))
+        drift = fk.jacobian_dot_qd(name).extract(keep, [0])
+        mark = len(prog.assignments)
+        os = operational_space(sp.Matrix(c["M"]), J, sp.Matrix(c["bias"]), drift, dyn.robot.is_chain, prog)
+        made = [e for _, e in prog.assignments[mark:]] + list(os.inertia) + list(os.bias)
+        if any(sp.sympify(e).has(sp.zoo, sp.nan, sp.oo) for e in made):
+            warnings.warn(
+                f"robot '{dyn.robot.name}': the operational-space functions of frame {name!r} are not "
+                f"generated: J M^-1 J^T over the task axes {axes} is singular at every q (the joints "
+                "supporting the frame cannot move it along every axis); choose fewer --task-axes",
+                SymdynWarning,
+                stacklevel=4,
+            )
+            continue
+        on = f"of frame {comment_text(name)} on {link}, task axes {axes}"
+        rows += [
+            (
+                f"{ident}_operational_space_inertia",
+                f"Lambda = (J M^-1 J^T)^-1 {on} (unrolled L D L^T, no square roots)",
+                (x.q, x.p),
+                (Output("Lambda", k, k, "operational-space inertia", ("k", "k")),),
+                _entries(os.inertia),
+            ),
+            (
+                f"{ident}_operational_space_bias",
+                f"mu + p = Lambda (J M^-1 (V + G + F) - Jdot qd) {on}",
+                (x.q, x.qd, x.p),
+                (Output("mu", k, 1, "operational-space bias mu + p", ("k", "1")),),
+                _entries(os.bias),
+            ),
+        ]
+    return _with_steps(rows, prog, first, "operational_space")
