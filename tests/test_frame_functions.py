@@ -1,6 +1,6 @@
 """The generated frame functions (symdyn.codegen.frame_functions: the kinematics and
 operational_space groups) in C, NumPy, CasADi, MATLAB/Octave and LaTeX, against the numeric
-oracle symdyn.rnea_frames (pose, Jacobians, drift, centre of mass) and, for Lambda and mu + p,
+oracle symdyn.oracle.frames (pose, Jacobians, drift, centre of mass) and, for Lambda and mu + p,
 NumPy formulas over the oracle's M (symdyn.rnea.mass_matrix), h = V + G + F (symdyn.rnea at
 qdd = 0), J and Jdot qd. One derivation per robot (cached), one Octave run for every robot."""
 
@@ -19,7 +19,6 @@ import numpy as np
 import pytest
 from cbuild import SANITIZE_FLAGS, STRICT_FLAGS, compile_shared, compilers, header_macros, write_files
 from robots import example, random_state, raw_example, y_robot
-from symdyn.rnea_frames import center_of_mass, frame_state
 
 import symdyn
 from symdyn.algorithms.operational_space import TASK_AXES
@@ -32,6 +31,7 @@ from symdyn.codegen import python as numpy_target
 from symdyn.codegen.frame_functions import choose_frames, identifier
 from symdyn.errors import SymdynError
 from symdyn.model.frames import Frame
+from symdyn.oracle.frames import center_of_mass, frame_state
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import mass_matrix, rnea
 
