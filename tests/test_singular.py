@@ -42,7 +42,14 @@ links:
   - {name: l2, joint: revolute, a: 0, alpha: 0, d: 0, theta: 0, mass: 0.5, com: [0, 0, -0.02]}
 """
 
-LEFT_OUT = ("forward_dynamics", "forward_dynamics_derivatives", "mass_matrix_inverse", "linearize")
+LEFT_OUT = (
+    "forward_dynamics",
+    "forward_dynamics_derivatives",
+    "mass_matrix_inverse",
+    "linearize",
+    "operational_space_inertia",
+    "operational_space_bias",
+)
 KEPT = tuple(n for n in (*FUNCTION_NAMES, *DERIVATIVE_FUNCTION_NAMES) if n not in LEFT_OUT)
 ON_AXIS = (
     "moves only mass that lies on its own axis, with no rotational inertia about that axis "
@@ -67,8 +74,8 @@ CASES = {"two_link": (two_link, "l2", 2), "toolbox_ur5": (ur5, "link6", 6)}
 def expected_warning(robot: str, link: str, k: int) -> str:
     return (
         f"robot '{robot}': M(q) is singular: the joint of link '{link}' (link {k}) {ON_AXIS}; so "
-        "forward_dynamics, forward_dynamics_derivatives, mass_matrix_inverse and linearize are not "
-        "generated (the other functions are)"
+        "forward_dynamics, forward_dynamics_derivatives, mass_matrix_inverse, linearize, "
+        "operational_space_inertia and operational_space_bias are not generated (the other functions are)"
     )
 
 
