@@ -45,7 +45,7 @@ def references(robot, states, k: int) -> dict[str, np.ndarray]:
     z = np.zeros_like(q)
     M = oracle.mass_matrix(robot, q)
     h0 = oracle.rnea(robot, q, qd, z, friction=False)
-    from symdyn.rnea_regressor import regressor
+    from symdyn.oracle.regressor import regressor
 
     return {
         "inverse_dynamics": oracle.rnea(robot, q, qd, qdd),

@@ -8,7 +8,7 @@ symdyn.generate(robot, targets=("c", "casadi"), out_dir="out")
 
 The package is layered, each floor importing only the ones below it:
 spatial -> model -> parsers; symbolic -> algorithms -> dynamics -> codegen -> apps -> cli.
-`rnea` (the numeric oracle) reads only the model.
+`oracle` (the numeric oracle; its public entry is `symdyn.rnea`) reads only the model.
 """
 
 __version__ = "0.1.0"

@@ -38,6 +38,7 @@ from __future__ import annotations
 import re
 import warnings
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import sympy as sp
@@ -54,6 +55,7 @@ from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
 from .algorithms.operational_space import operational_space, task_rows
 from .algorithms.regressor import regressor as regressor_matrix
+from .algorithms.singular import SingularJoint, describe_singular, singular_joints
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
 from .model.parameters import standard_parameters
@@ -79,7 +81,9 @@ def _check_quantity(name, where: str) -> str:
 
 
 def friction_vector(robot: Robot, qd) -> sp.Matrix:
-    """F_i = viscous_i qd_i + coulomb_i sign(qd_i) (Grupen (2015), slide 16).
+    """F_i = viscous_i qd_i + coulomb_i sign(qd_i) (Grupen (2015), slide 16), or with
+    direction-dependent Coulomb friction viscous_i qd_i + c+_i H(qd_i) - c-_i H(-qd_i), H the
+    Heaviside step with H(0) = 0 (`symdyn.model.robot.Friction`).
 
     Per body at its joint rate qd_b = S qd; a mimic joint's friction is projected onto
     the coordinate it follows, F = S^T F_b(qd_b).
@@ -94,10 +98,7 @@ def friction_vector(robot: Robot, qd) -> sp.Matrix:
     if len(qd) != robot.n:
         raise SymdynError(f"friction_vector: qd has length {len(qd)}, expected {robot.n} (one per joint)")
     rates = robot.body_rates(list(qd))
-    F_b = [
-        link.friction.viscous * rate + link.friction.coulomb * sp.sign(rate)
-        for link, rate in zip(robot.links, rates, strict=True)
-    ]
+    F_b = [link.friction.effort(rate) for link, rate in zip(robot.links, rates, strict=True)]
     if robot.n == robot.nb:
         return sp.Matrix(F_b)
     F = [sp.S.Zero] * robot.n
@@ -188,6 +189,13 @@ class Dynamics:
         _check_quantity(name, "Dynamics.expanded")
         entries = self.program.expand(list(self.compact[name]))
         return [simplify_entry(e) for e in entries] if self.simplified else entries
+
+    @cached_property
+    def singular_joints(self) -> tuple[SingularJoint, ...]:
+        """The joints that make M(q) singular for every q, with the cause: the exactly zero
+        pivots of M = L D L^T and the joints that move no mass (symdyn.algorithms.singular).
+        Empty when M can be inverted as far as its numbers tell."""
+        return singular_joints(self.robot, self.compact["M"])
 
     @property
     def configuration_space(self) -> ConfigurationSpace:
@@ -516,18 +524,17 @@ def _newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str,
     }
 
 
-def _warn_idle_joints(robot: Robot) -> None:
-    """A SymdynWarning naming the joints that move nothing with inertia (M singular)."""
-    idle = robot.idle_joints()
-    if idle:
-        names = ", ".join(f"'{robot.links[i].name}' (link {i + 1})" for i in idle)
-        warnings.warn(
-            f"robot '{robot.name}': joint(s) {names} move no mass or inertia (their subtrees have "
-            "zero mass and inertia and they have no rotor inertia), so M(q) is singular and "
-            "forward dynamics is undefined",
-            SymdynWarning,
-            stacklevel=3,
-        )
+#: How every message about a singular M starts after the robot's name (codegen repeats it).
+SINGULAR_M = "M(q) is singular"
+
+
+def singular_message(dyn: Dynamics) -> str:
+    """ "robot 'X': M(q) is singular: the joint of link 'Y' (link k) <why>" for a derivation
+    whose M is singular by construction (Dynamics.singular_joints; empty there: "")."""
+    joints = dyn.singular_joints
+    if not joints:
+        return ""
+    return f"robot '{dyn.robot.name}': {SINGULAR_M}: {describe_singular(dyn.robot, joints)}"
 
 
 def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = None) -> Dynamics:
@@ -551,8 +558,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         SymdynError: not a Robot, an unknown method or a simplify that is not True, False or None.
 
     Warns:
-        SymdynWarning: a joint moves nothing with mass or inertia (Robot.idle_joints), so M is
-            singular. Decided on numbers only: with a symbolic mass it cannot be.
+        SymdynWarning: M is singular for every q (Dynamics.singular_joints: a joint that moves
+            no mass, or only mass on its own axis, ...), naming the joints and why; forward
+            dynamics is undefined. Decided on numbers: a pivot that depends on a free
+            parameter is not zero.
     """
     if not isinstance(robot, Robot):
         raise SymdynError(
@@ -563,7 +572,6 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
     if simplify is not None and not isinstance(simplify, bool):
         raise SymdynError(f"derive: simplify must be True, False or None, got {simplify!r}")
     r = robot.resolved()
-    _warn_idle_joints(r)
     q, qd, qdd = joint_symbols(r.n)
     program = Program()
     with distribute(False):
@@ -582,7 +590,7 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
             terms["bias"] = terms["bias"] + F
     if simplify is None:
         simplify = r.n <= AUTO_SIMPLIFY_MAX_JOINTS
-    return Dynamics(
+    dyn = Dynamics(
         robot=r,
         method=method,
         q=q,
@@ -593,3 +601,6 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         compact={k: sp.Matrix(terms[k]) for k in ALL_QUANTITIES},
         simplified=bool(simplify),
     )
+    if dyn.singular_joints:
+        warnings.warn(f"{singular_message(dyn)}; forward dynamics is undefined", SymdynWarning, stacklevel=2)
+    return dyn

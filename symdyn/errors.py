@@ -1,8 +1,22 @@
-"""The one exception type symdyn raises for bad input, and its warning type."""
+"""The one exception type symdyn raises for bad input, its warning type, and the words of
+messages that several floors print."""
 
 from __future__ import annotations
 
-__all__ = ["SymdynError", "SymdynWarning", "location", "link_fields"]
+__all__ = ["SymdynError", "SymdynWarning", "location", "link_fields", "SINGULAR_REASONS"]
+
+#: Why a joint makes M(q) singular, as the end of a sentence whose subject is the joint: said by
+#: the derivation (symdyn.algorithms.singular) and by the numeric oracle (symdyn.oracle) alike.
+SINGULAR_REASONS = {
+    "massless": "moves no mass or inertia (its subtree has neither, and the joint no rotor inertia)",
+    "on_axis": (
+        "moves only mass that lies on its own axis, with no rotational inertia about that axis "
+        "(M has a zero on its diagonal for it)"
+    ),
+    "dependent": (
+        "moves the bodies only as the joints before it do (its column of M is a combination of theirs)"
+    ),
+}
 
 
 def location(

@@ -540,8 +540,68 @@ def branch_pairs(parents) -> list[tuple[int, int]]:
 
 def regressor_oracle(dyn, q, qd, qdd, params=None) -> dict[str, np.ndarray]:
     """The generated regressor functions' expected values from the oracle's numeric regressor
-    (symdyn.rnea_regressor): Y, and its columns of the base parameters for Y_b (one state or a batch)."""
-    from symdyn.rnea_regressor import regressor
+    (symdyn.oracle.regressor): Y, and its columns of the base parameters for Y_b (one state or a batch)."""
+    from symdyn.oracle.regressor import regressor
 
     Y = regressor(dyn.robot, q, qd, qdd, params)
     return {"regressor": Y, "base_regressor": Y[..., list(dyn.linear_compact()[1].columns)]}
+
+
+# --------------------------------------------------------------------------- processes
+
+
+def dead_pid() -> int:
+    """The id of a process that has exited (for the tests of leftovers of killed runs)."""
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True
+    )
+    return int(done.stdout)
+
+
+# --------------------------------------------------------------------------- direction-dependent friction
+
+#: a 3-link arm with direction-dependent Coulomb friction on links 1 (the Robotics Toolbox's PUMA 560
+#: joint 1: B = 1.48e-3, Tc+ = 0.395, Tc- = -0.435) and 3 (free parameters), symmetric on link 2
+ASYMMETRIC_FRICTION = Path(__file__).resolve().parent / "data" / "good" / "asymmetric_friction.yaml"
+#: values of its free parameters, in `robot.params` order (m3, b3, cp3, cm3)
+ASYMMETRIC_PARAMS = {"m3": 0.8, "b3": 0.05, "cp3": 0.2, "cm3": 0.25}
+
+
+@cache
+def asymmetric_friction() -> Robot:
+    """tests/data/good/asymmetric_friction.yaml through the loader."""
+    return load_robot(ASYMMETRIC_FRICTION)
+
+
+def friction_closed_form(qd) -> np.ndarray:
+    """F(qd) of `asymmetric_friction` at ASYMMETRIC_PARAMS written out by hand from its file:
+    b qd + c+ for qd > 0, b qd - c- for qd < 0, 0 at rest (link 2: 0.2 qd + 0.3 sign(qd))."""
+    qd = np.asarray(qd, dtype=float)
+
+    def one(b, cp, cm, x):
+        return b * x + np.where(x > 0, cp, 0.0) - np.where(x < 0, cm, 0.0)
+
+    return np.stack(
+        [
+            one(1.48e-3, 0.395, 0.435, qd[..., 0]),
+            one(0.2, 0.3, 0.3, qd[..., 1]),
+            one(0.05, 0.2, 0.25, qd[..., 2]),
+        ],
+        axis=-1,
+    )
+
+
+def friction_states(seed: int = 7):
+    """(q, qd, qdd, tau), 9 states of the 3-joint arm whose rates take every sign on every joint,
+    exactly 0 included (both branches of the Coulomb term and its value at rest)."""
+    rng = np.random.default_rng(seed)
+    signs = np.array([[1, 1, 1], [-1, -1, -1], [0, 0, 0], [1, -1, 0], [-1, 0, 1], [0, 1, -1],
+                      [1, 0, -1], [-1, 1, 0], [0, -1, 1]], dtype=float)  # fmt: skip
+    qd = signs * rng.uniform(0.2, 2.0, signs.shape)
+    q = rng.uniform(-np.pi, np.pi, signs.shape)
+    qdd = rng.uniform(-2, 2, signs.shape)
+    tau = rng.uniform(-3, 3, signs.shape)
+    return q, qd, qdd, tau

@@ -14,10 +14,13 @@ import pytest
 import sympy as sp
 from hypothesis import assume, given
 from hypothesis import strategies as st
+from robots import raw_example
+from timebound import within
 
-from symdyn.errors import SymdynWarning
+from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.model.angles import LARGEST, SNAP_TOLERANCE, WARN_TOLERANCE, snap_angle
 from symdyn.model.expressions import parse_expression
+from symdyn.parsers import robot_from_data
 
 HALF_PI = math.pi / 2
 
@@ -158,3 +161,43 @@ def test_the_rule_against_exact_arithmetic(k, offset):
     else:
         assert out == sp.Float(x)
         assert len(warned) == (1 if kk != 0 and distance <= WARN_TOLERANCE else 0)
+
+
+@pytest.mark.parametrize(
+    "text, double",
+    [
+        ("pi/2*pi/2", math.pi**2 / 4),
+        ("sqrt(2)", math.sqrt(2)),
+        ("sin(1)", math.sin(1)),
+        ("0.3*pi", 0.3 * math.pi),
+        ("pi + 0.25", math.pi + 0.25),
+    ],
+)
+def test_constants_that_sympy_cannot_simplify_become_doubles(text, double):
+    """cos(pi**2/4) would stay a symbol in every product of the derivation; the double does not."""
+    out, warned = snap(parse_expression(text))
+    assert out.is_Float and float(out) == pytest.approx(double, rel=1e-15) and not warned
+
+
+def test_a_constant_near_a_right_angle_snaps_like_a_decimal():
+    assert snap(parse_expression("0.5*pi"))[0] == sp.pi / 2
+    assert snap(parse_expression("pi*(1/2 + 1e-12)"))[0] == sp.pi / 2
+
+
+def test_a_constant_angle_that_is_not_a_finite_real_number_is_refused():
+    with pytest.raises(
+        SymdynError, match=r"f.yaml: link 2 \(a\): field 'alpha': angle .* not a finite real number"
+    ):
+        snap_angle(sp.sqrt(-2) + 1, file="f.yaml", link_index=2, link_name="a", field="alpha")
+
+
+def test_the_panda_with_a_twist_of_pi_squared_over_4_is_the_panda_with_its_double():
+    """examples/panda.yaml with link 4's alpha written "pi/2*pi/2" ran past 120 s; now it is the
+    robot with that twist written as the double pi**2/4 (2.4674011002723395)."""
+    data = raw_example("panda")
+    data["links"][3]["alpha"] = "pi/2*pi/2"
+    with within(20):
+        robot = robot_from_data(data, "panda")
+    data["links"][3]["alpha"] = math.pi**2 / 4
+    assert robot.links[3].frame == robot_from_data(data, "panda").links[3].frame
+    assert not any(link.frame.R.has(sp.pi**2) for link in robot.links)

@@ -1,6 +1,6 @@
 """Base parameters (symdyn.algorithms.base_parameters, `Dynamics.base_parameters`), judged independently.
 
-The oracle's numeric regressor (symdyn.rnea_regressor), stacked at random states other than the
+The oracle's numeric regressor (symdyn.oracle.regressor), stacked at random states other than the
 ones the derivation used, must have the rank the base parameters count (SVD rank); the combinations
 K must vanish on its null space (so K pi fixes tau) and be of full rank; Y_b pi_b with pi_b = K pi
 must equal tau of the numeric RNEA; and for the lecture's two-link arm with symbolic lengths the
@@ -19,7 +19,7 @@ import symdyn
 import symdyn.codegen
 from symdyn.errors import SymdynError
 from symdyn.model.parameters import numeric_parameters
-from symdyn.rnea_regressor import regressor as oracle_regressor
+from symdyn.oracle.regressor import regressor as oracle_regressor
 
 STATES = 40
 

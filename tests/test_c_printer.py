@@ -201,3 +201,16 @@ def test_what_cannot_be_printed_is_a_clear_error():
         printer.doprint(sp.exp(x))
     with pytest.raises(AssertionError, match="neither an input nor a temporary"):
         printer.doprint(sp.Symbol("w"))
+
+
+@pytest.mark.parametrize("precision", ["double", "float"])
+def test_heaviside_is_a_comparison(precision, tmp_path):
+    """Heaviside(x, 0) (direction-dependent Coulomb friction) is ((real)(x > 0)) and Heaviside(-x, 0)
+    is ((real)(x < 0)): no branch, 0 at 0."""
+    printer = CPrinter(NAMES, precision)
+    assert printer.doprint(sp.Heaviside(x, 0)) == f"(({precision})(x > 0))"
+    assert printer.doprint(sp.Heaviside(-x, 0)) == f"(({precision})(x < 0))"
+    plus, minus = printer.doprint(sp.Heaviside(x - y, 0)), printer.doprint(sp.Heaviside(y - x, 0))
+    lib = _library([f"out[0] = {plus};", f"out[1] = {minus};"], precision, tmp_path, "heaviside")
+    for a, b in ((-2.0, 0.5), (0.0, 0.0), (3.0, -1.0), (1e-30, 0.0), (0.0, 1e-30)):
+        assert list(_evaluate(lib, [a, b, 0.0], 2, precision)) == [float(a > b), float(a < b)], (a, b)

@@ -60,6 +60,8 @@ def test_inputs_are_vector_elements_and_small_powers_products():
         assert printer.doprint(x**-k) == "1/(" + "*".join(["q[0]"] * k) + ")"
     assert printer.doprint(x ** (MAX_UNROLLED_POWER + 1)) == f"q[0]**{MAX_UNROLLED_POWER + 1}"
     assert printer.doprint(sp.sign(y)) == "ca.sign(p[1])"
+    assert printer.doprint(sp.Heaviside(y, 0)) == "(p[1] > 0)"  # 0 at 0, as casadi 0/1
+    assert printer.doprint(-3 * sp.Heaviside(-y, 0)) == "-3*(p[1] < 0)"
 
 
 def test_literals_round_trip_a_double():

@@ -164,7 +164,7 @@ frames:
 
 @pytest.mark.parametrize("fmt", ["text", "json"])
 def test_frames_print_each_pose_and_jacobian_entry(capsys, tmp_path, fmt):
-    from symdyn.rnea_frames import frame_state
+    from symdyn.oracle.frames import frame_state
 
     path = tmp_path / "framed.yaml"
     path.write_text(FRAMED)

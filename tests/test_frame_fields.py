@@ -11,7 +11,7 @@ from test_frame_kinematics import TOL, urdf_dynamics
 
 import symdyn
 from symdyn.errors import SymdynError
-from symdyn.rnea_frames import frame_state
+from symdyn.oracle.frames import frame_state
 
 
 def test_urdf_keeps_the_frames_of_merged_links():

@@ -1,5 +1,5 @@
 """Frames and task space (symdyn.algorithms.frame_kinematics, .operational_space, Dynamics' frame
-methods) against the numeric oracle symdyn.rnea_frames, Pinocchio, Modern Robotics, finite
+methods) against the numeric oracle symdyn.oracle.frames, Pinocchio, Modern Robotics, finite
 differences and identities."""
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ from scipy.linalg import logm
 
 import symdyn
 from symdyn.errors import SymdynError
+from symdyn.oracle.frames import center_of_mass, frame_state
 from symdyn.regenerate import example_robot_data_folder
-from symdyn.rnea_frames import center_of_mass, frame_state
 
 TOL = 1e-9
 URDFS = {

@@ -17,7 +17,7 @@ from functools import cache
 import numpy as np
 import pytest
 import sympy as sp
-from robots import EXAMPLES_DIR, derived, example
+from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived, derived_robot, example
 
 import symdyn
 from symdyn.apps.excite import excite
@@ -156,3 +156,23 @@ def test_cli_bad_input_exits_1(tmp_path, capsys):
     assert "symdyn: error:" in capsys.readouterr().err
     assert main(["identify", str(EXAMPLES_DIR / "roger_arm.yaml"), str(tmp_path / "x.csv")]) == 1
     assert "free parameters" in capsys.readouterr().err
+
+
+def test_direction_dependent_coulomb_friction_is_identified_per_direction():
+    """With c+ != c- the base parameters hold fcp and fcn of each such joint on their own, and
+    noise-free torques of the oracle at random states (rates of both signs) give back the file's
+    magnitudes: 0.395 and 0.435 (the toolbox's PUMA 560 joint 1), cp3 and cm3, and fc2 = 0.3."""
+    robot = asymmetric_friction().numeric(ASYMMETRIC_PARAMS)
+    dyn = derived_robot(robot, "newton-euler")
+    rng = np.random.default_rng(11)
+    N = 120
+    q, qd, qdd = rng.uniform(-np.pi, np.pi, (N, 3)), rng.uniform(-2, 2, (N, 3)), rng.uniform(-3, 3, (N, 3))
+    data = Measurements(np.arange(N) * 0.01, q, qd, qdd, symdyn.rnea(robot, q, qd, qdd))
+    result = identify(robot, data, dyn.base_parameters)
+    got = dict(zip(result.names, result.estimate, strict=True))
+    want = {"fcp1": 0.395, "fcn1": 0.435, "fc2": 0.3, "fcp3": 0.2, "fcn3": 0.25, "fv1": 1.48e-3}
+    for name, value in want.items():
+        assert dict(dyn.base_parameters)[name] == sp.Symbol(name)  # a base parameter of its own
+        assert got[name] == pytest.approx(value, rel=1e-8), name
+    K = dyn.linear_compact()[1].matrix()
+    np.testing.assert_allclose(result.estimate, K @ numeric_parameters(robot), rtol=1e-8, atol=1e-10)

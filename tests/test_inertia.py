@@ -13,6 +13,7 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from timebound import refused
 
 from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.model.inertia import (
@@ -316,3 +317,30 @@ def test_box_properties(mass, a, b, c, rx, ry, rz):
     Ic = box(mass, a, b, c)
     shift = parallel_axis(Ic, mass, (rx, ry, rz)) - Ic
     assert np.linalg.eigvalsh(shift)[0] >= -1e-12 * max(1.0, np.abs(shift).max())
+
+
+# -- hostile numbers (issue 21): bounded before any eigenvalue is computed
+
+
+@pytest.mark.parametrize("entry", [-1e308, 1e200, 1.7976931348623157e308])
+def test_an_entry_beyond_1e150_is_refused_before_the_eigenvalues(entry):
+    """-1e308 made LinAlgError('Eigenvalues did not converge') escape the loader."""
+    with pytest.raises(
+        SymdynError, match=r"f.yaml: link 1 \(a\): field 'inertia': inertia tensor has an entry of"
+    ):
+        check_inertia(1.0, np.diag([entry, 1.0, 1.0]), file="f.yaml", link_index=1, link_name="a")
+    with pytest.raises(SymdynError, match="field 'mass': mass .* is too large"):
+        check_inertia(abs(entry), np.eye(3), file="f.yaml", link_index=1, link_name="a")
+
+
+def test_an_inertia_entry_of_minus_1e308_in_a_robot_file_exits_1_in_one_line(tmp_path, capsys):
+    path = tmp_path / "huge.yaml"
+    path.write_text(
+        "name: t\nlinks:\n  - name: a\n    joint: revolute\n    mass: 1\n"
+        "    inertia: {ixx: -1e308, iyy: 1, izz: 1}\n"
+    )
+    line = refused(capsys, "derive", path)
+    assert line == (
+        f"symdyn: error: {path}: link 1 (a): field 'inertia.ixx': number -1e+308 is too large "
+        "(more than 1e+150 in absolute value)"
+    )

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 
 import sympy as sp
 
-from symdyn.codegen.latex.notation import LINE_WIDTH, Notation, width
+from symdyn.codegen.latex.notation import LINE_WIDTH, DynamicsLatexPrinter, Notation, width
 
 
 def _notation(n: int) -> Notation:
@@ -67,3 +67,11 @@ def test_long_sums_break_at_top_level_signs():
         "  ", " "
     )
     assert nt.lines(nt.prepare(m1 * q1)) == [nt.latex(nt.prepare(m1 * q1))]
+
+
+def test_heaviside_prints_as_an_iverson_bracket():
+    """Direction-dependent Coulomb friction: H(qd) with H(0) = 0 as [qd > 0], H(-qd) as [qd < 0]."""
+    qd1 = sp.Symbol("qd1")
+    printer = DynamicsLatexPrinter({qd1: r"\dot{q}_{1}"})
+    assert printer.doprint(sp.Heaviside(qd1, 0)) == r"\left[\dot{q}_{1} > 0\right]"
+    assert printer.doprint(sp.Heaviside(-qd1, 0)) == r"\left[\dot{q}_{1} < 0\right]"

@@ -21,13 +21,21 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import sympy as sp
-from robots import derived, example, m1, roger_arm_lecture, roger_eye_lecture
+from robots import (
+    derived,
+    derived_robot,
+    example,
+    m1,
+    roger_arm_lecture,
+    roger_eye_lecture,
+)
 from sympy.printing.latex import LatexPrinter
 
 from symdyn.codegen import latex as latex_backend
 from symdyn.codegen import render as render_targets
 from symdyn.codegen.latex.base_parameters import base_parameters_latex
 from symdyn.dynamics import AUTO_SIMPLIFY_MAX_JOINTS
+from symdyn.parsers import robot_from_data
 
 rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -358,3 +366,28 @@ def test_fragment_compiles(name, tmp_path):
     assert proc.returncode == 0, proc.stdout[-3000:]
     assert (tmp_path / "doc.pdf").stat().st_size > 0
     assert "Undefined control sequence" not in proc.stdout
+
+
+def test_direction_dependent_friction_and_its_base_parameters():
+    """F_1 = 0.00148 qd1 + 0.395 [qd1 > 0] - 0.435 [qd1 < 0] as written in the robot file (a planar
+    two-link arm, to keep the closed forms short), and the Coulomb magnitudes of each direction as
+    base parameters f_{c+,i}, f_{c-,i}."""
+    link = {
+        "joint": "revolute",
+        "a": 0.5,
+        "mass": 1,
+        "com": [-0.25, 0, 0],
+        "inertia": {"ixx": 0.01, "iyy": 0.01, "izz": 0.02},
+    }
+    friction = ({"viscous": 1.48e-3, "coulomb": [0.395, 0.435]}, {"viscous": 0.2, "coulomb": 0.3})
+    data = {
+        "name": "two",
+        "links": [dict(link, name=f"l{i + 1}", friction=f) for i, f in enumerate(friction)],
+    }
+    dyn = derived_robot(robot_from_data(data), "newton-euler", None)
+    tex = latex_backend.latex_document_body(dyn) + base_parameters_latex(dyn)
+    coulomb = r"0.435 \left[\dot{q}_{1} < 0\right] + 0.395 \left[\dot{q}_{1} > 0\right]"
+    assert r"0.00148 \dot{q}_{1} - " + coulomb in tex
+    assert r"0.3 \operatorname{sgn}(\dot{q}_{2})" in tex
+    for name in ("f_{c+,1}", "f_{c-,1}", "f_{c,2}"):
+        assert f"= {name} &= {name}" in tex, name

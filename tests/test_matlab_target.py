@@ -13,6 +13,7 @@ and names MATLAB cannot take are refused.
 
 from __future__ import annotations
 
+import importlib
 import importlib.util
 import re
 import shutil
@@ -24,13 +25,25 @@ import numpy as np
 import pytest
 import sympy as sp
 from cbuild import build_dynamics, compilers
-from robots import assert_close, example, random_params, random_state
+from robots import (
+    ASYMMETRIC_PARAMS,
+    assert_close,
+    asymmetric_friction,
+    example,
+    friction_closed_form,
+    friction_states,
+    random_params,
+    random_state,
+)
 
 from symdyn.codegen import context, render
 from symdyn.codegen.matlab import MatlabPrinter
 from symdyn.codegen.render import header_lines
 from symdyn.errors import SymdynError
+from symdyn.oracle.regressor import regressor
 from symdyn.parsers import robot_from_data
+
+rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 
 ROBOTS = ("roger_arm", "puma560", "planar_prismatic_modified", "mr_ur5", "scara")
 STATES = 3
@@ -211,3 +224,47 @@ def test_a_parameter_named_like_a_matlab_word_is_renamed():
     assert re.search(r"^end_ = p\(1\);$", text, re.MULTILINE) and re.search(
         r"^zeros_ = p\(2\);$", text, re.MULTILINE
     )
+
+
+def test_direction_dependent_friction_in_octave(tmp_path):
+    """double(qd > 0) and double(qd < 0) in Octave: friction, inverse and forward dynamics and the
+    regressor equal the oracle (friction the hand-written closed form) at rates of both signs and 0."""
+    robot = asymmetric_friction()
+    for file, text in render(robot, targets=("matlab",)).items():
+        (tmp_path / file).write_text(text)
+    p = [ASYMMETRIC_PARAMS[str(s)] for s in robot.params]
+    states = list(zip(*friction_states(), strict=True))
+    calls = {
+        "friction": lambda q, qd, qdd, tau: (qd, p),
+        "inverse_dynamics": lambda q, qd, qdd, tau: (q, qd, qdd, p),
+        "forward_dynamics": lambda q, qd, qdd, tau: (q, qd, tau, p),
+        "regressor": lambda q, qd, qdd, tau: (q, qd, qdd, p),
+    }
+    lines = ["1;", f"addpath('{tmp_path}');"]
+    for s, state in enumerate(states):
+        for fname, args in calls.items():
+            call = f"{robot.name}_{fname}({', '.join(_numbers(a) for a in args(*state))})"
+            lines.append(f"o = {call}; fprintf('@ {fname} {s}'); fprintf(' %.17g', o.'); fprintf('\\n');")
+    (tmp_path / "run.m").write_text("\n".join(lines) + "\n")
+    done = subprocess.run(
+        [OCTAVE, "--no-gui", "--quiet", "--norc", "--no-history", str(tmp_path / "run.m")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=tmp_path,
+    )
+    got = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("@ "):
+            _, fname, s, *nums = line.split()
+            got[(fname, int(s))] = np.array([float(x) for x in nums])
+    assert len(got) == len(states) * len(calls), done.stdout[-2000:] + done.stderr[-2000:]
+    for s, (q, qd, qdd, tau) in enumerate(states):
+        want = {
+            "friction": friction_closed_form(qd),
+            "inverse_dynamics": rn.rnea(robot, q, qd, qdd, ASYMMETRIC_PARAMS),
+            "forward_dynamics": rn.forward_dynamics(robot, q, qd, tau, ASYMMETRIC_PARAMS),
+            "regressor": regressor(robot, q, qd, qdd, ASYMMETRIC_PARAMS),
+        }
+        for fname, w in want.items():
+            assert_close(got[(fname, s)], np.ravel(w), 1e-10, f"{fname} at state {s}")

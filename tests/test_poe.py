@@ -422,3 +422,15 @@ def test_ur5_answers_are_modern_robotics_numbers_and_check_confirms_them():
         check_answers(robot, {**data, "at": {**data["at"], "m9": 1.0}})
     with pytest.raises(SymdynError, match="checked symbolically"):
         check_answers(robot, {**data, "steps": {1: {"omega": [0, 0, "qd1"]}}})
+
+
+@pytest.mark.parametrize("bad", [np.inf, np.nan, 1e308, -1e200])
+def test_robot_from_poe_refuses_numbers_that_are_not_finite_or_beyond_1e150(bad):
+    """A NaN or an infinity in M raised ValueError from deep inside; 1e308 is out of range."""
+    M = [np.eye(4), np.eye(4)]
+    M[0][0, 3] = bad
+    S = np.array([[0, 0, 1, 0, 0, 0]]).T
+    with pytest.raises(SymdynError, match=r"robot_from_poe: Mlist\[0\] .*(not finite|more than 1e\+150)"):
+        robot_from_poe(M, [np.eye(6)], S)
+    with pytest.raises(SymdynError, match=r"robot_from_poe: Glist\[0\] .*(not finite|more than 1e\+150)"):
+        robot_from_poe([np.eye(4), np.eye(4)], [np.diag([bad, 1, 1, 1, 1, 1])], S)

@@ -57,6 +57,8 @@ def test_literals_round_trip_a_double():
         assert float(printer.doprint(sp.Float(v))) == v
     assert float(printer.doprint(sp.Rational(2, 7))) == 2 / 7
     assert printer.doprint(sp.sign(y)) == "np.sign(y)"  # sign(0) = 0 as in SymPy
+    assert printer.doprint(sp.Heaviside(y, 0)) == "np.heaviside(y, 0.0)"  # 0 at 0
+    assert printer.doprint(sp.Heaviside(-y, 0)) == "np.heaviside(-y, 0.0)"
 
 
 def test_parameter_names_that_clash_in_python(tmp_path):

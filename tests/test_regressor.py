@@ -1,7 +1,7 @@
 """The symbolic regressor (symdyn.algorithms.regressor, `Dynamics.regressor`), judged by independent routes.
 
 At random states the compact Y of the derivation (over its intermediates) must equal the oracle's
-numeric regressor symdyn.rnea_regressor entry by entry and give Y pi = tau of the numeric RNEA
+numeric regressor symdyn.oracle.regressor entry by entry and give Y pi = tau of the numeric RNEA
 symdyn.rnea (friction and rotor inertia included) with pi the standard parameters, to 1e-10
 relative: every example robot (standard and modified DH, prismatic joints, free parameters),
 random DH and general robots, URDF files, trees and mimic joints. On the two-link arm of the
@@ -18,12 +18,15 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings
 from robots import (
+    ASYMMETRIC_PARAMS,
     EXAMPLE_NAMES,
     assert_close,
+    asymmetric_friction,
     build_robot,
     derived,
     derived_robot,
     example,
+    friction_states,
     random_params,
     random_state,
     robot_specs,
@@ -34,7 +37,7 @@ from robots import (
 import symdyn
 from symdyn.model.parameters import numeric_parameters, standard_parameters
 from symdyn.model.robot import Mimic
-from symdyn.rnea_regressor import regressor as oracle_regressor
+from symdyn.oracle.regressor import regressor as oracle_regressor
 
 URDF_DIR = Path(__file__).resolve().parent / "data" / "urdf"
 URDFS = ("axes", "branch", "cartesian", "fixed_offset", "rpy_chain", "tree", "two_link")
@@ -105,3 +108,19 @@ def test_regressor_does_not_depend_on_the_inertial_values():
     heavier = replace(robot, links=tuple(replace(lk, mass=2 * lk.mass) for lk in robot.links))
     a = derived("planar_3r", "newton-euler").regressor
     assert sp.simplify(a - symdyn.derive(heavier, simplify=False).regressor) == sp.zeros(*a.shape)
+
+
+def test_direction_dependent_coulomb_friction():
+    """Two Coulomb columns per joint with c+ and c- (fcp, and fcn after the 13 nb others): the
+    compact Y equals the oracle's regressor and Y pi the oracle's tau at rates of both signs and 0."""
+    robot = asymmetric_friction()
+    dyn = derived_robot(robot, "newton-euler")
+    f = compact_function(dyn)
+    pi = numeric_parameters(robot, ASYMMETRIC_PARAMS)
+    p = [ASYMMETRIC_PARAMS[str(s)] for s in dyn.params]
+    assert standard_parameters(robot)[0][39:] == ("fcn1", "fcn3")
+    for q, qd, qdd, _ in zip(*friction_states(), strict=True):
+        Y = np.asarray(f(q, qd, qdd, p), dtype=float)
+        assert Y.shape == (3, 41)
+        assert_close(Y, oracle_regressor(robot, q, qd, qdd, ASYMMETRIC_PARAMS), RTOL, robot.name)
+        assert_close(Y @ pi, symdyn.rnea(robot, q, qd, qdd, ASYMMETRIC_PARAMS), RTOL, robot.name)

@@ -1,7 +1,7 @@
 """The generated regressor and base_regressor (symdyn.codegen.regressor_functions) in C, NumPy and CasADi.
 
 Compiled C (warnings as errors) called through ctypes, the NumPy module (one state and a batch) and
-the CasADi functions must equal the oracle's numeric regressor symdyn.rnea_regressor (Y, and its
+the CasADi functions must equal the oracle's numeric regressor symdyn.oracle.regressor (Y, and its
 columns of the base parameters for Y_b), and Y_b pi_b with pi_b = K pi must equal tau of the numeric
 RNEA, on a robot with a prismatic joint (SCARA), a tree with a mimic joint and a robot with free
 parameters. The C header defines NAME_NSTD and NAME_NBASE and names every column.
@@ -22,7 +22,7 @@ import symdyn
 from symdyn.codegen import render
 from symdyn.model.parameters import numeric_parameters
 from symdyn.model.robot import Mimic
-from symdyn.rnea_regressor import regressor as oracle_regressor
+from symdyn.oracle.regressor import regressor as oracle_regressor
 
 TOL = 1e-10
 

@@ -7,6 +7,7 @@ import hashlib
 import importlib
 import json
 import math
+import re
 import warnings
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 import sympy as sp
 import yaml
+from timebound import refused
 
 import symdyn.codegen
 from symdyn.apps.compiled import CompiledDynamics
@@ -318,6 +320,10 @@ BAD_FILES = {
     "negative_mass_param.yaml": (2, "elbow", "mass", "negative"),
     "non_psd_inertia.yaml": (2, "elbow", "inertia", "not positive semi-definite"),
     "negative_friction.yaml": (2, "elbow", "friction.viscous", "negative"),
+    "negative_coulomb_minus.yaml": (2, "elbow", "friction.coulomb.minus", "Tc- without its sign"),
+    "negative_coulomb_plus.yaml": (2, "elbow", "friction.coulomb.plus", "negative"),
+    "coulomb_length.yaml": (2, "elbow", "friction.coulomb", "[c_plus, c_minus]"),
+    "coulomb_not_number.yaml": (2, "elbow", "friction.coulomb.minus", "boolean"),
     "negative_motor_inertia.yaml": (2, "elbow", "motor.inertia", "negative"),
     "zero_gear_ratio.yaml": (2, "elbow", "motor.gear_ratio", "zero"),
     "reserved_name_in_expression.yaml": (2, "elbow", "a", "reserved for joint symbols"),
@@ -705,3 +711,70 @@ def _load_data(data):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         return robot_from_data(data, "data")
+
+
+def test_direction_dependent_coulomb_friction_is_read_as_written():
+    """coulomb: [c_plus, c_minus] keeps both magnitudes, expressions included; one number stays
+    symmetric (no second magnitude); the order of first appearance covers the list's names."""
+    data = yaml.safe_load((GOOD / "asymmetric_friction.yaml").read_text())
+    robot = _load("asymmetric_friction.yaml")
+    f1, f2, f3 = (link.friction for link in robot.links)
+    want = data["links"][0]["friction"]
+    assert (f1.viscous, f1.coulomb, f1.coulomb_minus) == (
+        sp.Float(want["viscous"]),
+        sp.Float(want["coulomb"][0]),
+        sp.Float(want["coulomb"][1]),
+    )
+    assert f1.asymmetric and f3.asymmetric and not f2.asymmetric
+    assert (f2.coulomb, f2.coulomb_minus) == (sp.Float(0.3), None)
+    assert (f3.viscous, f3.coulomb, f3.coulomb_minus) == sp.symbols("b3 cp3 cm3")
+    assert robot.params == sp.symbols("m3 b3 cp3 cm3")
+
+
+def test_a_negative_coulomb_magnitude_from_a_parameter_value_is_refused():
+    data = yaml.safe_load((GOOD / "asymmetric_friction.yaml").read_text())
+    data["parameters"] = {"cm3": "-2*cp3", "cp3": 0.1}
+    with pytest.raises(SymdynError) as info:
+        robot_from_data(data, "arm.yaml")
+    err = info.value
+    assert (err.link_index, err.link_name, err.field) == (3, "wrist", "friction.coulomb.minus")
+    assert "must not be negative (got -0.2)" in str(err) and "\n" not in str(err)
+
+
+# -- hostile input: powers completed by parameter values, constant angles (issue 21)
+
+
+@pytest.mark.parametrize(
+    "parameters, mass, message",
+    [
+        ({}, "((((x+1)**64)**64)**64)", r"field 'mass': exponent 262144 of '\(x \+ 1\)\*\*262144'"),
+        ({"x": 3}, "(((((x**64)**64)**64)**64)**64)", "field 'mass': exponent 1073741824"),
+        ({"e": "9**9"}, "m*b**e", r"field 'mass': exponent 387420489 in 'b\*\*e' is larger than 64"),
+        (
+            {"a1": 3, "a2": "a1**64", "a3": "a2**64"},
+            "a3",
+            r"field 'parameters.a3': number 'a2\*\*64' is too large",
+        ),
+        ({"a1": "y**8", "a2": "a1**8", "a3": "a2**8"}, "a3", r"field 'parameters.a3': exponent 512"),
+    ],
+)
+def test_powers_merged_or_completed_by_values_are_refused_quickly(
+    tmp_path, capsys, parameters, mass, message
+):
+    """The command exits 1 with one line within 10 s (before: it hung in SymPy)."""
+    data = _one_link(mass=mass)
+    data["parameters"] = parameters
+    path = tmp_path / "tower.yaml"
+    path.write_text(yaml.safe_dump(data))
+    line = refused(capsys, "derive", path)
+    assert re.search(message, line), line
+
+
+def test_an_angle_that_a_parameter_makes_constant_is_evaluated_to_a_double():
+    """alpha: x with x: pi*pi/4 is used as the double nearest to pi**2/4, like alpha: pi/2*pi/2."""
+    data = _one_link(alpha="x")
+    data["parameters"] = {"x": "pi*pi/4"}
+    via_parameter = robot_from_data(data, "data")
+    written = robot_from_data(_one_link(alpha=2.4674011002723395), "data")
+    assert via_parameter.links[1].frame.R == written.links[1].frame.R
+    assert not via_parameter.resolved().links[1].frame.R.has(sp.pi)

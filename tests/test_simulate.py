@@ -182,8 +182,32 @@ def test_bad_input(roger):
         simulate(load_robot(EXAMPLES / "roger_arm.yaml"), Q0, QD0, duration=0.1, dt=1e-2)
 
 
+def test_step_count_and_time_expressions_are_checked(roger):
+    """dt = 5e-324 made duration / dt infinite (OverflowError); 1/t raised ZeroDivisionError."""
+    with pytest.raises(SymdynError, match="too many"):
+        simulate(roger, Q0, QD0, duration=1.0, dt=5e-324)
+    for bad in (float("nan"), float("inf"), -1.0, 0, True, "0.1"):
+        with pytest.raises(SymdynError, match="dt must be a positive number"):
+            simulate(roger, Q0, QD0, duration=0.1, dt=bad)
+        with pytest.raises(SymdynError, match="duration must be a positive number"):
+            simulate(roger, Q0, QD0, duration=bad, dt=0.01)
+    with pytest.raises(SymdynError, match=r"tau\[2\] = 1/t is not a finite real number at t = 0 s"):
+        simulate(roger, Q0, QD0, duration=0.1, dt=0.01, tau=["0", "1/t"])
+    with pytest.raises(
+        SymdynError, match=r"tau\[1\] = sqrt\(t - 0.05\) is not a finite real number at t = 0 s"
+    ):
+        simulate(roger, Q0, QD0, duration=0.1, dt=0.01, tau=["sqrt(t - 0.05)", "0"])
+    # a finite expression of t is evaluated as before: tau = sqrt(t) against the oracle's step
+    good = simulate(roger, Q0, QD0, duration=0.02, dt=0.01, tau=["sqrt(t)", "0"], integrator="euler")
+    qdd = rn.forward_dynamics(roger, Q0, QD0, np.array([0.0, 0.0]))
+    np.testing.assert_allclose(good.qd[1], QD0 + 0.01 * qdd, rtol=1e-12)
+
+
 def test_divergence_is_an_error(roger):
     with pytest.raises(SymdynError, match="diverged"):
+        # 1e150 N m: the largest number an expression may hold (symdyn.model.bounded)
+        simulate(roger, Q0, QD0, duration=2.0, dt=0.5, tau=["1e150", "0"], integrator="euler")
+    with pytest.raises(SymdynError, match=r"field 'tau\[1\]': number 1e\+300 is too large"):
         simulate(roger, Q0, QD0, duration=1.0, dt=0.5, tau=["1e300", "0"], integrator="euler")
 
 
@@ -283,6 +307,22 @@ def test_cli_free_parameters_via_params(tmp_path, monkeypatch):
         (["--q0", "1", "2", "--integrator", "lecture", "--tau", "0", "0", "--track", "t", "t"], "exclude"),
         (["--q0", "1", "2", "--kp", "5"], "--track only"),
         (["--q0", "1", "2", "--plot", "x.gif"], "not supported"),
+        # hostile input (issue 21): no traceback, one line, nothing written
+        (["--dt", "5e-324"], "is inf steps, too many (at most 10000000)"),
+        (["--dt", "1e-300", "--duration", "1e300"], "is inf steps, too many"),
+        (["--dt", "1e-10"], "too many (at most 10000000)"),
+        (["--track", "1/t", "0"], "reference[1] = 1/t is not a finite real number at t = 0 s"),
+        (
+            ["--track", "0", "sqrt(t - 1)"],
+            "reference[2] = sqrt(t - 1) is not a finite real number at t = 0 s",
+        ),
+        (["--track", "t**t**t", "0"], "d/dt reference[1] = "),
+        (
+            ["--tau", "1/(t - 0.005)", "0"],
+            "tau[1] = 1/(t - 0.005) is not a finite real number at t = 0.005 s",
+        ),
+        (["--params", "m1=-1"], "parameter m1 = -1: link 1 (upper_arm): field 'mass': mass -1.0 is negative"),
+        (["--params", "m2=-1e-300"], "parameter m2 = -1e-300: link 2 (forearm): field 'mass'"),
     ],
 )
 def test_cli_bad_input_one_line_no_output(extra, message, tmp_path, monkeypatch, capsys):

@@ -1,7 +1,7 @@
 """The derivation step by step (symdyn.apps.steps, `symdyn derive --steps`, `symdyn check` steps).
 
 Expected values come from an independent route: the numeric oracle's spatial recursion
-(Featherstone's spatial vectors at the body origin, symdyn.rnea_spatial) rerun here so that
+(Featherstone's spatial vectors at the body origin, symdyn.oracle.spatial) rerun here so that
 its per-link velocities, accelerations and transmitted forces can be read, the oracle's
 energies (symdyn.rnea.kinetic_energy, potential_energy) and mass matrix, and Craig's closed
 forms for his two-link arm (examples/answers/craig_two_link_answers.yaml, transcribed from
@@ -23,8 +23,8 @@ from symdyn.apps.check import check_answers
 from symdyn.apps.steps import derivation_steps
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError
-from symdyn.rnea_inputs import numeric_model
-from symdyn.rnea_spatial import crm, joint_poses, motion_transforms, mv, subspaces
+from symdyn.oracle.inputs import numeric_model
+from symdyn.oracle.spatial import crm, joint_poses, motion_transforms, mv, subspaces
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 ROBOTS = ("craig_two_link_values", "planar_prismatic_modified", "puma560", "mr_ur5", "scara")

@@ -26,6 +26,7 @@ import pytest
 import sympy as sp
 from cbuild import build_dynamics, compilers
 from robots import assert_close, mat, random_state, rpy, rx, ry, rz, vec
+from timebound import refused
 
 import symdyn.codegen
 from symdyn import inertia as si
@@ -1005,3 +1006,31 @@ def test_real_robot_generated_c_matches_rnea(name, tmp_path, rng):
         assert_close(lib.inverse_dynamics(q, qd, qdd), rnea(robot, q, qd, qdd))
         assert_close(lib.mass_matrix(q), mass_matrix(robot, q))
         assert_close(lib.gravity(q), gravity_torque(robot, q))
+
+
+# -- hostile numbers (issue 21): read as doubles, finite, at most 1e150
+
+
+def _two_link_with(tmp_path, old: str, new: str) -> Path:
+    path = tmp_path / "numbers.urdf"
+    text = (DATA / "two_link.urdf").read_text()
+    assert old in text
+    path.write_text(text.replace(old, new))
+    return path
+
+
+def test_a_number_with_thousands_of_digits_is_read_as_its_double(tmp_path):
+    """Kept at the text's precision, 3,000 digits made `--target latex` run for minutes."""
+    digits = "2." + "3" * 3000
+    robot = load_urdf(_two_link_with(tmp_path, 'value="2.0"', f'value="{digits}"'))
+    mass = robot.links[0].mass
+    assert mass.is_Float and mass._prec == 53 and float(mass) == float(digits) == 7 / 3
+
+
+@pytest.mark.parametrize("value", ["1e308", "-1e151", "1e400", "-" + "9" * 400])
+def test_numbers_beyond_1e150_or_not_finite_are_refused_in_one_line(tmp_path, capsys, value):
+    path = _two_link_with(tmp_path, 'izz="0.04"', f'izz="{value}"')
+    line = refused(capsys, "generate", path, "--target", "latex", "--out", tmp_path / "out", seconds=10)
+    assert f"{path}: link 2 (upper): field 'inertial.inertia.izz': " in line
+    assert "is too large (more than 1e+150 in absolute value)" in line or "is not a finite number" in line
+    assert not (tmp_path / "out").exists()

@@ -122,6 +122,8 @@ def _value(e: sp.Expr, values: dict, memo: dict, count: int):
         out = np.cos(args[0])
     elif isinstance(e, sp.sign):
         out = np.sign(args[0])
+    elif isinstance(e, sp.Heaviside):
+        out = np.heaviside(args[0], args[1])
     else:
         out = (
             float(e)

@@ -24,10 +24,13 @@ and the columns of row j for body i are, with u = s_w x w_i,
 
 (Atkeson, An and Hollerbach, "Estimation of inertial parameters of manipulator loads and links",
 1986; Khalil and Dombre, Modeling, Identification and Control of Robots (2002), ch. 9). The joint's
-own columns are qdd_j (rotor), qd_j (viscous) and sign(qd_j) (Coulomb) on its row. Only one motion
+own columns are qdd_j (rotor), qd_j (viscous) and sign(qd_j) (Coulomb) on its row; with
+direction-dependent Coulomb friction H(qd_j) (c+) there and -H(-qd_j) (c-) in the column of fcn_j,
+after the 13 nb others (symdyn.model.parameters; H(0) = 0). Only one motion
 vector per pair (j, i) is carried, never the ten wrench columns, and exact zeros fold away, so a
 chain costs O(n^2) small products. Mimic joints: the recursion runs on the nb bodies at q_b, S qd,
-S qdd and the rows are projected, Y = S^T Y_b (symdyn.algorithms.coordinates), so Y is n x 13 nb.
+S qdd and the rows are projected, Y = S^T Y_b (symdyn.algorithms.coordinates), so Y is n x 13 nb
+(plus one column per link with direction-dependent Coulomb friction).
 """
 
 from __future__ import annotations
@@ -36,7 +39,7 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-from ..model.parameters import PER_BODY
+from ..model.parameters import PER_BODY, asymmetric_bodies
 from ..model.robot import Robot
 from ..spatial import vectors as v3
 from ..spatial.motion import Motion, motion_subspace
@@ -85,7 +88,8 @@ def body_regressor(
     program: Program,
     rotations: list[JointFrame] | None = None,
 ) -> list[list[sp.Expr]]:
-    """Y_b (nb x 13 nb) with tau_b = Y_b pi: the bodies' joint efforts, rotor and friction included.
+    """Y_b (nb x 13 nb, + fcn columns) with tau_b = Y_b pi: the bodies' joint efforts, rotor and
+    friction included.
 
     Args:
         robot: the model, nb bodies in a tree (parents first).
@@ -109,7 +113,8 @@ def body_regressor(
         parent, W_parent = (base, v3.ZERO33) if p < 0 else (motions[p], Ws[p])
         motions.append(outward(link, frames[i], parent, W_parent, qd_b[i], qdd_b[i], program, k))
         Ws.append(tilde(program, motions[i].w, motions[i].wd, k))
-    Y: list[list[sp.Expr]] = [[sp.S.Zero] * (PER_BODY * nb) for _ in range(nb)]
+    extra = {i: PER_BODY * nb + k for k, i in enumerate(asymmetric_bodies(robot))}
+    Y: list[list[sp.Expr]] = [[sp.S.Zero] * (PER_BODY * nb + len(extra)) for _ in range(nb)]
     for j, link in enumerate(robot.links):
         carried = {j: motion_subspace(link.joint, link.axis)}  # joint j's unit motion, frame i
         for i in range(j, nb):
@@ -119,12 +124,16 @@ def body_regressor(
                 carried[i] = _to_child(frames[i], carried[parents[i]], program, f"s{j + 1}_{i + 1}_")
             cols = _inertial_columns(carried[i], motions[i], Ws[i])
             Y[j][PER_BODY * i : PER_BODY * i + 10] = [program.let(c, f"Y{j + 1}_") for c in cols]
-        Y[j][PER_BODY * j + 10 : PER_BODY * j + 13] = [sp.sympify(qdd_b[j]), qd_b[j], sp.sign(qd_b[j])]
+        coulomb = link.friction.coulomb_columns(qd_b[j])
+        Y[j][PER_BODY * j + 10 : PER_BODY * j + 13] = [sp.sympify(qdd_b[j]), qd_b[j], coulomb[0]]
+        if j in extra:
+            Y[j][extra[j]] = coulomb[1]
     return Y
 
 
 def regressor(robot: Robot, q: Sequence, qd: Sequence, qdd: Sequence, program: Program) -> sp.Matrix:
-    """The regressor Y(q, qd, qdd), n x 13 nb, with tau = Y pi (joint space; see the module docstring).
+    """The regressor Y(q, qd, qdd), n x 13 nb (+ fcn columns), with tau = Y pi (joint space; see
+    the module docstring).
 
     Args:
         robot: the model (parameters with values substituted: `Robot.resolved`).
@@ -137,7 +146,5 @@ def regressor(robot: Robot, q: Sequence, qd: Sequence, qdd: Sequence, program: P
     """
     q_b, qd_b, qdd_b = robot.body_positions(list(q)), robot.body_rates(list(qd)), robot.body_rates(list(qdd))
     Y_b = body_regressor(robot, q_b, qd_b, qdd_b, program)
-    columns = [
-        project_vector(robot, [row[c] for row in Y_b], program, "Y") for c in range(PER_BODY * robot.nb)
-    ]
+    columns = [project_vector(robot, [row[c] for row in Y_b], program, "Y") for c in range(len(Y_b[0]))]
     return sp.Matrix(robot.n, len(columns), lambda r, c: columns[c][r])

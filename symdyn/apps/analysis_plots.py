@@ -75,7 +75,7 @@ def _draw_shapes(ax, a: Analysis, origin=(0.0, 0.0), scale: float = 1.0, swap=Fa
 
 def _gravity_layout(robot: Robot, axes: tuple[str, ...], params=None) -> tuple[bool, bool, bool]:
     """(swap, invert vertical, invert horizontal) so that gravity points down on the page."""
-    from ..rnea import numeric_model
+    from ..oracle.inputs import numeric_model
 
     g = numeric_model(robot, robot.param_values(params) if robot.params else None).gravity
     idx = [TASK_AXES.index(a) for a in axes]

@@ -15,13 +15,18 @@ the files the caller names as the ones it will load (all of them unless told), a
 library it loads, not the generated sources it never reads). Anything else (a truncated
 file, a foreign or hand-edited folder) is removed and rebuilt; a file found corrupt by
 `Entry.file` removes the entry and raises `CorruptEntryError`, on which the caller rebuilds.
-An entry is built in a private staging folder under the root and published by one
-rename, so a reader never sees half an entry, and two processes building the same entry
-both end with a complete one (the loser of the rename uses the winner's after verifying it).
+An entry is built in a private staging folder under the root (`.build-PID-XXXXXXXX`) and
+published by one rename, so a reader never sees half an entry, and two processes building the
+same entry both end with a complete one (the loser of the rename uses the winner's after
+verifying it). A build removes the staging folders that runs killed mid-build left, once stale
+(symdyn.leftovers: their process gone, or older than an hour); `usage` counts them.
+A cache folder that cannot be written (read-only, full) raises SymdynError naming it and
+$SYMDYN_CACHE_DIR, never a raw OSError.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -33,6 +38,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import SymdynError
+from ..leftovers import is_stale, remove
 
 __all__ = [
     "CACHE_ENV",
@@ -44,6 +50,7 @@ __all__ = [
     "get_or_build",
     "clear",
     "usage",
+    "leftovers",
 ]
 
 #: The environment variable that relocates the cache.
@@ -195,15 +202,50 @@ def get_or_build(key: str, build: Callable[[Path], dict]) -> Entry:
     """The entry for `key`, built first when missing or corrupt.
 
     build(folder) writes the entry's files into `folder` and returns its metadata (JSON-ready).
+
+    Raises:
+        SymdynError: the cache folder cannot be written (its OSError, said in one line).
     """
     entry = lookup(key)
     if entry is not None:
         return entry
+    try:
+        return _build_entry(key, build)
+    except OSError as e:
+        raise SymdynError(
+            f"the symdyn cache at {cache_dir()} cannot be written ({e.strerror or e}"
+            f"{': ' + str(e.filename) if e.filename else ''}); make it writable, or point ${CACHE_ENV} "
+            "to a writable folder"
+        ) from None
+
+
+def _staging_pid(name: str) -> int | None:
+    """The process that made the staging folder `name` (.build-PID-XXXXXXXX), None when not said."""
+    head = name[len(_STAGING) :].split("-", 1)[0]
+    return int(head) if head.isdigit() and "-" in name[len(_STAGING) :] else None
+
+
+def _staging_folders(layout: Path) -> list[Path]:
+    try:
+        return [p for p in layout.iterdir() if p.name.startswith(_STAGING) and p.is_dir()]
+    except OSError:
+        return []
+
+
+def _sweep(layout: Path) -> None:
+    """Remove the stale staging folders of killed builds (a live build's folder is kept)."""
+    for folder in _staging_folders(layout):
+        if is_stale(folder, _staging_pid(folder.name)):
+            remove(folder)
+
+
+def _build_entry(key: str, build: Callable[[Path], dict]) -> Entry:
     import tempfile
 
     layout = cache_dir() / _LAYOUT
     layout.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=_STAGING, dir=layout))
+    _sweep(layout)
+    staging = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{os.getpid()}-", dir=layout))
     try:
         meta = build(staging)
         files = {p.name: _digest(p) for p in sorted(staging.iterdir())}
@@ -224,8 +266,17 @@ def get_or_build(key: str, build: Callable[[Path], dict]) -> Entry:
         _remove(staging)
 
 
+def _folder_size(folder: Path) -> int:
+    size = 0
+    for dirpath, _, names in os.walk(folder):
+        for name in names:
+            with contextlib.suppress(OSError):  # removed meanwhile
+                size += os.lstat(os.path.join(dirpath, name)).st_size
+    return size
+
+
 def usage() -> tuple[Path, int, int]:
-    """(root folder, number of entries, total bytes) of the cache."""
+    """(root folder, number of entries, total bytes of the entries) of the cache."""
     root = cache_dir()
     layout = root / _LAYOUT
     count = size = 0
@@ -233,18 +284,34 @@ def usage() -> tuple[Path, int, int]:
         for folder in layout.iterdir():
             if folder.is_dir() and not folder.name.startswith(_STAGING):
                 count += 1
-                size += sum(p.stat().st_size for p in folder.iterdir() if p.is_file())
+                size += _folder_size(folder)
     return root, count, size
+
+
+def leftovers() -> tuple[int, int]:
+    """(number, total bytes) of the staging folders in the cache: builds under way, or left by
+    killed ones (removed by the next build once stale, and by `clear`)."""
+    folders = _staging_folders(cache_dir() / _LAYOUT)
+    return len(folders), sum(_folder_size(f) for f in folders)
 
 
 def clear() -> int:
     """Remove every entry (and leftover staging folder); returns how many entries were removed.
 
     Only symdyn's own layout folder is touched, never other files under the root.
+
+    Raises:
+        SymdynError: the cache folder cannot be written.
     """
     layout = cache_dir() / _LAYOUT
     if not layout.is_dir():
         return 0
     count = sum(1 for f in layout.iterdir() if f.is_dir() and not f.name.startswith(_STAGING))
-    _remove(layout)
+    try:
+        shutil.rmtree(layout)
+    except OSError as e:
+        raise SymdynError(
+            f"the symdyn cache at {cache_dir()} cannot be cleared ({e.strerror or e}"
+            f"{': ' + str(e.filename) if e.filename else ''})"
+        ) from None
     return count

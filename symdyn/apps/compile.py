@@ -32,8 +32,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SymdynError, SymdynWarning
+from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
 from . import cache
+from .singular import INVERTING, NotGeneratedError, guarded
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
 
@@ -164,6 +166,10 @@ def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamic
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
+    if robot.params:  # the values pass the robot file's physical checks (mass >= 0, ...)
+        from ..model.physical import check_values
+
+        check_values(robot, robot.param_values(params, "symdyn.compile"), "symdyn.compile")
     from ..codegen.functions import FAMILIES
 
     families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
@@ -227,18 +233,20 @@ class CompiledDynamics:
         if self._library is None:
             _warn_fallback()
             for f in meta["functions"]:
-                setattr(self, f["name"], _numpy_method(self, f["name"]))
+                setattr(self, f["name"], guarded(self, f["name"], _numpy_method(self, f["name"])))
         return self
 
     def __getattr__(self, name: str):
         """The C methods, bound on first use (cffi parses the declarations then: ~0.1 s)."""
         entry = self.__dict__.get("_entry")
+        if entry is not None and name in INVERTING and name not in self.__dict__.get("functions", ()):
+            raise NotGeneratedError(self.robot.name, name)
         if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
             raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
         ffi, lib = _load_library(self._library, entry.meta["functions"])
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
-            setattr(self, f["name"], _c_method(ffi, lib, f, p_ptr))
+            setattr(self, f["name"], guarded(self, f["name"], _c_method(ffi, lib, f, p_ptr)))
         return self.__dict__[name]
 
     @property
@@ -270,11 +278,9 @@ class CompiledDynamics:
             except cache.CorruptEntryError:  # changed since it was built: build the entry again
                 self._entry = self._rebuild()
                 path = self._entry.file(name)
-            module = types.ModuleType(path.stem)
-            module.__file__ = str(path)
-            # symdyn's own output for this robot, verified against the cache manifest's digest
-            exec(compile_source(path), module.__dict__)
-            self._module = module
+            # symdyn's own output for this robot, verified against the cache manifest's digest,
+            # imported from its file (never exec'd from a string)
+            self._module = load_module(path, path.stem)
         return self._module
 
     def derived_entry(self, kind: str, build: Callable) -> cache.Entry:
@@ -294,13 +300,6 @@ class CompiledDynamics:
     def __repr__(self) -> str:
         names = ", ".join(self.functions)
         return f"<CompiledDynamics {self.robot.name}: {self.n} joints, {self.backend}, {names}>"
-
-
-def compile_source(path: Path):
-    """The code object of a generated Python file."""
-    import builtins
-
-    return builtins.compile(path.read_text(encoding="utf-8"), str(path), "exec")
 
 
 def _warn_fallback() -> None:

@@ -50,7 +50,14 @@ class Reference:
         self.exprs = time_expressions(exprs, n, "reference", broadcast=False)
         self.d_exprs = [sp.diff(e, TIME) for e in self.exprs]
         self.dd_exprs = [sp.diff(e, TIME) for e in self.d_exprs]
-        self._f = [lambdify_time(x) for x in (self.exprs, self.d_exprs, self.dd_exprs)]
+        self._f = [
+            lambdify_time(x, what)
+            for x, what in zip(
+                (self.exprs, self.d_exprs, self.dd_exprs),
+                ("reference", "d/dt reference", "d2/dt2 reference"),
+                strict=True,
+            )
+        ]
 
     @property
     def n(self) -> int:

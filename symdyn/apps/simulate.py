@@ -77,6 +77,8 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
+#: The most steps a run may have (its arrays hold MAX_STEPS + 1 states).
+MAX_STEPS = 10_000_000
 #: Runs of at least this many steps show a progress bar by default (when stderr is a terminal).
 PROGRESS_MIN_STEPS = 2000
 
@@ -109,14 +111,37 @@ def time_expressions(values: Sequence, n: int, what: str = "tau", broadcast: boo
     return exprs
 
 
-def lambdify_time(exprs: Sequence[sp.Expr]) -> Callable[[float], np.ndarray]:
-    """A function t -> array (n,) (or (n, len(t)) for an array t) of the parsed expressions."""
+def lambdify_time(exprs: Sequence[sp.Expr], what: str = "tau") -> Callable[[float], np.ndarray]:
+    """A function t -> array (n,) (or (n, len(t)) for an array t) of the parsed expressions.
+
+    Evaluated in floating point (NumPy, warnings silenced): a value that is not a finite real
+    number at some t (1/t at t = 0, sqrt(t - 1) before t = 1, an overflow) raises SymdynError
+    naming `what`[i], the expression and the first such t, instead of a Python exception or
+    NaN entering the simulation.
+    """
     import sympy as sp
 
     funcs = [sp.lambdify(sp.Symbol("t"), e, modules="numpy") for e in exprs]
 
     def f(t):
-        return np.array([np.broadcast_to(np.asarray(g(t), dtype=float), np.shape(t)) for g in funcs])
+        ts = np.asarray(t, dtype=float)
+        rows = []
+        for i, (g, e) in enumerate(zip(funcs, exprs, strict=True), 1):
+            with np.errstate(all="ignore"):
+                try:
+                    v = np.asarray(g(ts))
+                except (ArithmeticError, ValueError, TypeError):  # e.g. 0.0 ** -1 on a Python float
+                    v = np.full(ts.shape, np.nan)
+            if np.iscomplexobj(v):
+                v = np.where(v.imag == 0, v.real, np.nan)
+            v = np.broadcast_to(v.astype(float), ts.shape)
+            bad = ~np.isfinite(v)
+            if bad.any():
+                at = float(ts.flat[np.flatnonzero(bad)[0]]) if ts.ndim else float(ts)
+                text = str(e) if len(str(e)) <= 60 else str(e)[:57] + "..."
+                raise SymdynError(f"{what}[{i}] = {text} is not a finite real number at t = {at:g} s")
+            rows.append(v)
+        return np.array(rows)
 
     return f
 
@@ -340,9 +365,15 @@ def simulate(
             raise SymdynError(f"{name} must be a positive number, got {v!r}")
     if dt > duration:
         raise SymdynError(f"dt ({dt}) is longer than the duration ({duration})")
-    steps = math.ceil(duration / dt - 1e-9)
-    if steps > 10_000_000:
-        raise SymdynError(f"{steps} steps is too many (at most 10000000); increase dt")
+    ratio = duration / dt
+    if not ratio < MAX_STEPS + 1:  # also an infinite ratio (dt = 5e-324)
+        raise SymdynError(
+            f"duration {duration:g} s with dt {dt:g} s is {ratio:.3g} steps, too many (at most "
+            f"{MAX_STEPS}); increase dt"
+        )
+    steps = math.ceil(ratio - 1e-9)
+    if steps > MAX_STEPS:
+        raise SymdynError(f"{steps} steps is too many (at most {MAX_STEPS}); increase dt")
     if "forward_dynamics" not in plant.functions:
         raise SymdynError(
             f"robot '{plant.robot.name}': no forward dynamics (M(q) is singular), cannot simulate"

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..algorithms.operational_space import TASK_AXES
 from ..errors import SymdynError
+from ..loading import load_module
 from .compile import CompiledDynamics
 
 if TYPE_CHECKING:
@@ -97,9 +98,10 @@ def _cached_kinematics(plant: CompiledDynamics):
         else:
             namespace = {name: getattr(np, name) for name in meta["names"]}
             path = entry.file(_SOURCE)
-            # symdyn's own lambdify output for this robot, verified against the manifest's digest
-            exec(compile(path.read_text(encoding="utf-8"), str(path), "exec"), namespace)
-            found = namespace[meta["function"]], tuple(meta["live"]), tuple(meta["params"])
+            # symdyn's own lambdify output for this robot, verified against the manifest's digest,
+            # imported from its file (never exec'd from a string)
+            module = load_module(path, "symdyn_task_space", namespace)
+            found = getattr(module, meta["function"]), tuple(meta["live"]), tuple(meta["params"])
         plant._task_space = found
     return found
 

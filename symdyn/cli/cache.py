@@ -56,6 +56,13 @@ def cmd_cache(args: argparse.Namespace) -> int:
     root, count, size = cache.usage()
     entries = f"{count} entr{'y' if count == 1 else 'ies'}"
     print(f"{root}: {entries}, {_size(size)} (relocate with ${cache.CACHE_ENV})")
+    left, left_size = cache.leftovers()
+    if left:
+        print(
+            f"{root}: {left} unfinished build folder{'' if left == 1 else 's'} (.build-*), "
+            f"{_size(left_size)}: a build under way, or left by a killed one (the next build "
+            "removes those of finished processes and any older than an hour; --clear removes them all)"
+        )
     return 0
 
 

@@ -14,11 +14,14 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..dynamics import derive
-from ..errors import SymdynError
+from ..dynamics import SINGULAR_M, derive
+from ..errors import SymdynError, SymdynWarning
+from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
 from .frame_functions import choose_frames
 from .functions import FRAME_GROUPS, FUNCTION_NAMES, GROUPS, build_functions
@@ -65,6 +68,18 @@ def context(
     (symdyn.codegen.frame_functions.choose_frames), which are checked before anything is derived."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
+    if not is_c_identifier(robot.name):
+        raise SymdynError(
+            f"robot name {robot.name!r} is not a valid C identifier (letters, digits and underscores, "
+            "not starting with a digit, not a C keyword): it names the generated files and functions"
+        )
+    bad = [str(p) for p in robot.params if not is_c_identifier(str(p))]
+    if bad:
+        raise SymdynError(
+            f"robot '{robot.name}': parameter name(s) {', '.join(map(repr, bad))} are not valid C "
+            "identifiers (letters, digits and underscores, not starting with a digit, not a C keyword): "
+            "they name the generated code's parameters"
+        )
     groups = _groups(functions)
     choice = None
     if groups is not None and set(groups) & set(FRAME_GROUPS):
@@ -74,7 +89,9 @@ def context(
             "--frames and --task-axes choose the frames of the kinematics and operational_space "
             "function groups: name them in --functions"
         )
-    dyn = derive(robot, method=method, simplify=False)
+    with warnings.catch_warnings():  # build_functions says it again, with the functions left out
+        warnings.filterwarnings("ignore", f"robot '.*': {re.escape(SINGULAR_M)}", SymdynWarning)
+        dyn = derive(robot, method=method, simplify=False)
     notes: tuple[str, ...] = ()
     if prune is not None:
         from .pruned import pruned_dynamics

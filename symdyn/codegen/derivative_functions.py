@@ -18,8 +18,7 @@ dqdd/dx = -M^-1 dtau/dx with dtau/dx evaluated at qdd = FD(q, qd, tau) = M^-1 (t
 The Coulomb friction sign(qd) contributes zero (its derivative almost everywhere).
 
 The three functions that invert M are left out, like forward_dynamics, when M is singular
-by construction (a joint that moves no mass or inertia, Robot.idle_joints; the forward
-dynamics family already warns about it).
+by construction (Dynamics.singular_joints; symdyn.codegen.functions.build_functions warns).
 """
 
 from __future__ import annotations
@@ -81,7 +80,7 @@ def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             _entries(dq, dqd),
         ),
     ]
-    if not dyn.robot.idle_joints():
+    if not dyn.singular_joints:
         Minv = ldlt_inverse(sp.Matrix(c["M"]), elimination_order(n, dyn.robot.is_chain), prog, "Di")
         # qdd = FD(q, qd, tau) = M^-1 (tau - bias) with the same M^-1, then dtau/dx at that qdd
         b = sp.Matrix([prog.let(x.tau.symbols[i] - c["bias"][i], "Db") for i in range(n)])

@@ -17,12 +17,13 @@ LTDL factorization that exploits branch-induced sparsity): on a tree numbered pa
 first this creates no fill-in, so L keeps the zeros of joints on different branches. A
 chain, whose M is dense, keeps the forward order.
 
-A generated function cannot raise, so forward_dynamics is not generated for a robot whose
-M is singular by construction: a joint that moves no mass or inertia (a massless subtree
-and no rotor inertia, symdyn.model.robot.Robot.idle_joints) would make some D_j an exact
-zero. `build_functions` then leaves it out with a SymdynWarning naming the joints, and the
-other six functions are generated as usual. This is decided on numbers only: with symbolic
-masses M cannot be known to be singular, and forward_dynamics is generated.
+A generated function cannot raise, so the functions that invert M (INVERTING: forward_dynamics
+and three derivative functions) are not generated for a robot whose M is singular by
+construction: some pivot D_j is an exact zero once the numbers are in, because a joint moves no
+mass or inertia, or only mass on its own axis (Dynamics.singular_joints,
+symdyn.algorithms.singular). `build_functions` then leaves them out with one SymdynWarning
+naming the joints, why, and the functions left out; the others are generated as usual. With
+symbolic masses only a pivot that is identically zero counts.
 """
 
 from __future__ import annotations
@@ -32,11 +33,11 @@ from collections.abc import Callable, Sequence
 
 import sympy as sp
 
-from ..dynamics import QUANTITIES, Dynamics
+from ..dynamics import QUANTITIES, Dynamics, singular_message
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
-from .derivative_functions import derivative_rows
+from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
 from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
 from .function_rows import (
     DIMS,
@@ -101,32 +102,20 @@ def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
     return x
 
 
-def _solvable(dyn: Dynamics) -> bool:
-    """Whether M can be inverted as far as the numbers tell; warn naming the joints if not."""
-    robot = dyn.robot
-    idle = robot.idle_joints()
-    if idle:
-        names = ", ".join(f"'{robot.links[i].name}' (link {i + 1})" for i in idle)
-        warnings.warn(
-            f"robot '{robot.name}': forward_dynamics is not generated: joint(s) {names} move no mass "
-            "or inertia, so M(q) is singular; the other functions are",
-            SymdynWarning,
-            stacklevel=4,
-        )
-    return not idle
-
-
 def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """The six functions of tau = M qdd + V + G + F and its terms (slide 16), over `dyn.program`."""
     n = dyn.n
     c = dyn.compact
+    friction = "F(qd) = viscous qd + coulomb sign(qd)"
+    if any(link.friction.asymmetric for link in dyn.robot.links):
+        friction += ", or c+ [qd > 0] - c- [qd < 0] per direction"
     table = [
         ("inverse_dynamics", "tau = M(q) qdd + V(q, qd) + G(q) + F(qd)", (x.q, x.qd, x.qdd, x.p), "tau"),
         ("mass_matrix", "M(q), row-major n x n", (x.q, x.p), "M"),
         ("coriolis_matrix", "C(q, qd) from Christoffel symbols, row-major; C qd = V", (x.q, x.qd, x.p), "C"),
         ("coriolis", "V(q, qd) = C(q, qd) qd", (x.q, x.qd, x.p), "V"),
         ("gravity", "G(q)", (x.q, x.p), "G"),
-        ("friction", "F(qd) = viscous qd + coulomb sign(qd)", (x.qd, x.p), "F"),
+        ("friction", friction, (x.qd, x.p), "F"),
     ]
     rows = []
     for name, doc, inputs, out in table:
@@ -137,8 +126,8 @@ def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
 
 def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """forward_dynamics, the unrolled LDL^T solve of M qdd = tau - bias (module docstring), or
-    nothing (with a SymdynWarning) when M is singular by construction."""
-    if not _solvable(dyn):
+    nothing when M is singular by construction (build_functions warns)."""
+    if dyn.singular_joints:
         return []
     n = dyn.n
     c = dyn.compact
@@ -196,6 +185,27 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
 )
 
 
+#: Per family, the functions it leaves out when M is singular by construction (they invert M).
+INVERTING: dict[Callable[[Dynamics, Inputs], list[FunctionRow]], tuple[str, ...]] = {
+    forward_dynamics_rows: ("forward_dynamics",),
+    derivative_rows: DERIVATIVE_FUNCTION_NAMES[1:],
+}
+
+
+def _warn_singular(dyn: Dynamics, families) -> None:
+    """One SymdynWarning: M is singular (which joints, why) and the functions left out."""
+    left_out = [name for family in families for name in INVERTING.get(family, ())]
+    if not dyn.singular_joints or not left_out:
+        return
+    listed = ", ".join(left_out[:-1]) + (" and " if len(left_out) > 1 else "") + left_out[-1]
+    warnings.warn(
+        f"{singular_message(dyn)}; so {listed} {'are' if len(left_out) > 1 else 'is'} not generated "
+        "(the other functions are)",
+        SymdynWarning,
+        stacklevel=3,
+    )
+
+
 #: The groups of functions `symdyn generate --functions` selects, by the builders of FAMILIES.
 GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] = {
     "dynamics": (dynamics_rows, forward_dynamics_rows),
@@ -216,7 +226,8 @@ def build_functions(
     """The generated functions of a derived robot, one CSE pass per `FunctionRow.cse` group.
 
     All of FAMILIES' rows: the seven of docs/generated-code.md, or six without forward_dynamics
-    (and a SymdynWarning) when a joint moves no mass or inertia (see the module docstring), then
+    (and one SymdynWarning naming what is left out) when M is singular by construction (see the
+    module docstring), then
     regressor and base_regressor (symdyn.codegen.regressor_functions), tip_wrench_torque for
     product-of-exponentials robots, and the derivatives (symdyn.codegen.derivative_functions);
     the frame groups (FRAME_GROUPS: kinematics, operational_space; symdyn.codegen.frame_functions)
@@ -235,7 +246,9 @@ def build_functions(
         frames = choose_frames(dyn.robot)
     x = Inputs.of(dyn, frames)
     chosen = {b for g in groups for b in GROUPS[g]}
-    rows = [row for family in FAMILIES if family in chosen for row in family(dyn, x)]
+    families = [family for family in FAMILIES if family in chosen]
+    _warn_singular(dyn, families)
+    rows = [row for family in families for row in family(dyn, x)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
     code = {}

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["TreePrinter", "free_name"]
+__all__ = ["TreePrinter", "free_name", "step_comparison"]
 
 
 def free_name(base: str, taken, temporary) -> str:
@@ -24,6 +24,14 @@ def free_name(base: str, taken, temporary) -> str:
         candidate = f"{base}_" if k == 0 else f"{base}_{k}"
         k += 1
     return candidate
+
+
+def step_comparison(e: sp.Heaviside) -> tuple[sp.Expr, str]:
+    """The Heaviside step H(x) with H(0) = 0 (direction-dependent Coulomb friction) as a strict
+    comparison with zero, (x, ">"), or (y, "<") when x reads as -y: H(x) = [x > 0], H(-y) = [y < 0]."""
+    assert isinstance(e, sp.Heaviside) and e.args[1:] == (sp.S.Zero,), e
+    x = e.args[0]
+    return (-x, "<") if x.could_extract_minus_sign() else (x, ">")
 
 
 class TreePrinter:

@@ -41,10 +41,13 @@ def regressor_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     Y = dyn.regressor_compact()
     n = dyn.n
     state = (x.q, x.qd, x.qdd, x.p)
+    per_body = "13 per body"
+    if Y.cols > 13 * dyn.robot.nb:
+        per_body += ", then fcn per joint with direction-dependent Coulomb friction"
     rows = [
         FunctionRow(
             "regressor",
-            "Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body)",
+            f"Y(q, qd, qdd) with tau = Y pi, pi the standard parameters ({per_body})",
             state,
             (
                 Output(

@@ -14,7 +14,12 @@ with its twists written that way needs 652 operations for its inverse dynamics, 
   file, the link, the field and the multiple to write instead. Angles near 0 are not
   warned about: a printed table shows a rounded zero as 0, so a small nonzero angle
   there is meant (a calibration offset, say);
-* every other value is returned unchanged: exact values (0, pi/2, pi/3), expressions
+* a constant that is neither a rational number nor a rational multiple of pi (pi**2/4,
+  sqrt(2), sin(1), 0.3*pi) is evaluated to a double first, and the two rules above apply to that
+  double: SymPy cannot simplify the sine of such a constant, and keeping cos(pi**2/4) as a
+  symbol makes the derivation of a seven-joint arm run for minutes; a constant that does not
+  evaluate to a finite real number is a SymdynError naming the file, link and field;
+* every other value is returned unchanged: exact values (0, 1, pi/2, pi/3), expressions
   with parameters, angles farther than 1e-3 rad from every multiple of pi/2, and
   angles beyond LARGEST = 1e4 rad (no description has them; far out, doubles
   could not tell 1e-9 rad).
@@ -33,9 +38,9 @@ import warnings
 
 import sympy as sp
 
-from ..errors import SymdynWarning, location
+from ..errors import SymdynError, SymdynWarning, location
 
-__all__ = ["SNAP_TOLERANCE", "WARN_TOLERANCE", "LARGEST", "snap_angle"]
+__all__ = ["SNAP_TOLERANCE", "WARN_TOLERANCE", "LARGEST", "snap_angle", "constant_angle"]
 
 #: Angles this close (rad) to a multiple of pi/2 become that exact multiple.
 SNAP_TOLERANCE = 1e-9
@@ -59,14 +64,16 @@ def snap_angle(
 ) -> sp.Expr:
     """`value` (an angle in rad), or the exact multiple k*pi/2 within SNAP_TOLERANCE of it.
 
-    Only numbers written with a decimal part (SymPy expressions holding a Float and no
-    symbol) are considered. file, link_index, link_name and field locate the angle in
-    the warning; `angle` names it within the field (e.g. "pitch" of an rpy triple) and
-    `line` is the line of the file. With `expressions` the format accepts expressions,
-    and the warning suggests writing the multiple as one (pi/2); otherwise (URDF) it
-    suggests the double nearest to the multiple (1.5707963267948966).
+    Only constants (no symbol) that are not exact (a rational number or a rational multiple
+    of pi) are considered, as the double they evaluate to (`constant_angle`). file,
+    link_index, link_name and field locate the angle in the warning; `angle` names it
+    within the field (e.g. "pitch" of an rpy triple) and `line` is the line of the file.
+    With `expressions` the format accepts expressions, and the warning suggests writing
+    the multiple as one (pi/2); otherwise (URDF) it suggests the double nearest to the
+    multiple (1.5707963267948966).
     """
-    if value.free_symbols or not value.has(sp.Float):
+    value = constant_angle(value, file=file, link_index=link_index, link_name=link_name, field=field)
+    if value.free_symbols or not value.is_Float:
         return value
     x = float(value)
     if not abs(x) <= LARGEST:
@@ -89,3 +96,20 @@ def snap_angle(
             stacklevel=2,
         )
     return value
+
+
+def constant_angle(value: sp.Expr, **where) -> sp.Expr:
+    """`value`, or the double nearest to it if it is a constant other than a float, a rational
+    number or a rational multiple of pi (pi**2/4, sqrt(2), 0.3*pi); SymdynError (naming `where`: file,
+    link_index, link_name, field) if such a constant is not a finite real number. The rule
+    `snap_angle` applies first; the robot loader applies it to an angle that a parameter's value
+    makes constant."""
+    if value.free_symbols or value.is_Float or value.is_Rational or (value / sp.pi).is_Rational:
+        return value
+    try:
+        x = complex(value.evalf(17))
+    except (TypeError, ValueError):
+        x = complex(math.nan)
+    if x.imag != 0 or not math.isfinite(x.real):
+        raise SymdynError(f"angle {value} is not a finite real number", **where)
+    return sp.Float(x.real)

@@ -11,9 +11,10 @@ executes code from it.
 
 Limits that keep a hostile file from hanging the loader: text at most
 2000 characters, nesting depth at most 100, integer literals at most 30
-digits, numeric exponents of absolute value at most 64 and numeric powers of
-at most 4096 bits (256 bits under a root). Division by zero, non-finite and non-real results are
-errors.
+digits, and the bounds of `symdyn.model.bounded` on the result (exponents at most 64 in
+absolute value once SymPy has merged powers of powers, numeric powers of at most 4096 bits,
+256 bits under a root, numbers at most 1e150 in absolute value). Division by zero,
+non-finite and non-real results are errors.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from collections.abc import Callable
 import sympy as sp
 
 from ..errors import SymdynError
+from .bounded import MAX_EXPONENT, check_bounded, check_power
 
 __all__ = [
     "parse_expression",
@@ -43,10 +45,7 @@ __all__ = [
 
 MAX_TEXT_LENGTH = 2000
 MAX_DEPTH = 100
-MAX_EXPONENT = 64
 MAX_INT_DIGITS = 30
-MAX_POWER_BITS = 4096
-MAX_ROOT_BITS = 256
 
 _FUNCTIONS: dict[str, Callable[[sp.Expr], sp.Expr]] = {
     "sin": sp.sin,
@@ -250,20 +249,7 @@ class _Builder:
         return self._power(node, left, right)
 
     def _power(self, node: ast.AST, base: sp.Expr, exponent: sp.Expr) -> sp.Expr:
-        if exponent.is_Number:
-            seg = self._segment(node)
-            if abs(exponent) > MAX_EXPONENT:
-                raise self.fail(
-                    f"exponent {exponent} in '{seg}' is larger than {MAX_EXPONENT} in absolute value"
-                )
-            if base.is_zero and exponent.is_negative:
-                raise self.fail(f"division by zero in '{seg}'")
-            if base.is_Rational and exponent.is_Rational:
-                bits = max(int(base.p).bit_length(), int(base.q).bit_length())
-                # exact roots of huge integers make SymPy factorise: keep them small
-                limit = MAX_POWER_BITS if exponent.is_Integer else MAX_ROOT_BITS
-                if bits * max(abs(exponent), 1) > limit:
-                    raise self.fail(f"number '{seg}' is too large")
+        check_power(base, exponent, self.fail, self._segment(node))
         return base**exponent
 
     def _call(self, node: ast.Call, depth: int) -> sp.Expr:
@@ -324,7 +310,9 @@ def parse_expression_names(
     if isinstance(value, bool):
         raise fail(f"expected a number or an expression, not the boolean {value}")
     if isinstance(value, (int, float)):
-        return _number(value, fail), ()
+        expr = _number(value, fail)
+        check_bounded(expr, fail)
+        return expr, ()
     if not isinstance(value, str):
         kind = "null" if value is None else type(value).__name__
         raise fail(f"expected a number or an expression, not a {kind}")
@@ -342,6 +330,7 @@ def parse_expression_names(
         raise fail(f"cannot parse expression '{_short(text)}'") from None
     builder = _Builder(text, fail, allow_joint_symbols)
     expr = builder.build(tree.body)
+    check_bounded(expr, fail)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise fail(f"expression '{_short(text)}' is not finite ({expr})")
     if expr.has(sp.I):

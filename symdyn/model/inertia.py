@@ -24,6 +24,7 @@ import numpy as np
 import sympy as sp
 
 from symdyn.errors import SymdynError, SymdynWarning, location
+from symdyn.model.bounded import MAX_MAGNITUDE
 
 __all__ = [
     "box",
@@ -241,7 +242,8 @@ def check_inertia(
 
     Only numeric values are checked (SymPy numbers are evaluated; anything with free symbols
     is skipped). Errors (SymdynError, field "mass" or "inertia"): mass negative or not
-    finite; tensor not 3x3, not finite, not symmetric, or not positive semi-definite
+    finite or more than 1e150; tensor not 3x3, not finite, an entry of more than 1e150 in absolute
+    value (checked before any eigenvalue is computed), not symmetric, or not positive semi-definite
     (smallest eigenvalue < -1e-12 * scale). Warnings (SymdynWarning): principal moments
     breaking the triangle inequality I1 + I2 >= I3 (relative tolerance 1e-9), zero mass with
     a non-zero tensor.
@@ -255,6 +257,8 @@ def check_inertia(
             raise SymdynError(f"mass {mass} is not a real number", field="mass", **where) from None
         if not np.isfinite(m):
             raise SymdynError(f"mass {mass} is not finite", field="mass", **where)
+        if abs(m) > MAX_MAGNITUDE:
+            raise SymdynError(f"mass {m:g} is too large (more than {MAX_MAGNITUDE:g})", field="mass", **where)
         if m < 0:
             raise SymdynError(f"mass {mass} is negative", field="mass", **where)
     A = _numeric_matrix(inertia)
@@ -265,9 +269,15 @@ def check_inertia(
     if not np.all(np.isfinite(A)):
         raise SymdynError("inertia tensor has non-finite entries", field="inertia", **where)
     scale = float(np.max(np.abs(A)))
+    if scale > MAX_MAGNITUDE:
+        raise SymdynError(
+            f"inertia tensor has an entry of {scale:g} in absolute value (more than {MAX_MAGNITUDE:g})",
+            field="inertia",
+            **where,
+        )
     if np.max(np.abs(A - A.T)) > 1e-9 * scale:
         raise SymdynError("inertia tensor is not symmetric", field="inertia", **where)
-    moments = np.linalg.eigvalsh(0.5 * (A + A.T))
+    moments = np.linalg.eigvalsh(0.5 * (A + A.T))  # entries <= 1e150: their squares stay finite
     if moments[0] < -(1e-12 * scale + ABSOLUTE_TOLERANCE):
         raise SymdynError(
             f"inertia tensor is not positive semi-definite (principal moments {moments.tolist()})",

@@ -8,8 +8,11 @@ with c the centre of mass in body frame i and I the inertia tensor about the ORI
 frame i, I = I_c + m (c^T c 1 - c c^T) (parallel-axis theorem; I_c about the centre of mass,
 `Link.inertia`; off-diagonal entries are the tensor's, minus the product-of-inertia integrals);
 then the joint's 3: Ia_i = gear_ratio^2 J_m (reflected rotor inertia), fv_i (viscous friction),
-fc_i (Coulomb friction). The equations of motion are linear in this vector,
-tau = Y(q, qd, qdd) pi (symdyn.rnea_regressor; Atkeson, An and Hollerbach 1986).
+fc_i (Coulomb friction). A link with direction-dependent Coulomb friction (symdyn.model.friction)
+calls its 13th parameter fcp_i (the magnitude for qd_i > 0) and adds fcn_i (the magnitude for
+qd_i < 0); these extra parameters follow the 13 nb others, in link order, so that column 13 i + k
+is always parameter k of body i + 1. The equations of motion are linear in this vector,
+tau = Y(q, qd, qdd) pi (symdyn.oracle.regressor; Atkeson, An and Hollerbach 1986).
 """
 
 from __future__ import annotations
@@ -17,7 +20,14 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-__all__ = ["INERTIAL_NAMES", "JOINT_NAMES", "PER_BODY", "standard_parameters", "numeric_parameters"]
+__all__ = [
+    "INERTIAL_NAMES",
+    "JOINT_NAMES",
+    "PER_BODY",
+    "standard_parameters",
+    "numeric_parameters",
+    "asymmetric_bodies",
+]
 
 #: the 10 inertial parameters of a body, Pinocchio's order (toDynamicParameters)
 INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
@@ -25,6 +35,18 @@ INERTIAL_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz
 JOINT_NAMES = ("Ia", "fv", "fc")
 #: parameters per body
 PER_BODY = len(INERTIAL_NAMES) + len(JOINT_NAMES)
+
+
+def asymmetric_bodies(robot) -> list[int]:
+    """The 0-based indices of the links with direction-dependent Coulomb friction, in link order:
+    their fcn parameters are the columns 13 nb, 13 nb + 1, ... of the regressor."""
+    return [i for i, link in enumerate(robot.links) if link.friction.asymmetric]
+
+
+def _body_names(i: int, asymmetric: bool) -> list[str]:
+    """The 13 parameter names of body i (1-based)."""
+    joint = ("Ia", "fv", "fcp") if asymmetric else JOINT_NAMES
+    return [f"{p}{i}" for p in (*INERTIAL_NAMES, *joint)]
 
 
 def _body_parameters(link) -> list[sp.Expr]:
@@ -38,11 +60,13 @@ def _body_parameters(link) -> list[sp.Expr]:
 
 
 def standard_parameters(robot) -> tuple[tuple[str, ...], tuple[sp.Expr, ...]]:
-    """The standard parameter vector pi of a robot: 13 per body, link 1 first.
+    """The standard parameter vector pi of a robot: 13 per body, link 1 first, then one per link
+    with direction-dependent Coulomb friction.
 
     Per body i (1-based, every link including mimic joints' bodies): m_i, m_i c_i (body frame i),
     the inertia tensor about body frame i's origin (I_xx, I_xy, I_yy, I_xz, I_yz, I_zz: Pinocchio's
-    `Inertia.toDynamicParameters` order), then Ia_i = gear_ratio^2 J_m, fv_i, fc_i.
+    `Inertia.toDynamicParameters` order), then Ia_i = gear_ratio^2 J_m, fv_i, fc_i (fcp_i when
+    the link's Coulomb friction depends on the direction); then fcn_i of each such link.
 
     Args:
         robot: a `symdyn.Robot`; its valued parameters are substituted (`Robot.resolved`).
@@ -52,13 +76,17 @@ def standard_parameters(robot) -> tuple[tuple[str, ...], tuple[sp.Expr, ...]]:
         expressions in which only the robot's free parameters stay symbols.
     """
     links = robot.resolved().links
-    names = tuple(f"{p}{i}" for i in range(1, len(links) + 1) for p in (*INERTIAL_NAMES, *JOINT_NAMES))
-    values = tuple(x for link in links for x in _body_parameters(link))
-    return names, values
+    extra = asymmetric_bodies(robot)
+    names = [name for i, link in enumerate(links, 1) for name in _body_names(i, link.friction.asymmetric)]
+    names += [f"fcn{i + 1}" for i in extra]
+    values = [x for link in links for x in _body_parameters(link)]
+    values += [sp.sympify(links[i].friction.coulomb_minus) for i in extra]
+    return tuple(names), tuple(values)
 
 
 def numeric_parameters(robot, params=None) -> np.ndarray:
-    """The standard parameter vector pi (13 nb,) as floats, with the free parameters' values.
+    """The standard parameter vector pi (13 nb + fcn columns,) as floats, with the free parameters'
+    values.
 
     Args:
         robot: a `symdyn.Robot`.

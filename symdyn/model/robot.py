@@ -36,6 +36,7 @@ import sympy as sp
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
 from .frames import Frame, check_frame_names, unknown_frame
+from .friction import Friction
 from .limits import check_limits
 from .parameter_names import parameter_names_problem
 from .table import robot_table
@@ -46,14 +47,6 @@ __all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "Frame", "JOINT_TYPES"
 JOINT_TYPES = ("revolute", "prismatic")
 #: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
 DEFAULT_GRAVITY = (sp.Integer(0), sp.Integer(0), sp.Float(-9.81))
-
-
-@dataclass(frozen=True)
-class Friction:
-    """Joint friction F_i = viscous * qd_i + coulomb * sign(qd_i) (slide 16)."""
-
-    viscous: sp.Expr = sp.S.Zero
-    coulomb: sp.Expr = sp.S.Zero
 
 
 @dataclass(frozen=True)
@@ -104,10 +97,7 @@ class Link:
             mass=sp.sympify(self.mass).xreplace(x),
             com=self.com.xreplace(x),
             inertia=self.inertia.xreplace(x),
-            friction=Friction(
-                sp.sympify(self.friction.viscous).xreplace(x),
-                sp.sympify(self.friction.coulomb).xreplace(x),
-            ),
+            friction=self.friction.subs(x),
             motor=Motor(
                 sp.sympify(self.motor.inertia).xreplace(x),
                 sp.sympify(self.motor.gear_ratio).xreplace(x),
@@ -362,6 +352,8 @@ class Robot:
                 values[p] = float(v)
             except (TypeError, ValueError):
                 raise SymdynError(f"{prefix}parameter {p} must be a number, got {v!r}") from None
+            if not np.isfinite(values[p]):
+                raise SymdynError(f"{prefix}parameter {p} must be finite, got {v!r}")
         return values
 
     def _listing(self) -> str:

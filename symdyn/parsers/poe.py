@@ -29,6 +29,7 @@ from collections.abc import Callable, Sequence
 import sympy as sp
 
 from ..errors import SymdynError
+from ..model.bounded import check_bounded
 from ..model.expressions import is_c_identifier
 from ..model.frames import Frame
 from ..model.inertia import check_inertia
@@ -175,10 +176,14 @@ def _clean(T: Transform) -> Transform:
 
 
 def _sympy(x) -> sp.Expr:
-    """A number or SymPy expression; integral floats become exact integers."""
+    """A number or SymPy expression (finite, within symdyn.model.bounded's bounds); integral floats
+    become exact integers."""
     if isinstance(x, str):
         raise TypeError("strings are not accepted here; pass numbers or SymPy expressions")
     value = x if isinstance(x, sp.Basic) else sp.sympify(float(x) if hasattr(x, "dtype") else x, strict=True)
+    if value.has(sp.oo, -sp.oo, sp.zoo, sp.nan):
+        raise ValueError(f"{value} is not finite")
+    check_bounded(value, SymdynError)  # finite, at most 1e150, exponents at most 64
     if value.is_Float and float(value) == round(float(value)):
         return sp.Integer(round(float(value)))
     return value

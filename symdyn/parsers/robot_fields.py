@@ -88,6 +88,7 @@ class LinkData:
     inertia: dict[str, sp.Expr] = field(default_factory=dict)
     viscous: sp.Expr = sp.S.Zero
     coulomb: sp.Expr = sp.S.Zero
+    coulomb_minus: sp.Expr | None = None  # set by `coulomb: [plus, minus]` (direction-dependent)
     motor_inertia: sp.Expr = sp.S.Zero
     gear_ratio: sp.Expr = sp.S.One
     mimic: tuple[str, sp.Expr, sp.Expr] | None = None  # (link name, multiplier, offset)
@@ -306,15 +307,36 @@ class RobotFileReader:
                 entries = self.mapping(value, INERTIA_KEYS, "inertia", link)
                 link.inertia = {k: self.expr(v, f"inertia.{k}", link) for k, v in entries.items()}
             elif key == "friction":
-                entries = self.mapping(value, FRICTION_KEYS, "friction", link)
-                for k, v in entries.items():
-                    setattr(link, k, self.expr(v, f"friction.{k}", link))
+                self._read_friction(value, link)
             elif key == "motor":
                 entries = self.mapping(value, MOTOR_KEYS, "motor", link)
                 for k, v in entries.items():
                     attr = "motor_inertia" if k == "inertia" else k
                     setattr(link, attr, self.expr(v, f"motor.{k}", link))
         return link
+
+    def _read_friction(self, value: object, link: LinkData) -> None:
+        """friction: {viscous: b, coulomb: c} or {viscous: b, coulomb: [c_plus, c_minus]}, the
+        second form direction-dependent (both magnitudes; their signs are checked once
+        parameters have values, symdyn.parsers.robot_file)."""
+        entries = self.mapping(value, FRICTION_KEYS, "friction", link)
+        if "viscous" in entries:
+            link.viscous = self.expr(entries["viscous"], "friction.viscous", link)
+        if "coulomb" not in entries:
+            return
+        coulomb = entries["coulomb"]
+        if not isinstance(coulomb, list):
+            link.coulomb = self.expr(coulomb, "friction.coulomb", link)
+            return
+        if len(coulomb) != 2:
+            raise self.error(
+                "expected one number (symmetric) or a list of 2 numbers or expressions [c_plus, c_minus] "
+                f"(magnitudes for positive and negative joint rates), got {_count(len(coulomb))}",
+                link=link,
+                field="friction.coulomb",
+            )
+        link.coulomb = self.expr(coulomb[0], "friction.coulomb.plus", link)
+        link.coulomb_minus = self.expr(coulomb[1], "friction.coulomb.minus", link)
 
     def limits(self, value: object, link: LinkData) -> None:
         """limits: [lower, upper], the joint's range in rad or m (null: none). Whether they are
@@ -356,6 +378,10 @@ class RobotFileReader:
             if k != "joint":
                 factors[k] = self.expr(v, f"mimic.{k}", link)
         link.mimic = (joint, factors["multiplier"], factors["offset"])
+
+
+def _count(k: int) -> str:
+    return f"{k} entry" if k == 1 else f"{k} entries"
 
 
 def _kind(value: object) -> str:

@@ -27,9 +27,13 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..errors import SymdynError
+from ..errors import SymdynError, link_fields
+from ..model.angles import constant_angle
+from ..model.bounded import bounded_subs
 from ..model.frames import Frame
-from ..model.inertia import check_inertia, tensor_from_components
+from ..model.friction import coulomb_fields
+from ..model.inertia import tensor_from_components
+from ..model.physical import check_link_numbers
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
@@ -41,9 +45,8 @@ from .yaml_text import parse_text
 
 __all__ = ["robot_from_bytes", "robot_from_data"]
 
-#: Largest resolved parameter value (nodes of its expression tree / bits of a number).
+#: Largest resolved parameter value (nodes of its expression tree).
 _MAX_NODES = 20000
-_MAX_BITS = 8192
 
 
 def robot_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
@@ -102,49 +105,82 @@ def _resolve_values(reader: RobotFileReader) -> dict[str, sp.Expr]:
             path.pop()
             state[node] = 2
             mapping = {sp.Symbol(m): resolved[m] for m in deps[node]}
-            value = values[node].xreplace(mapping) if mapping else values[node]
+            value = bounded_subs(values[node], mapping, _fail(reader, f"parameters.{node}"))
             _check_size(value, reader, f"parameters.{node}")
             resolved[node] = value
     return {n: resolved[n] for n in values}
 
 
 def _check_size(expr: sp.Expr, reader: RobotFileReader, field: str) -> None:
-    for count, sub in enumerate(sp.preorder_traversal(expr)):
+    for count, _ in enumerate(sp.preorder_traversal(expr)):
         if count > _MAX_NODES:
-            raise reader.error("value grows too large after substituting parameters", field=field)
-        if sub.is_Rational and max(int(sub.p).bit_length(), int(sub.q).bit_length()) > _MAX_BITS:
             raise reader.error("value grows too large after substituting parameters", field=field)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise reader.error(f"value is not finite after substituting parameters ({expr})", field=field)
 
 
-def _number(expr: sp.Expr) -> float | None:
-    """A float if `expr` has no free symbols, else None."""
-    if expr.free_symbols:
-        return None
-    try:
-        return float(expr)
-    except TypeError:
-        return None
+def _fail(reader: RobotFileReader, field: str, link: LinkData | None = None):
+    """A `fail` for symdyn.model.bounded that names the file, the link and the field."""
+    return lambda message: reader.error(message, link=link, field=field)
+
+
+def _link_expressions(link: LinkData):
+    """(field, expression) of every number-or-expression a link entry holds."""
+    for name in ("gamma", "b", "a", "alpha", "d", "theta", "mass"):
+        yield name, getattr(link, name)
+    yield "friction.viscous", link.viscous
+    yield from coulomb_fields(link.coulomb, link.coulomb_minus).items()
+    yield "motor.inertia", link.motor_inertia
+    yield "motor.gear_ratio", link.gear_ratio
+    yield from ((f"com.{ax}", v) for ax, v in zip("xyz", link.com, strict=True))
+    yield from ((f"inertia.{k}", v) for k, v in link.inertia.items())
+    if link.mimic is not None:
+        yield from (("mimic.multiplier", link.mimic[1]), ("mimic.offset", link.mimic[2]))
+    if link.limits is not None:
+        yield from (("limits.lower", link.limits[0]), ("limits.upper", link.limits[1]))
+
+
+def _poe_expressions(poe):
+    """(field, expression) of every entry of a product-of-exponentials link (PoeLink)."""
+    for field, matrix in (
+        ("frame.rotation", poe.M.R),
+        ("frame", poe.M.p),
+        ("spatial_inertia", poe.G),
+        ("screw", poe.S),
+    ):
+        yield from ((field, x) for x in matrix)
+
+
+def _check_substituted(reader: RobotFileReader, subs: dict) -> None:
+    """Substitute the parameter values into every field with the bounds of symdyn.model.bounded,
+    so that no power that a value completes (b**e with e: 9**9) is evaluated later."""
+    for i, link in enumerate(reader.links):
+        fields = _link_expressions(link)
+        if isinstance(reader, PoeFileReader):
+            fields = (*fields, *_poe_expressions(reader.poe[i]))
+        for field, expr in fields:
+            if isinstance(expr, sp.Basic):
+                bounded_subs(expr, subs, _fail(reader, field, link))
+    for ax, v in zip("xyz", reader.gravity or (), strict=False):
+        bounded_subs(v, subs, _fail(reader, f"gravity.{ax}"))
 
 
 def _check_link_numbers(
     reader: RobotFileReader, link: LinkData, tensor: sp.ImmutableMatrix, subs: dict
 ) -> None:
     """Refuse impossible numbers of a link (`tensor`: its inertia as written) once parameters have values."""
-    mass = link.mass.xreplace(subs)
-    check_inertia(mass, tensor.xreplace(subs), file=reader.file, link_index=link.index, link_name=link.name)
-    for fld, value in (
-        ("friction.viscous", link.viscous),
-        ("friction.coulomb", link.coulomb),
-        ("motor.inertia", link.motor_inertia),
-    ):
-        x = _number(value.xreplace(subs))
-        if x is not None and x < 0:
-            raise reader.error(f"must not be negative (got {x:g})", link=link, field=fld)
-    x = _number(link.gear_ratio.xreplace(subs))
-    if x is not None and x == 0:
-        raise reader.error("gear ratio must not be zero", link=link, field="motor.gear_ratio")
+    check_link_numbers(
+        link.mass.xreplace(subs),
+        tensor.xreplace(subs),
+        {
+            "friction.viscous": link.viscous.xreplace(subs),
+            **{k: v.xreplace(subs) for k, v in coulomb_fields(link.coulomb, link.coulomb_minus).items()},
+            "motor.inertia": link.motor_inertia.xreplace(subs),
+        },
+        link.gear_ratio.xreplace(subs),
+        file=reader.file,
+        **link_fields(link),
+    )
 
 
 def _build(data: object, file: str | None, digest: str | None) -> Robot:
@@ -154,6 +190,7 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
     values = _resolve_values(reader)
     subs = {sp.Symbol(n): v for n, v in values.items()}
     params = tuple(sp.Symbol(n) for n in dict.fromkeys(reader.order) if n not in values)
+    _check_substituted(reader, subs)
     links = reader.links_of_model(subs) if isinstance(reader, PoeFileReader) else _dh_links(reader, subs)
     for ld in reader.links:
         reader.check_limits(ld, subs)
@@ -186,6 +223,12 @@ def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
     links: list[Link] = []
     frames: list[Transform] = []  # each link's DH frame in its body frame
     for i, ld in enumerate(reader.links):
+        for key in ("alpha", "theta", "gamma"):
+            if getattr(ld, key).free_symbols:  # a parameter's value may make it a constant like pi**2/4
+                value = getattr(ld, key).xreplace(subs)
+                double = constant_angle(value, file=reader.file, **link_fields(ld), field=key)
+                if double is not value:
+                    setattr(ld, key, double)
         tensor = tensor_from_components(ld.inertia)
         _check_link_numbers(reader, ld, tensor, subs)
         prev = frames[parents[i]] if parents[i] >= 0 else Transform.identity()
@@ -203,7 +246,7 @@ def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:
                 mass=ld.mass,
                 com=com,
                 inertia=inertia,
-                friction=Friction(ld.viscous, ld.coulomb),
+                friction=Friction(ld.viscous, ld.coulomb, ld.coulomb_minus),
                 motor=Motor(ld.motor_inertia, ld.gear_ratio),
                 frame=frame,
                 parent=None if parents[i] == i - 1 else parents[i],

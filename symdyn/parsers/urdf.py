@@ -49,9 +49,10 @@ Refused, naming the joint: floating and planar joints in the loaded part (a
 floating root joint, such as world -> base_link, with the hint to load the part
 below it with --base: floating bases are out of scope); a mimic of an unknown,
 fixed or unloaded joint, and mimic cycles; a locked joint that mimics a joint of
-the chain. Numbers are read as exact SymPy numbers: integers as Integer, others
-as Float of the written text; an rpy angle within 1e-9 rad of a multiple of pi/2
-is taken as that exact multiple, so that its sine and cosine are exactly 0 or +-1
+the chain. Numbers are read as doubles (finite, at most 1e150 in absolute
+value): integer values as Integer, others as the Float of the double; an rpy
+angle within 1e-9 rad of a multiple of pi/2 is taken as that exact multiple, so
+that its sine and cosine are exactly 0 or +-1
 (the 1.5707963267948966 of xacro output), and one within 1e-3 rad of a nonzero
 multiple but not 1e-9 (1.5708) warns (symdyn.model.angles).
 

@@ -4,8 +4,9 @@ Every link and joint of the file is read and checked here, one clear SymdynError
 (file, link, field, line) per problem; the tree, the chain and the Robot are built
 from these records by symdyn.parsers.urdf_tree and symdyn.parsers.urdf.
 
-Numbers are read as exact SymPy numbers: integers as Integer, others as Float of
-the written text. An origin's rotation is R = Rz(yaw) Ry(pitch) Rx(roll) (the URDF
+Numbers are read as doubles (Python's float(), whatever number of digits is written),
+finite and at most 1e150 in absolute value: integer values below 2**53 become exact
+Integers, others a Float of the double. An origin's rotation is R = Rz(yaw) Ry(pitch) Rx(roll) (the URDF
 rpy convention), its entries numbers (cos(1) becomes 0.5403...). Each rpy angle
 passes through symdyn.model.angles.snap_angle, the rule of the DH loader too:
 within 1e-9 rad of a multiple of pi/2 it is taken as that exact multiple, so that
@@ -31,6 +32,7 @@ import sympy as sp
 
 from ..errors import SymdynError, link_fields
 from ..model.angles import snap_angle
+from ..model.bounded import MAX_MAGNITUDE
 from ..model.expressions import C_KEYWORDS
 from ..model.inertia import tensor_from_components
 from ..spatial.transform import Transform, rpy_matrix
@@ -133,15 +135,22 @@ class UrdfReader:
 
     # -- values
     def number(self, text: str | None, where: dict, line: int) -> sp.Expr:
+        """A number of the file, read as a double (float(), whatever digits are written): finite and
+        at most MAX_MAGNITUDE = 1e150 in absolute value; an integer value below 2**53 becomes an
+        exact Integer, any other a Float of the double."""
         s = (text or "").strip()
         if not _NUMBER.match(s):
-            raise self.error(f"expected a number, got {text!r}", line=line, **where)
+            raise self.error(f"expected a number, got {_short(repr(text))}", line=line, **where)
         x = float(s)
         if not math.isfinite(x):
-            raise self.error(f"{s} is not a finite number", line=line, **where)
+            raise self.error(f"{_short(s)} is not a finite number", line=line, **where)
+        if abs(x) > MAX_MAGNITUDE:
+            raise self.error(
+                f"{x!r} is too large (more than {MAX_MAGNITUDE:g} in absolute value)", line=line, **where
+            )
         if x == int(x) and abs(x) < 2**53:
             return sp.Integer(int(x))
-        return sp.Float(s)
+        return sp.Float(x)
 
     def vector(self, text: str | None, where: dict, line: int) -> list[sp.Expr]:
         parts = (text or "").split()
@@ -352,6 +361,10 @@ class UrdfReader:
                 **_at(where, label + ".limit"),
             )
         return None if lower == upper else (lower, upper)
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _at(where: dict, fld: str) -> dict:

@@ -5,6 +5,14 @@ executed or constructed beyond mappings, lists, strings and numbers). yaml.safe_
 silently keeps the last of repeated keys; a robot file must not repeat one, so the
 node tree is checked before it is turned into data, and the error names the key's
 line, the link and the field. Tab-indented JSON (valid JSON, not YAML) is read as JSON.
+
+Anchors, aliases and merge keys (`&a`, `*a`, `<<: *a`) are allowed, but bounded: an alias
+stands for a copy of its anchor's node, so a few hundred bytes of nested aliases can stand for
+millions of nodes (a merge-key bomb of 24 levels doubles at each one). Before anything is
+constructed, the size of the document with every alias expanded is counted on the node graph
+(each node once, so the count itself takes linear time); a document of more than
+MAX_EXPANDED_NODES = 100,000 expanded nodes is refused (the largest example robot has fewer
+than 1,000).
 """
 
 from __future__ import annotations
@@ -15,15 +23,37 @@ import yaml
 
 from ..errors import SymdynError
 
-__all__ = ["parse_text"]
+__all__ = ["parse_text", "MAX_EXPANDED_NODES"]
+
+#: Most nodes a robot file may have once its aliases and merge keys are expanded.
+MAX_EXPANDED_NODES = 100_000
+#: Longest integer a robot file may write, in characters (the expression parser takes 30 digits).
+MAX_INT_TEXT = 100
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader whose integers are refused beyond MAX_INT_TEXT characters before int() reads them
+    (Python refuses more than 4300 digits with a ValueError, and YAML 1.1's base-60 integers grow
+    with every ':')."""
+
+    def construct_yaml_int(self, node: yaml.ScalarNode) -> int:
+        if len(node.value) > MAX_INT_TEXT:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"an integer of more than {MAX_INT_TEXT} characters", node.start_mark
+            )
+        return super().construct_yaml_int(node)
+
+
+_Loader.add_constructor("tag:yaml.org,2002:int", _Loader.construct_yaml_int)
 
 
 def parse_text(text: str, file: str) -> object:
     """The data of a robot file's text (None for an empty document); SymdynError for bad YAML/JSON."""
     try:
-        loader = yaml.SafeLoader(text)
+        loader = _Loader(text)
         try:
             node = loader.get_single_node()
+            _check_expanded_size(node, file)
             _check_duplicate_keys(node, file)
             return None if node is None else loader.construct_document(node)
         finally:
@@ -54,14 +84,50 @@ def _parse_json(text: str, file: str) -> object:
             out[k] = v
         return out
 
+    def integer(digits: str) -> int:
+        if len(digits) > MAX_INT_TEXT:
+            raise SymdynError(f"invalid JSON: an integer of more than {MAX_INT_TEXT} characters", file=file)
+        return int(digits)
+
     try:
-        return json.loads(text, object_pairs_hook=pairs)
+        return json.loads(text, object_pairs_hook=pairs, parse_int=integer)
     except json.JSONDecodeError as exc:
         raise SymdynError(
             f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", file=file
         ) from None
     except RecursionError:
         raise SymdynError("invalid JSON: nested too deeply", file=file) from None
+
+
+def _check_expanded_size(root: yaml.Node | None, file: str) -> None:
+    """Refuse a document whose node graph, aliases and merge keys expanded, exceeds MAX_EXPANDED_NODES."""
+    size: dict[int, int] = {}  # id(node) -> expanded size
+    started: set[int] = set()
+    stack: list[tuple[yaml.Node, bool]] = [] if root is None else [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        if id(node) in size or (not children_done and id(node) in started):
+            continue
+        if isinstance(node, yaml.MappingNode):
+            children = [n for pair in node.value for n in pair]
+        elif isinstance(node, yaml.SequenceNode):
+            children = list(node.value)
+        else:
+            size[id(node)] = 1
+            continue
+        if children_done:
+            # a node that is its own descendant (a recursive alias) counts as one here
+            size[id(node)] = 1 + sum(size.get(id(c), 1) for c in children)
+            if size[id(node)] > MAX_EXPANDED_NODES:
+                raise SymdynError(
+                    f"the document expands to more than {MAX_EXPANDED_NODES:,} nodes once its aliases "
+                    f"and merge keys (line {node.start_mark.line + 1}) are expanded; write it out plainly",
+                    file=file,
+                )
+            continue
+        started.add(id(node))
+        stack.append((node, True))
+        stack.extend((c, False) for c in children if id(c) not in size)
 
 
 def _check_duplicate_keys(root: yaml.Node | None, file: str) -> None:

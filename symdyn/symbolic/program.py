@@ -52,7 +52,7 @@ def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
     """Total derivative of e, given the derivatives `dmap` of the symbols it uses (others 0).
 
     Handles the forms the recursions produce (sums, products, integer powers,
-    sin, cos, sign) directly, which is much faster than SymPy's general diff.
+    sin, cos, sign, Heaviside) directly, which is much faster than SymPy's general diff.
     """
     if e.is_Symbol:
         return dmap.get(e, sp.S.Zero)
@@ -78,8 +78,8 @@ def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
         da = _derivative(args[0], dmap, memo)
         slope = sp.cos(args[0]) if isinstance(e, sp.sin) else -sp.sin(args[0])
         out = slope * da if da is not _ZERO else _ZERO
-    elif isinstance(e, sp.sign):
-        out = sp.S.Zero  # almost everywhere
+    elif isinstance(e, (sp.sign, sp.Heaviside)):
+        out = sp.S.Zero  # almost everywhere (Coulomb friction)
     else:
         out = sp.Add(*[e.diff(s) * d for s, d in dmap.items() if s in e.free_symbols])
     memo[e] = out

@@ -7,6 +7,8 @@ M_PI and an F suffix). The rules, docs/generated-code.md:
   (x*x*x), negative ones as a division (1.0/(x*x)), the operation counts assume so;
 * 1/x as a division, x**(1/2) as sqrt(x), any other power as pow(x, y);
 * sign(x) as ((double)((x > 0) - (x < 0))), so sign(0) = 0 as in SymPy;
+* Heaviside(x, 0) (direction-dependent Coulomb friction) as ((double)(x > 0)), and
+  Heaviside(-x, 0) as ((double)(x < 0)): 0 at 0, branch-free;
 * every number as a floating literal that round-trips a double (repr, up to 17
   digits); pi and other constants by their value;
 * under --precision float the literal suffix f and the float functions sinf, cosf, ...
@@ -24,7 +26,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...symbolic.simplify import MAX_UNROLLED_POWER
-from ..printing import TreePrinter
+from ..printing import TreePrinter, step_comparison
 from .config import MATH_CALLS, CConfig
 
 __all__ = ["CPrinter", "ADD", "MUL", "UNARY", "ATOM"]
@@ -83,6 +85,9 @@ class CPrinter(TreePrinter):
         if isinstance(e, sp.sign):
             x = self._print(e.args[0])[0]
             return f"(({self.config.real})(({x} > 0) - ({x} < 0)))", ATOM
+        if isinstance(e, sp.Heaviside):
+            x, op = step_comparison(e)
+            return f"(({self.config.real})({self._print(x)[0]} {op} 0))", ATOM
         call = MATH_CALLS.get(type(e))
         if call is not None:
             if not e.free_symbols:

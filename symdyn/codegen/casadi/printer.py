@@ -1,7 +1,8 @@
 """SymPy expression -> Python text over casadi SX values (the CasADi backend's printer and names).
 
 A small tree printer: sin/cos/tan/sqrt/sign/Abs map to casadi (ca.sin, ...,
-`CASADI_FUNCTIONS`), integer powers up to simplify.MAX_UNROLLED_POWER become
+`CASADI_FUNCTIONS`), Heaviside(x, 0) becomes the comparison (x > 0) (Heaviside(-x, 0):
+(x < 0)), integer powers up to simplify.MAX_UNROLLED_POWER become
 multiplications (as the operation counts assume), rationals and floats become
 float literals with full precision (repr), pi becomes math.pi. Inputs print as
 indexed vector elements (q[0], p[2]): a parameter's name never becomes a Python
@@ -15,7 +16,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...symbolic.simplify import MAX_UNROLLED_POWER
-from ..printing import TreePrinter
+from ..printing import TreePrinter, step_comparison
 
 __all__ = ["CasadiPrinter", "CASADI_FUNCTIONS", "input_names"]
 
@@ -109,6 +110,9 @@ class CasadiPrinter(TreePrinter):
         raise SymdynError(f"casadi target: cannot print {type(e).__name__} ({e})")
 
     def _call(self, e: sp.Expr) -> tuple[str, int]:
+        if isinstance(e, sp.Heaviside):  # a 0/1 casadi expression, 0 at 0
+            x, op = step_comparison(e)
+            return f"({self._print(x)[0]} {op} 0)", _ATOM
         if e.is_Function and e.func in CASADI_FUNCTIONS:
             args = ", ".join(self._print(a)[0] for a in e.args)
             return f"{CASADI_FUNCTIONS[e.func]}({args})", _ATOM

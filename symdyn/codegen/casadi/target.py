@@ -25,6 +25,7 @@ import tempfile
 from dataclasses import asdict, replace
 
 from ...errors import SymdynError
+from ...loading import load_module
 from ..functions import FunctionSpec
 from ..render import RenderContext, environment, header_lines
 from .printer import CasadiPrinter, input_names
@@ -102,12 +103,14 @@ def render_module(ctx: RenderContext) -> str:
 
 
 def serialise(text: str, ctx: RenderContext) -> dict[str, bytes]:
-    """Execute the module text in a fresh namespace and save every function with casadi."""
-    namespace: dict = {"__name__": module_name(ctx)}
-    exec(compile(text, f"<{module_name(ctx)}.py>", "exec"), namespace)  # our own generated text
-    functions = namespace["functions"]()
+    """Write the module text to a temporary file, import it from there (symdyn.loading:
+    never exec'd from a string) and save every function with casadi."""
     files: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory(prefix="symdyn-casadi-") as tmp:
+        source = os.path.join(tmp, f"{module_name(ctx)}.py")
+        with open(source, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        functions = load_module(source, module_name(ctx)).functions()
         for spec in ctx.functions:
             path = os.path.join(tmp, f"{spec.name}.casadi")
             functions[spec.name].save(path)

@@ -18,11 +18,12 @@ from .notation import DynamicsLatexPrinter, Notation
 
 __all__ = ["parameter_latex", "base_parameters_latex"]
 
-_NAME = re.compile(r"(m|mx|my|mz|Ixx|Ixy|Iyy|Ixz|Iyz|Izz|Ia|fv|fc)(\d+)(R?)\Z")
+_NAME = re.compile(r"(m|mx|my|mz|Ixx|Ixy|Iyy|Ixz|Iyz|Izz|Ia|fv|fcp|fcn|fc)(\d+)(R?)\Z")
 
 
 def parameter_latex(name: str) -> str:
     """m1 -> m_{1}, mx1 -> (mx)_{1}, Izz2 -> I_{zz,2}, Ia1 -> I_{a,1}, fv1 -> f_{v,1},
+    fcp1 -> f_{c+,1}, fcn1 -> f_{c-,1},
     Izz1R -> I_{zz,1}^{R}."""
     match = _NAME.match(name)
     assert match, name
@@ -32,7 +33,8 @@ def parameter_latex(name: str) -> str:
     elif head.startswith("m"):
         tex = f"(m{head[1]})_{{{index}}}"
     else:
-        tex = f"{head[0]}_{{{head[1:]},{index}}}"
+        sub = {"cp": "c+", "cn": "c-"}.get(head[1:], head[1:])
+        tex = f"{head[0]}_{{{sub},{index}}}"
     return tex + ("^{R}" if regrouped else "")
 
 

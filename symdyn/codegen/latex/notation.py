@@ -22,6 +22,7 @@ from sympy.printing.latex import LatexPrinter
 
 from ...dynamics import Dynamics
 from ...symbolic.simplify import chop_float_noise
+from ..printing import step_comparison
 
 __all__ = ["DynamicsLatexPrinter", "Notation", "escape_text", "width", "LINE_WIDTH", "MATRIX_WIDTH"]
 
@@ -50,6 +51,12 @@ class DynamicsLatexPrinter(LatexPrinter):
 
     def _print_sign(self, expr, exp=None) -> str:
         tex = f"\\operatorname{{sgn}}({self._print(expr.args[0])})"
+        return f"{tex}^{{{exp}}}" if exp else tex
+
+    def _print_Heaviside(self, expr, exp=None) -> str:
+        """H(x) with H(0) = 0 as the Iverson bracket [x > 0] (H(-x) as [x < 0])."""
+        x, op = step_comparison(expr)
+        tex = f"\\left[{self._print(x)} {op} 0\\right]"
         return f"{tex}^{{{exp}}}" if exp else tex
 
     def terms(self, expr: sp.Expr) -> list[str]:

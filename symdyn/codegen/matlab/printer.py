@@ -4,7 +4,8 @@ A scalar MATLAB expression is written as C's with the same precedences (+ -, * /
 minus binding more loosely than ^), so the printer is the C printer's tree
 (symdyn.codegen.c.printer: powers up to MAX_UNROLLED_POWER as products, numbers as
 literals that round-trip a double) with MATLAB's calls: abs instead of fabs, sign(x) (0 at
-0, as SymPy's), and any other power as x^y. Only double precision exists here.
+0, as SymPy's), Heaviside(x, 0) as double(x > 0) (Heaviside(-x, 0) as double(x < 0)), and any
+other power as x^y. Only double precision exists here.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import sympy as sp
 from ...errors import SymdynError
 from ...symbolic.simplify import MAX_UNROLLED_POWER
 from ..c.printer import ATOM, UNARY, CPrinter
+from ..printing import step_comparison
 
 __all__ = ["MatlabPrinter", "MATLAB_CALLS"]
 
@@ -28,6 +30,9 @@ class MatlabPrinter(CPrinter):
         super().__init__(names, "double")
 
     def _call(self, e: sp.Expr) -> tuple[str, int]:
+        if isinstance(e, sp.Heaviside):
+            x, op = step_comparison(e)
+            return f"double({self._print(x)[0]} {op} 0)", ATOM
         call = MATLAB_CALLS.get(type(e))
         if call is None:
             raise SymdynError(f"cannot print '{type(e).__name__}' as MATLAB: {e}")

@@ -2,7 +2,8 @@
 
 `NumpyPrinter` is SymPy's NumPyPrinter with `np.` functions, small integer
 powers as products (as the operation counts assume), floats and rationals in
-full precision (repr) and sign as np.sign. `local_names` gives every free
+full precision (repr), sign as np.sign and Heaviside(x, 0) as
+np.heaviside(x, 0.0) (0 at 0). `local_names` gives every free
 parameter a Python name that shadows nothing the generated module defines.
 The statements around the expressions are spelled in templates/python/module.py.j2.
 """
@@ -61,6 +62,10 @@ class NumpyPrinter(NumPyPrinter):
 
     def _print_sign(self, expr) -> str:
         return f"np.sign({self._print(expr.args[0])})"
+
+    def _print_Heaviside(self, expr) -> str:
+        assert expr.args[1:] == (sp.S.Zero,), expr
+        return f"np.heaviside({self._print(expr.args[0])}, 0.0)"
 
     def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
         base, exp = expr.base, expr.exp

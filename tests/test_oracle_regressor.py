@@ -1,4 +1,4 @@
-"""The oracle's regressor (symdyn.rnea_regressor): tau = Y(q, qd, qdd) pi, judged by independent routes.
+"""The oracle's regressor (symdyn.oracle.regressor): tau = Y(q, qd, qdd) pi, judged by independent routes.
 
 Y @ pi, with pi the standard parameters of symdyn.standard_parameters (read from the model's
 fields), must equal the numeric RNEA symdyn.rnea (which builds each body's spatial inertia from
@@ -22,10 +22,13 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings
 from robots import (
+    ASYMMETRIC_PARAMS,
     EXAMPLE_NAMES,
     assert_close,
+    asymmetric_friction,
     build_robot,
     example,
+    friction_states,
     random_params,
     random_state,
     robot_specs,
@@ -37,11 +40,11 @@ from test_parameters import pinocchio_order
 
 import symdyn
 from symdyn.errors import SymdynError
-from symdyn.model.parameters import numeric_parameters
+from symdyn.model.parameters import numeric_parameters, standard_parameters
 from symdyn.model.robot import Mimic
-from symdyn.rnea_regressor import regressor
+from symdyn.oracle.regressor import regressor
 
-rr = importlib.import_module("symdyn.rnea_regressor")
+rr = importlib.import_module("symdyn.oracle.regressor")
 URDF_DIR = Path(__file__).resolve().parent / "data" / "urdf"
 URDFS = ("axes", "branch", "cartesian", "fixed_offset", "rpy_chain", "tree", "two_link")
 ROBOT_DATA = {
@@ -146,7 +149,7 @@ def test_regressor_is_independent_of_the_symbolic_code():
     nodes = list(ast.walk(ast.parse(source)))
     modules = {n.module for n in nodes if isinstance(n, ast.ImportFrom)}
     modules |= {a.name for n in nodes if isinstance(n, ast.Import) for a in n.names}
-    assert modules <= {"__future__", "numpy", "rnea_inputs", "rnea_spatial"}
+    assert modules <= {"__future__", "numpy", "inputs", "spatial"}
     assert "sympy" not in source
 
 
@@ -185,3 +188,22 @@ def test_inertial_columns_against_pinocchio(name):
         theirs = S.T @ np.concatenate([theirs[:, 10 * (j - 1) : 10 * j] for j in order], axis=1)
         ours = regressor(robot, q, qd, qdd).reshape(robot.n, robot.nb, 13)[:, :, :10].reshape(robot.n, -1)
         assert_close(ours, theirs, RTOL, name)
+
+
+def test_direction_dependent_coulomb_columns():
+    """Links 1 and 3 of the arm have c+ and c-: their fc column holds [qd > 0] (fcp) and a column
+    after the 13 nb others holds -[qd < 0] (fcn, link order); link 2 keeps sign(qd). Y pi is the
+    oracle's tau at rates of both signs and exactly 0."""
+    robot = asymmetric_friction()
+    names = standard_parameters(robot)[0]
+    assert (names[12], names[25], names[38], names[39:]) == ("fcp1", "fc2", "fcp3", ("fcn1", "fcn3"))
+    pi = numeric_parameters(robot, ASYMMETRIC_PARAMS)
+    assert (pi[12], pi[25], pi[38], *pi[39:]) == (0.395, 0.3, 0.2, 0.435, 0.25)
+    for q, qd, qdd, _ in zip(*friction_states(), strict=True):
+        Y = regressor(robot, q, qd, qdd, ASYMMETRIC_PARAMS)
+        assert Y.shape == (3, 41)
+        expected = np.zeros((3, 5))
+        expected[0, 0], expected[1, 1], expected[2, 2] = qd[0] > 0, np.sign(qd[1]), qd[2] > 0
+        expected[0, 3], expected[2, 4] = -1.0 * (qd[0] < 0), -1.0 * (qd[2] < 0)
+        np.testing.assert_array_equal(Y[:, [12, 25, 38, 39, 40]], expected)
+        assert_close(Y @ pi, symdyn.rnea(robot, q, qd, qdd, ASYMMETRIC_PARAMS), RTOL, robot.name)

@@ -11,21 +11,23 @@ so its wrench f_i = I_i a_i + v_i x* I_i v_i = A(v_i, a_i) pi_i with A the 6 x 1
 column k is B_k a_i + v_i x* B_k v_i for the basis inertia B_k = dI_i/dpi_k. Joint j's effort
 collects the wrenches of its subtree, tau_j = S_j^T sum_{i in subtree(j)} j_X_i^* f_i, so row j
 of Y holds S_j^T j_X_i^* A(v_i, a_i) in the columns of each body i that joint j supports; the
-rotor and friction columns are qdd_j, qd_j and sign(qd_j) on joint j's own row. The parameter
-order is symdyn.model.parameters (Pinocchio's `toDynamicParameters`, then Ia, fv, fc).
+rotor and friction columns are qdd_j, qd_j and sign(qd_j) on joint j's own row (direction-dependent
+Coulomb friction: [qd_j > 0] there and -[qd_j < 0] in joint j's fcn column after the 13 nb
+others). The parameter order is symdyn.model.parameters (Pinocchio's `toDynamicParameters`, then
+Ia, fv, fc).
 
 As symdyn.rnea, this runs on the nb bodies at q_b = S q + o, qd_b = S qd, qdd_b = S qdd and
 projects the rows with S^T (mimic joints), gravity entering as the base acceleration [0; -g].
 It shares no code with the symbolic derivation: the spatial kinematics are the oracle's own
-(symdyn.rnea_spatial) and the model comes from `symdyn.rnea_inputs`.
+(symdyn.oracle.spatial) and the model comes from `symdyn.oracle.inputs`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .rnea_inputs import NumericModel, body_positions, body_rates, checked_inputs, project, skew
-from .rnea_spatial import crm, joint_poses, motion_transforms, mv, subspaces
+from .inputs import NumericModel, body_positions, body_rates, checked_inputs, project, skew
+from .spatial import crm, joint_poses, motion_transforms, mv, subspaces
 
 __all__ = ["regressor", "PER_BODY"]
 
@@ -56,7 +58,7 @@ def _body_regressor(
     """Y_b (N, nb, 13 nb): the bodies' joint efforts tau_b = Y_b pi, in body coordinates."""
     N, nb = qd_b.shape
     S = subspaces(mdl)
-    Y = np.zeros((N, nb, PER_BODY * nb))
+    Y = np.zeros((N, nb, PER_BODY * nb + np.count_nonzero(mdl.asymmetric)))
     v, a = [], []
     for i in range(nb):
         p = mdl.parent[i]
@@ -80,7 +82,11 @@ def _body_regressor(
             j = mdl.parent[j]
         Y[:, i, PER_BODY * i + 10] = qdd_b[:, i]
         Y[:, i, PER_BODY * i + 11] = qd_b[:, i]
-        Y[:, i, PER_BODY * i + 12] = np.sign(qd_b[:, i])
+        if mdl.asymmetric[i]:  # H(qd) for fcp, -H(-qd) for fcn (after the 13 nb columns)
+            Y[:, i, PER_BODY * i + 12] = qd_b[:, i] > 0
+            Y[:, i, PER_BODY * nb + np.count_nonzero(mdl.asymmetric[:i])] = -1.0 * (qd_b[:, i] < 0)
+        else:
+            Y[:, i, PER_BODY * i + 12] = np.sign(qd_b[:, i])
     return Y
 
 

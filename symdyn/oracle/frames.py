@@ -1,7 +1,7 @@
 """The numeric oracle's frame kinematics: pose, Jacobians, drift and centre of mass, NumPy only.
 
 Independent of the symbolic code (symdyn.algorithms.frame_kinematics): it reads only the
-numeric model (symdyn.rnea_inputs) and works in spatial algebra, body coordinates
+numeric model (symdyn.oracle.inputs) and works in spatial algebra, body coordinates
 (Featherstone, Rigid Body Dynamics Algorithms (2008), ch. 2-3), one state at a time:
 
     v_i = i_X_p v_p + S_i qd_i,   a_i = i_X_p a_p + v_i x S_i qd_i     (qdd = 0, base at rest)
@@ -20,9 +20,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .errors import SymdynError
-from .rnea_inputs import NumericModel, body_positions, body_rates, checked_inputs, skew
-from .rnea_spatial import joint_poses, subspaces
+from ..errors import SymdynError
+from .inputs import NumericModel, body_positions, body_rates, checked_inputs, skew
+from .spatial import joint_poses, subspaces
 
 __all__ = ["FrameState", "frame_state", "center_of_mass"]
 

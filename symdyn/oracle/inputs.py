@@ -16,7 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import SymdynError
+from ..errors import SymdynError
 
 __all__ = [
     "NumericModel",
@@ -38,15 +38,17 @@ class NumericModel:
     `axis` (nb,3) in the body frame; `mass` (nb,); `com` (nb,3) body frame;
     `inertia` (nb,3,3) about the centre of mass; `spatial_inertia` (nb,6,6) about
     the body origin; `viscous`, `coulomb`, `reflected` (nb,) friction and
-    gear_ratio**2 * rotor inertia; `gravity` (3,) in the base frame (the robot's world gravity
-    turned by the base rotation, base_R_world g); `base_R`, `base_p` (3,3), (3,) the base frame
-    in the world; `frame_link` (nf,) int and `frame_R`, `frame_p` (nf,3,3), (nf,3): the link
-    (-1: base) and placement in its body frame of every frame (`frame_names`: the links' names,
-    then Robot.frames'); `parent` (nb,) int,
+    gear_ratio**2 * rotor inertia; `coulomb_minus` (nb,) the Coulomb magnitude for negative
+    rates (`coulomb` where `asymmetric` (nb,) bool is False); `gravity` (3,) in the base frame
+    (the robot's world gravity turned by the base rotation, base_R_world g); `base_R`, `base_p`
+    (3,3), (3,) the base frame in the world; `frame_link` (nf,) int and `frame_R`, `frame_p`
+    (nf,3,3), (nf,3): the link (-1: base) and placement in its body frame of every frame
+    (`frame_names`: the links' names, then Robot.frames'); `parent` (nb,) int,
     lambda(i) with -1 for the base (parents before children); `coordinate` (nb,) int, the
     independent coordinate each body's joint follows, with `multiplier` and `offset` (nb,)
     (q_i = multiplier_i q[coordinate_i] + offset_i); `selection` (nb, n) the matrix S of
-    qd_b = S qd; `names` the links' names and `name` the robot's, for messages.
+    qd_b = S qd; `own` (n,) int, per coordinate the link whose joint it is (not a mimic);
+    `names` the links' names and `name` the robot's, for messages.
     """
 
     revolute: np.ndarray
@@ -59,6 +61,8 @@ class NumericModel:
     spatial_inertia: np.ndarray
     viscous: np.ndarray
     coulomb: np.ndarray
+    coulomb_minus: np.ndarray
+    asymmetric: np.ndarray
     reflected: np.ndarray
     gravity: np.ndarray
     base_R: np.ndarray
@@ -72,6 +76,7 @@ class NumericModel:
     multiplier: np.ndarray
     offset: np.ndarray
     selection: np.ndarray
+    own: np.ndarray
     names: tuple[str, ...]
     name: str
 
@@ -151,10 +156,14 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
     spatial[:, :3, 3:] = m * cx
     spatial[:, 3:, :3] = m * np.swapaxes(cx, -1, -2)
     spatial[:, 3:, 3:] = m * np.eye(3)
-    fr = [(lk.friction.viscous, lk.friction.coulomb, lk.motor.reflected_inertia) for lk in links]
+    fr = [
+        (lk.friction.viscous, lk.friction.coulomb, lk.motor.reflected_inertia, lk.friction.coulomb_minus)
+        for lk in links
+    ]
+    fr = [(*t[:3], t[1] if t[3] is None else t[3]) for t in fr]
     fr = np.array(
         [[_floats(x, (), f"{lk.name} friction/motor") for x in t] for lk, t in zip(links, fr, strict=True)]
-    ).reshape(n, 3)
+    ).reshape(n, 4)
     coords = r.coordinates
     coordinate = np.array([c.index for c in coords], dtype=int).reshape(n)
     multiplier = np.array(
@@ -175,12 +184,14 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
         revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
         R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
         spatial_inertia=spatial, viscous=fr[:, 0], coulomb=fr[:, 1], reflected=fr[:, 2],
+        coulomb_minus=fr[:, 3], asymmetric=np.array([lk.friction.asymmetric for lk in links], dtype=bool),
         gravity=base_R.T @ _floats(r.gravity, (3,), "gravity"), base_R=base_R,
         base_p=_floats(r.base.p, (3,), "base.xyz"), frame_link=np.array([k for k, _, _ in frames], dtype=int),
         frame_R=frame_R, frame_p=frame_p, frame_names=tuple(name for _, name, _ in frames),
         parent=np.array(r.parents, dtype=int).reshape(n),
         coordinate=coordinate, multiplier=multiplier.reshape(n), offset=offset.reshape(n),
-        selection=selection, names=tuple(lk.name for lk in links), name=r.name,
+        selection=selection, own=np.array([i for i, lk in enumerate(links) if lk.mimic is None], dtype=int),
+        names=tuple(lk.name for lk in links), name=r.name,
     )  # fmt: skip
 
 

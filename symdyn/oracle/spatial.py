@@ -3,15 +3,15 @@ motion subspaces and the spatial cross product, for a batch of N states.
 
 Spatial vectors are Featherstone's (Rigid Body Dynamics Algorithms, 2008, ch. 2), in body
 coordinates at the body origin, angular part first: motion v = [omega; v_O], force f = [n_O; f].
-Shared by the numeric RNEA (symdyn.rnea) and its regressor (symdyn.rnea_regressor); like them it
-reads only the numeric model (symdyn.rnea_inputs), never the symbolic derivation.
+Shared by the numeric RNEA (symdyn.rnea) and its regressor (symdyn.oracle.regressor); like them it
+reads only the numeric model (symdyn.oracle.inputs), never the symbolic derivation.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .rnea_inputs import NumericModel, skew
+from .inputs import NumericModel, skew
 
 __all__ = ["joint_poses", "motion_transforms", "subspaces", "crm", "mv"]
 
