@@ -22,6 +22,7 @@ import warnings
 from pathlib import Path
 
 from .codegen import TARGETS, file_tools, render
+from .codegen.functions import FRAME_GROUPS, GROUPS
 from .codegen.output import write_files
 from .errors import SymdynError
 from .model.robot import Robot
@@ -42,6 +43,9 @@ EXAMPLES = ("roger_arm", "puma560", "panda", "solo12")
 #: examples that are URDF files of the example-robot-data package: name -> path in its robots/
 URDF_EXAMPLES = {"solo12": "solo_description/robots/solo12.urdf"}
 TOOLCHAIN_FILE = "TOOLCHAIN"
+#: the examples whose generated/ files include the frame functions (kinematics, operational_space):
+#: name -> (frames, task axes); the other examples get every group but those
+FRAME_EXAMPLES = {"panda": ("link7", None)}
 
 
 def versions() -> dict[str, str]:
@@ -108,7 +112,12 @@ def render_all(root: Path) -> dict[str, dict[str, str | bytes]]:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for name in EXAMPLES:
-            out[name] = render(example_robot(root, name), targets=tuple(TARGETS), functions=("all",))
+            groups = [g for g in GROUPS if g not in FRAME_GROUPS]
+            frames, axes = FRAME_EXAMPLES.get(name, (None, None))
+            if frames is not None:
+                groups += list(FRAME_GROUPS)
+            robot = example_robot(root, name)
+            out[name] = render(robot, tuple(TARGETS), functions=groups, frames=frames, task_axes=axes)
     return out
 
 

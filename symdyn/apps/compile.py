@@ -35,6 +35,7 @@ from ..errors import SymdynError, SymdynWarning
 from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
 from . import cache
+from .compiled_frames import FrameMethods
 from .singular import INVERTING, NotGeneratedError, guarded
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
@@ -94,8 +95,12 @@ def _options(method: str, precision: str = "double") -> dict:
     }
 
 
-def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
-    """build(folder): derive, generate (C, NumPy, runtime), compile; return the entry's metadata."""
+def _build(robot, method: str, options: dict, frames: dict | None = None) -> Callable[[Path], dict]:
+    """build(folder): derive, generate (C, NumPy, runtime), compile; return the entry's metadata.
+
+    `frames`: None (the functions of symdyn.codegen.context's default groups) or the keywords
+    functions, frames and task_axes of the frame functions' own entry (CompiledDynamics.frame_functions).
+    """
 
     def build(folder: Path) -> dict:
         from ..codegen import c as c_target
@@ -104,7 +109,7 @@ def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
         from ..codegen.c.runtime import function_table, render_runtime
         from .build import compile_library, library_suffix
 
-        ctx = context(robot, options["precision"], method)
+        ctx = context(robot, options["precision"], method, **(frames or {}))
         files = {**c_target.render(ctx), **render_runtime(ctx), **numpy_target.render(ctx)}
         for name, text in files.items():
             (folder / name).write_text(text, encoding="utf-8")
@@ -117,7 +122,12 @@ def _build(robot, method: str, options: dict) -> Callable[[Path], dict]:
                 folder / library,
             )
         return {
-            "robot": {"name": ctx.name, "n": ctx.robot.n, "params": [str(s) for s in ctx.dynamics.params]},
+            "robot": {
+                "name": ctx.name,
+                "n": ctx.robot.n,
+                "params": [str(s) for s in ctx.dynamics.params],
+                "frames": list(ctx.robot.frame_names),
+            },
             "functions": function_table(ctx),
             "numpy": numpy_target.file_name(ctx.name),
             "library": library,
@@ -147,6 +157,7 @@ def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: 
         entry = cache.get_or_build(key, _build(robot, method, options))
     self = CompiledDynamics._from_entry(entry, robot, params)
     self._source = ({**key_parts, "method": method}, make_robot)
+    self._build_frames = lambda robot, folder, frames: _build(robot, method, options, frames)(folder)
 
     def rebuild() -> cache.Entry:
         return cache.get_or_build(key, _build(robot if robot is not None else make_robot(), method, options))
@@ -205,7 +216,7 @@ def _bind(names: list[str], robot, params) -> np.ndarray | None:
     return np.array([float(by_name[n]) for n in names], dtype=np.float64) if names else None
 
 
-class CompiledDynamics:
+class CompiledDynamics(FrameMethods):
     """The generated functions of a robot as methods, bound to values of its free parameters.
 
     CompiledDynamics(robot, params) is symdyn.compile(robot, params). `backend` is "c" or
@@ -226,6 +237,9 @@ class CompiledDynamics:
         self.param_names = tuple(info["params"])
         self.p = _bind(info["params"], self.robot, params)
         self._entry = entry
+        self._params = params
+        self._frame_libraries: dict = {}
+        self.frame_names = tuple(info.get("frames", ()))
         self._module = None
         self.functions = tuple(f["name"] for f in meta["functions"])
         self._library = entry.file(meta["library"]) if meta["library"] else None
@@ -296,6 +310,36 @@ class CompiledDynamics:
             robot = self.robot if not isinstance(self.robot, RobotInfo) else make_robot()
             entry = cache.get_or_build(key, lambda folder: build(robot, folder))
         return entry
+
+    def function(self, name: str) -> Callable:
+        """The generated function `name` (one of `functions`), also where a method of this class
+        has its name (a frame's functions may: frame_pose, com, ...)."""
+        if name not in self.__dict__:
+            if name not in self.functions:
+                raise SymdynError(f"symdyn.compile: no generated function {name!r}")
+            return self.__getattr__(name)
+        return self.__dict__[name]
+
+    def frame_functions(self, frame: str, group: str = "kinematics", axes=None) -> CompiledDynamics:
+        """The compiled functions of group `group` ("kinematics" or "operational_space", task axes
+        `axes`, default all six) of one frame, in a cache entry of their own built on first use:
+        methods <identifier>_pose, ..., com, ... (symdyn.codegen.frame_functions)."""
+        from ..algorithms.operational_space import TASK_AXES, task_rows
+        from ..model.frames import unknown_frame
+
+        if frame not in self.frame_names:
+            raise unknown_frame(frame, self.frame_names, f"symdyn.compile: robot '{self.robot.name}'")
+        assert group in ("kinematics", "operational_space"), group
+        task = ",".join(TASK_AXES[r] for r in task_rows(axes, "symdyn.compile: axes"))
+        key = (frame, group, task)
+        if key not in self._frame_libraries:
+            options = {"functions": (group,), "frames": [frame], "task_axes": task}
+            entry = self.derived_entry(
+                f"frames {frame!r} {group} {task}",
+                lambda robot, folder: self._build_frames(robot, folder, options),
+            )
+            self._frame_libraries[key] = CompiledDynamics._from_entry(entry, self.robot, self._params)
+        return self._frame_libraries[key]
 
     def __repr__(self) -> str:
         names = ", ".join(self.functions)

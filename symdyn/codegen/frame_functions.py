@@ -25,6 +25,7 @@ end_effector), each once.
 from __future__ import annotations
 
 import re
+import warnings
 from collections.abc import Sequence
 
 import sympy as sp
@@ -32,8 +33,9 @@ import sympy as sp
 from ..algorithms.frame_kinematics import FrameKinematics
 from ..algorithms.operational_space import operational_space, task_rows
 from ..dynamics import Dynamics
-from ..errors import SymdynError
+from ..errors import SymdynError, SymdynWarning
 from ..model.robot import Robot
+from ..symbolic.program import Program
 from .function_rows import FrameChoice, FunctionRow, Inputs, Output
 
 __all__ = [
@@ -132,9 +134,13 @@ def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
     return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
 
 
-def _with_steps(rows: list[tuple], steps: list, cse: str) -> list[FunctionRow]:
-    """FunctionRows of one CSE group, the first carrying every new step (build_functions
-    gathers the rows' steps into one program)."""
+def _with_steps(rows: list[tuple], prog: Program, first: int, cse: str) -> list[FunctionRow]:
+    """FunctionRows of one CSE group, the first carrying every step after `first` in `prog` that
+    the rows need (build_functions gathers the rows' steps into one program)."""
+    if not rows:
+        return []
+    new = {s for s, _ in prog.assignments[first:]}
+    steps = [a for a in prog.needed([e for row in rows for e in row[4]]) if a[0] in new]
     carried = [tuple(steps)] + [()] * (len(rows) - 1)
     return [FunctionRow(*row, s, cse=cse) for row, s in zip(rows, carried, strict=True)]
 
@@ -203,7 +209,7 @@ def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             _entries(fk.com_jacobian_dot_qd()),
         ),
     ]
-    return _with_steps(rows, prog.assignments[first:], "kinematics")
+    return _with_steps(rows, prog, first, "kinematics")
 
 
 def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
@@ -218,10 +224,23 @@ def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     k = len(keep)
     axes = ", ".join(x.frames.axes)
     rows: list[tuple] = []
+    if dyn.robot.idle_joints():
+        return []  # M is singular by construction (forward_dynamics' family warns)
     for name, ident, link in x.frames.frames:
         J = fk.jacobian(name, "world").extract(keep, list(range(n)))
         drift = fk.jacobian_dot_qd(name).extract(keep, [0])
+        mark = len(prog.assignments)
         os = operational_space(sp.Matrix(c["M"]), J, sp.Matrix(c["bias"]), drift, dyn.robot.is_chain, prog)
+        made = [e for _, e in prog.assignments[mark:]] + list(os.inertia) + list(os.bias)
+        if any(sp.sympify(e).has(sp.zoo, sp.nan, sp.oo) for e in made):
+            warnings.warn(
+                f"robot '{dyn.robot.name}': the operational-space functions of frame {name!r} are not "
+                f"generated: J M^-1 J^T over the task axes {axes} is singular at every q (the joints "
+                "supporting the frame cannot move it along every axis); choose fewer --task-axes",
+                SymdynWarning,
+                stacklevel=4,
+            )
+            continue
         on = f"of frame {comment_text(name)} on {link}, task axes {axes}"
         rows += [
             (
@@ -239,4 +258,4 @@ def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 _entries(os.bias),
             ),
         ]
-    return _with_steps(rows, prog.assignments[first:], "operational_space")
+    return _with_steps(rows, prog, first, "operational_space")

@@ -240,12 +240,11 @@ def build_functions(
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
-    if groups is None:
-        groups = [g for g in GROUPS if g not in FRAME_GROUPS]
-    if frames is None and set(groups) & set(FRAME_GROUPS):
+    per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
+    chosen = set(FAMILIES) - per_frame if groups is None else {b for g in groups for b in GROUPS[g]}
+    if frames is None and chosen & per_frame:
         frames = choose_frames(dyn.robot)
     x = Inputs.of(dyn, frames)
-    chosen = {b for g in groups for b in GROUPS[g]}
     families = [family for family in FAMILIES if family in chosen]
     _warn_singular(dyn, families)
     rows = [row for family in families for row in family(dyn, x)]
