@@ -95,7 +95,7 @@ def check(what: str, text: str, refs: list[dict]) -> dict[str, float]:
 
 def bench_robot(name: str, work: Path, opts, pin_exe: Path | None) -> dict:
     inside, tip, frame, frames = ROBOTS[name]
-    urdf = robots._example_robot(inside)
+    urdf = robots.example_robot_file(inside)
     if urdf is None:
         raise SystemExit("example-robot-data is not installed (pip install 'symdyn[test]')")
     from symdyn.parsers import load
