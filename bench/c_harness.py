@@ -23,7 +23,51 @@ from states import CHECK_TOL, NCHECK, NSTATES, rel_err
 import symdyn
 from symdyn.model.parameters import numeric_parameters
 
-__all__ = ["HARNESS", "parse_harness", "build_c", "check_c", "time_compiled"]
+__all__ = ["HARNESS", "C_READ_STATES", "C_TIME_MAIN", "parse_harness", "build_c", "check_c", "time_compiled"]
+
+#: The part of a harness's main that reads the states file argv[1] into Q, QD, QDD, TAU (K states
+#: of N joints; needs `FILE *f` and `int k`). Shared with bench/frames_harness.py.
+C_READ_STATES = r"""    f = fopen(argv[1], "rb");
+    if (!f) {
+        perror(argv[1]);
+        return 2;
+    }
+    for (k = 0; k < K; ++k) {
+        if (fread(Q[k], sizeof(double), N, f) != N || fread(QD[k], sizeof(double), N, f) != N
+            || fread(QDD[k], sizeof(double), N, f) != N || fread(TAU[k], sizeof(double), N, f) != N) {
+            fprintf(stderr, "short states file\n");
+            return 2;
+        }
+    }
+    fclose(f);
+"""
+
+#: The end of a harness's main that times the NB benchmarks of run_bench(b, it) with REPS and
+#: TARGET_MS from argv[3], argv[4] and prints `time LABEL ITERATIONS NS...` lines (needs ns, iters,
+#: b, r, reps, target_ns and LABELS). Shared with bench/frames_harness.py.
+C_TIME_MAIN = r"""    reps = argc > 3 ? atoi(argv[3]) : 11;
+    if (reps < 1) reps = 1;
+    if (reps > MAXREPS) reps = MAXREPS;
+    target_ns = 1e6 * (argc > 4 ? atof(argv[4]) : 10.0);
+    /* calibrate (this also warms up): iterations per repetition for ~target_ns */
+    for (b = 0; b < NB; ++b) {
+        long it = 64;
+        double t;
+        while ((t = run_bench(b, it) * (double)it) < 0.25 * target_ns) it *= 2;
+        iters[b] = (long)(target_ns / (t / (double)it)) + 1;
+        run_bench(b, iters[b]);
+    }
+    /* repetitions interleaved across the functions, so a change of machine load during the run
+       falls on all of them alike */
+    for (r = 0; r < reps; ++r)
+        for (b = 0; b < NB; ++b) ns[b][r] = run_bench(b, iters[b]);
+    for (b = 0; b < NB; ++b) {
+        printf("time %s %ld", LABELS[b], iters[b]);
+        for (r = 0; r < reps; ++r) printf(" %.3f", ns[b][r]);
+        printf("\n");
+    }
+    return 0;
+"""
 
 HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench/run.py), do not edit. */
 #define _POSIX_C_SOURCE 199309L
@@ -137,20 +181,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s STATES check NCHECK | STATES time REPS TARGET_MS\n", argv[0]);
         return 2;
     }}
-    f = fopen(argv[1], "rb");
-    if (!f) {{
-        perror(argv[1]);
-        return 2;
-    }}
-    for (k = 0; k < K; ++k) {{
-        if (fread(Q[k], sizeof(double), N, f) != N || fread(QD[k], sizeof(double), N, f) != N
-            || fread(QDD[k], sizeof(double), N, f) != N || fread(TAU[k], sizeof(double), N, f) != N) {{
-            fprintf(stderr, "short states file\n");
-            return 2;
-        }}
-    }}
-    fclose(f);
-    cr_work(cr_{prefix}_inverse_dynamics_work, &sz_iw, &sz_w);
+{read_states}    cr_work(cr_{prefix}_inverse_dynamics_work, &sz_iw, &sz_w);
     cr_work(cr_{prefix}_mass_matrix_work, &sz_iw, &sz_w);
     cr_work(cr_{prefix}_gravity_work, &sz_iw, &sz_w);
     cr_iw = malloc(sizeof(casadi_int) * (size_t)sz_iw);
@@ -175,29 +206,7 @@ int main(int argc, char **argv)
         }}
         return 0;
     }}
-    reps = argc > 3 ? atoi(argv[3]) : 11;
-    if (reps < 1) reps = 1;
-    if (reps > MAXREPS) reps = MAXREPS;
-    target_ns = 1e6 * (argc > 4 ? atof(argv[4]) : 10.0);
-    /* calibrate (this also warms up): iterations per repetition for ~target_ns */
-    for (b = 0; b < NB; ++b) {{
-        long it = 64;
-        double t;
-        while ((t = run_bench(b, it) * (double)it) < 0.25 * target_ns) it *= 2;
-        iters[b] = (long)(target_ns / (t / (double)it)) + 1;
-        run_bench(b, iters[b]);
-    }}
-    /* repetitions interleaved across the functions, so a change of machine load during the run
-       falls on all of them alike */
-    for (r = 0; r < reps; ++r)
-        for (b = 0; b < NB; ++b) ns[b][r] = run_bench(b, iters[b]);
-    for (b = 0; b < NB; ++b) {{
-        printf("time %s %ld", LABELS[b], iters[b]);
-        for (r = 0; r < reps; ++r) printf(" %.3f", ns[b][r]);
-        printf("\n");
-    }}
-    return 0;
-}}
+{time_main}}}
 """
 
 
@@ -222,7 +231,15 @@ def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
     """Write the CasADi route's C and the harness; compile all three with FLAGS."""
     casadi_route.write_c(fns, f"cr_{row.name}", work)
     harness = work / f"bench_{row.name}.c"
-    harness.write_text(HARNESS.format(name=row.name, prefix=robot.name, n=robot.n, nstates=NSTATES))
+    text = HARNESS.format(
+        name=row.name,
+        prefix=robot.name,
+        n=robot.n,
+        nstates=NSTATES,
+        read_states=C_READ_STATES,
+        time_main=C_TIME_MAIN,
+    )
+    harness.write_text(text)
     exe = work / f"bench_{row.name}"
     sources = [harness, gen_dir / f"{robot.name}_dynamics.c", work / f"cr_{row.name}.c"]
     t0 = time.perf_counter()

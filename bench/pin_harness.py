@@ -29,7 +29,7 @@ from machine import BENCH, CXX_COMPILER, CXX_EXTRA, FLAGS, compiler_version, log
 from row import Row
 from states import CHECK_TOL, NCHECK, NSTATES
 
-__all__ = ["prepare", "check_pinocchio", "pinocchio_model_text", "MIMIC_NOTE"]
+__all__ = ["prepare", "check_pinocchio", "pinocchio_model_text", "model_and_states_lines", "MIMIC_NOTE"]
 
 MIMIC_NOTE = (
     "mimic joints: Pinocchio not run (bench/pinocchio_harness.cpp gives every link an independent "
@@ -87,20 +87,26 @@ def find_headers() -> tuple[Headers | None, str]:
     return None, f"pin {pin_version} installed but cmeel.prefix/include/pinocchio was not found"
 
 
-def build_pinocchio(headers: Headers, build_dir: Path) -> tuple[Path, str]:
-    """Compile bench/pinocchio_harness.cpp (cached by source, flags, compiler and headers)."""
-    src = BENCH / "pinocchio_harness.cpp"
+def build_pinocchio(
+    headers: Headers, build_dir: Path, source: str = "pinocchio_harness.cpp"
+) -> tuple[Path, str]:
+    """Compile bench/SOURCE with bench/pinocchio_model.hpp (cached by sources, flags, compiler, headers)."""
+    src = BENCH / source
     inc = headers.include
     cmd_flags = [*FLAGS, *CXX_EXTRA, *PIN_DEFINES, "-I", str(inc), "-I", str(headers.eigen)]
     config = (inc / "pinocchio" / "config.hpp").read_bytes()
     key = hashlib.sha256(
-        src.read_bytes() + config + " ".join(cmd_flags).encode() + compiler_version(CXX_COMPILER).encode()
+        src.read_bytes()
+        + (BENCH / "pinocchio_model.hpp").read_bytes()
+        + config
+        + " ".join(cmd_flags).encode()
+        + compiler_version(CXX_COMPILER).encode()
     ).hexdigest()[:16]
-    exe = build_dir / f"pinocchio_harness_{key}"
+    exe = build_dir / f"{src.stem}_{key}"
     if exe.exists():
         return exe, "cached build"
     build_dir.mkdir(parents=True, exist_ok=True)
-    log(f"compiling the Pinocchio harness (several minutes, cached in {project_path(build_dir)}) ...")
+    log(f"compiling {source} (several minutes, cached in {project_path(build_dir)}) ...")
     t0 = time.perf_counter()
     tmp = exe.with_suffix(".tmp")
     # -w: GCC 12 prints false -Wstringop-overread warnings from Eigen's AVX-512 code
@@ -109,13 +115,14 @@ def build_pinocchio(headers: Headers, build_dir: Path) -> tuple[Path, str]:
     return exe, f"compiled in {time.perf_counter() - t0:.0f} s"
 
 
-def prepare(build_dir: Path) -> tuple[Path | None, str]:
-    """The compiled harness (None if Pinocchio is missing or does not compile) and the report's note."""
+def prepare(build_dir: Path, source: str = "pinocchio_harness.cpp") -> tuple[Path | None, str]:
+    """The compiled harness bench/SOURCE (None if Pinocchio is missing or does not compile) and
+    the report's note."""
     headers, why = find_headers()
     if headers is None:
         return None, why + "; Pinocchio columns skipped"
     try:
-        exe, how = build_pinocchio(headers, build_dir)
+        exe, how = build_pinocchio(headers, build_dir, source)
     except (RuntimeError, OSError) as exc:
         log(f"the Pinocchio harness did not compile:\n{exc}")
         why = "the harness did not compile (the compiler's messages are on stderr)"
@@ -125,6 +132,25 @@ def prepare(build_dir: Path) -> tuple[Path | None, str]:
 
 def pinocchio_model_text(robot, states, refs: list[dict]) -> str:
     """The MODEL.txt of bench/pinocchio_harness.cpp, with symdyn.rnea's reference numbers `refs`."""
+    lines = model_and_states_lines(robot, states)
+    lines.append(f"ncheck {NCHECK}")
+    for k in range(NCHECK):
+        ref = refs[k]
+        vec = np.concatenate(
+            [
+                ref["rnea_nofriction"],
+                ref["mass_matrix"].ravel(),
+                ref["gravity"],
+                ref["coriolis"],
+                ref["aba_nofriction"],
+            ]
+        )
+        lines.append(f"{k} " + " ".join(repr(float(v)) for v in vec))
+    return "\n".join(lines) + "\n"
+
+
+def model_and_states_lines(robot, states) -> list[str]:
+    """The model and the states of MODEL.txt (bench/pinocchio_model.hpp reads them)."""
     m = casadi_route.robot_arrays(robot)
     assert not m.has_mimic, "the Pinocchio harness models independent joints only"
     lines = [f"n {m.n}", "gravity " + " ".join(repr(float(x)) for x in m.gravity)]
@@ -150,20 +176,7 @@ def pinocchio_model_text(robot, states, refs: list[dict]) -> str:
     for k in range(NSTATES):
         vec = np.concatenate([states[x][k] for x in ("q", "qd", "qdd", "tau")])
         lines.append(" ".join(repr(float(v)) for v in vec))
-    lines.append(f"ncheck {NCHECK}")
-    for k in range(NCHECK):
-        ref = refs[k]
-        vec = np.concatenate(
-            [
-                ref["rnea_nofriction"],
-                ref["mass_matrix"].ravel(),
-                ref["gravity"],
-                ref["coriolis"],
-                ref["aba_nofriction"],
-            ]
-        )
-        lines.append(f"{k} " + " ".join(repr(float(v)) for v in vec))
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def check_pinocchio(row: Row, robot, exe: Path, work: Path, states, refs: list[dict]) -> list | None:

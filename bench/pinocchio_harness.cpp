@@ -32,22 +32,8 @@
 // Compiled by bench/run.py with g++ -O3 -march=native -DNDEBUG -std=c++17 against the
 // pinocchio and Eigen headers of the `pin` and `cmeel-eigen` wheels (header-only use: the
 // templates are instantiated here with these flags, not taken from libpinocchio).
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <ctime>
-#include <fstream>
-#include <iostream>
-#include <string>
-#include <vector>
+#include "pinocchio_model.hpp"
 
-#if __has_include("pinocchio/multibody.hpp")  // pinocchio >= 4
-  #include "pinocchio/multibody.hpp"
-#else
-  #include "pinocchio/multibody/data.hpp"
-  #include "pinocchio/multibody/model.hpp"
-#endif
 #include "pinocchio/algorithm/aba-derivatives.hpp"
 #include "pinocchio/algorithm/aba.hpp"
 #include "pinocchio/algorithm/crba.hpp"
@@ -55,135 +41,6 @@
 #include "pinocchio/algorithm/rnea-derivatives.hpp"
 #include "pinocchio/algorithm/rnea.hpp"
 
-using pinocchio::Data;
-using pinocchio::Model;
-using Eigen::MatrixXd;
-using Eigen::VectorXd;
-
-static volatile double sink;
-
-static double now_ns()
-{
-  timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return 1e9 * double(t.tv_sec) + double(t.tv_nsec);
-}
-
-static void fail(const std::string & what)
-{
-  std::cerr << "pinocchio_harness: " << what << std::endl;
-  std::exit(2);
-}
-
-template<typename T>
-static T read(std::istream & in, const char * what)
-{
-  T x;
-  if (!(in >> x))
-    fail(std::string("bad or missing ") + what);
-  return x;
-}
-
-static void expect(std::istream & in, const std::string & word)
-{
-  if (read<std::string>(in, word.c_str()) != word)
-    fail("expected '" + word + "'");
-}
-
-static bool is_unit(const Eigen::Vector3d & a, int k)
-{
-  for (int j = 0; j < 3; ++j)
-    if (std::abs(a[j] - (j == k ? 1.0 : 0.0)) > 1e-15)
-      return false;
-  return true;
-}
-
-static Model build_model(std::istream & in, int & n)
-{
-  expect(in, "n");
-  n = read<int>(in, "n");
-  Model model;
-  expect(in, "gravity");
-  Eigen::Vector3d g;
-  for (int j = 0; j < 3; ++j)
-    g[j] = read<double>(in, "gravity");
-  std::vector<double> armature(n);
-  for (int i = 0; i < n; ++i)
-  {
-    expect(in, "joint");
-    const std::string type = read<std::string>(in, "joint type");
-    const int parent_line = read<int>(in, "parent");
-    if (parent_line < -1 || parent_line >= i)
-      fail("joint " + std::to_string(i + 1) + ": the parent must be -1 (base) or an earlier joint");
-    const pinocchio::JointIndex parent = pinocchio::JointIndex(parent_line + 1);
-    Eigen::Vector3d axis, p, com;
-    Eigen::Matrix3d R;
-    for (int j = 0; j < 3; ++j)
-      axis[j] = read<double>(in, "axis");
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        R(r, c) = read<double>(in, "placement R");
-    for (int j = 0; j < 3; ++j)
-      p[j] = read<double>(in, "placement p");
-    const double mass = read<double>(in, "mass");
-    for (int j = 0; j < 3; ++j)
-      com[j] = read<double>(in, "com");
-    double I[6];  // xx xy xz yy yz zz
-    for (int j = 0; j < 6; ++j)
-      I[j] = read<double>(in, "inertia");
-    armature[i] = read<double>(in, "armature");
-
-    const pinocchio::SE3 placement(R, p);
-    const std::string name = "joint" + std::to_string(i + 1);
-    pinocchio::JointIndex id;
-    if (type == "R")
-    {
-      if (is_unit(axis, 0))
-        id = model.addJoint(parent, pinocchio::JointModelRX(), placement, name);
-      else if (is_unit(axis, 1))
-        id = model.addJoint(parent, pinocchio::JointModelRY(), placement, name);
-      else if (is_unit(axis, 2))
-        id = model.addJoint(parent, pinocchio::JointModelRZ(), placement, name);
-      else
-        id = model.addJoint(parent, pinocchio::JointModelRevoluteUnaligned(axis), placement, name);
-    }
-    else if (type == "P")
-    {
-      if (is_unit(axis, 0))
-        id = model.addJoint(parent, pinocchio::JointModelPX(), placement, name);
-      else if (is_unit(axis, 1))
-        id = model.addJoint(parent, pinocchio::JointModelPY(), placement, name);
-      else if (is_unit(axis, 2))
-        id = model.addJoint(parent, pinocchio::JointModelPZ(), placement, name);
-      else
-        id = model.addJoint(parent, pinocchio::JointModelPrismaticUnaligned(axis), placement, name);
-    }
-    else
-      fail("joint type must be R or P, not " + type);
-    const pinocchio::Symmetric3 Ic(I[0], I[1], I[3], I[2], I[4], I[5]);  // xx xy yy xz yz zz
-    if (id != pinocchio::JointIndex(i + 1))
-      fail("joint " + std::to_string(i + 1) + " got Pinocchio index " + std::to_string(id));
-    model.appendBodyToJoint(id, pinocchio::Inertia(mass, com, Ic), pinocchio::SE3::Identity());
-  }
-  if (model.nv != n)
-    fail("model has nv != n");
-  for (int i = 0; i < n; ++i)
-    model.armature[i] = armature[i];
-  model.gravity.linear(g);
-  return model;
-}
-
-static double rel_err(const MatrixXd & got, const MatrixXd & want)
-{
-  const double scale = std::max(1.0, want.cwiseAbs().maxCoeff());
-  return (got - want).cwiseAbs().maxCoeff() / scale;
-}
-
-static MatrixXd symmetric(MatrixXd A)  // Pinocchio fills the upper triangle of M and M^-1
-{
-  A.triangularView<Eigen::StrictlyLower>() = A.transpose().triangularView<Eigen::StrictlyLower>();
-  return A;
-}
 
 // The derivatives against central differences (step 1e-6) of rnea and aba, M^-1 against crba.
 static void check_derivatives(
@@ -223,23 +80,6 @@ static void check_derivatives(
   std::printf("dcheck aba_derivatives %.3e\n", e_ad);
   std::printf("dcheck minverse %.3e\n", e_mi);
 }
-
-// ns per call of `body` over `it` calls on states k = 0, 1, ... (cycling: the state changes every
-// call), one output element per call accumulated into the volatile sink.
-template<typename Body>
-static double loop(long it, int nstates, Body && body)
-{
-  const double s = now_ns();
-  int k = 0;
-  for (long i = 0; i < it; ++i)
-  {
-    sink += body(k);
-    if (++k == nstates)
-      k = 0;
-  }
-  return (now_ns() - s) / double(it);
-}
-
 int main(int argc, char ** argv)
 {
   if (argc != 4)
@@ -254,14 +94,9 @@ int main(int argc, char ** argv)
   Model model = build_model(in, n);
   Data data(model);
 
-  expect(in, "nstates");
-  const int K = read<int>(in, "nstates");
-  std::vector<VectorXd> Q(K, VectorXd(n)), QD(K, VectorXd(n)), QDD(K, VectorXd(n)),
-    TAU(K, VectorXd(n));
-  for (int k = 0; k < K; ++k)
-    for (auto * v : {&Q[k], &QD[k], &QDD[k], &TAU[k]})
-      for (int j = 0; j < n; ++j)
-        (*v)[j] = read<double>(in, "state");
+  const States states = read_states(in, n);
+  const int K = states.K;
+  const std::vector<VectorXd> &Q = states.Q, &QD = states.QD, &QDD = states.QDD, &TAU = states.TAU;
 
   // --- check against symdyn.rnea
   expect(in, "ncheck");
@@ -355,28 +190,6 @@ int main(int argc, char ** argv)
     }
     return -1.0;
   };
-  // calibrate (this also warms up): iterations per repetition for ~target_ns
-  std::vector<long> iters(NB);
-  for (int b = 0; b < NB; ++b)
-  {
-    long it = 64;
-    double t;
-    while ((t = run_bench(b, it) * double(it)) < 0.25 * target_ns)
-      it *= 2;
-    iters[b] = long(target_ns / (t / double(it))) + 1;
-    run_bench(b, iters[b]);
-  }
-  // repetitions interleaved across the algorithms
-  std::vector<std::vector<double>> ns(NB, std::vector<double>(reps));
-  for (int r = 0; r < reps; ++r)
-    for (int b = 0; b < NB; ++b)
-      ns[b][r] = run_bench(b, iters[b]);
-  for (int b = 0; b < NB; ++b)
-  {
-    std::printf("time %s %ld", labels[b], iters[b]);
-    for (int r = 0; r < reps; ++r)
-      std::printf(" %.3f", ns[b][r]);
-    std::printf("\n");
-  }
+  time_benchmarks(labels, NB, run_bench, reps, target_ns);
   return 0;
 }

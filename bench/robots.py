@@ -42,6 +42,7 @@ from symdyn.spatial.transform import Transform
 
 __all__ = [
     "generic_arm",
+    "example_robot_file",
     "puma560_symbolic",
     "puma560_float_text",
     "write_robot_files",
@@ -198,7 +199,7 @@ def puma560_float_text(path: Path = PUMA_FILE) -> str:
     return header + text
 
 
-def _example_robot(inside: str) -> Path | None:
+def example_robot_file(inside: str) -> Path | None:
     """A URDF that example-robot-data (the test extra) ships under robots/, if installed."""
     try:
         from importlib.metadata import PackageNotFoundError, distribution
@@ -221,7 +222,7 @@ ROBOTS = {  # name -> robot file (chains are written by bench/chains.py)
     "chain_12": chains.chain_file(12),
 }
 URDF_TIPS: dict[Path, str] = {}  # URDF file -> the tip link of its chain
-if (_urdf := _example_robot("panda_description/urdf/panda.urdf")) is not None:
+if (_urdf := example_robot_file("panda_description/urdf/panda.urdf")) is not None:
     ROBOTS["panda_urdf"] = _urdf  # the same arm as panda.yaml, through the URDF loader
     URDF_TIPS[_urdf] = "panda_hand"
 _TREE_FILES = {  # whole URDF trees on a fixed base (no tip); joint order = Pinocchio's
@@ -229,7 +230,7 @@ _TREE_FILES = {  # whole URDF trees on a fixed base (no tip); joint order = Pino
     "solo12": "solo_description/robots/solo12.urdf",
 }
 for _name, _inside in _TREE_FILES.items():
-    if (_urdf := _example_robot(_inside)) is not None:
+    if (_urdf := example_robot_file(_inside)) is not None:
         ROBOTS[_name] = _urdf
 QUICK_ROBOTS = ("roger_arm_values", "puma560", "panda")
 ARMS = ("puma560", "stanford", "panda")  # the issue's "6-7 joint arms with numeric parameters"

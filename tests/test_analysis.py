@@ -283,3 +283,46 @@ def test_plots_return_the_image_they_write(roger, tmp_path):
             data = draw(path)
             assert isinstance(data, bytes) and data.startswith(magic), (name, suffix)
             assert path.read_bytes() == data, (name, suffix)
+
+
+def test_frame_option_uses_that_frames_jacobian(tmp_path, monkeypatch, capsys):
+    """--frame F: J and Jdot qd of F (the generated functions) equal the numeric oracle's, and
+    the analysis follows from them; an unknown frame is one line naming the near match."""
+    from symdyn.oracle.frames import frame_state
+
+    path = tmp_path / "roger_tool.yaml"
+    path.write_text(
+        ROGER.read_text()
+        + "frames:\n  - {name: tool, link: forearm, xyz: [0.1, 0.05, 0], rpy: [0, 0, 0.3]}\n"
+    )
+    robot = load_robot(path)
+    q, qd = np.array([0.3, 1.1]), np.array([0.8, -1.5])
+    result = analyze(robot, q, qd, torque_limits=2, frame="tool")
+    fs = frame_state(robot, "tool", q, qd)
+    assert result.axes == ("x", "y")
+    assert np.allclose(result.J, fs.jacobian[:2], atol=1e-14) and np.allclose(
+        result.Jdot_qd, fs.drift[:2], atol=1e-13
+    )
+    M, V, G, _, _ = lecture(q, qd)
+    assert np.allclose(result.v_grav, -fs.jacobian[:2] @ np.linalg.solve(M, G), atol=1e-12)
+    argv = [
+        "analyze",
+        path,
+        "--q",
+        "0.3",
+        "1.1",
+        "--torque-limits",
+        "2",
+        "--frame",
+        "tool",
+        "--format",
+        "json",
+    ]
+    assert run_cli(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert np.allclose(doc["dynamic_manipulability"]["bias"], -fs.jacobian[:2] @ np.linalg.solve(M, G))
+    monkeypatch.chdir(tmp_path)
+    assert run_cli(["analyze", path, "--q", "0", "1", "--torque-limits", "2", "--frame", "tol"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("symdyn: error: ") and "unknown frame 'tol'" in err and "'tool'" in err
+    assert err.count("\n") == 1

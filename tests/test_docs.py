@@ -326,7 +326,13 @@ KATEX_ASSETS = (
     "assets/katex-init.js",
 )
 #: Pages whose equations are typeset (a sample: every page with an equation has them).
-MATH_PAGES = ("index.md", "lecture.md", "generated-code.md", "tutorials/embedded-c.md")
+MATH_PAGES = (
+    "index.md",
+    "lecture.md",
+    "generated-code.md",
+    "tutorials/embedded-c.md",
+    "tutorials/operational-space.md",
+)
 EXTERNAL = re.compile(
     r"<(?:script|link|img|iframe)\b[^>]*\b(?:src|href)=[\"'](?:https?:)?//[^\"']*[\"'][^>]*>"
     r"|@import\s+(?:url\()?[\"']?(?:https?:)?//|url\([\"']?(?:https?:)?//",

@@ -1,9 +1,9 @@
 """Dynamic conditioning of a manipulator (lecture slides 21-23).
 
-At a state (q, qd), with M, V, G, F from the robot's generated NumPy module
-and J the end-effector's geometric Jacobian (base frame; end-effector = origin
-of the last convention frame, `kinematics.end_effector_jacobian`), restricted
-to the chosen task axes (rows x, y, z, rx, ry, rz):
+At a state (q, qd), with M, V, G, F the robot's compiled functions and J the
+world-aligned Jacobian of a frame (by default the last link's; the generated
+NAME_F_jacobian, symdyn.apps.task_space), restricted to the chosen task axes
+(rows x, y, z, rx, ry, rz):
 
 * Generalized inertia ellipsoid (slide 21): with qd = 0 and no gravity,
   tau = M qdd; the unit sphere of joint accelerations maps onto the ellipsoid
@@ -15,7 +15,8 @@ to the chosen task axes (rows x, y, z, rx, ry, rz):
       xdd = J qdd + Jdot qd = J M^-1 L tau_hat + v_bias,  L = diag(torque limits),
       v_bias = Jdot qd - J M^-1 (V + G + F) = v_vel + v_grav,
       v_vel = Jdot qd - J M^-1 (V + F),  v_grav = -J M^-1 G.
-  Jdot qd is exact: the symbolic time derivative of J, sum_j dJ/dq_j qd_j, times qd.
+  Jdot qd is exact: the generated NAME_F_jacobian_dot_qd, the frame's classical
+  acceleration at qdd = 0 (symdyn.algorithms.frame_kinematics).
   F(qd) (friction) is zero at qd = 0 and for frictionless robots.
 * Dynamic manipulability ellipsoid: tau_hat^T tau_hat <= 1 gives
       (xdd - v_bias)^T (J M^-1 L^2 M^-T J^T)^-1 (xdd - v_bias) <= 1;
@@ -50,7 +51,7 @@ from .geometry import (
     inertia_ellipsoid,
     zonotope_vertex_signs,
 )
-from .task_space import TASK_AXES, default_axes, parse_axes, task_jacobian
+from .task_space import TASK_AXES, default_axes, default_frame, parse_axes, task_jacobian
 
 __all__ = [
     "TASK_AXES",
@@ -60,6 +61,7 @@ __all__ = [
     "Analysis",
     "parse_axes",
     "default_axes",
+    "default_frame",
     "task_jacobian",
     "inertia_ellipsoid",
     "dynamic_manipulability",

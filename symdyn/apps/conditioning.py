@@ -1,8 +1,8 @@
 """The dynamic conditioning analysis at one state (q, qd): `analyze` and its report `Analysis`.
 
-With M, V, G, F from the robot's generated NumPy module (symdyn.apps.compiled), J
-and Jdot qd from symdyn.apps.task_space (end-effector, base frame, chosen task
-rows) and L = diag(torque limits):
+With M, V, G, F from the robot's compiled functions (symdyn.apps.compiled), J and Jdot qd
+the generated ones of the chosen frame (symdyn.apps.task_space: by default the last link's,
+world-aligned, chosen task rows) and L = diag(torque limits):
     xdd = J M^-1 L tau_hat + v_bias,   v_bias = Jdot qd - J M^-1 (V + G + F) = v_vel + v_grav,
     v_vel = Jdot qd - J M^-1 (V + F),  v_grav = -J M^-1 G,
 and the shapes of symdyn.apps.geometry: the inertia ellipsoid of M, the dynamic
@@ -28,7 +28,7 @@ from .geometry import (
     dynamic_manipulability,
     inertia_ellipsoid,
 )
-from .task_space import default_axes, joint_vector, parse_axes, task_jacobian
+from .task_space import default_axes, default_frame, joint_vector, parse_axes, task_jacobian
 
 if TYPE_CHECKING:
     from ..model.robot import Robot
@@ -78,6 +78,7 @@ class Analysis:
     inertia: InertiaEllipsoid
     manipulability: DynamicManipulability
     polytope: AccelerationPolytope
+    frame: str = ""  # the frame whose J and Jdot qd were used
 
     @property
     def bias(self) -> np.ndarray:
@@ -123,7 +124,7 @@ class Analysis:
         dm = self.manipulability
         lines = [
             f"# {self.robot} at q = {vec(self.q)}, qd = {vec(self.qd)}",
-            f"# task axes {', '.join(self.axes)} (end-effector, base frame); "
+            f"# task axes {', '.join(self.axes)} of frame {self.frame} (world-aligned); "
             f"torque limits |tau_i| <= {vec(self.torque_limits)}",
             "",
             "inertia ellipsoid {M qdd : |qdd| <= 1} (joint-torque space):",
@@ -164,13 +165,15 @@ def analyze(
     axes=None,
     params=None,
     dynamics: CompiledDynamics | None = None,
+    frame: str | None = None,
 ) -> Analysis:
     """Inertia ellipsoid, dynamic manipulability and acceleration polytope at (q, qd).
 
-    torque_limits: one bound for every joint or one per joint (N m or N); axes: task
-    rows of the end-effector Jacobian (default: the linear axes that move, e.g. x, y
-    for a planar arm). `dynamics` reuses a CompiledDynamics of the same robot; `robot` may
-    itself be a CompiledDynamics (its parameters bound, its kinematics from the cache).
+    torque_limits: one bound for every joint or one per joint (N m or N); frame: the frame whose
+    Jacobian is used (default: the last link's, symdyn.apps.task_space.default_frame); axes: task
+    rows of its Jacobian (default: the linear axes that move, e.g. x, y for a planar arm).
+    `dynamics` reuses a CompiledDynamics of the same robot; `robot` may itself be a
+    CompiledDynamics (its parameters bound, its frame functions from the cache).
     """
     if isinstance(robot, CompiledDynamics):
         dynamics = compiled_dynamics(robot, params)
@@ -179,13 +182,14 @@ def analyze(
     q = joint_vector(q, n, "q")
     qd = np.zeros(n) if qd is None else joint_vector(qd, n, "qd")
     limits = _torque_limits(torque_limits, n)
-    names = parse_axes(axes) or default_axes(robot)
     dyn = dynamics if dynamics is not None else compiled_dynamics(robot, params)
+    frame = frame or default_frame(dyn)
+    names = parse_axes(axes) or default_axes(dyn, frame)
     M = np.asarray(dyn.mass_matrix(q), dtype=float)
     V = np.asarray(dyn.coriolis(q, qd), dtype=float)
     G = np.asarray(dyn.gravity(q), dtype=float)
     F = np.asarray(dyn.friction(qd), dtype=float)
-    J, Jdq = task_jacobian(dyn if isinstance(robot, CompiledDynamics) else robot, q, qd, names, params)
+    J, Jdq = task_jacobian(dyn, q, qd, names, frame=frame)
     try:
         Minv = np.linalg.inv(M)
     except np.linalg.LinAlgError as exc:
@@ -211,4 +215,5 @@ def analyze(
         inertia=inertia_ellipsoid(M),
         manipulability=dynamic_manipulability(J, M, limits, bias),
         polytope=acceleration_polytope(A, bias),
+        frame=frame,
     )

@@ -1,31 +1,31 @@
-"""The task space of the end-effector: its axes, and its Jacobian J with the bias Jdot qd as numbers.
+"""The task space of a frame: its axes, and its Jacobian J with the drift Jdot qd as numbers.
 
-J is the geometric Jacobian of the origin of the last convention frame (the last link's frame),
-in the base frame, rows x, y, z (linear) and rx, ry, rz (angular); a task picks some of these
-rows. J and Jdot qd come from symdyn.algorithms.frame_kinematics (the drift by its outward
-recursion at qdd = 0), over named intermediates.
+J is the world-aligned Jacobian of a frame's origin (rows x, y, z (linear) and rx, ry, rz
+(angular); without `base:` the world is the base frame), by default the frame of the last link
+(its convention frame); a task picks some of these rows. J and Jdot qd are the generated
+NAME_F_jacobian and NAME_F_jacobian_dot_qd (symdyn.codegen.frame_functions), compiled and cached
+by `symdyn.compile` (CompiledDynamics.frame_jacobian, frame_jacobian_dot_qd): straight-line C,
+or the generated NumPy module without a C compiler; no SymPy once the cache holds them.
 """
 
 from __future__ import annotations
 
-import inspect
-import re
 from collections.abc import Sequence
-from functools import lru_cache
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..algorithms.operational_space import TASK_AXES
 from ..errors import SymdynError
-from ..loading import load_module
-from .compile import CompiledDynamics
+from .compiled import CompiledDynamics, compiled_dynamics
 
 if TYPE_CHECKING:
     from ..model.robot import Robot
 
-__all__ = ["TASK_AXES", "parse_axes", "default_axes", "task_jacobian", "joint_vector"]
+__all__ = ["TASK_AXES", "parse_axes", "default_frame", "default_axes", "task_jacobian", "joint_vector"]
+
+#: Configurations (fixed seed) at which default_axes looks for the rows that move.
+_PROBES = np.random.default_rng(20240521).uniform(-np.pi, np.pi, (4, 64))
 
 
 def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
@@ -44,100 +44,52 @@ def parse_axes(axes: str | Sequence[str] | None) -> tuple[str, ...] | None:
     return tuple(names)
 
 
-@lru_cache(maxsize=32)
-def _kinematics(robot: Robot):
-    """(f(q, qd, p) -> (J 6xn, Jdot qd 6), the linear rows not identically zero, free params)."""
-    from dataclasses import replace
-
-    import sympy as sp
-
-    from ..algorithms.frame_kinematics import FrameKinematics
-    from ..model.symbols import joint_symbols
-    from ..spatial.transform import Transform
-    from ..symbolic.program import Program
-
-    r = robot.resolved()
-    q, qd, _ = joint_symbols(r.n)
-    fk = FrameKinematics(replace(r, base=Transform.identity()), list(q), list(qd), Program())
-    tip = r.links[-1].name
-    J, bias = fk.jacobian(tip), fk.jacobian_dot_qd(tip)
-    steps = fk.program.needed([*J, *bias])
-    args = [list(q), list(qd), list(r.params)]
-    f = sp.lambdify(args, [J, bias], modules="numpy", cse=lambda exprs: (steps, exprs))
-    live = tuple(TASK_AXES[i] for i in range(3) if any(x != 0 for x in J[i, :]))
-    return f, live, tuple(str(p) for p in r.params)
+def _dynamics(robot: Robot | CompiledDynamics, params=None) -> CompiledDynamics:
+    """The robot compiled (a CompiledDynamics is kept, its parameters bound)."""
+    return robot if isinstance(robot, CompiledDynamics) else compiled_dynamics(robot, params)
 
 
-_SOURCE = "task_space.py"
-
-
-def _store_kinematics(robot: Robot, folder: Path) -> dict:
-    """The cache entry of the kinematics: lambdify's source (numpy names only) and the live axes."""
-    f, live, params = _kinematics(robot)
-    text = inspect.getsource(f)
-    names = sorted(set(re.findall(r"\b([A-Za-z_][A-Za-z0-9_]*)\(", text)) - {f.__name__})
-    portable = all(getattr(np, name, None) is f.__globals__.get(name) for name in names)
-    if portable:
-        (folder / _SOURCE).write_text(text, encoding="utf-8")
-    return {
-        "live": list(live),
-        "params": list(params),
-        "function": f.__name__,
-        "names": names if portable else None,
-    }
-
-
-def _cached_kinematics(plant: CompiledDynamics):
-    """_kinematics from the plant's cache entry (no SymPy on a hit), or derived when not portable."""
-    found = plant.__dict__.get("_task_space")
+def default_frame(robot: Robot | CompiledDynamics) -> str:
+    """The frame analysed when none is named: the last link's (its convention frame)."""
+    dyn = _dynamics(robot)
+    found = dyn.__dict__.get("_last_link")
     if found is None:
-        entry = plant.derived_entry("task-space", _store_kinematics)
-        meta = entry.meta
-        if meta["names"] is None:
-            found = _kinematics(plant.robot)
-        else:
-            namespace = {name: getattr(np, name) for name in meta["names"]}
-            path = entry.file(_SOURCE)
-            # symdyn's own lambdify output for this robot, verified against the manifest's digest,
-            # imported from its file (never exec'd from a string)
-            module = load_module(path, "symdyn_task_space", namespace)
-            found = getattr(module, meta["function"]), tuple(meta["live"]), tuple(meta["params"])
-        plant._task_space = found
+        entry = dyn.derived_entry("last link", lambda r, folder: {"frame": r.resolved().links[-1].name})
+        found = dyn._last_link = entry.meta["frame"]
     return found
 
 
-def _kinematics_any(robot: Robot | CompiledDynamics):
-    return _cached_kinematics(robot) if isinstance(robot, CompiledDynamics) else _kinematics(robot)
+def default_axes(robot: Robot | CompiledDynamics, frame: str | None = None) -> tuple[str, ...]:
+    """The linear axes x, y, z whose Jacobian rows are not identically zero (x, y for a planar arm).
 
-
-def default_axes(robot: Robot | CompiledDynamics) -> tuple[str, ...]:
-    """The linear axes x, y, z whose Jacobian rows are not identically zero (x, y for a planar arm)."""
-    live = _kinematics_any(robot)[1]
+    A row counts as identically zero when it is below 1e-12 (relative to J) at four random
+    configurations: an analytic function of q that vanishes there vanishes everywhere but on a
+    set of measure zero.
+    """
+    dyn = _dynamics(robot)
+    frame = frame or default_frame(dyn)
+    J = np.asarray(dyn.frame_jacobian(frame, _PROBES[:, : dyn.n]), dtype=float)
+    scale = max(1.0, float(np.abs(J).max()))
+    live = tuple(TASK_AXES[i] for i in range(3) if np.abs(J[:, i, :]).max() > 1e-12 * scale)
     return live or ("x", "y", "z")
 
 
 def task_jacobian(
-    robot: Robot | CompiledDynamics, q, qd=None, axes=None, params=None
+    robot: Robot | CompiledDynamics, q, qd=None, axes=None, params=None, frame: str | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(J, Jdot qd) of the end-effector, rows `axes` (default `default_axes`), as numbers.
+    """(J, Jdot qd) of `frame` (default `default_frame`), rows `axes` (default `default_axes`).
 
-    robot: a Robot (free parameters from `params`), or a CompiledDynamics with its parameters
-    bound, whose kinematics come from the cache.
+    robot: a Robot (free parameters from `params`), compiled on first use, or a CompiledDynamics
+    with its parameters bound.
     """
-    f, _, free = _kinematics_any(robot)
-    names = parse_axes(axes) or default_axes(robot)
-    n = robot.n
+    dyn = _dynamics(robot, params)
+    frame = frame or default_frame(dyn)
+    names = parse_axes(axes) or default_axes(dyn, frame)
+    n = dyn.n
     q = joint_vector(q, n, "q")
     qd = np.zeros(n) if qd is None else joint_vector(qd, n, "qd")
-    if isinstance(robot, CompiledDynamics):
-        by_name = dict(zip(robot.param_names, [] if robot.p is None else robot.p, strict=True))
-    else:
-        values = robot.param_values(params) if robot.params else {}
-        by_name = {str(k): v for k, v in values.items()}
-    p = [by_name[s] for s in free]
-    J, b = f(q, qd, p)
-    J = np.asarray(J, dtype=float).reshape(6, n)
-    b = np.asarray(b, dtype=float).reshape(6)
+    J = np.asarray(dyn.frame_jacobian(frame, q), dtype=float).reshape(6, n)
+    b = np.asarray(dyn.frame_jacobian_dot_qd(frame, q, qd), dtype=float).reshape(6)
     rows = [TASK_AXES.index(a) for a in names]
     return J[rows], b[rows]
 

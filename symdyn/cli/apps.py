@@ -5,7 +5,7 @@
            --duration T --dt H [--integrator rk4|euler|lecture|semi-implicit|rk45|dop853]
            [--rtol R --atol A]
            [--params NAME=VALUE ...] --out traj.csv [--plot traj.png] [--progress]
-    symdyn analyze ROBOT --q Q ... [--qd QD ...] --torque-limits L ... [--axes x,y]
+    symdyn analyze ROBOT --q Q ... [--qd QD ...] --torque-limits L ... [--frame F] [--axes x,y]
            [--params NAME=VALUE ...] [--format text|json] [--plot fig.png]
     symdyn check ROBOT ANSWERS.yaml [--method newton-euler|lagrange] [--samples N] [--verbose]
 
@@ -270,7 +270,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     q = _vector(args.q, n, "--q")
     qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
     limits = _numbers(args.torque_limits, "--torque-limits")
-    result = analyze(plant, q, qd, torque_limits=limits, axes=axes)
+    result = analyze(plant, q, qd, torque_limits=limits, axes=axes, frame=args.frame)
     image = None
     if args.plot:
         if len(result.axes) != 2:
@@ -394,8 +394,13 @@ def _analyze_arguments(a: argparse.ArgumentParser) -> None:
         "--torque-limits", **vec, required=True, help="|tau_i| bounds: one for all, or one per joint"
     )
     a.add_argument(
+        "--frame",
+        help="the frame whose Jacobian and Jdot qd are used: a link or a frame of the robot "
+        "(default: the last link)",
+    )
+    a.add_argument(
         "--axes",
-        help="task axes of the end-effector Jacobian (base frame), comma-separated among "
+        help="task axes of the frame's world-aligned Jacobian, comma-separated among "
         "x,y,z,rx,ry,rz (default: the linear axes that move, e.g. x,y for a planar arm)",
     )
     a.add_argument("--params", nargs="+", metavar="NAME=VALUE", help="parameter values (free or overriding)")
