@@ -106,19 +106,22 @@ def example_robot(root: Path, name: str) -> Robot:
     return dataclasses.replace(load_urdf(folder / URDF_EXAMPLES[name]), name=name)
 
 
+def render_example(root: Path, name: str) -> dict[str, str | bytes]:
+    """{file name: content} of one example robot for every target, with the groups generated/
+    holds for it (every group; the frame groups only for FRAME_EXAMPLES)."""
+    groups = [g for g in GROUPS if g not in FRAME_GROUPS]
+    frames, axes = FRAME_EXAMPLES.get(name, (None, None))
+    if frames is not None:
+        groups += list(FRAME_GROUPS)
+    robot = example_robot(root, name)
+    return render(robot, tuple(TARGETS), functions=groups, frames=frames, task_axes=axes)
+
+
 def render_all(root: Path) -> dict[str, dict[str, str | bytes]]:
     """robot name -> {file name: content} for every example robot and target."""
-    out = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        for name in EXAMPLES:
-            groups = [g for g in GROUPS if g not in FRAME_GROUPS]
-            frames, axes = FRAME_EXAMPLES.get(name, (None, None))
-            if frames is not None:
-                groups += list(FRAME_GROUPS)
-            robot = example_robot(root, name)
-            out[name] = render(robot, tuple(TARGETS), functions=groups, frames=frames, task_axes=axes)
-    return out
+        return {name: render_example(root, name) for name in EXAMPLES}
 
 
 def main(argv=None) -> int:
