@@ -79,14 +79,14 @@ from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Mimic, Robot
 from ..spatial.transform import Transform
-from .safe_xml import looks_like_xml, parse_xml
+from .safe_xml import Element, looks_like_xml, parse_xml
 from .source import MAX_BYTES, read_source
 from .urdf_elements import MOVABLE, UrdfJoint, UrdfReader, numeric, urdf_robot_name
 from .urdf_merge import body_parts, merge_inertials
 from .urdf_mimic import mimic_error, resolve_mimic
 from .urdf_tree import UrdfTree, link_name
 
-__all__ = ["load_urdf", "urdf_from_bytes", "urdf_robot_name", "MAX_BYTES"]
+__all__ = ["load_urdf", "urdf_from_bytes", "urdf_from_root", "urdf_robot_name", "MAX_BYTES"]
 
 
 def _check_inertials(reader: UrdfReader, names: list[str]) -> None:
@@ -272,6 +272,14 @@ def urdf_from_bytes(raw: bytes, file: str, digest: str, base: str | None, tip: s
             "a robot file (YAML or JSON) is read by symdyn.load_robot",
             file=file,
         )
+    return urdf_from_root(parse_xml(raw, file), file, digest, base, tip)
+
+
+def urdf_from_root(root: Element, file: str, digest: str, base: str | None, tip: str | None) -> Robot:
+    """The `Robot` of a URDF file's parsed top element (`file` names it, `digest` is its sha256)."""
+    for what, value in (("base", base), ("tip", tip)):
+        if value is not None and not isinstance(value, str):
+            raise SymdynError(f"{what} must be a link name, not {value!r}", file=file)
     reader = UrdfReader(file)
-    reader.read(parse_xml(raw, file))
+    reader.read(root)
     return _build(reader, digest, base, tip)

@@ -197,8 +197,8 @@ class UrdfReader:
     def read(self, root: Element) -> None:
         if root.tag == "mujoco":
             raise self.error(
-                "an MJCF file (top element <mujoco>): symdyn does not read MJCF yet; "
-                "it reads URDF (top element <robot>) and robot files (YAML or JSON)"
+                "an MJCF file (top element <mujoco>), not a URDF: read it with symdyn.load_mjcf "
+                "(or symdyn.load_robot, which recognises either)"
             )
         if root.tag != "robot":
             raise self.error(

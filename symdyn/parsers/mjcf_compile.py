@@ -1,0 +1,62 @@
+"""An MJCF file compiled by MuJoCo itself (the `mujoco` package, the `mjcf` extra), and the names
+of its compiled model.
+
+MuJoCo's compiler resolves everything the format lets a file say indirectly: <default> classes
+and childclass, <include>, angle="degree", euler sequences, quat/axisangle/xyaxes/zaxis
+orientations, fullinertia/diaginertia with quat, inertia computed from geoms. symdyn reads the
+compiled model (mujoco.MjModel) rather than the XML, so that it sees what MuJoCo simulates.
+A file MuJoCo rejects (a missing include, an unknown attribute, a missing mesh) is a SymdynError
+with MuJoCo's own message (the element and its line) on one line.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..errors import SymdynError
+from .optional import optional_module
+from .safe_xml import parse_xml
+
+__all__ = ["compile_mjcf", "model_name", "mujoco_module", "names"]
+
+
+def mujoco_module(file: str | None = None) -> Any:
+    """The `mujoco` package, or SymdynError naming the `mjcf` extra."""
+    return optional_module("mujoco", "mjcf", "reading an MJCF (MuJoCo) file", file)
+
+
+def compile_mjcf(raw: bytes, file: str) -> Any:
+    """The mujoco.MjModel of the MJCF file `file` (whose bytes are `raw`).
+
+    The bytes are first read by symdyn's hardened XML parser (a DOCTYPE, and so any entity, is
+    refused) and must have the top element <mujoco>; MuJoCo then compiles the file from its path,
+    so that <include file=...> and asset paths resolve next to it.
+    """
+    root = parse_xml(raw, file)
+    if root.tag != "mujoco":
+        raise SymdynError(f"not an MJCF file: its top element is <{root.tag}>, not <mujoco>", file=file)
+    mujoco = mujoco_module(file)
+    try:
+        return mujoco.MjModel.from_xml_path(file)
+    except ValueError as exc:
+        text = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
+        raise SymdynError(f"MuJoCo's compiler refused it: {text}", file=file) from None
+
+
+def names(model: Any, kind: str, count: int, default: str) -> list[str]:
+    """The names of the model's objects of `kind` ("body", "jnt", "site"): names[i] of object i,
+    f"{default}{i}" for an unnamed one."""
+    raw = bytes(model.names)
+    addresses = getattr(model, f"name_{kind}adr")
+    out = []
+    for i in range(count):
+        start = int(addresses[i])
+        name = raw[start : raw.index(b"\0", start)].decode("utf-8", "replace")
+        out.append(name or f"{default}{i}")
+    return out
+
+
+def model_name(model: Any) -> str:
+    """The <mujoco model="..."> name ('MuJoCo Model' when the file gives none)."""
+    raw = bytes(model.names)
+    return raw[: raw.index(b"\0")].decode("utf-8", "replace")
