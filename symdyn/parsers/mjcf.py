@@ -43,7 +43,7 @@ from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import Friction, Link, Motor, Robot
 from ..spatial.transform import Transform, rot_axis
-from .mjcf_compile import compile_mjcf, model_name, mujoco_module, names
+from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
 from .mjcf_values import number, pose, vector
 from .source import read_source
 from .urdf_elements import UrdfInertial, numeric, urdf_robot_name
@@ -83,6 +83,7 @@ def load_mjcf(path: str | os.PathLike) -> Robot:
 def mjcf_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
     """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
     model = compile_mjcf(raw, file)
+    check_numbers(model, file)
     flags = _disabled(model)
     body_names = names(model, "body", model.nbody, "body")
     joint_names = names(model, "jnt", model.njnt, "joint")

@@ -11,13 +11,25 @@ with MuJoCo's own message (the element and its line) on one line.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
+import numpy as np
+
 from ..errors import SymdynError
+from ..model.bounded import MAX_MAGNITUDE
 from .optional import optional_module
 from .safe_xml import parse_xml
 
-__all__ = ["compile_mjcf", "model_name", "mujoco_module", "names"]
+__all__ = ["check_numbers", "compile_mjcf", "model_name", "mujoco_module", "names"]
+
+#: the arrays of the compiled model that symdyn reads, by the kind of object they describe
+_ARRAYS = {
+    "body": ("pos", "quat", "ipos", "iquat", "mass", "inertia"),
+    "jnt": ("pos", "axis", "range"),
+    "site": ("pos", "quat"),
+}
+_DOF_ARRAYS = ("armature", "damping", "frictionloss")
 
 
 def mujoco_module(file: str | None = None) -> Any:
@@ -60,3 +72,32 @@ def model_name(model: Any) -> str:
     """The <mujoco model="..."> name ('MuJoCo Model' when the file gives none)."""
     raw = bytes(model.names)
     return raw[: raw.index(b"\0")].decode("utf-8", "replace")
+
+
+def check_numbers(model: Any, file: str) -> None:
+    """Every number symdyn reads from the compiled model is finite and at most MAX_MAGNITUDE =
+    1e150 in absolute value, as in a URDF; SymdynError naming the body, joint or site and the field.
+    """
+    labels = {
+        kind: names(model, kind, len(getattr(model, f"{kind}_{_ARRAYS[kind][0]}")), kind) for kind in _ARRAYS
+    }
+    checks = [
+        (f"{kind} '{labels[kind][i]}'", f, getattr(model, f"{kind}_{f}")[i])
+        for kind in _ARRAYS
+        for f in _ARRAYS[kind]
+        for i in range(len(getattr(model, f"{kind}_{f}")))
+    ]
+    checks += [
+        (f"joint '{labels['jnt'][int(model.dof_jntid[d])]}'", f, getattr(model, f"dof_{f}")[d])
+        for f in _DOF_ARRAYS
+        for d in range(model.nv)
+    ]
+    checks += [("option", "gravity", model.opt.gravity), ("model", "qpos0", model.qpos0)]
+    for what, fld, values in checks:
+        for x in np.atleast_1d(values):
+            if not (math.isfinite(float(x)) and abs(float(x)) <= MAX_MAGNITUDE):
+                raise SymdynError(
+                    f"{what}: {fld} {float(x)!r} is not a finite number of at most {MAX_MAGNITUDE:g} "
+                    "in absolute value",
+                    file=file,
+                )
