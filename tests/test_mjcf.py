@@ -197,6 +197,18 @@ def test_ignored_forces_are_warned_about(tmp_path):
         symdyn.load_mjcf(path)
 
 
+def test_mujocos_own_warnings_become_symdyn_warnings(tmp_path, capfd):
+    """MuJoCo prints its warnings itself (to the process's stderr): they become SymdynWarnings."""
+    path = tmp_path / "nan.xml"
+    path.write_text((DATA / "bad_number.xml").read_text().replace("1e200", "nan"))
+    with (
+        pytest.warns(symdyn.SymdynWarning, match=r"nan.xml: MuJoCo: XML contains a 'NaN'"),
+        pytest.raises(SymdynError, match="joint 'j': damping nan is not a finite number"),
+    ):
+        symdyn.load_mjcf(path)
+    assert capfd.readouterr() == ("", "")
+
+
 def test_a_missing_mujoco_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "mujoco", None)  # `import mujoco` raises ImportError
     with pytest.raises(SymdynError, match=r"needs the Python package 'mujoco'.*pip install 'symdyn\[mjcf\]'"):

@@ -6,17 +6,19 @@ and childclass, <include>, angle="degree", euler sequences, quat/axisangle/xyaxe
 orientations, fullinertia/diaginertia with quat, inertia computed from geoms. symdyn reads the
 compiled model (mujoco.MjModel) rather than the XML, so that it sees what MuJoCo simulates.
 A file MuJoCo rejects (a missing include, an unknown attribute, a missing mesh) is a SymdynError
-with MuJoCo's own message (the element and its line) on one line.
+with MuJoCo's own message (the element and its line) on one line; MuJoCo's warnings, which it
+would print itself, become SymdynWarnings naming the file.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
 
-from ..errors import SymdynError
+from ..errors import SymdynError, SymdynWarning
 from ..model.bounded import MAX_MAGNITUDE
 from .optional import optional_module
 from .safe_xml import parse_xml
@@ -48,11 +50,21 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
     if root.tag != "mujoco":
         raise SymdynError(f"not an MJCF file: its top element is <{root.tag}>, not <mujoco>", file=file)
     mujoco = mujoco_module(file)
+    said: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(said.append)  # MuJoCo would print its warnings itself
     try:
         return mujoco.MjModel.from_xml_path(file)
     except ValueError as exc:
-        text = "; ".join(line.strip() for line in str(exc).splitlines() if line.strip())
-        raise SymdynError(f"MuJoCo's compiler refused it: {text}", file=file) from None
+        raise SymdynError(f"MuJoCo's compiler refused it: {_one_line(str(exc))}", file=file) from None
+    finally:
+        mujoco.set_mju_user_warning(previous)
+        for text in dict.fromkeys(said):
+            warnings.warn(f"{file}: MuJoCo: {_one_line(text)}", SymdynWarning, stacklevel=4)
+
+
+def _one_line(text: str) -> str:
+    return "; ".join(line.strip() for line in text.splitlines() if line.strip())
 
 
 def names(model: Any, kind: str, count: int, default: str) -> list[str]:
