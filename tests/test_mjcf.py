@@ -125,6 +125,16 @@ def test_the_mapping_of_joint_fields():
     assert limited == (sp.Float(-90 * np.pi / 180), sp.Float(120 * np.pi / 180))  # degrees -> rad
 
 
+def test_disabled_flags_drop_their_terms(tmp_path):
+    path = tmp_path / "flags.xml"
+    flags = '<option><flag gravity="disable" damper="disable" constraint="disable"/></option>'
+    path.write_text((DATA / "friction.xml").read_text().replace("<worldbody>", flags + "<worldbody>"))
+    robot = symdyn.load_mjcf(path)
+    assert robot.gravity == sp.ImmutableMatrix([0, 0, 0])
+    assert all(link.friction.viscous == 0 and link.friction.coulomb == 0 for link in robot.links)
+    assert [link.motor.inertia for link in robot.links] == [sp.Float(0.12), sp.Float(0.04), sp.Float(0.5)]
+
+
 def test_right_angles_in_degrees_become_exact():
     """euler="90 0 -90" (degrees, compiled to a quaternion of doubles) gives exact 0 and +-1."""
     robot = symdyn.load_mjcf(DATA / "euler_degrees.xml")

@@ -124,6 +124,8 @@ def _disabled(model: Any) -> set[str]:
     ):
         if int(model.opt.disableflags) & int(bit):
             out.add(name)
+    if int(model.opt.disableflags) & int(bits.mjDSBL_CONSTRAINT):
+        out.add("frictionloss")  # MuJoCo's frictionloss is a constraint
     return out
 
 
