@@ -29,7 +29,7 @@ if TYPE_CHECKING:  # what the names below are, for type checkers and the API ref
     from .model.frames import Frame
     from .model.parameters import standard_parameters
     from .model.robot import Link, Robot
-    from .parsers import load_robot, load_urdf, robot_from_data, robot_from_poe
+    from .parsers import load_mjcf, load_robot, load_urdf, robot_from_data, robot_from_poe
 
 # Every other public name is imported on first use (PEP 562), so that `import symdyn` and a
 # cached `symdyn simulate` start without SymPy: name -> (module, attribute or None for the module).
@@ -47,6 +47,7 @@ _LAZY = {
     "Robot": (".model.robot", "Robot"),
     "load_robot": (".parsers", "load_robot"),
     "load_urdf": (".parsers", "load_urdf"),
+    "load_mjcf": (".parsers", "load_mjcf"),
     "robot_from_data": (".parsers", "robot_from_data"),
     "robot_from_poe": (".parsers", "robot_from_poe"),
 }
@@ -98,6 +99,7 @@ __all__ = [
     "inertia",
     "kinematics",
     "load_robot",
+    "load_mjcf",
     "load_urdf",
     "rnea",
     "robot_from_data",

@@ -1,9 +1,10 @@
 """Fuzzing the loaders: mutated robot files and URDFs load, or fail with one SymdynError, in time.
 
-The example robot files (examples/*.yaml) and a few URDFs of tests/data/urdf are mutated:
-numbers replaced with extreme or garbage values (1e308, nan, 1e400, thousands of digits),
-expressions that hang a careless parser (exponent towers, 9**9**9, pi/2*pi/2), fields deleted,
-list entries duplicated, odd keys and strings inserted, the text truncated. Every outcome must
+The example robot files (examples/*.yaml), a few URDFs of tests/data/urdf and MJCF files of
+tests/data/mjcf are mutated: numbers replaced with extreme or garbage values (1e308, nan, 1e400,
+thousands of digits), expressions that hang a careless parser (exponent towers, 9**9**9,
+pi/2*pi/2), fields deleted, list entries duplicated, odd keys and strings inserted, the text
+truncated. Every outcome must
 be a Robot or a SymdynError within TIME_BOUND seconds, never another exception or a hang; for the
 two-joint Roger's arm the loaded robot is also derived and its NumPy code rendered.
 
@@ -36,6 +37,7 @@ from symdyn.parsers import load_robot, load_urdf
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 URDFS = [ROOT / "tests" / "data" / "urdf" / f"{n}.urdf" for n in ("two_link", "rpy_chain", "tree", "branch")]
+MJCFS = [ROOT / "tests" / "data" / "mjcf" / f"{n}.xml" for n in ("defaults", "orientations", "tree", "sites")]
 #: Seconds one case may take (loading, and deriving and rendering Roger's arm).
 TIME_BOUND = 10
 EXAMPLES_PER_TEST = int(os.environ.get("SYMDYN_FUZZ_EXAMPLES", "100"))
@@ -225,11 +227,9 @@ def test_mutated_roger_arms_derive_and_render_or_fail_cleanly(data):
 _ATTRIBUTE = re.compile(r'="([^"]*)"')
 
 
-@FUZZ
-@given(st.data())
-def test_mutated_urdfs_load_or_fail_cleanly(data):
-    source = data.draw(st.sampled_from(URDFS))
-    text = source.read_text()
+def _mutated_xml(data, text: str) -> str:
+    """The XML text with 1 to 3 mutations: a hostile attribute value, a line deleted or
+    duplicated, the text cut short."""
     for _ in range(data.draw(st.integers(1, 3))):
         kind = data.draw(
             st.sampled_from(["attribute", "attribute", "delete line", "duplicate line", "truncate"])
@@ -249,11 +249,23 @@ def test_mutated_urdfs_load_or_fail_cleanly(data):
             text = "".join([*lines[: i + 1], lines[i], *lines[i + 1 :]])
         else:
             text = text[: data.draw(st.integers(0, len(text)))]
+    return text
+
+
+@pytest.mark.parametrize("kind", ["urdf", "mjcf"])
+@FUZZ
+@given(data=st.data())
+def test_mutated_xml_files_load_or_fail_cleanly(kind, data):
+    """URDFs (load_urdf) and MJCF files (load_robot; compiled by MuJoCo, in the test extra)."""
+    if kind == "mjcf":
+        pytest.importorskip("mujoco", reason="the test extra installs mujoco")
+    source = data.draw(st.sampled_from(URDFS if kind == "urdf" else MJCFS))
+    text = _mutated_xml(data, source.read_text())
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / source.name
         path.write_text(text)
         with within(TIME_BOUND):
-            _outcome(load_urdf, path)
+            _outcome(load_urdf if kind == "urdf" else load_robot, path)
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -1,5 +1,5 @@
 """symdyn.load_robot and the command line recognise a robot description by its content, whatever the
-file's name: a URDF (<robot>), MJCF (<mujoco>, refused: not read yet), other XML (refused) and robot
+file's name: a URDF (<robot>), MJCF (<mujoco>), other XML (refused) and robot
 files (YAML or JSON). The robot loaded by content is compared with the one its own loader makes."""
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ ROOT = Path(__file__).resolve().parents[1]
 URDF = ROOT / "tests" / "data" / "urdf" / "two_link.urdf"
 ROGER = ROOT / "examples" / "roger_arm.yaml"
 MJCF = '<mujoco model="arm">\n  <worldbody/>\n</mujoco>\n'
+MJCF_ARM = ROOT / "tests" / "data" / "mjcf" / "slide.xml"
 
 
 def _same(a, b) -> None:
@@ -53,10 +54,24 @@ def test_load_urdf_of_a_robot_file_points_to_load_robot():
     )
 
 
+def test_load_urdf_refuses_mjcf_naming_its_loader(tmp_path):
+    path = tmp_path / "model.yaml"
+    path.write_text(MJCF)
+    with pytest.raises(SymdynError) as info:
+        load_urdf(path)
+    assert str(info.value) == (
+        f"{path}: an MJCF file (top element <mujoco>), not a URDF: read it with symdyn.load_mjcf "
+        "(or symdyn.load_robot, which recognises either)"
+    )
+    with pytest.raises(SymdynError, match="no hinge or slide joint"):
+        symdyn.load_robot(path)
+    with pytest.raises(SymdynError, match="a base or tip link applies to URDF files only"):
+        symdyn.load_robot(path, base="x")
+
+
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        (MJCF, "an MJCF file (top element <mujoco>): symdyn does not read MJCF yet"),
         ('<?xml version="1.0"?>\n<sdf version="1.6"/>', "an XML file whose top element is <sdf>"),
         ("<robot", "invalid XML at line 1"),
     ],
@@ -79,12 +94,12 @@ def test_every_command_reads_by_content(tmp_path, capsys):
     assert main(["generate", str(urdf), "--target", "python", "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["two_link_numpy.py"]
     capsys.readouterr()
-    mjcf = tmp_path / "arm.xml"
-    mjcf.write_text(MJCF)
-    assert main(["derive", str(mjcf)]) == 1
+    mjcf = tmp_path / "arm.txt"
+    mjcf.write_bytes(MJCF_ARM.read_bytes())
+    assert main(["derive", str(mjcf), "--format", "json"]) == 0
+    assert '"robot": "slide"' in capsys.readouterr().out
+    empty = tmp_path / "empty.xml"
+    empty.write_text(MJCF)
+    assert main(["derive", str(empty)]) == 1
     err = capsys.readouterr().err
-    assert (
-        err
-        == f"symdyn: error: {mjcf}: an MJCF file (top element <mujoco>): symdyn does not read MJCF yet; "
-        + ("it reads URDF (top element <robot>) and robot files (YAML or JSON)\n")
-    )
+    assert err == f"symdyn: error: {empty}: no hinge or slide joint: the model has nothing that moves\n"

@@ -3,7 +3,9 @@
 The applications (simulate, analyze) key their cache entry by the robot file's bytes and
 the options that change the robot (--base, --tip, --params), so a second run of an unchanged
 file finds its compiled library without parsing the file, deriving or importing SymPy
-(symdyn.apps.compile.cached_dynamics).
+(symdyn.apps.compile.cached_dynamics). MJCF and xacro files, whose robot depends on the files
+they include (and on --xacro-arg), are loaded every time and compiled through symdyn.compile's
+cache, keyed by the loaded robot.
 """
 
 from __future__ import annotations
@@ -24,15 +26,20 @@ def cached_plant(args: argparse.Namespace, make_robot, **options):
 
     try:
         with open(args.robot, "rb") as fh:
-            digest = hashlib.sha256(fh.read()).hexdigest()
+            raw = fh.read()
     except OSError:
         return _uncached(make_robot)
+    if b"<mujoco" in raw or b"xacro" in raw:  # MJCF and xacro read other files too (includes)
+        return _uncached(make_robot)
+    digest = hashlib.sha256(raw).hexdigest()
     key = {"file": digest, "base": args.base, "tip": args.tip, **options}
     return cached_dynamics(key, make_robot)
 
 
 def _uncached(make_robot):
-    """The loader's own error for a file that cannot be read (it raises before anything is built)."""
+    """The robot compiled through symdyn.compile's own cache (keyed by the loaded robot): for the
+    loader's own error on a file that cannot be read, and for files whose robot depends on other
+    files (MJCF and xacro includes), which the key of the file's bytes would miss."""
     from ..apps.compile import compile
 
     return compile(make_robot())

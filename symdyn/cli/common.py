@@ -1,10 +1,11 @@
-"""What every subcommand shares: the robot argument (a robot file or a URDF) and its loader."""
+"""What every subcommand shares: the robot argument (a robot file, a URDF or xacro, an MJCF file)
+and its loader."""
 
 from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_robot_argument", "load_robot_argument", "METHODS"]
+__all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METHODS"]
 
 #: symdyn.dynamics.METHODS, spelled here so that building the parser imports no SymPy
 #: (tests/test_cli.py checks that the two agree).
@@ -12,19 +13,53 @@ METHODS = ("newton-euler", "lagrange")
 
 
 def load_robot_argument(args: argparse.Namespace):
-    """A robot from a robot file, or from a URDF file with --base/--tip: recognised by its content
-    (symdyn.parsers.loading), whatever its name."""
+    """A robot from a robot file, an MJCF file, or a URDF file with --base/--tip (a xacro file with
+    --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.loading), whatever
+    its name."""
     from ..parsers import load
 
-    return load(args.robot, base=args.base, tip=args.tip)
+    return load(args.robot, base=args.base, tip=args.tip, **xacro_arguments(args))
+
+
+def xacro_arguments(args: argparse.Namespace) -> dict:
+    """xacro_args and package_dirs of the loaders, from --xacro-arg NAME:=VALUE and --package-dir
+    NAME=DIR (each repeatable); a malformed one is a SymdynError naming the option."""
+    from ..errors import SymdynError
+
+    out: dict = {"xacro_args": {}, "package_dirs": {}}
+    for key, option, sep, given in (
+        ("xacro_args", "--xacro-arg", ":=", args.xacro_arg),
+        ("package_dirs", "--package-dir", "=", args.package_dir),
+    ):
+        for text in given or ():
+            name, found, value = text.partition(sep)
+            if not found or not name.strip():
+                raise SymdynError(f"{option} {text!r}: expected NAME{sep}VALUE")
+            out[key][name.strip()] = value
+    return {key: value or None for key, value in out.items()}
 
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "robot", help="robot file (YAML or JSON) or URDF file, recognised by its content, whatever its name"
+        "robot",
+        help="robot file (YAML or JSON), URDF (or xacro) or MJCF file, recognised by its content, "
+        "whatever its name",
     )
     parser.add_argument("--base", help="URDF: the link the robot hangs from (default: the root link)")
     parser.add_argument(
         "--tip",
         help="URDF: load only the chain from the base to this link (default: the whole tree)",
+    )
+    parser.add_argument(
+        "--xacro-arg",
+        action="append",
+        metavar="NAME:=VALUE",
+        help="xacro: an argument of the file (repeatable)",
+    )
+    parser.add_argument(
+        "--package-dir",
+        action="append",
+        metavar="NAME=DIR",
+        help="xacro: the folder of package NAME, for $(find NAME) and package://NAME (repeatable; "
+        "else ROS_PACKAGE_PATH)",
     )

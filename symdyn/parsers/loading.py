@@ -1,33 +1,57 @@
 """Loading a robot description by its content, whatever the file's name: XML whose top element is
-<robot> is a URDF (symdyn.parsers.urdf), <mujoco> is MJCF (refused: not read yet), anything else
-a robot file (YAML or JSON, symdyn.parsers.robot_file)."""
+<robot> is a URDF (symdyn.parsers.urdf), <mujoco> is MJCF (symdyn.parsers.mjcf), anything else a
+robot file (YAML or JSON, symdyn.parsers.robot_file)."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 
 from ..errors import SymdynError
 from ..model.robot import Robot
+from .mjcf import mjcf_from_bytes
 from .robot_file import robot_from_bytes
-from .safe_xml import looks_like_xml
+from .safe_xml import looks_like_xml, parse_xml
 from .source import read_source
-from .urdf import urdf_from_bytes
+from .urdf import urdf_from_root
 
 __all__ = ["load_robot"]
 
 
-def load_robot(path: str | os.PathLike, base: str | None = None, tip: str | None = None) -> Robot:
-    """Read a robot file (YAML or JSON) or a URDF, recognised by its content, and return the `Robot`.
+def load_robot(
+    path: str | os.PathLike,
+    base: str | None = None,
+    tip: str | None = None,
+    **xacro: Mapping[str, str] | None,
+) -> Robot:
+    """Read a robot file (YAML or JSON), a URDF (or xacro) or an MJCF file, recognised by its content.
 
-    A file that starts with an XML element ('<') is read as a URDF (`symdyn.load_urdf`, with
-    `base` and `tip`: see there); an MJCF file (top element <mujoco>) or other XML is refused
-    with a SymdynError naming the file. Anything else is a robot file, which takes neither
-    `base` nor `tip`. Raises SymdynError (naming file, link and field) for any bad input; warns
-    with SymdynWarning for implausible inertial data.
+    A file that starts with an XML element ('<') is read as MJCF when its top element is
+    <mujoco> (`symdyn.load_mjcf`), otherwise as a URDF (`symdyn.load_urdf`, with `base` and
+    `tip`, and a xacro file expanded with the keywords xacro_args= and package_dirs=: see there;
+    other XML is refused with a SymdynError naming the file). Anything else is a robot file. Only
+    a URDF takes `base` and `tip`, only xacro xacro_args and package_dirs. Raises SymdynError
+    (naming file, link and field) for any bad input; warns with SymdynWarning for implausible
+    inertial data.
     """
+    unknown = sorted(set(xacro) - {"xacro_args", "package_dirs"})
+    if unknown:
+        raise TypeError(f"load_robot() got an unexpected keyword argument '{unknown[0]}'")
     file, raw, digest = read_source(path, "robot file")
     if looks_like_xml(raw):
-        return urdf_from_bytes(raw, file, digest, base, tip)
-    if base is not None or tip is not None:
-        raise SymdynError("a base or tip link applies to URDF files only (this is a robot file)", file=file)
+        root = parse_xml(raw, file)
+        if root.tag == "mujoco":
+            _urdf_only(base, tip, xacro, file, "an MJCF file")
+            return mjcf_from_bytes(raw, file, digest)
+        return urdf_from_root(root, file, digest, base, tip, **xacro)
+    _urdf_only(base, tip, xacro, file, "a robot file")
     return robot_from_bytes(raw, file, digest)
+
+
+def _urdf_only(base: str | None, tip: str | None, xacro: dict, file: str, what: str) -> None:
+    if base is not None or tip is not None:
+        raise SymdynError(f"a base or tip link applies to URDF files only (this is {what})", file=file)
+    if any(xacro.values()):
+        raise SymdynError(
+            f"xacro arguments and package folders apply to xacro files only (this is {what})", file=file
+        )

@@ -56,6 +56,10 @@ that its sine and cosine are exactly 0 or +-1
 (the 1.5707963267948966 of xacro output), and one within 1e-3 rad of a nonzero
 multiple but not 1e-9 (1.5708) warns (symdyn.model.angles).
 
+A xacro file (named *.xacro, or a <robot> declaring the xacro namespace or holding <xacro:...>
+elements) is first expanded by the `xacro` package in a child process, with the arguments and
+package folders given (symdyn.parsers.xacro_expand); the URDF it makes is then read as below.
+
 The XML is read with the standard library's expat parser, hardened: a document
 type declaration (<!DOCTYPE ...>, which a URDF never needs) is refused, so no
 entity can be declared, expanded or fetched; parameter entities and external
@@ -71,6 +75,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Mapping
 
 import sympy as sp
 
@@ -79,14 +84,15 @@ from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Mimic, Robot
 from ..spatial.transform import Transform
-from .safe_xml import looks_like_xml, parse_xml
+from .safe_xml import Element, looks_like_xml, parse_xml
 from .source import MAX_BYTES, read_source
 from .urdf_elements import MOVABLE, UrdfJoint, UrdfReader, numeric, urdf_robot_name
 from .urdf_merge import body_parts, merge_inertials
 from .urdf_mimic import mimic_error, resolve_mimic
 from .urdf_tree import UrdfTree, link_name
+from .xacro_expand import expand_xacro, is_xacro
 
-__all__ = ["load_urdf", "urdf_from_bytes", "urdf_robot_name", "MAX_BYTES"]
+__all__ = ["load_urdf", "urdf_from_bytes", "urdf_from_root", "urdf_robot_name", "MAX_BYTES"]
 
 
 def _check_inertials(reader: UrdfReader, names: list[str]) -> None:
@@ -248,30 +254,62 @@ def _fixed_parts(tree: UrdfTree, base: str) -> list:
     return parts
 
 
-def load_urdf(path: str | os.PathLike, base: str | None = None, tip: str | None = None) -> Robot:
+def load_urdf(
+    path: str | os.PathLike,
+    base: str | None = None,
+    tip: str | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+    package_dirs: Mapping[str, str] | None = None,
+) -> Robot:
     """Read a URDF file and return the tree below `base`, or the chain from `base` to `tip`, as a `Robot`.
 
     base: a link name (default: the root link); tip: a link below it (default: none,
-    the whole tree; see the module documentation). Raises SymdynError naming file,
+    the whole tree; see the module documentation). A xacro file (named *.xacro, or declaring
+    the xacro namespace) is expanded first by the `xacro` package (pip install 'symdyn[xacro]'),
+    with the arguments `xacro_args` ({name: value}, as xacro's name:=value) and the package
+    folders `package_dirs` ({package: folder}, for $(find pkg) and package://pkg; then
+    ROS_PACKAGE_PATH): symdyn.parsers.xacro_expand. Raises SymdynError naming file,
     link and field for bad input; warns with SymdynWarning for implausible inertial
     data of the links used. The robot's name is the URDF name made a C identifier.
     `symdyn.load_robot` reads a URDF too (it recognises one by its content).
     """
     file, raw, digest = read_source(path, "URDF file")
-    return urdf_from_bytes(raw, file, digest, base, tip)
+    return urdf_from_bytes(raw, file, digest, base, tip, xacro_args=xacro_args, package_dirs=package_dirs)
 
 
-def urdf_from_bytes(raw: bytes, file: str, digest: str, base: str | None, tip: str | None) -> Robot:
-    """The `Robot` of a URDF file's bytes (`file` names it in messages, `digest` is their sha256)."""
-    for what, value in (("base", base), ("tip", tip)):
-        if value is not None and not isinstance(value, str):
-            raise SymdynError(f"{what} must be a link name, not {value!r}", file=file)
+def urdf_from_bytes(
+    raw: bytes, file: str, digest: str, base: str | None, tip: str | None, **xacro: Mapping[str, str] | None
+) -> Robot:
+    """The `Robot` of a URDF file's bytes (`file` names it in messages, `digest` is their sha256);
+    `xacro`: xacro_args and package_dirs of a xacro file (see load_urdf)."""
     if not looks_like_xml(raw):
         raise SymdynError(
             "not a URDF: the file does not start with an XML element ('<'); "
             "a robot file (YAML or JSON) is read by symdyn.load_robot",
             file=file,
         )
+    return urdf_from_root(parse_xml(raw, file), file, digest, base, tip, **xacro)
+
+
+def urdf_from_root(
+    root: Element,
+    file: str,
+    digest: str,
+    base: str | None,
+    tip: str | None,
+    xacro_args: Mapping[str, str] | None = None,
+    package_dirs: Mapping[str, str] | None = None,
+) -> Robot:
+    """The `Robot` of a URDF file's parsed top element (`file` names it, `digest` is its sha256);
+    a xacro file is expanded first (its digest is then the expanded URDF's)."""
+    for what, value in (("base", base), ("tip", tip)):
+        if value is not None and not isinstance(value, str):
+            raise SymdynError(f"{what} must be a link name, not {value!r}", file=file)
+    if root.tag == "robot" and is_xacro(file, root):
+        raw, digest = expand_xacro(file, xacro_args, package_dirs)
+        root = parse_xml(raw, file)
+    elif xacro_args or package_dirs:
+        raise SymdynError("xacro arguments and package folders apply to xacro files only", file=file)
     reader = UrdfReader(file)
-    reader.read(parse_xml(raw, file))
+    reader.read(root)
     return _build(reader, digest, base, tip)

@@ -197,15 +197,14 @@ class UrdfReader:
     def read(self, root: Element) -> None:
         if root.tag == "mujoco":
             raise self.error(
-                "an MJCF file (top element <mujoco>): symdyn does not read MJCF yet; "
-                "it reads URDF (top element <robot>) and robot files (YAML or JSON)"
+                "an MJCF file (top element <mujoco>), not a URDF: read it with symdyn.load_mjcf "
+                "(or symdyn.load_robot, which recognises either)"
             )
         if root.tag != "robot":
             raise self.error(
                 f"an XML file whose top element is <{root.tag}>: symdyn reads URDF (top element "
                 "<robot>) and robot files (YAML or JSON)"
             )
-        self._refuse_xacro(root)
         if "name" not in root.attrib:
             raise self.error("<robot> needs the attribute 'name'", field="robot.name", line=root.line)
         self.robot_name = urdf_robot_name(root.attrib["name"])
@@ -216,16 +215,6 @@ class UrdfReader:
             self._read_link(i, el)
         for el in root.all("joint"):
             self._read_joint(el)
-
-    def _refuse_xacro(self, root: Element) -> None:
-        stack = [root]
-        while stack:
-            el = stack.pop()
-            if el.tag.startswith("xacro:"):
-                raise self.error(
-                    f"<{el.tag}> is a xacro macro: expand the file with xacro first", line=el.line
-                )
-            stack.extend(el.children)
 
     def _read_link(self, index: int, el: Element) -> None:
         name = el.attrib.get("name", "")

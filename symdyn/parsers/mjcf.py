@@ -1,0 +1,249 @@
+"""MJCF (MuJoCo XML) -> `symdyn.model.robot.Robot`, read as MuJoCo compiles it (docs/mjcf.md).
+
+The file is compiled by MuJoCo (symdyn.parsers.mjcf_compile) and the compiled model's arrays are
+walked, body by body (MuJoCo numbers a parent before its children):
+
+* a hinge joint becomes a revolute link, a slide joint a prismatic one, named after the body.
+  symdyn rotates a link about the origin of its body frame, MuJoCo about the joint's anchor
+  (jnt_pos, in the body frame): the link's body frame is MuJoCo's body frame moved to the
+  anchor (same axes), so its centre of mass is ipos - anchor; `Link.frame` gives MuJoCo's body
+  frame back. The axis is jnt_axis. A joint's ref (qpos0) is folded into the placement, so that
+  q is MuJoCo's qpos;
+* a body with several joints becomes a chain of links, one per joint in MuJoCo's order (each
+  joint moves the body frame the earlier ones moved): the links of the first joints are massless
+  and named after their joint, the last carries the body's mass and its name;
+* a body without joints is welded to its parent: it is merged into the parent's link (masses
+  add, inertias move to the common centre of mass: symdyn.parsers.urdf_merge) and keeps its
+  frame under its name (`Robot.frames`); bodies welded to the world are the ground;
+* sites are frames on the link of their body;
+* armature becomes the rotor inertia (gear ratio 1: M gains the armature on its diagonal, as in
+  MuJoCo), damping the viscous friction and frictionloss the Coulomb friction c sign(qd) (MuJoCo
+  enforces it as a constraint instead: the same force while the joint slides);
+* gravity is <option gravity> (zero when the flag gravity is disabled; disabling the damper or
+  frictionloss flags drops those terms too); a joint's range is the link's limits when the
+  joint is limited.
+
+Refused, naming the file, body and joint: ball joints; a free joint (a floating base, not
+supported yet). Warned about and ignored: joint stiffness (springs), gravity compensation and
+equality constraints, which symdyn does not model. Every number is a compiled double
+(symdyn.parsers.mjcf_values: rotations snapped to exact multiples of pi/2 within 1e-9 rad).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import sympy as sp
+
+from ..errors import SymdynError, SymdynWarning
+from ..model.frames import Frame
+from ..model.inertia import check_inertia
+from ..model.robot import Friction, Link, Motor, Robot
+from ..spatial.transform import Transform, rot_axis
+from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
+from .mjcf_values import number, pose, vector
+from .source import read_source
+from .urdf_elements import UrdfInertial, numeric, urdf_robot_name
+from .urdf_merge import merge_inertials
+
+__all__ = ["load_mjcf", "mjcf_from_bytes"]
+
+_FREE, _BALL, _SLIDE, _HINGE = 0, 1, 2, 3
+
+
+@dataclass
+class _Walk:
+    """What the walk has built: the links (fields for Link), the frames, and where each body sits."""
+
+    file: str
+    model: Any
+    links: list[dict] = field(default_factory=list)
+    parts: list[list[tuple[UrdfInertial, Transform]]] = field(default_factory=list)
+    frames: list[Frame] = field(default_factory=list)
+    #: per body: (link index or -1, the MuJoCo body frame in that link's body frame)
+    owner: list[tuple[int, Transform]] = field(default_factory=list)
+
+
+def load_mjcf(path: str | os.PathLike) -> Robot:
+    """Read an MJCF (MuJoCo XML) file and return its robot on a fixed base.
+
+    The file is compiled by MuJoCo (the `mujoco` package: pip install 'symdyn[mjcf]') and read
+    from the compiled model (see the module documentation and docs/mjcf.md). Raises SymdynError
+    naming the file (and the body and joint) for bad input, with MuJoCo's message for a file its
+    compiler rejects; warns with SymdynWarning for what is ignored and for implausible inertias.
+    `symdyn.load_robot` reads MJCF too (it recognises the top element <mujoco>).
+    """
+    file, raw, digest = read_source(path, "MJCF file")
+    return mjcf_from_bytes(raw, file, digest)
+
+
+def mjcf_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
+    """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
+    model = compile_mjcf(raw, file)
+    check_numbers(model, file)
+    flags = _disabled(model)
+    body_names = names(model, "body", model.nbody, "body")
+    joint_names = names(model, "jnt", model.njnt, "joint")
+    site_names = names(model, "site", model.nsite, "site")
+    _refuse_clashes(file, body_names[1:], site_names)
+    _warn_ignored(file, model, flags, body_names, joint_names)
+    walk = _Walk(file, model, owner=[(-1, Transform.identity())])
+    for b in range(1, model.nbody):
+        _body(walk, b, body_names, joint_names, flags)
+    for s in range(model.nsite):
+        k, T = walk.owner[int(model.site_bodyid[s])]
+        where = {"file": file, "field": f"site({site_names[s]}).quat"}
+        walk.frames.append(Frame(site_names[s], k, T @ pose(model.site_pos[s], model.site_quat[s], **where)))
+    if not walk.links:
+        raise SymdynError("no hinge or slide joint: the model has nothing that moves", file=file)
+    gravity = [sp.S.Zero] * 3 if "gravity" in flags else [number(g) for g in model.opt.gravity]
+    return Robot(
+        name=urdf_robot_name(model_name(model)),
+        links=tuple(_link(walk, i, fields) for i, fields in enumerate(walk.links)),
+        gravity=sp.ImmutableMatrix(3, 1, gravity),
+        source=file,
+        source_sha256=digest,
+        convention="mjcf",
+        frames=tuple(walk.frames),
+    )
+
+
+def _disabled(model: Any) -> set[str]:
+    """The disabled flags of <option><flag> that change the dynamics symdyn derives."""
+    mujoco = mujoco_module()
+    bits = mujoco.mjtDisableBit
+    out = set()
+    for name, bit in (
+        ("gravity", bits.mjDSBL_GRAVITY),
+        ("damper", bits.mjDSBL_DAMPER),
+        ("frictionloss", bits.mjDSBL_FRICTIONLOSS),
+        ("spring", bits.mjDSBL_SPRING),
+    ):
+        if int(model.opt.disableflags) & int(bit):
+            out.add(name)
+    if int(model.opt.disableflags) & int(bits.mjDSBL_CONSTRAINT):
+        out.add("frictionloss")  # MuJoCo's frictionloss is a constraint
+    return out
+
+
+def _refuse_clashes(file: str, bodies: list[str], sites: list[str]) -> None:
+    """Bodies and sites become frames named after them, so a site may not share a body's name."""
+    for name in sorted(set(bodies) & set(sites)):
+        raise SymdynError(
+            f"'{name}' names both a body and a site: symdyn names links and frames after them, "
+            "so rename one of them",
+            file=file,
+        )
+
+
+def _warn_ignored(file: str, model: Any, flags: set[str], bodies: list[str], joints: list[str]) -> None:
+    """A SymdynWarning for each kind of force MuJoCo applies that symdyn's model leaves out."""
+    ignored = []
+    stiff = [joints[j] for j in range(model.njnt) if float(model.jnt_stiffness[j]) != 0]
+    if stiff and "spring" not in flags:
+        ignored.append(f"the stiffness (spring) of joint {', '.join(repr(n) for n in stiff)}")
+    held = [bodies[b] for b in range(model.nbody) if float(model.body_gravcomp[b]) != 0]
+    if held:
+        ignored.append(f"the gravity compensation of body {', '.join(repr(n) for n in held)}")
+    if model.neq:
+        ignored.append(f"{model.neq} equality constraint(s)")
+    for what in ignored:
+        warnings.warn(f"{file}: {what} is ignored: symdyn does not model it", SymdynWarning, stacklevel=4)
+
+
+def _body(walk: _Walk, b: int, body_names: list[str], joint_names: list[str], flags: set[str]) -> None:
+    """Body b: merged into its parent's link (no joint), or one link per joint."""
+    model, name = walk.model, body_names[b]
+    k, T_parent = walk.owner[int(model.body_parentid[b])]
+    T = T_parent @ pose(model.body_pos[b], model.body_quat[b], file=walk.file, field=f"body({name}).quat")
+    first, count = int(model.body_jntadr[b]), int(model.body_jntnum[b])
+    for n, j in enumerate(range(first, first + count)):
+        _refuse_joint(walk, int(model.jnt_type[j]), name, joint_names[j])
+        T = _joint(walk, j, k, T, name if n == count - 1 else joint_names[j], flags)
+        k = len(walk.links) - 1
+    walk.owner.append((k, T))
+    if not count:
+        walk.frames.append(Frame(name, k, T))
+    massive = float(model.body_mass[b]) != 0 or any(float(x) != 0 for x in model.body_inertia[b])
+    if k >= 0 and massive:
+        inertial = UrdfInertial(
+            number(model.body_mass[b]),
+            pose(model.body_ipos[b], model.body_iquat[b], file=walk.file, field=f"body({name}).iquat"),
+            sp.ImmutableMatrix(sp.diag(*[number(x) for x in model.body_inertia[b]])),
+        )
+        walk.parts[k].append((inertial, T))
+
+
+def _refuse_joint(walk: _Walk, kind: int, body: str, joint: str) -> None:
+    """A free or ball joint is refused, naming the body and the joint."""
+    if kind == _FREE:
+        why = (
+            "a free joint (a floating base): symdyn does not support floating bases yet; weld the "
+            "robot's root body to the world (remove the free joint)"
+        )
+    elif kind == _BALL:
+        why = "a ball joint: symdyn handles hinge and slide joints only (write it as three hinge joints)"
+    else:
+        return
+    raise SymdynError(
+        f"body '{body}', joint '{joint}' is {why}", file=walk.file, field=f"joint({joint}).type"
+    )
+
+
+def _joint(walk: _Walk, j: int, parent: int, T: Transform, name: str, flags: set[str]) -> Transform:
+    """Append the link of joint j, whose MuJoCo body frame sits at T in link `parent`'s frame;
+    return that body frame (moved by this joint) in the new link's frame."""
+    model = walk.model
+    hinge = int(model.jnt_type[j]) == _HINGE
+    axis = vector(model.jnt_axis[j])
+    shift = Transform.from_translation(list(vector(model.jnt_pos[j]))) if hinge else Transform.identity()
+    ref = number(model.qpos0[int(model.jnt_qposadr[j])])
+    placement = T @ shift
+    if ref != 0:
+        motion = rot_axis(list(axis), -ref) if hinge else None
+        placement = placement @ (
+            Transform.from_rotation(motion.applyfunc(numeric))
+            if hinge
+            else Transform.from_translation(list(-axis * ref))
+        )
+    dof = int(model.jnt_dofadr[j])
+    limits = None
+    if bool(model.jnt_limited[j]):
+        lower, upper = (number(x) for x in model.jnt_range[j])
+        limits = (lower, upper) if lower < upper else None
+    walk.links.append(
+        {
+            "name": name,
+            "joint": "revolute" if hinge else "prismatic",
+            "placement": placement,
+            "axis": axis,
+            "friction": Friction(
+                sp.S.Zero if "damper" in flags else number(model.dof_damping[dof]),
+                sp.S.Zero if "frictionloss" in flags else number(model.dof_frictionloss[dof]),
+            ),
+            "motor": Motor(number(model.dof_armature[dof]), sp.S.One),
+            "frame": shift.inverse(),
+            "parent": parent,
+            "limits": limits,
+        }
+    )
+    walk.parts.append([])
+    return shift.inverse()
+
+
+def _link(walk: _Walk, i: int, fields: dict) -> Link:
+    """Link i with the merged mass, centre of mass and inertia of the bodies it carries."""
+    mass, com, inertia = merge_inertials(walk.parts[i])
+    mass, com, inertia = numeric(mass), com.applyfunc(numeric), inertia.applyfunc(numeric)
+    check_inertia(mass, inertia, file=walk.file, link_index=i + 1, link_name=fields["name"])
+    parent = fields.pop("parent")
+    return Link(
+        mass=mass,
+        com=com,
+        inertia=inertia,
+        parent=None if parent == i - 1 else parent,
+        **fields,
+    )

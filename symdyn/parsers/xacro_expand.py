@@ -1,0 +1,107 @@
+"""xacro files expanded into URDF before the URDF loader reads them (docs/urdf.md, "xacro").
+
+A file is a xacro file when its name ends in .xacro, or its top element <robot> declares the
+xacro namespace (xmlns:xacro) or holds a <xacro:...> element. It is expanded by the `xacro`
+package (the `xacro` extra) in a child process (symdyn.parsers.xacro_run) with the arguments
+NAME:=VALUE given (`xacro_args`) and the package folders given (`package_dirs`, for
+`$(find pkg)` and `package://pkg/` includes; then ROS_PACKAGE_PATH). The child gets at most
+TIMEOUT seconds and MEMORY bytes. An error of xacro (an undefined argument or property, a missing
+package or include) is a SymdynError on one line naming the file, and the line of the xacro
+source where the text it concerns can be found.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Mapping
+from pathlib import Path
+
+from ..errors import SymdynError
+from .safe_xml import Element
+
+__all__ = ["is_xacro", "expand_xacro", "xacro_options", "TIMEOUT", "MEMORY"]
+
+#: seconds the expansion may take
+TIMEOUT = 60
+#: bytes of address space the expanding process may use
+MEMORY = 2 * 2**30
+_RUNNER = Path(__file__).with_name("xacro_run.py")
+
+
+def is_xacro(file: str, root: Element) -> bool:
+    """Whether the file is a xacro file (see the module documentation)."""
+    if file.endswith(".xacro") or "xmlns:xacro" in root.attrib:
+        return True
+    stack = [root]
+    while stack:
+        el = stack.pop()
+        if el.tag.startswith("xacro:"):
+            return True
+        stack.extend(el.children)
+    return False
+
+
+def xacro_options(
+    file: str, xacro_args: Mapping[str, str] | None, package_dirs: Mapping[str, str] | None
+) -> tuple[dict[str, str], dict[str, str]]:
+    """The xacro arguments and package folders, checked: names and values are strings, folders exist."""
+    out = []
+    for what, given in (("xacro argument", xacro_args), ("package folder", package_dirs)):
+        checked = {}
+        for name, value in (given or {}).items():
+            if not isinstance(name, str) or not name or not isinstance(value, (str, os.PathLike)):
+                raise SymdynError(f"{what} {name!r}={value!r}: name and value must be strings", file=file)
+            checked[name] = os.fspath(value)
+        out.append(checked)
+    for name, folder in out[1].items():
+        if not os.path.isdir(folder):
+            raise SymdynError(f"package folder {name}={folder}: no such folder", file=file)
+        out[1][name] = os.path.abspath(folder)
+    return out[0], out[1]
+
+
+def expand_xacro(
+    file: str, xacro_args: Mapping[str, str] | None = None, package_dirs: Mapping[str, str] | None = None
+) -> tuple[bytes, str]:
+    """The URDF that xacro makes of `file`, as bytes, and their sha256 hex digest.
+
+    Raises:
+        SymdynError: the xacro package is missing (naming the extra), the expansion fails (xacro's
+            message, naming the file and line), takes more than TIMEOUT s or MEMORY bytes.
+    """
+    args, packages = xacro_options(file, xacro_args, package_dirs)
+    if importlib.util.find_spec("xacro") is None:
+        raise SymdynError(
+            "expanding a xacro file needs the Python package 'xacro', which is not installed: "
+            "pip install 'symdyn[xacro]'",
+            file=file,
+        )
+    request = {"file": os.path.abspath(file), "args": args, "packages": packages, "memory": MEMORY}
+    try:
+        done = subprocess.run(
+            [sys.executable, str(_RUNNER)],
+            input=json.dumps(request),
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT,
+            check=False,
+        )
+    except subprocess.TimeoutExpired:
+        raise SymdynError(f"xacro did not finish expanding the file within {TIMEOUT} s", file=file) from None
+    try:
+        answer = json.loads(done.stdout)
+    except ValueError:
+        last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        raise SymdynError(f"xacro failed: {last}", file=file) from None
+    if "error" in answer:
+        where = answer.get("file") or file
+        where = file if os.path.abspath(where) == request["file"] else where
+        line = f" (line {answer['line']})" if answer.get("line") else ""
+        raise SymdynError(f"xacro: {answer['error']}{line}", file=where)
+    urdf = answer["urdf"].encode("utf-8")
+    return urdf, hashlib.sha256(urdf).hexdigest()

@@ -1,0 +1,294 @@
+"""MJCF (MuJoCo XML) input, with MuJoCo itself as the oracle (`mujoco` in the test extra).
+
+Each file of tests/data/mjcf exercises one feature of the format (docs/mjcf.md); symdyn's model of
+it (symdyn.load_mjcf) is compared with MuJoCo's compiled model of the same file at random states:
+tau against mj_inverse's qfrc_inverse (M qdd + bias - passive forces: gravity, Coriolis and the
+joint damping, with data.qvel set) and M against mj_fullM (armature on the diagonal). MuJoCo's
+frictionloss is a constraint (its force comes out of the constraint solver, bounded by the
+frictionloss, not c sign(qd)), so the MuJoCo side runs with its constraints disabled (joint limits
+too, which random states violate) and symdyn's Coulomb term is left out. Sites are compared
+with MuJoCo's site_xpos/site_xmat.
+Example-robot-data URDFs converted to MJCF by MuJoCo itself (meshes stripped, saved with
+mj_saveLastXML) are compared with symdyn's URDF loader and Pinocchio on the original URDF.
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import symdyn
+from symdyn import SymdynError
+from symdyn.regenerate import example_robot_data_folder
+from symdyn.rnea import forward_kinematics, mass_matrix
+from tests.robots import assert_close, ev
+from tests.timebound import refused
+
+mujoco = pytest.importorskip("mujoco", reason="the test extra installs mujoco")
+
+DATA = Path(__file__).resolve().parent / "data" / "mjcf"
+FEATURES = (
+    "defaults",
+    "euler_degrees",
+    "orientations",
+    "fullinertia",
+    "geom_inertia",
+    "friction",
+    "tree",
+    "slide",
+    "sites",
+    "include/included",
+)
+TOL = 1e-12
+
+
+def _mujoco(path: Path):
+    """MuJoCo's model of the file without constraints: frictionloss (see the module docstring)
+    and joint limits, which random states violate, are MuJoCo's constraints."""
+    model = mujoco.MjModel.from_xml_path(str(path))
+    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    return model, mujoco.MjData(model)
+
+
+def _mujoco_dynamics(model, data, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
+    """(qfrc_inverse, M) of MuJoCo at one state."""
+    data.qpos[:], data.qvel[:], data.qacc[:] = q, qd, qdd
+    mujoco.mj_inverse(model, data)
+    M = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, M)
+    return data.qfrc_inverse.copy(), M
+
+
+def _states(n: int, count: int = 3, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        yield rng.uniform(-1.5, 1.5, n), rng.uniform(-2, 2, n), rng.uniform(-2, 2, n)
+
+
+def _without_coulomb(robot, q, qd, qdd) -> np.ndarray:
+    """symdyn's tau with the viscous friction but not the Coulomb term."""
+    viscous = np.array([float(link.friction.viscous) for link in robot.links])
+    return symdyn.rnea(robot, q, qd, qdd, friction=False) + viscous * qd
+
+
+@pytest.mark.parametrize("name", FEATURES)
+def test_rnea_and_mass_matrix_agree_with_mujoco(name):
+    path = DATA / f"{name}.xml"
+    robot = symdyn.load_mjcf(path)
+    model, data = _mujoco(path)
+    assert robot.n == model.nv
+    for q, qd, qdd in _states(robot.n):
+        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
+        assert_close(_without_coulomb(robot, q, qd, qdd), tau, TOL, f"{name}: tau")
+        assert_close(mass_matrix(robot, q), M, TOL, f"{name}: M")
+
+
+def _agrees_with_mujoco(name: str, tau_of, M_of, seed: int) -> None:
+    """tau_of(q, qd, qdd) (with its Coulomb term, taken off here) and M_of(q) against MuJoCo."""
+    path = DATA / f"{name}.xml"
+    robot = symdyn.load_mjcf(path)
+    model, data = _mujoco(path)
+    coulomb = np.array([float(link.friction.coulomb) for link in robot.links])
+    for q, qd, qdd in _states(robot.n, 2, seed=seed):
+        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
+        assert_close(tau_of(q, qd, qdd) - coulomb * np.sign(qd), tau, TOL, f"{name}: tau")
+        assert_close(M_of(q), M, TOL, f"{name}: M")
+
+
+@pytest.mark.parametrize("name", ["friction", "tree", "slide"])
+def test_the_derivation_agrees_with_mujoco(name):
+    dyn = symdyn.derive(symdyn.load_mjcf(DATA / f"{name}.xml"))
+    _agrees_with_mujoco(name, lambda q, qd, qdd: ev(dyn, "tau", q, qd, qdd), lambda q: ev(dyn, "M", q), 1)
+
+
+def test_generated_c_agrees_with_mujoco():
+    plant = symdyn.compile(symdyn.load_mjcf(DATA / "friction.xml"))
+    _agrees_with_mujoco("friction", plant.inverse_dynamics, plant.mass_matrix, 2)
+
+
+def test_the_mapping_of_joint_fields():
+    robot = symdyn.load_mjcf(DATA / "friction.xml")
+    assert [link.joint for link in robot.links] == ["revolute", "revolute", "prismatic"]
+    assert [link.motor.inertia for link in robot.links] == [sp.Float(0.12), sp.Float(0.04), sp.Float(0.5)]
+    assert [link.motor.gear_ratio for link in robot.links] == [1, 1, 1]
+    assert [link.friction.viscous for link in robot.links] == [sp.Float(0.8), sp.Float(0.25), 2]
+    assert [link.friction.coulomb for link in robot.links] == [sp.Float(0.3), sp.Float(0.1), 0]
+    assert robot.gravity == sp.ImmutableMatrix([0, 0, -9.81])
+    assert symdyn.load_mjcf(DATA / "tree.xml").gravity == sp.ImmutableMatrix([0, -2, -9.81])
+    limited = symdyn.load_mjcf(DATA / "euler_degrees.xml").links[1].limits
+    assert limited == (sp.Float(-90 * np.pi / 180), sp.Float(120 * np.pi / 180))  # degrees -> rad
+
+
+def test_disabled_flags_drop_their_terms(tmp_path):
+    path = tmp_path / "flags.xml"
+    flags = '<option><flag gravity="disable" damper="disable" constraint="disable"/></option>'
+    path.write_text((DATA / "friction.xml").read_text().replace("<worldbody>", flags + "<worldbody>"))
+    robot = symdyn.load_mjcf(path)
+    assert robot.gravity == sp.ImmutableMatrix([0, 0, 0])
+    assert all(link.friction.viscous == 0 and link.friction.coulomb == 0 for link in robot.links)
+    assert [link.motor.inertia for link in robot.links] == [sp.Float(0.12), sp.Float(0.04), sp.Float(0.5)]
+
+
+def test_right_angles_in_degrees_become_exact():
+    """euler="90 0 -90" (degrees, compiled to a quaternion of doubles) gives exact 0 and +-1."""
+    robot = symdyn.load_mjcf(DATA / "euler_degrees.xml")
+    R = robot.links[0].placement.R
+    assert all(x in (0, 1, -1) for x in R)
+    assert sp.ImmutableMatrix([[0, 0, -1], [1, 0, 0], [0, -1, 0]]) == R  # zyx: Rz(90) Ry(0) Rx(-90)
+
+
+def test_names_tree_and_merged_bodies():
+    robot = symdyn.load_mjcf(DATA / "tree.xml")
+    names = [link.name for link in robot.links]
+    assert names == ["torso", "left_pitch", "left", "left_hand", "right"]
+    assert robot.parents == (-1, 0, 1, 2, 0)
+    assert robot.links[0].mass == 5  # the welded head merged into the torso
+    assert [f.name for f in robot.frames] == ["head"]
+    assert robot.links[1].mass == 0  # the first joint of a body with two joints: massless
+
+
+def test_sites_agree_with_mujoco():
+    path = DATA / "sites.xml"
+    robot = symdyn.load_mjcf(path)
+    model, data = _mujoco(path)
+    for q, _, _ in _states(robot.n):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        poses = forward_kinematics(robot, q)
+        for s in range(model.nsite):
+            frame = robot.frame(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, s))
+            T = np.array(frame.placement.matrix(), dtype=float)
+            if frame.link >= 0:
+                T = poses[frame.link] @ T
+            assert_close(T[:3, 3], data.site_xpos[s], TOL, frame.name)
+            assert_close(T[:3, :3].ravel(), data.site_xmat[s], TOL, frame.name)
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("bad_ball", "field 'joint(shoulder).type': body 'l1', joint 'shoulder' is a ball joint"),
+        ("bad_free", "field 'joint(root).type': body 'base', joint 'root' is a free joint (a floating base)"),
+        (
+            "bad_include",
+            "MuJoCo's compiler refused it: XML Error: Error opening file 'no_such_file.xml'; "
+            "Element 'include', line 2",
+        ),
+        (
+            "bad_attribute",
+            "MuJoCo's compiler refused it: XML Error: Schema violation: unrecognized attribute: 'axiz'; "
+            "Element 'joint', line 4",
+        ),
+        (
+            "bad_number",
+            "joint 'j': damping 1e+200 is not a finite number of at most 1e+150 in absolute value",
+        ),
+    ],
+)
+def test_bad_files_are_one_line_errors(capsys, name, message):
+    path = DATA / f"{name}.xml"
+    line = refused(capsys, "derive", path)
+    assert line.startswith(f"symdyn: error: {path}: {message}"), line
+
+
+def test_ignored_forces_are_warned_about(tmp_path):
+    path = tmp_path / "spring.xml"
+    path.write_text(
+        '<mujoco><worldbody><body name="b"><joint name="j" stiffness="3"/>'
+        '<geom size="0.1" pos="0.1 0 0"/></body></worldbody></mujoco>'
+    )
+    with pytest.warns(symdyn.SymdynWarning, match="the stiffness .spring. of joint 'j' is ignored"):
+        symdyn.load_mjcf(path)
+
+
+def test_mujocos_own_warnings_become_symdyn_warnings(tmp_path, capfd):
+    """MuJoCo prints its warnings itself (to the process's stderr): they become SymdynWarnings."""
+    path = tmp_path / "nan.xml"
+    path.write_text((DATA / "bad_number.xml").read_text().replace("1e200", "nan"))
+    with (
+        pytest.warns(symdyn.SymdynWarning, match=r"nan.xml: MuJoCo: XML contains a 'NaN'"),
+        pytest.raises(SymdynError, match="joint 'j': damping nan is not a finite number"),
+    ):
+        symdyn.load_mjcf(path)
+    assert capfd.readouterr() == ("", "")
+
+
+def test_a_missing_mujoco_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "mujoco", None)  # `import mujoco` raises ImportError
+    with pytest.raises(SymdynError, match=r"needs the Python package 'mujoco'.*pip install 'symdyn\[mjcf\]'"):
+        symdyn.load_mjcf(DATA / "slide.xml")
+
+
+# ------------------------------------------------------------ example-robot-data through MuJoCo
+
+ROBOTS = example_robot_data_folder()
+CONVERTED = (
+    "panda_description/urdf/panda.urdf",
+    "ur_description/urdf/ur5_robot.urdf",
+    "solo_description/robots/solo12.urdf",
+)
+#: mj_saveLastXML writes 6 significant digits: positions, quaternions, masses and inertias rounded
+#: at 5e-6 relative, which the dynamics show as relative errors of a few 1e-6
+SAVED_TOL = 2e-5
+
+
+def _stripped(urdf: Path, folder: Path) -> Path:
+    """The URDF without <visual>, <collision> (meshes) and <mimic> (MuJoCo ignores mimic joints)."""
+    root = ET.parse(urdf).getroot()
+    for parent in root.iter():
+        for child in list(parent):
+            if child.tag in ("visual", "collision", "mimic"):
+                parent.remove(child)
+    out = folder / urdf.name
+    out.write_text(ET.tostring(root, encoding="unicode"))
+    return out
+
+
+@pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")
+@pytest.mark.parametrize("rel", CONVERTED)
+def test_urdfs_converted_by_mujoco(tmp_path, rel):
+    urdf = _stripped(ROBOTS / rel, tmp_path)
+    model = mujoco.MjModel.from_xml_string(urdf.read_text())
+    saved = tmp_path / "saved.xml"
+    mujoco.mj_saveLastXML(str(saved), model)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", symdyn.SymdynWarning)  # the published data's own oddities
+        robot = symdyn.load_mjcf(saved)
+        original = symdyn.load_urdf(urdf)
+    names = [link.name for link in original.links]
+    assert sorted(link.name for link in robot.links) == sorted(names)
+    order = [[link.name for link in robot.links].index(n) for n in names]  # MJCF index of each URDF link
+    saved_model, saved_data = _mujoco(saved)
+    pin = pytest.importorskip("pinocchio")
+    pmodel = pin.buildModelFromUrdf(str(urdf))
+    pdata = pmodel.createData()
+    pin_order = [pmodel.getJointId(n) - 1 for n in _joints_by_child(urdf, names)]
+    for q, qd, qdd in _states(robot.n):
+        qm, qdm, qddm = (np.empty_like(x) for x in (q, qd, qdd))
+        qm[order], qdm[order], qddm[order] = q, qd, qdd
+        # the MJCF reader against MuJoCo on the same saved file: to double precision
+        tau, M = _mujoco_dynamics(saved_model, saved_data, qm, qdm, qddm)
+        tau_mjcf = _without_coulomb(robot, qm, qdm, qddm)
+        M_mjcf = mass_matrix(robot, qm)
+        assert_close(tau_mjcf, tau, TOL, f"{rel}: tau against MuJoCo")
+        assert_close(M_mjcf, M, TOL, f"{rel}: M against MuJoCo")
+        # the saved MJCF against the original URDF (symdyn and Pinocchio): to the saved digits
+        want = symdyn.rnea(original, q, qd, qdd, friction=False)
+        assert_close(symdyn.rnea(robot, qm, qdm, qddm, friction=False)[order], want, SAVED_TOL, rel)
+        assert_close(M_mjcf[np.ix_(order, order)], mass_matrix(original, q), SAVED_TOL, rel)
+        qp, vp, ap = (np.empty_like(x) for x in (q, qd, qdd))
+        qp[pin_order], vp[pin_order], ap[pin_order] = q, qd, qdd
+        tau_pin = pin.rnea(pmodel, pdata, qp, vp, ap)[pin_order]
+        assert_close(want, tau_pin, 1e-9, f"{rel}: symdyn's URDF against Pinocchio")
+
+
+def _joints_by_child(urdf: Path, links: list[str]) -> list[str]:
+    """The URDF joint whose child is each of `links`."""
+    by_child = {j.find("child").get("link"): j.get("name") for j in ET.parse(urdf).getroot().findall("joint")}
+    return [by_child[name] for name in links]

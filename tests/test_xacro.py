@@ -1,0 +1,128 @@
+"""xacro input: a .xacro file (or any <robot> declaring the xacro namespace) is expanded by the
+`xacro` package (in the test extra) before the URDF loader reads it.
+
+tests/data/xacro/arm.urdf.xacro uses an argument, properties, math expressions, a macro and a
+macro included from a package ($(find arm_parts)); arm_expanded.urdf is the same arm written out
+by hand for upper_length:=0.5 (not by the code under test). The two robots must have the same
+links and the same dynamics (symdyn.rnea and M at random states).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import symdyn
+from symdyn import SymdynError
+from symdyn.cli.main import main
+from symdyn.parsers import xacro_expand
+from symdyn.rnea import mass_matrix
+from tests.robots import assert_close, random_state
+from tests.timebound import refused
+
+pytest.importorskip("xacro", reason="the test extra installs xacro")
+
+DATA = Path(__file__).resolve().parent / "data" / "xacro"
+ARM = DATA / "arm.urdf.xacro"
+PACKAGES = {"arm_parts": str(DATA / "packages" / "arm_parts")}
+
+
+def test_the_expanded_arm_is_the_hand_expanded_urdf():
+    robot = symdyn.load_urdf(ARM, xacro_args={"upper_length": "0.5"}, package_dirs=PACKAGES)
+    hand = symdyn.load_urdf(DATA / "arm_expanded.urdf")
+    assert robot.name == hand.name == "xacro_arm"
+    for got, want in zip(robot.links, hand.links, strict=True):
+        assert (got.name, got.joint, got.parent, got.axis) == (want.name, want.joint, want.parent, want.axis)
+        assert got.friction == want.friction
+        assert np.allclose(np.array(got.limits, dtype=float), np.array(want.limits, dtype=float), 0, 1e-15)
+    assert robot.links[0].placement.R == hand.links[0].placement.R  # rpy ${pi / 2}: exact
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        q, qd, qdd = random_state(hand, rng)
+        assert_close(symdyn.rnea(robot, q, qd, qdd), symdyn.rnea(hand, q, qd, qdd), 1e-13)
+        assert_close(mass_matrix(robot, q), mass_matrix(hand, q), 1e-13)
+
+
+def test_defaults_ros_package_path_and_load_robot(monkeypatch, tmp_path):
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(DATA / "packages"))
+    robot = symdyn.load_robot(ARM)  # the argument's default, 0.4; the package found along the path
+    assert robot.links[1].placement.p == sp.ImmutableMatrix([sp.Float(0.4), 0, 0])
+    renamed = tmp_path / "arm.urdf"  # no .xacro: recognised by its xmlns:xacro
+    renamed.write_bytes(ARM.read_bytes())
+    monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path) + ":" + str(DATA / "packages"))
+    assert symdyn.load_robot(renamed).links[1].placement.p == robot.links[1].placement.p
+
+
+def test_the_command_line_takes_xacro_arguments(capsys):
+    args = [
+        "derive",
+        ARM,
+        "--xacro-arg",
+        "upper_length:=0.5",
+        "--package-dir",
+        f"arm_parts={PACKAGES['arm_parts']}",
+    ]
+    assert main([str(a) for a in args] + ["--format", "json"]) == 0
+    got = capsys.readouterr().out
+    assert main(["derive", str(DATA / "arm_expanded.urdf"), "--format", "json"]) == 0
+    want = capsys.readouterr().out
+    assert json.loads(got) == json.loads(want)  # the same equations, printed to 15 digits
+
+
+@pytest.mark.parametrize(
+    ("file", "options", "message"),
+    [
+        (
+            "undefined_arg.urdf.xacro",
+            [],
+            "xacro: undefined argument 'mass': give it with --xacro-arg mass:=VALUE (xacro_args=) (line 6)",
+        ),
+        (
+            "undefined_property.urdf.xacro",
+            [],
+            "xacro: name 'link_mass' is not defined; when evaluating expression 'link_mass * 2' (line 6)",
+        ),
+        (
+            "arm.urdf.xacro",
+            [],
+            "xacro: package 'arm_parts' not found: give its folder with --package-dir arm_parts=DIR "
+            "(package_dirs= in Python) or add the folder that holds it to ROS_PACKAGE_PATH (line 8)",
+        ),
+        ("arm.urdf.xacro", ["--package-dir", "arm_parts=/no/such/folder"], "package folder arm_parts="),
+        ("arm_expanded.urdf", ["--xacro-arg", "a:=1"], "xacro arguments and package folders apply to"),
+    ],
+)
+def test_xacro_errors_are_one_line(capsys, monkeypatch, file, options, message):
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    path = DATA / file
+    line = refused(capsys, "derive", path, *options, seconds=30)
+    assert line.startswith(f"symdyn: error: {path}: {message}"), line
+
+
+def test_a_malformed_option_is_refused(capsys):
+    line = refused(capsys, "derive", ARM, "--xacro-arg", "upper_length=0.5")
+    assert line == "symdyn: error: --xacro-arg 'upper_length=0.5': expected NAME:=VALUE"
+
+
+def test_an_expansion_that_does_not_end_is_stopped(tmp_path, monkeypatch):
+    path = tmp_path / "hang.xacro"
+    path.write_text(
+        '<robot name="h" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<xacro:property name="x" value="${9**9**9}"/><link name="a${x}"/></robot>'
+    )
+    monkeypatch.setattr(xacro_expand, "TIMEOUT", 2)
+    with pytest.raises(SymdynError, match="xacro did not finish expanding the file within 2 s"):
+        symdyn.load_urdf(path)
+
+
+def test_a_missing_xacro_names_the_extra(monkeypatch):
+    real = xacro_expand.importlib.util.find_spec
+    monkeypatch.setattr(
+        xacro_expand.importlib.util, "find_spec", lambda name, *a: None if name == "xacro" else real(name, *a)
+    )
+    with pytest.raises(SymdynError, match=r"needs the Python package 'xacro'.*pip install 'symdyn\[xacro\]'"):
+        symdyn.load_urdf(ARM, package_dirs=PACKAGES)
