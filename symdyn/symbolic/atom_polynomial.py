@@ -97,13 +97,16 @@ class Atoms:
         self._cosine_of: dict[int, int] = {}  # sine variable -> cosine variable
         self._atoms: dict[tuple, tuple[int, int]] = {}
         self._gens: dict[int, int] = {}
-        self._angles: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}
+        self._angles: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by (block, multiple)
+        self._sums: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by k
+        self._names: list[str] = []
         self._taken = set(taken)
         self._sep = "" if ring.n < 10 else "_"
 
     # -- variables --------------------------------------------------------------------
     def _variable(self, symbol: sp.Expr) -> int:
         self.symbols.append(symbol)
+        self._names.append(sp.sstr(symbol))
         return len(self.symbols) - 1
 
     def atom(self, block: tuple[int, ...], m=1) -> tuple[int, int]:
@@ -135,7 +138,7 @@ class Atoms:
         return hit
 
     def name(self, v: int) -> str:
-        return sp.sstr(self.symbols[v])
+        return self._names[v]
 
     def is_atom(self, v: int) -> bool:
         return v in self.definitions
@@ -201,6 +204,12 @@ class Atoms:
 
     def angle(self, k: tuple) -> tuple[AtomPoly, AtomPoly]:
         """(cos, sin) of k . q + k_radians over the atoms (the radian part as number factors)."""
+        hit = self._sums.get(k)
+        if hit is None:
+            hit = self._sums[k] = self._angle(k)
+        return hit
+
+    def _angle(self, k: tuple) -> tuple[AtomPoly, AtomPoly]:
         n = self.ring.n
         cos: AtomPoly = {(): Fraction(1)}
         sin: AtomPoly = {}

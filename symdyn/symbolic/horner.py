@@ -157,11 +157,25 @@ class Factoring:
         return sp.Symbol(name)
 
     def _write(self, piece: _Piece) -> sp.Expr:
-        if piece.var is None:
-            return fast_add([self._term(m, c) for m, c in piece.terms])
-        v = self.symbols[piece.var]
-        q = self.expr(piece.q)
-        return sp.Add(v * q, self.expr(piece.r))
+        """v1 Q1 + v2 Q2 + ... + (plain sum): the chain of remainders R written in one sum
+        (not nested Adds, whose flattening would cost the square of the length), up to a
+        remainder used elsewhere too, which is written by name when shared."""
+        terms: list[sp.Expr] = []
+        p, sign = piece, 1
+        while True:
+            if p.var is None:
+                terms += [self._term(m, c if sign > 0 else -c) for m, c in p.terms]
+                break
+            t = self.symbols[p.var] * self.expr(p.q)
+            terms.append(t if sign > 0 else -t)
+            if p.r is None:
+                break
+            r, s = p.r
+            if r.uses > 1:
+                terms.extend(sp.Add.make_args(self.expr((r, s * sign))))
+                break
+            p, sign = r, sign * s
+        return fast_add(terms)
 
     def _term(self, mono: tuple, c) -> sp.Expr:
         return fast_mul([to_sympy_number(c), *[self.symbols[v] ** e for v, e in mono]])
