@@ -160,3 +160,28 @@ def test_product_form_refuses_lumped(capsys):
     assert main(["derive", str(EXAMPLES_DIR / "roger_arm.yaml"), "--form", "product", "--lumped"]) == 1
     err = capsys.readouterr().err
     assert "--form product" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("name", SMALL)
+def test_json_strings_read_back_exactly(name):
+    """Every string of the JSON keys parses with sympy.sympify to the expression it was written
+    from (exact data)."""
+    from symdyn.cli.derive_product import product_json
+
+    dyn = _rational(name, "newton-euler")
+    pf = dyn.product_form()
+    doc = product_json(dyn)
+
+    def same(text: str, e: sp.Expr) -> bool:
+        """Equal, floats (a decimal left in the data: SCARA's 0.12*pi**2) up to their 15 printed digits."""
+        d = sp.expand(sp.sympify(text) - e)
+        return d.xreplace({f: 0 for f in d.atoms(sp.Float) if abs(f) < 1e-15}) == 0
+
+    assert list(doc["atoms"]) == [str(s) for s, _ in pf.atoms]
+    assert all(same(v, e) for v, (_, e) in zip(doc["atoms"].values(), pf.atoms, strict=True))
+    assert list(doc["shared"]) == [str(s) for s, _ in pf.shared]
+    assert all(same(v, e) for v, (_, e) in zip(doc["shared"].values(), pf.shared, strict=True))
+    for label, e in pf.entries["M"]:
+        i, j = (int(x) - 1 for x in label[2:-1].split(","))
+        assert same(doc["M"][i][j], e) and same(doc["M"][j][i], e), label
+    assert all(same(v, e) for v, (_, e) in zip(doc["G"], pf.entries["G"], strict=True))
