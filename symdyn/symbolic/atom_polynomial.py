@@ -99,6 +99,7 @@ class Atoms:
         self._gens: dict[int, int] = {}
         self._angles: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by (block, multiple)
         self._sums: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by k
+        self._floats: dict[tuple, list] = {}  # by (k, kind), float coefficients
         self._names: list[str] = []
         self._taken = set(taken)
         self._sep = "" if ring.n < 10 else "_"
@@ -228,14 +229,30 @@ class Atoms:
             )
         return cos, sin
 
+    def _float_angle(self, k: tuple, kind: int) -> list[tuple[tuple, float]]:
+        """angle(k)[kind] with float coefficients, for terms with float coefficients."""
+        hit = self._floats.get((k, kind))
+        if hit is None:
+            hit = self._floats[(k, kind)] = [(m, float(x)) for m, x in self.angle(k)[kind].items()]
+        return hit
+
     def convert(self, p: TrigPoly) -> AtomPoly:
-        """The TrigPoly p over the atoms: each term's angle expanded, times its monomial."""
+        """The TrigPoly p over the atoms: each term's angle expanded, times its monomial. Terms
+        with float coefficients are summed in floats (the Panda: 15 million products)."""
         out: AtomPoly = {}
+        floats: dict[tuple, float] = {}
         for (mono, k, kind), c in p.items():
-            trig = self.angle(k)[kind]
             factor = tuple(sorted((self.generator(g), e) for g, e in mono))
-            for tm, x in trig.items():
+            if type(c) is float:
+                for tm, x in self._float_angle(k, kind):
+                    key = mono_mul(tm, factor)
+                    floats[key] = floats.get(key, 0.0) + c * x
+                continue
+            for tm, x in self.angle(k)[kind].items():
                 _put(out, mono_mul(tm, factor), _mul_coef(c, x))
+        for key, x in floats.items():
+            if x != 0.0:
+                _put(out, key, x)
         return out
 
 
