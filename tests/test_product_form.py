@@ -185,3 +185,13 @@ def test_json_strings_read_back_exactly(name):
         i, j = (int(x) - 1 for x in label[2:-1].split(","))
         assert same(doc["M"][i][j], e) and same(doc["M"][j][i], e), label
     assert all(same(v, e) for v, (_, e) in zip(doc["G"], pf.entries["G"], strict=True))
+
+
+@pytest.mark.parametrize("case", ["chain", "gripper", "ytree"])
+def test_mimic_joints_and_trees(case):
+    """Mimic joints (multiples -2 q_1 + 0.3, 0.5 q_4: constant angles as number factors, a
+    fractional multiple as its own atom) and kinematic trees: still the configuration form."""
+    from test_mimic import CASES as MIMIC_CASES
+
+    dyn = derive(MIMIC_CASES[case][0], simplify=False)
+    dyn.product_form().check(dyn.configuration_space, rel=1e-12)
