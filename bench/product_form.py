@@ -63,8 +63,10 @@ def _row(label: str, make, kind) -> dict:
             strings = [value[i][j] for i in range(dyn.n) for j in range(i, dyn.n)]
         ops[key] = _count(s for s in strings if s != "0")
     row["product"] = ops
-    entries, _ = configuration_entries(dyn, cs=cs, text=True)
-    row["configuration"] = {k: _count(e for _, e in entries[k]) for k in ("M", "B", "Csq", "G")}
+    row["configuration"] = None  # the Panda's strings are too long for sympify (RecursionError)
+    if cs.readable:
+        entries, _ = configuration_entries(dyn, cs=cs, text=True)
+        row["configuration"] = {k: _count(e for _, e in entries[k]) for k in ("M", "B", "Csq", "G")}
     row["names"] = (len(doc["atoms"]), len(doc["shared"]))
     return row
 
@@ -88,11 +90,11 @@ def product_report(markdown: bool = False) -> str:
         p, c = r["product"], r["configuration"]
         akb = AKB_PRUNED_OPS if "pruned" in r["robot"] else AKB_OPS
         ratio = f"{sum(p.values()) / akb:.2f} x {akb:,}" if r["robot"].startswith("PUMA") else "—"
+        conf = (" / ".join(f"{v:,}" for v in c.values()), f"{sum(c.values()):,}") if c else ("—", "—")
         out.append(
             f"| {r['robot']} | {r['seconds']:.2f} | {r['product_seconds']:.2f} | {r['bytes'] / 1024:.1f} | "
             f"{r['names'][0]} / {r['names'][1]} | {' / '.join(f'{v:,}' for v in p.values())} | "
-            f"{sum(p.values()):,} | {' / '.join(f'{v:,}' for v in c.values())} | "
-            f"{sum(c.values()):,} | {ratio} |"
+            f"{sum(p.values()):,} | {conf[0]} | {conf[1]} | {ratio} |"
         )
     if not markdown:
         out = [line.replace("|", " ").strip() for line in out if not line.startswith("|---")]
