@@ -195,3 +195,15 @@ def test_mimic_joints_and_trees(case):
 
     dyn = derive(MIMIC_CASES[case][0], simplify=False)
     dyn.product_form().check(dyn.configuration_space, rel=1e-12)
+
+
+def test_check_catches_a_wrong_entry():
+    """The check is not vacuous: a changed coefficient of a shared quantity fails it."""
+    import dataclasses
+
+    dyn = _rational("roger_arm", "newton-euler")
+    pf = dyn.product_form()
+    (name, e), *rest = pf.shared
+    wrong = dataclasses.replace(pf, shared=[(name, e + sp.Rational(1, 10**9)), *rest])
+    with pytest.raises(AssertionError):
+        wrong.check(dyn.configuration_space, rel=0.0)

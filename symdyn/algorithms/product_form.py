@@ -110,7 +110,7 @@ class ProductForm:
             got = {lab: e for lab, e in self.entries[name]}
             for lab, (k, c) in labels.items():
                 want = cs.ring.named(cs.poly(name, k, c))
-                have = ring.named(ring.convert(sp.expand(got.get(lab, sp.S.Zero).xreplace(sub))))
+                have = ring.named(ring.convert(got.get(lab, sp.S.Zero).xreplace(sub)))
                 big = max([abs(float(x)) for x in want.values()] or [0.0])
                 for key in set(want) | set(have):
                     a, b = want.get(key, 0), have.get(key, 0)
