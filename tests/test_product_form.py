@@ -6,6 +6,8 @@ routes, and by value against the numeric oracle symdyn.rnea and Pinocchio."""
 from __future__ import annotations
 
 import json
+import shutil
+import subprocess
 from functools import cache
 
 import numpy as np
@@ -207,3 +209,19 @@ def test_check_catches_a_wrong_entry():
     wrong = dataclasses.replace(pf, shared=[(name, e + sp.Rational(1, 10**9)), *rest])
     with pytest.raises(AssertionError):
         wrong.check(dyn.configuration_space, rel=0.0)
+
+
+@pytest.mark.skipif(not shutil.which("pdflatex"), reason="no pdflatex")
+def test_puma_latex_compiles(tmp_path):
+    from symdyn.cli.derive_product import product_latex
+
+    tex = product_latex(derived("puma560", "newton-euler"))
+    assert "c_{23} &= \\cos{\\left(q_{2} + q_{3} \\right)}" in tex and "C^{\\mathrm{sq}}_{" in tex
+    (tmp_path / "puma.tex").write_text(tex)
+    (tmp_path / "doc.tex").write_text(
+        "\\documentclass{article}\n\\usepackage{amsmath}\n\\begin{document}\n\\input{puma.tex}\n\\end{document}\n"
+    )
+    cmd = ["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "doc.tex"]
+    proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    assert "Undefined control sequence" not in proc.stdout
