@@ -100,14 +100,20 @@ def _total(d: dict | None) -> str:
     return "—" if not d else f"{sum(d.values()):,}"
 
 
-def configuration_report(markdown: bool = False) -> str:
-    """Run every row once and format the table."""
+def run_rows(robots, row) -> list[dict]:
+    """row(label, make, kind) for every robot, with progress on stderr."""
     warnings.simplefilter("ignore")
     rows = []
-    for label, make, expanded in _robots():
+    for label, make, kind in robots:
         print(f"  [{label}] ...", file=sys.stderr, flush=True)
-        rows.append(_row(label, make, expanded))
+        rows.append(row(label, make, kind))
         print(f"  {rows[-1]}", file=sys.stderr, flush=True)
+    return rows
+
+
+def configuration_report(markdown: bool = False) -> str:
+    """Run every row once and format the table."""
+    rows = run_rows(_robots(), _row)
     head = (
         "| robot | derive (s) | text (KB) | Christoffel symbols | M / B / Csq / G, configuration form | "
         "total | lumped (entries + constants) | 1 % pruned (bound) | compact M, V, G | expanded M, V, G | "

@@ -134,7 +134,18 @@ def main(argv=None) -> int:
         help="instead: the configuration-space form of the PUMA 560, Stanford arm and Panda "
         "(bench/configuration_form.py)",
     )
+    p.add_argument(
+        "--product",
+        action="store_true",
+        help="instead: the product form (derive --form product) of the PUMA 560, Stanford arm and "
+        "Panda, operations and times (bench/product_form.py)",
+    )
     args = p.parse_args(argv)
+    if args.product:
+        from product_form import product_report
+
+        print(product_report(args.markdown), end="")
+        return 0
     if args.configuration:
         from configuration_form import configuration_report
 

@@ -54,6 +54,7 @@ from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
 from .algorithms.operational_space import operational_space, task_rows
+from .algorithms.product_form import ProductForm, product_form
 from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.singular import SingularJoint, describe_singular, singular_joints
 from .algorithms.tip_wrench import tip_wrench_torque
@@ -205,6 +206,16 @@ class Dynamics:
             c = self.compact
             self._configuration = configuration_space(self.program, c["M"], list(c["G"]), list(self.q))
         return self._configuration
+
+    @cached_property
+    def _product(self) -> ProductForm:
+        return product_form(self.robot, self.configuration_space, self.closed_form("F"))
+
+    def product_form(self) -> ProductForm:
+        """The configuration-space form over the trig atoms c_i, s_i (and c_23, s_23 for
+        consecutive parallel axes), factored and with equal or opposite pieces shared
+        (symdyn.algorithms.product_form; `derive --form product`)."""
+        return self._product
 
     @property
     def B(self) -> sp.Matrix:

@@ -31,6 +31,8 @@ from ..symbolic.trig_text import number_text
 
 __all__ = [
     "FORMS",
+    "header",
+    "json_header",
     "derive_text",
     "derive_json",
     "configuration_entries",
@@ -45,7 +47,7 @@ FORMS = ("configuration", "compact", "expanded")
 PRINTED = ("M", "C", "V", "G", "F")
 
 
-def _header(dyn: Dynamics, equation: str) -> list[str]:
+def header(dyn: Dynamics, equation: str) -> list[str]:
     return [
         f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
@@ -133,7 +135,7 @@ def _value(v: sp.Expr) -> str:
 def _configuration_text(dyn: Dynamics, lumped: bool, pruned=None) -> str:
     n = dyn.n
     pairs = ", ".join(f"{dyn.qd[i]}*{dyn.qd[j]}" for i, j in pair_columns(n)) or "none"
-    lines = _header(dyn, "tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)")
+    lines = header(dyn, "tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)")
     lines.append(f"# [qd qd] = ({pairs}); [qd^2] = ({', '.join(f'{v}**2' for v in dyn.qd)})")
     if pruned is not None:
         lines += prune_summary(dyn, pruned)
@@ -177,7 +179,7 @@ def derive_text(dyn: Dynamics, form: str = "configuration", lumped: bool = False
     configuration form only)."""
     if form == "configuration":
         return _configuration_text(dyn, lumped, pruned)
-    lines = _header(dyn, "tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd")
+    lines = header(dyn, "tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd")
     if form == "compact":
         temporaries, mats = _compact(dyn)
         lines.append("")
@@ -197,10 +199,9 @@ def _nested(m: sp.Matrix, vector: bool) -> list:
     return [[sp.sstr(m[i, j]) for j in range(m.cols)] for i in range(m.rows)]
 
 
-def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False) -> str:
-    """The JSON of `symdyn derive`: keys M, C, V, G, F (and B, Csq, lumped in the
-    configuration form; assignments in the compact form)."""
-    doc: dict = {
+def json_header(dyn: Dynamics, form: str) -> dict:
+    """The keys every JSON of `derive` starts with: robot, method, joints, form, q, qd, qdd, params."""
+    return {
         "robot": dyn.robot.name,
         "method": dyn.method,
         "joints": dyn.n,
@@ -210,6 +211,12 @@ def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False
         "qdd": [str(s) for s in dyn.qdd],
         "params": [str(s) for s in dyn.params],
     }
+
+
+def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False) -> str:
+    """The JSON of `symdyn derive`: keys M, C, V, G, F (and B, Csq, lumped in the
+    configuration form; assignments in the compact form)."""
+    doc = json_header(dyn, form)
     if form == "configuration":
         doc.update(_configuration_json(dyn, lumped))
         return json.dumps(doc, indent=2) + "\n"

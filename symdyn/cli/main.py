@@ -103,7 +103,16 @@ def cmd_derive(args: argparse.Namespace) -> int:
                 "--form compact (ask for --form configuration to print it all the same)",
                 file=sys.stderr,
             )
-    if args.format == "latex":
+    if args.form == "product":
+        from . import derive_product as prod
+
+        if args.lumped or args.prune is not None:
+            raise SymdynError(
+                "derive: --lumped and --prune apply to --form configuration, not --form product"
+            )
+        writer = {"text": prod.product_text, "json": prod.product_json_text, "latex": prod.product_latex}
+        text = writer[args.format](dyn)
+    elif args.format == "latex":
         configuration = args.form == "configuration"
         text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
     elif args.prune is not None:
@@ -159,11 +168,11 @@ def _derive_arguments(d: argparse.ArgumentParser) -> None:
     )
     d.add_argument(
         "--form",
-        choices=("configuration", "compact", "expanded"),
+        choices=("configuration", "product", "compact", "expanded"),
         default=None,
         help="configuration: M, B [qd qd], Csq [qd^2], G, F (default, unless larger than "
-        "100,000 terms: then compact); compact: named intermediates; "
-        "expanded: the full expansion",
+        "100,000 terms: then compact); product: the same over c_i, s_i, c_23, ..., factored "
+        "and shared; compact: named intermediates; expanded: the full expansion",
     )
     d.add_argument(
         "--lumped",

@@ -50,6 +50,7 @@ __all__ = [
     "largest",
     "is_float_data",
     "print_order",
+    "mono_mul",
 ]
 
 Monomial = tuple[tuple[int, int], ...]
@@ -120,7 +121,8 @@ def scale(p: TrigPoly, factor) -> TrigPoly:
     return {key: c * factor for key, c in p.items()}
 
 
-def _mono_mul(a: Monomial, b: Monomial) -> Monomial:
+def mono_mul(a: Monomial, b: Monomial) -> Monomial:
+    """The product of two monomials (sorted tuples of (variable, exponent))."""
     if not a:
         return b
     if not b:
@@ -164,7 +166,7 @@ def multiply(p: TrigPoly, r: TrigPoly) -> TrigPoly:
     for (ma, ka, ta), ca in p.items():
         a_const = not any(ka)
         for (mb, kb, tb), cb in r.items():
-            mono = _mono_mul(ma, mb)
+            mono = mono_mul(ma, mb)
             c = ca * cb
             if a_const:  # cos(0) = 1
                 _put(out, mono, kb, tb, c)

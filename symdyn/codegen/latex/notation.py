@@ -155,12 +155,13 @@ class Notation:
     def latex(self, expr: sp.Expr) -> str:
         return self.printer.doprint(expr)
 
-    def lines(self, expr: sp.Expr) -> list[str]:
+    def lines(self, expr: sp.Expr, expand: bool = True) -> list[str]:
         """The entry broken into displayed lines at its top-level + and - (none when short).
 
-        A long product with a sum inside (a (b + c)) is multiplied out first, so it can break.
+        A long product with a sum inside (a (b + c)) is multiplied out first, so it can break
+        (unless `expand` is False: a factored form stays factored).
         """
-        if not expr.is_Add and width(self.latex(expr)) > LINE_WIDTH and expr.has(sp.Add):
+        if expand and not expr.is_Add and width(self.latex(expr)) > LINE_WIDTH and expr.has(sp.Add):
             expanded = sp.expand(expr)
             expr = expanded if expanded.is_Add else expr
         terms = self.printer.terms(expr)
