@@ -62,9 +62,14 @@ def example(name: str) -> Robot:
 
 
 @cache
+def _raw_example_text(name: str) -> str:
+    return (EXAMPLES_DIR / f"{name}.yaml").read_text()
+
+
 def raw_example(name: str) -> dict:
-    """The example file as plain data (yaml.safe_load), independent of the loader."""
-    return yaml.safe_load((EXAMPLES_DIR / f"{name}.yaml").read_text())
+    """The example file as plain data (yaml.safe_load), independent of the loader: a fresh
+    copy each call, so that a test may change it without changing another test's."""
+    return yaml.safe_load(_raw_example_text(name))
 
 
 def raw_value(value, parameters: dict | None = None) -> sp.Expr:

@@ -710,7 +710,7 @@ BAD = [
     ("bad_xml.urdf", None, None, None, "invalid XML at line 5, column 3: mismatched tag"),
     ("bad_entity_expansion.urdf", None, None, None, "line 2: document type declarations (<!DOCTYPE>)"),
     ("bad_external_entity.urdf", None, None, None, "line 2: document type declarations (<!DOCTYPE>)"),
-    # a xacro file (xmlns:xacro) is expanded first; what remains is a lone base link
+    # a xacro file (a <xacro:property>) is expanded first; what remains is a lone base link
     ("bad_xacro.urdf", None, None, None, "the base link 'base' has no links below it"),
     ("bad_root.urdf", None, None, None, "an XML file whose top element is <sdf>: symdyn reads URDF"),
 ]

@@ -1,4 +1,4 @@
-"""xacro input: a .xacro file (or any <robot> declaring the xacro namespace) is expanded by the
+"""xacro input: a .xacro file (or any <robot> holding <xacro:...> elements) is expanded by the
 `xacro` package (in the test extra) before the URDF loader reads it.
 
 tests/data/xacro/arm.urdf.xacro uses an argument, properties, math expressions, a macro and a
@@ -9,6 +9,7 @@ links and the same dynamics (symdyn.rnea and M at random states).
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -20,6 +21,7 @@ import symdyn
 from symdyn import SymdynError
 from symdyn.cli.main import main
 from symdyn.parsers import xacro_expand
+from symdyn.parsers.safe_xml import parse_xml
 from symdyn.rnea import mass_matrix
 from tests.robots import assert_close, random_state
 from tests.timebound import refused
@@ -51,7 +53,7 @@ def test_defaults_ros_package_path_and_load_robot(monkeypatch, tmp_path):
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(DATA / "packages"))
     robot = symdyn.load_robot(ARM)  # the argument's default, 0.4; the package found along the path
     assert robot.links[1].placement.p == sp.ImmutableMatrix([sp.Float(0.4), 0, 0])
-    renamed = tmp_path / "arm.urdf"  # no .xacro: recognised by its xmlns:xacro
+    renamed = tmp_path / "arm.urdf"  # no .xacro: recognised by its <xacro:...> elements
     renamed.write_bytes(ARM.read_bytes())
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(tmp_path) + ":" + str(DATA / "packages"))
     assert symdyn.load_robot(renamed).links[1].placement.p == robot.links[1].placement.p
@@ -117,6 +119,21 @@ def test_an_expansion_that_does_not_end_is_stopped(tmp_path, monkeypatch):
     monkeypatch.setattr(xacro_expand, "TIMEOUT", 2)
     with pytest.raises(SymdynError, match="xacro did not finish expanding the file within 2 s"):
         symdyn.load_urdf(path)
+
+
+def test_a_urdf_that_only_declares_the_xacro_namespace_is_read_as_it_is(tmp_path):
+    """Exported URDFs often keep xmlns:xacro: without a <xacro:...> element the file is the plain
+    URDF it is, read without xacro, so its digest (in generated headers) is the file's own."""
+    plain = tmp_path / "plain.urdf"
+    plain.write_text(
+        '<robot name="p" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="base"/>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="l"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        '<link name="l"><inertial><mass value="1"/><origin xyz="0.1 0 0"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link></robot>'
+    )
+    assert not xacro_expand.is_xacro(str(plain), parse_xml(plain.read_bytes(), str(plain)))
+    assert symdyn.load_urdf(plain).source_sha256 == hashlib.sha256(plain.read_bytes()).hexdigest()
 
 
 def test_a_missing_xacro_names_the_extra(monkeypatch):

@@ -56,9 +56,9 @@ that its sine and cosine are exactly 0 or +-1
 (the 1.5707963267948966 of xacro output), and one within 1e-3 rad of a nonzero
 multiple but not 1e-9 (1.5708) warns (symdyn.model.angles).
 
-A xacro file (named *.xacro, or a <robot> declaring the xacro namespace or holding <xacro:...>
-elements) is first expanded by the `xacro` package in a child process, with the arguments and
-package folders given (symdyn.parsers.xacro_expand); the URDF it makes is then read as below.
+A xacro file (named *.xacro, or a <robot> holding <xacro:...> elements) is first expanded by
+the `xacro` package in a child process, with the arguments and package folders given
+(symdyn.parsers.xacro_expand); the URDF it makes is then read as below.
 
 The XML is read with the standard library's expat parser, hardened: a document
 type declaration (<!DOCTYPE ...>, which a URDF never needs) is refused, so no

@@ -1,7 +1,8 @@
 """xacro files expanded into URDF before the URDF loader reads them (docs/urdf.md, "xacro").
 
-A file is a xacro file when its name ends in .xacro, or its top element <robot> declares the
-xacro namespace (xmlns:xacro) or holds a <xacro:...> element. It is expanded by the `xacro`
+A file is a xacro file when its name ends in .xacro, or its <robot> holds a <xacro:...> element.
+A declaration of the xacro namespace alone (xmlns:xacro, which many exported URDFs keep) does not
+make one: such a file is read as the plain URDF it is. It is expanded by the `xacro`
 package (the `xacro` extra) in a child process (symdyn.parsers.xacro_run) with the arguments
 NAME:=VALUE given (`xacro_args`) and the package folders given (`package_dirs`, for
 `$(find pkg)` and `package://pkg/` includes; then ROS_PACKAGE_PATH). The child gets at most
@@ -35,7 +36,7 @@ _RUNNER = Path(__file__).with_name("xacro_run.py")
 
 def is_xacro(file: str, root: Element) -> bool:
     """Whether the file is a xacro file (see the module documentation)."""
-    if file.endswith(".xacro") or "xmlns:xacro" in root.attrib:
+    if file.endswith(".xacro"):
         return True
     stack = [root]
     while stack:
