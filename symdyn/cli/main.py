@@ -106,12 +106,10 @@ def cmd_derive(args: argparse.Namespace) -> int:
     if args.form == "product":
         from . import derive_product as prod
 
-        if args.lumped or args.prune is not None:
-            raise SymdynError(
-                "derive: --lumped and --prune apply to --form configuration, not --form product"
-            )
+        if args.prune is not None:
+            raise SymdynError("derive: --prune applies to --form configuration, not --form product")
         writer = {"text": prod.product_text, "json": prod.product_json_text, "latex": prod.product_latex}
-        text = writer[args.format](dyn)
+        text = writer[args.format](dyn, lumped=args.lumped)
     elif args.format == "latex":
         configuration = args.form == "configuration"
         text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
