@@ -71,9 +71,12 @@ def _derive_json(dyn) -> str:
 
 
 def _derive_latex(dyn) -> str:
+    """--form compact/expanded in LaTeX: the target's closed form up to three joints, beyond
+    that its eliminated form (named intermediates; the product form is --form product)."""
     from ..codegen.latex import dynamics_latex
+    from ..dynamics import AUTO_SIMPLIFY_MAX_JOINTS
 
-    return dynamics_latex(dyn)
+    return dynamics_latex(dyn, "auto" if dyn.n <= AUTO_SIMPLIFY_MAX_JOINTS else "eliminated")
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
