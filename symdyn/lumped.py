@@ -37,19 +37,21 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field, replace
+from fractions import Fraction
 
 import sympy as sp
 
 from .algorithms.base_parameters import BaseParameters
 from .algorithms.configuration_space import ConfigurationSpace, pair_columns
+from .algorithms.product_form import ProductForm, product_form
 from .dynamics import Dynamics, derive
 from .errors import SymdynError
 from .model.parameters import PER_BODY, standard_parameters
 from .model.robot import Friction, Motor, Robot
 from .symbolic.lumping import Lumper, split_sign
-from .symbolic.trig_polynomial import to_sympy_number
+from .symbolic.trig_polynomial import TrigRing, scale, to_sympy_number
 
-__all__ = ["LumpedConstants", "lumped_constants", "symbolic_inertia", "REL_TOL"]
+__all__ = ["LumpedConstants", "lumped_constants", "lumped_product_form", "symbolic_inertia", "REL_TOL"]
 
 #: decimal data: a residual coefficient below this times the largest coefficient compared is zero
 REL_TOL = 1e-9
@@ -110,6 +112,16 @@ class LumpedConstants:
             if sp.Symbol(n) in used:
                 needed |= e.free_symbols
         return [(s, v) for s, v in self.standard.items() if s in needed and v != s]
+
+    def values(self) -> dict[sp.Symbol, sp.Expr]:
+        """Each name the named entries use (lumped constants I_k, g_k, base parameters and the
+        standard parameters in them) -> its value in the robot file's symbols."""
+        standard = dict(self.standard_definitions())
+        base = {s: e.xreplace(standard) for s, e in self.base_definitions()}
+        for s in self.inertial.referenced | self.gravity.referenced:
+            base.setdefault(s, standard.get(s, s))
+        out = {s: e.xreplace(base) for s, e in self.definitions()}
+        return {**standard, **base, **out}
 
     def notes(self) -> list[str]:
         """One line each: why the base parameters are not used, or how many coefficients are
@@ -299,3 +311,29 @@ def lumped_constants(dyn: Dynamics, cs: ConfigurationSpace | None = None) -> Lum
     reserved |= set(base.names)
     lumpers = (Lumper(q, prefix, known[prefix], reserved) for prefix in ("I", "g"))
     return LumpedConstants(cs, *lumpers, base, standard)
+
+
+def lumped_product_form(dyn: Dynamics) -> tuple[ProductForm, LumpedConstants]:
+    """The product form (symdyn.algorithms.product_form) with its coefficients written over the
+    lumped constants of `derive --lumped` (`lumped_constants`): every entry of the
+    configuration form has its angle groups' coefficients named (in `derive --lumped`'s order,
+    so the names are the same), the named entries become trigonometric polynomials over the
+    names, and those are rewritten over the atoms, factored and shared as without lumping.
+    Substituting `LumpedConstants.values` into it gives the configuration form back
+    (`ProductForm.check` with `constants`)."""
+    cs = dyn.configuration_space
+    lc = lumped_constants(dyn, cs)
+    ring = TrigRing(cs.ring.q)
+    named = {(name, row, col): ring.convert(lc.entry(name, row, col)) for name, row, col in _entries(cs)}
+    n = cs.n
+    gamma = {}
+    for (name, k, c), p in named.items():
+        if p and name == "B":
+            i, j = pair_columns(n)[c]
+            gamma[(k, i, j)] = scale(p, Fraction(1, 2))
+        elif p and name == "Csq":
+            gamma[(k, c, c)] = p
+    M = [[named[("M", min(i, j), max(i, j))] for j in range(n)] for i in range(n)]
+    G = [named[("G", k, 0)] for k in range(n)]
+    form = ConfigurationSpace(ring, M, G, gamma)
+    return product_form(dyn.robot, form, dyn.closed_form("F")), lc

@@ -13,7 +13,7 @@ from functools import cache
 import numpy as np
 import pytest
 import sympy as sp
-from robots import EXAMPLE_NAMES, EXAMPLES_DIR, derived, example, random_state, rational_example
+from robots import EXAMPLE_NAMES, EXAMPLES_DIR, derived, example, random_state, rational_example, trig_zero
 
 from symdyn import rnea
 from symdyn.algorithms.configuration_space import pair_columns
@@ -158,8 +158,69 @@ def test_roger_arm_cli_text_json_latex(capsys):
     assert "s_{12} &= \\sin{\\left(q_{1} + q_{2} \\right)}" in tex and "M_{1,1} &=" in tex
 
 
-def test_product_form_refuses_lumped(capsys):
-    assert main(["derive", str(EXAMPLES_DIR / "roger_arm.yaml"), "--form", "product", "--lumped"]) == 1
+def _json(capsys, *argv) -> dict:
+    assert main(["derive", *argv, "--format", "json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def _entries_back(doc: dict) -> dict[str, sp.Expr]:
+    """Every entry of a product-form JSON with the standard parameters, base parameters, lumped
+    constants, atoms and shared quantities substituted back (innermost first)."""
+    sub: dict = {}
+    for key in ("standard_parameters", "base_parameters", "lumped", "atoms", "shared"):
+        for k, v in doc.get(key, {}).items():
+            sub[sp.Symbol(k)] = sp.sympify(v).xreplace(sub)
+    out = {f"G[{k + 1}]": sp.sympify(e).xreplace(sub) for k, e in enumerate(doc["G"])}
+    for name in ("M", "B", "Csq"):
+        for k, row in enumerate(doc[name]):
+            out.update({f"{name}[{k + 1},{c + 1}]": sp.sympify(e).xreplace(sub) for c, e in enumerate(row)})
+    return out
+
+
+def test_roger_arm_lumped_product_form_is_the_product_form(capsys):
+    """`--form product --lumped`: the coefficients are derive --lumped's constants (the same
+    names and definitions, over the base parameters: the arm's data is symbolic), and with them
+    substituted back every entry is exactly the product form's without lumping."""
+    path = str(EXAMPLES_DIR / "roger_arm.yaml")
+    lumped = _json(capsys, path, "--form", "product", "--lumped")
+    plain = _json(capsys, path, "--form", "product")
+    configuration = _json(capsys, path, "--lumped")
+    for key in ("lumped", "base_parameters", "standard_parameters"):
+        assert lumped[key] == configuration[key], key
+    assert lumped["M"][0][0] == "I1 + I2*c2" and lumped["G"][0] == "g1*s1 + g2*s12"
+    want, got = _entries_back(plain), _entries_back(lumped)
+    assert set(want) == set(got)
+    for label, e in got.items():
+        assert trig_zero(e - want[label], 2), label
+    assert main(["derive", path, "--form", "product", "--lumped", "--format", "latex"]) == 0
+    tex = capsys.readouterr().out
+    assert "I_{1} &= \\mathrm{Izz}_{1R} + \\mathrm{Izz}_{2}" in tex
+    assert "M_{1,1} &= I_{1} + I_{2} c_{2}" in tex
+
+
+def test_lumped_product_form_of_the_puma(capsys):
+    """The PUMA 560: numeric data (constants named by value) within 1e-12; its first four links
+    with symbolic inertial parameters (exact base parameters): the lumped product form with the
+    constants' values substituted is exactly the configuration form, as the product form is."""
+    from test_lumped import _puma
+
+    from symdyn.lumped import lumped_product_form
+
+    dyn = derived("puma560", "newton-euler")
+    pf, lc = lumped_product_form(dyn)
+    assert lc.base is None and len(lc.definitions()) > 20
+    pf.check(dyn.configuration_space, rel=1e-12, constants=lc.values())
+    dyn = derive(_puma(4, True), simplify=False)
+    pf, lc = lumped_product_form(dyn)
+    assert lc.base is not None and not lc.notes()
+    assert {str(s) for s in lc.values()} >= {"I1", "Izz1R"}
+    pf.check(dyn.configuration_space, rel=0.0, constants=lc.values())
+    dyn.product_form().check(dyn.configuration_space, rel=0.0)
+
+
+def test_product_form_refuses_prune(capsys):
+    path = str(EXAMPLES_DIR / "roger_arm.yaml")
+    assert main(["derive", path, "--form", "product", "--prune", "0.01"]) == 1
     err = capsys.readouterr().err
     assert "--form product" in err and len(err.strip().splitlines()) == 1
 

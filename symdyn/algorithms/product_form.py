@@ -85,9 +85,10 @@ class ProductForm:
     entries: dict[str, list[tuple[str, sp.Expr]]]
     groups: list[tuple[int, ...]]
 
-    def substitution(self) -> dict[sp.Symbol, sp.Expr]:
-        """name -> definition in q and the parameters (shared quantities over atoms expanded)."""
-        sub = dict(self.atoms)
+    def substitution(self, constants: dict | None = None) -> dict[sp.Symbol, sp.Expr]:
+        """name -> definition in q and the parameters (shared quantities over atoms expanded;
+        constants: the lumped constants' values, symdyn.lumped, substituted too)."""
+        sub = {**dict(self.atoms), **(constants or {})}
         for name, e in self.shared:
             sub[name] = e.xreplace(sub)
         return sub
@@ -99,12 +100,12 @@ class ProductForm:
                     return e
         raise KeyError(label)
 
-    def check(self, cs: ConfigurationSpace, rel: float = 1e-12) -> None:
-        """Assert that every entry, atoms and shared quantities substituted back, is the
-        configuration form's entry: exactly for exact data, within rel of the entry's
-        largest coefficient for float data."""
+    def check(self, cs: ConfigurationSpace, rel: float = 1e-12, constants: dict | None = None) -> None:
+        """Assert that every entry, atoms and shared quantities (and the lumped `constants`,
+        name -> value) substituted back, is the configuration form's entry: exactly for exact
+        data, within rel of the entry's largest coefficient for float data."""
         ring = TrigRing(cs.ring.q)
-        sub = self.substitution()
+        sub = self.substitution(constants)
         for name in ("M", "B", "Csq", "G"):
             labels = dict(_labelled(cs, name))
             got = {lab: e for lab, e in self.entries[name]}

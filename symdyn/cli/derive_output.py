@@ -36,6 +36,11 @@ __all__ = [
     "derive_text",
     "derive_json",
     "configuration_entries",
+    "lumped_sections",
+    "lumped_lines",
+    "lumped_json",
+    "lumped_latex",
+    "latex_align",
     "prune_summary",
     "frame_names",
     "frames_text",
@@ -145,9 +150,17 @@ def _configuration_text(dyn: Dynamics, lumped: bool, pruned=None) -> str:
     for name, items in entries.items():
         lines.append("")
         lines += [f"{label} = {e}" for label, e in items] or [f"# {name} = 0"]
-    for head, items in lumped_sections(constants) if constants is not None else []:
-        lines += ["", f"# {head}"] + [f"{s} = {_value(v)}" for s, v in items]
+    if constants is not None:
+        lines += lumped_lines(constants)
     return "\n".join(lines) + "\n"
+
+
+def lumped_lines(constants) -> list[str]:
+    """The text of the lumped constants' sections: a blank line, `# heading`, `name = value`."""
+    out = []
+    for head, items in lumped_sections(constants):
+        out += ["", f"# {head}"] + [f"{s} = {_value(v)}" for s, v in items]
+    return out
 
 
 def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
@@ -269,13 +282,20 @@ def _configuration_json(dyn: Dynamics, lumped: bool) -> dict:
         "Csq": Csq,
     }
     if constants is not None:
-        sections = dict(lumped_sections(constants))
-        doc["lumped"] = {str(s): _value(v) for s, v in sections.get("lumped constants", [])}
-        for head in ("base parameters", "standard parameters"):
-            if head in sections:
-                doc[head.replace(" ", "_")] = {str(s): _value(v) for s, v in sections[head]}
-        if constants.notes():
-            doc["notes"] = constants.notes()
+        doc.update(lumped_json(constants))
+    return doc
+
+
+def lumped_json(constants) -> dict:
+    """The JSON keys of the lumped constants: lumped (name -> definition), base_parameters and
+    standard_parameters (name -> definition, when used) and notes (when any)."""
+    sections = dict(lumped_sections(constants))
+    doc = {"lumped": {str(s): _value(v) for s, v in sections.get("lumped constants", [])}}
+    for head in ("base parameters", "standard parameters"):
+        if head in sections:
+            doc[head.replace(" ", "_")] = {str(s): _value(v) for s, v in sections[head]}
+    if constants.notes():
+        doc["notes"] = constants.notes()
     return doc
 
 
@@ -294,6 +314,27 @@ def _latex_name(name: str) -> str:
     return f"{head}_{{{m[2]}}}"
 
 
+def latex_align(nt, items, expand: bool = True) -> str:
+    """One align* of (LaTeX head, expression), each broken at its top-level + and - when long."""
+    rows = []
+    for head, e in items:
+        lines = nt.lines(nt.prepare(e), expand=expand)
+        rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
+    return "\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}"
+
+
+def lumped_latex(nt, constants) -> list[str]:
+    """The lumped constants' sections as align* blocks (the lumped constants, the base
+    parameters, the standard parameters), after giving each name they use its LaTeX name in
+    the Notation nt (I12 -> I_{12}) so entries written over them print too."""
+    sections = lumped_sections(constants)
+    named = {s for _, items in sections for s, _ in items}
+    named |= constants.inertial.referenced | constants.gravity.referenced
+    for s in sorted(named, key=str):
+        nt.names.setdefault(s, _latex_name(s.name))
+    return [latex_align(nt, [(nt.names[s], v) for s, v in items]) for _, items in sections]
+
+
 def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
     """The configuration-space form in LaTeX (amsmath): one align* per quantity, each entry
     broken over lines at its top-level + and - when long (symdyn.codegen.latex.Notation)."""
@@ -301,26 +342,15 @@ def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
 
     nt = Notation(dyn)
     entries, constants = configuration_entries(dyn, lumped)
-    sections = lumped_sections(constants) if constants is not None else []
-    named = {s for _, items in sections for s, _ in items}
-    if constants is not None:
-        named |= constants.inertial.referenced | constants.gravity.referenced
-    for s in sorted(named, key=str):
-        nt.names.setdefault(s, _latex_name(s.name))
     out = [
         "% tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)  (needs \\usepackage{amsmath})",
     ]
+    definitions = lumped_latex(nt, constants) if constants is not None else []
     out += [f"% note: {note}" for note in (constants.notes() if constants is not None else [])]
-    definitions = [(head, [(str(s), v) for s, v in items]) for head, items in sections]
-    for name, items in [*entries.items(), *definitions]:
-        if not items:
-            continue
-        rows = []
-        for label, e in items:
-            head = nt.names[sp.Symbol(label)] if name not in entries else _latex_label(name, label)
-            lines = nt.lines(nt.prepare(e))
-            rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
-        out.append("\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}")
+    for name, items in entries.items():
+        if items:
+            out.append(latex_align(nt, [(_latex_label(name, label), e) for label, e in items]))
+    out += definitions
     abbreviations = []
     for ph, (kind, idx) in sorted(nt.trig.items(), key=lambda item: item[0].name):
         angle = " + ".join(f"q_{{{i}}}" for i in idx)

@@ -11,6 +11,11 @@ entries of B and Csq, G and F over them.
 
 JSON: keys `atoms` and `shared` (name -> expression, in the order defined), `M` (rows), `B`,
 `Csq` (rows), `G`, `F` (lists), every string read by sympy.sympify.
+
+With `lumped` (`derive --form product --lumped`) the coefficients are the lumped constants of
+`derive --lumped` (symdyn.lumped.lumped_product_form: named by value, or over the base
+parameters when the inertial data is symbolic), defined after the atoms as `derive --lumped`
+defines them (JSON: keys `lumped`, `base_parameters`, `standard_parameters`, `notes`).
 """
 
 from __future__ import annotations
@@ -22,8 +27,9 @@ import sympy as sp
 from ..algorithms.configuration_space import pair_columns
 from ..algorithms.product_form import ProductForm
 from ..dynamics import Dynamics
+from ..lumped import LumpedConstants, lumped_product_form
 from ..symbolic.horner import product_text as text
-from .derive_output import header, json_header
+from .derive_output import header, json_header, latex_align, lumped_json, lumped_latex, lumped_lines
 
 __all__ = ["product_text", "product_json", "product_json_text", "product_latex"]
 
@@ -36,16 +42,25 @@ def _groups_note(dyn: Dynamics, pf: ProductForm) -> str:
     return f"# atoms c_i = cos(q_i), s_i = sin(q_i), c_ij.. = cos(q_i + q_j + ..){parallel}"
 
 
-def product_text(dyn: Dynamics, pf: ProductForm | None = None) -> str:
-    """The product form as text: atoms, shared quantities, then the entries, one a line
-    (pf: another product form of dyn, a pruned one, instead of its own)."""
-    pf = pf or dyn.product_form()
+def _form(dyn: Dynamics, lumped: bool) -> tuple[ProductForm, LumpedConstants | None]:
+    return lumped_product_form(dyn) if lumped else (dyn.product_form(), None)
+
+
+def product_text(dyn: Dynamics, pf: ProductForm | None = None, lumped: bool = False) -> str:
+    """The product form as text: atoms, lumped constants (with `lumped`), shared quantities,
+    then the entries, one a line (pf: another product form of dyn, a pruned one, instead of
+    its own)."""
+    lc = None
+    if pf is None:
+        pf, lc = _form(dyn, lumped)
     n = dyn.n
     pairs = ", ".join(f"{dyn.qd[i]}*{dyn.qd[j]}" for i, j in pair_columns(n)) or "none"
     lines = header(dyn, _EQUATION)
     lines.append(f"# [qd qd] = ({pairs}); [qd^2] = ({', '.join(f'{v}**2' for v in dyn.qd)})")
     lines.append(_groups_note(dyn, pf))
+    lines += [f"# note: {note}" for note in (lc.notes() if lc is not None else [])]
     lines += ["", "# atoms"] + [f"{s} = {text(e)}" for s, e in pf.atoms]
+    lines += lumped_lines(lc) if lc is not None else []
     if pf.shared:
         lines += ["", "# shared"] + [f"{s} = {text(e)}" for s, e in pf.shared]
     for name, items in pf.entries.items():
@@ -72,10 +87,14 @@ def product_json(dyn: Dynamics, pf: ProductForm | None = None) -> dict:
     }
 
 
-def product_json_text(dyn: Dynamics) -> str:
-    """The JSON of `derive --form product`: json_header's keys, then product_json's."""
+def product_json_text(dyn: Dynamics, lumped: bool = False) -> str:
+    """The JSON of `derive --form product`: json_header's keys, then product_json's (and with
+    `lumped` the lumped constants' keys, derive_output.lumped_json)."""
+    pf, lc = _form(dyn, lumped)
     doc = json_header(dyn, "product")
-    doc.update(product_json(dyn))
+    doc.update(product_json(dyn, pf))
+    if lc is not None:
+        doc.update(lumped_json(lc))
     return json.dumps(doc, indent=2) + "\n"
 
 
@@ -85,14 +104,15 @@ def _label(name: str, label: str) -> str:
     return f"{head}_{{{label[len(name) + 1 : -1]}}}"
 
 
-def product_latex(dyn: Dynamics) -> str:
-    """The product form in LaTeX (amsmath): the atoms c_{23} = cos(q_2 + q_3), the shared
-    quantities x_{1}, ..., and one equation per entry, long ones broken at their top-level
-    + and - (the factored products are kept whole)."""
+def product_latex(dyn: Dynamics, lumped: bool = False) -> str:
+    """The product form in LaTeX (amsmath): the atoms c_{23} = cos(q_2 + q_3), the lumped
+    constants (with `lumped`), the shared quantities x_{1}, ..., and one equation per entry,
+    long ones broken at their top-level + and - (the factored products are kept whole)."""
     from ..codegen.latex.notation import Notation
 
-    pf = dyn.product_form()
+    pf, lc = _form(dyn, lumped)
     nt = Notation(dyn)
+    definitions = lumped_latex(nt, lc) if lc is not None else []
     qnames = {q: f"q_{{{i + 1}}}" for i, q in enumerate(dyn.q)}
     for s, _ in pf.atoms:
         nt.names[s] = f"{s.name[0]}_{{{s.name[1:]}}}"
@@ -100,15 +120,12 @@ def product_latex(dyn: Dynamics) -> str:
         nt.names[s] = f"x_{{{s.name[1:]}}}"
 
     def rows(items) -> str:
-        out = []
-        for head, e in items:
-            lines = nt.lines(nt.prepare(e), expand=False)
-            out.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
-        return "\\begin{align*}\n" + " \\\\\n".join(out) + "\n\\end{align*}"
+        return latex_align(nt, items, expand=False)
 
     parts = [f"% {_EQUATION}  (needs \\usepackage{{amsmath}})"]
     atoms = [f"{nt.names[s]} &= {sp.latex(e, symbol_names=qnames)}" for s, e in pf.atoms]
     parts.append("\\begin{align*}\n" + " \\\\\n".join(atoms) + "\n\\end{align*}")
+    parts += [f"% note: {note}" for note in (lc.notes() if lc is not None else [])] + definitions
     if pf.shared:
         parts.append(rows([(nt.names[s], e) for s, e in pf.shared]))
     for name, items in pf.entries.items():

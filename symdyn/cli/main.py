@@ -71,9 +71,12 @@ def _derive_json(dyn) -> str:
 
 
 def _derive_latex(dyn) -> str:
+    """--form compact/expanded in LaTeX: the target's closed form up to three joints, beyond
+    that its eliminated form (named intermediates; the product form is --form product)."""
     from ..codegen.latex import dynamics_latex
+    from ..dynamics import AUTO_SIMPLIFY_MAX_JOINTS
 
-    return dynamics_latex(dyn)
+    return dynamics_latex(dyn, "auto" if dyn.n <= AUTO_SIMPLIFY_MAX_JOINTS else "eliminated")
 
 
 def cmd_derive(args: argparse.Namespace) -> int:
@@ -106,12 +109,10 @@ def cmd_derive(args: argparse.Namespace) -> int:
     if args.form == "product":
         from . import derive_product as prod
 
-        if args.lumped or args.prune is not None:
-            raise SymdynError(
-                "derive: --lumped and --prune apply to --form configuration, not --form product"
-            )
+        if args.prune is not None:
+            raise SymdynError("derive: --prune applies to --form configuration, not --form product")
         writer = {"text": prod.product_text, "json": prod.product_json_text, "latex": prod.product_latex}
-        text = writer[args.format](dyn)
+        text = writer[args.format](dyn, lumped=args.lumped)
     elif args.format == "latex":
         configuration = args.form == "configuration"
         text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)

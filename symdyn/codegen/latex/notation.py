@@ -164,7 +164,7 @@ class Notation:
         if expand and not expr.is_Add and width(self.latex(expr)) > LINE_WIDTH and expr.has(sp.Add):
             expanded = sp.expand(expr)
             expr = expanded if expanded.is_Add else expr
-        terms = self.printer.terms(expr)
+        terms = self.printer.terms(expr) if expand else self._pieces(expr)
         lines, current = [], ""
         for t in terms:
             if current and width(current + t) > LINE_WIDTH:
@@ -174,6 +174,33 @@ class Notation:
                 current += t
         lines.append(current)
         return lines
+
+    def _pieces(self, expr: sp.Expr) -> list[str]:
+        """The terms of expr, each with its sign (as `DynamicsLatexPrinter.terms`), a long
+        product with a sum inside opened up: a \\bigl(b + c\\bigr) as the pieces
+        "a \\bigl(b", " + c\\bigr)" (recursively), so a factored entry can break inside its
+        parentheses (\\bigl( and \\bigr) may stand on different lines of an align*)."""
+        terms = self.printer._as_ordered_terms(expr, order=None) if expr.is_Add else [expr]
+        out: list[str] = []
+        for k, term in enumerate(terms):
+            negative = term.could_extract_minus_sign()
+            pieces = self._factor_pieces(-term if negative else term)
+            sign = ("- " if k == 0 else " - ") if negative else ("" if k == 0 else " + ")
+            out += [sign + pieces[0], *pieces[1:]]
+        return out
+
+    def _factor_pieces(self, term: sp.Expr) -> list[str]:
+        text = self.printer._print(term)
+        sums = [f for f in term.args if f.is_Add] if term.is_Mul else []
+        if width(text) <= LINE_WIDTH or not sums:
+            return [text]
+        inner = max(sums, key=lambda f: width(self.latex(f)))
+        rest = sp.Mul(*[f for f in term.args if f is not inner])
+        pieces = self._pieces(inner)
+        head = "" if rest == 1 else self.printer._print(rest) + " "
+        pieces[0] = f"{head}\\bigl({pieces[0]}"
+        pieces[-1] += "\\bigr)"
+        return pieces
 
     def label(self, name: str, i: int, j: int | None = None) -> str:
         return f"{name}_{{{i + 1}}}" if j is None else f"{name}_{{{i + 1}{self.sep}{j + 1}}}"

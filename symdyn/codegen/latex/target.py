@@ -3,11 +3,15 @@
 The file is a fragment for the body of a document (no preamble) that needs
 only amsmath. It prints M, V, G, F (and C for up to three joints) of
 tau = M(q) qdd + V(q, qd) + G(q) + F(qd) in the notation of
-symdyn.codegen.latex.notation. Two forms:
+symdyn.codegen.latex.notation. Three forms:
 - closed form (up to three joints): the trigonometrically simplified entries
   (`Dynamics.simplified`), matrices entry by entry in a bmatrix when the rows
   are short, else one equation per entry, long sums broken over lines;
-- eliminated form (more joints): the common subexpressions of M, V, G and F
+- product form (more joints): the atoms c_i, s_i, c_23 (abbreviations), the
+  shared quantities x_1, x_2, ..., then M, B, Csq, G and F over them, with
+  V = B [qd qd] + Csq [qd^2] (symdyn.codegen.latex.product), unless it is
+  larger than its bound (printed in the file);
+- eliminated form (beyond that bound): the common subexpressions of M, V, G and F
   as one align* list of definitions x_{1}, x_{2}, ... in evaluation order,
   then the entries over them (M by its upper triangle). Definitions that are
   just s_{..} or c_{..} are inlined.
@@ -24,12 +28,14 @@ import dataclasses
 
 import sympy as sp
 
+from ...algorithms.configuration_space import pair_columns
 from ...dynamics import AUTO_SIMPLIFY_MAX_JOINTS, Dynamics
 from ...symbolic.simplify import eliminate
 from ..render import RenderContext, environment, header_lines
 from .base_parameters import base_parameters_latex
 from .frames import frames_latex
 from .notation import MATRIX_WIDTH, Notation, escape_text, width
+from .product import product_blocks, product_choice
 
 __all__ = ["render", "latex_document_body", "dynamics_latex", "file_name", "AMSMATH_NOTE", "TOOLS"]
 
@@ -44,9 +50,15 @@ def file_name(name: str) -> str:
 
 
 def _quantity(
-    nt: Notation, name: str, entries: list[sp.Expr], shape: tuple[int, int], symmetric: bool
+    nt: Notation,
+    name: str,
+    entries: list[sp.Expr],
+    shape: tuple[int, int],
+    symmetric: bool,
+    expand: bool = True,
 ) -> dict:
-    """One of M, C, V, G, F: a bmatrix when its rows are short, else one equation per entry."""
+    """One of M, C, V, G, F: a bmatrix when its rows are short, else one equation per entry
+    (expand False: a factored entry stays factored when broken over lines)."""
     rows, cols = shape
     texts = [nt.latex(e) for e in entries]
     grid = [texts[r * cols : (r + 1) * cols] for r in range(rows)]
@@ -59,7 +71,7 @@ def _quantity(
             if symmetric and c < r:
                 continue
             label = nt.label(name, r) if cols == 1 else nt.label(name, r, c)
-            eqs.append((label, nt.lines(entries[r * cols + c])))
+            eqs.append((label, nt.lines(entries[r * cols + c], expand=expand)))
     mirror = (nt.label(name, 1, 0), nt.label(name, 0, 1)) if symmetric else None
     return {"name": name, "grid": None, "equations": eqs, "mirror": mirror}
 
@@ -110,28 +122,41 @@ def _eliminated_blocks(dyn: Dynamics, nt: Notation) -> tuple[list[dict], list[tu
 def latex_document_body(dyn: Dynamics, form: str = "auto") -> str:
     """The LaTeX fragment (without header) for `dyn`.
 
-    form: "closed" (simplified closed forms, with C), "eliminated" (definitions
-    x_k then M, V, G, F over them) or "auto": closed up to three joints.
+    form: "closed" (simplified closed forms, with C), "product" (the product form: atoms,
+    shared quantities x_k, then M, B, Csq, G, F over them), "eliminated" (definitions x_k then
+    M, V, G, F over them) or "auto": closed up to three joints, beyond that the product form
+    unless it is larger than its bound (symdyn.codegen.latex.product: product_choice).
     """
-    if form not in ("auto", "closed", "eliminated"):
-        raise ValueError(f"unknown form '{form}' (auto, closed or eliminated)")
-    closed = dyn.n <= AUTO_SIMPLIFY_MAX_JOINTS if form == "auto" else form == "closed"
+    if form not in ("auto", "closed", "product", "eliminated"):
+        raise ValueError(f"unknown form '{form}' (auto, closed, product or eliminated)")
+    if form == "auto":
+        form = "closed" if dyn.n <= AUTO_SIMPLIFY_MAX_JOINTS else "product"
     nt = Notation(dyn)
-    if closed:
+    pf, choice = (None, None)
+    if form == "product":
+        pf, choice = product_choice(dyn)
+        form = "product" if pf is not None else "eliminated"
+    if form == "closed":
         blocks, definitions = _closed_blocks(dyn, nt), []
+    elif form == "product":
+        blocks, definitions = product_blocks(dyn, nt, pf, _quantity)
     else:
         blocks, definitions = _eliminated_blocks(dyn, nt)
     robot = dyn.robot
+    n = dyn.n
+    pairs = [f"\\dot{{q}}_{{{i + 1}}} \\dot{{q}}_{{{j + 1}}}" for i, j in pair_columns(n)]
     return (
         environment()
         .get_template("latex/body.tex.j2")
         .render(
             name=robot.name,
             tex_name=escape_text(robot.name),
-            n=dyn.n,
-            joints=[str(i) for i in range(1, dyn.n + 1)] if dyn.n <= 3 else ["1", "\\dots", str(dyn.n)],
+            n=n,
+            joints=[str(i) for i in range(1, n + 1)] if n <= 3 else ["1", "\\dots", str(n)],
             method=dyn.method,
-            closed=closed,
+            form=form,
+            choice=choice,
+            pairs=pairs if n <= 3 else [pairs[0], "\\dots", pairs[-1]],
             params=nt.params,
             legend=nt.legend(),
             definitions=definitions,
@@ -140,9 +165,10 @@ def latex_document_body(dyn: Dynamics, form: str = "auto") -> str:
     )
 
 
-def dynamics_latex(dyn: Dynamics) -> str:
-    """The text of `symdyn derive --format latex`: the amsmath note and the fragment."""
-    return AMSMATH_NOTE + "\n" + latex_document_body(dyn)
+def dynamics_latex(dyn: Dynamics, form: str = "auto") -> str:
+    """The text of `symdyn derive --format latex`: the amsmath note and the fragment (form: as
+    `latex_document_body`)."""
+    return AMSMATH_NOTE + "\n" + latex_document_body(dyn, form)
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
