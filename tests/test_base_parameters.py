@@ -13,7 +13,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import sympy as sp
-from robots import EXAMPLE_NAMES, assert_close, derived, derived_robot, random_params, random_state, y_robot
+from robots import (
+    EXAMPLE_NAMES,
+    assert_close,
+    derived,
+    derived_robot,
+    random_params,
+    random_state,
+    raw_example,
+    y_robot,
+)
 
 import symdyn
 import symdyn.codegen
@@ -94,6 +103,21 @@ def test_mimic_joint_with_a_symbolic_length_is_refused_clearly():
     )
     valued = symdyn.robot_from_data({**MIMIC_SYM, "parameters": {"a": 0.4}}, source="test")
     check(symdyn.derive(valued, simplify=False), seed=9)
+
+
+def test_numbers_whose_powers_overflow_are_refused_clearly():
+    """A length of 1e140 passes the 1e150 bound on numbers but its powers in the regressor exceed
+    double precision: the base parameters are refused with one line (before: an empty column table
+    crashed the C target), and generate leaves out base_regressor with a SymdynWarning."""
+    data = raw_example("roger_arm")
+    data["parameters"] = {"g": 9.81, "m1": 1, "m2": 1, "l1": 1e140, "l2": 1}
+    robot = symdyn.robot_from_data(data, source="huge.yaml")
+    with pytest.raises(SymdynError, match="the regressor overflows double precision") as info:
+        symdyn.derive(robot, simplify=False).linear_compact()
+    assert "\n" not in str(info.value)
+    with pytest.warns(symdyn.SymdynWarning, match="base_regressor is not generated"):
+        files = symdyn.codegen.render(robot, targets=("c",), functions=("regressor",))
+    assert "roger_arm_regressor(" in files["roger_arm_dynamics.h"]
 
 
 _BODY = {"mass": 1, "com": [0.1, 0.02, 0], "inertia": {"ixx": 0.1, "iyy": 0.2, "izz": 0.3}}

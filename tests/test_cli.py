@@ -243,3 +243,13 @@ def test_main_builds_the_named_subcommand_only(monkeypatch, capsys):
         main(["no-such-command"])
     assert built == ["cache", None]  # an unknown word: the whole parser, whose error lists the commands
     assert "invalid choice" in capsys.readouterr().err
+
+
+def test_messages_quoting_user_text_stay_one_line(tmp_path, capsys):
+    """A file name with a newline and a terminal escape is printed escaped: one line, no control
+    character reaching the terminal."""
+    bad = tmp_path / "bad\nname\x1b[2J.yaml"
+    bad.write_text("links: [")
+    assert main(["derive", str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "\x1b" not in err and "bad\\nname\\x1b[2J.yaml" in err, err

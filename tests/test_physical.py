@@ -98,6 +98,16 @@ def test_direction_dependent_coulomb_magnitudes_checked_at_run_time():
             with_parameters(robot, {**ASYMMETRIC_PARAMS, name: -0.3})
 
 
+@pytest.mark.parametrize("value", [1e300, -1e308, 1.0000001e150])
+def test_run_time_values_are_bounded_like_file_numbers(roger, value):
+    """A value over 1e150 in size is refused at run time as in a file (it overflows once
+    multiplied), naming the parameter, by with_parameters (--params) and by compile."""
+    values = {"m1": 1.0, "m2": 1.0, "l1": value, "l2": 1.0, "g": 9.81}
+    for bind in (lambda v: with_parameters(roger, v), lambda v: symdyn.compile(roger, v)):
+        with pytest.raises(SymdynError, match=r"parameter l1 = .* is too large \(more than 1e\+150"):
+            bind(values)
+
+
 def test_file_values_overridden_at_run_time_are_checked():
     """A parameter the file gave a value for, overridden at run time (--params, --model-params)."""
     robot = robot_from_data(_two_link(_link("m2"), {"m2": 1.0}))

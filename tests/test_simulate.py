@@ -211,6 +211,18 @@ def test_divergence_is_an_error(roger):
         simulate(roger, Q0, QD0, duration=1.0, dt=0.5, tau=["1e300", "0"], integrator="euler")
 
 
+def test_a_singular_mass_matrix_is_named_as_the_cause(tmp_path, capsys):
+    """m1 = 0 makes Roger's arm (point masses) singular at q = 0 (det M = l1^2 l2^2 m2^2 (1 -
+    cos^2 q2) = 0): no step size helps, so the error names M, not the integrator, in C and in the
+    Python loop alike."""
+    params = ["m1=0", "m2=1", "l1=1", "l2=1", "g=9.81"]
+    status = run_cli(["simulate", ROGER, "--params", *params, "--duration", "0.01", "--dt", "0.001",
+                      "--out", tmp_path / "x.csv"])  # fmt: skip
+    line = capsys.readouterr().err.strip()
+    assert status == 1 and "\n" not in line and not (tmp_path / "x.csv").exists()
+    assert "the mass matrix M(q) is singular at q = [0, 0]" in line, line
+
+
 def test_progress_bar():
     out = io.StringIO()
     bar = ProgressBar(200, 2.0, True, out)

@@ -275,8 +275,15 @@ def find_base_parameters(
     p0 = {s: float(v) for s, v in zip(params, rng.uniform(0.5, 2.0, len(params)), strict=True)}
     count = -(-STATES_PER_COLUMN * Y.cols // robot.n) + 10
     states = _states(robot, rng, count)
-    W = _stacked(program, Y, (q, qd, qdd), states, p0)
-    norms = np.linalg.norm(W, axis=0)
+    with np.errstate(all="ignore"):
+        W = _stacked(program, Y, (q, qd, qdd), states, p0)
+        norms = np.linalg.norm(W, axis=0)
+    if not np.isfinite(norms).all():
+        raise SymdynError(
+            f"robot '{robot.name}': the regressor overflows double precision at ordinary joint states "
+            "(a length, mass or inertia so large that its powers exceed 1e308), so its base parameters "
+            "cannot be found; give the robot in units that keep its numbers moderate"
+        )
     nonzero = [c for c in range(W.shape[1]) if norms[c] > ZERO_TOL * norms.max()]
     A = W[:, nonzero] / norms[nonzero]
     rank = _pivoted_rank(A)

@@ -10,7 +10,6 @@ This module adds `compiled_dynamics` (a Robot or a CompiledDynamics) and `with_p
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -32,6 +31,7 @@ def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
     """
     import sympy as sp
 
+    from ..model.parameter_names import parameter_number
     from ..model.physical import check_values  # here: a warm run from the cache imports no SymPy
 
     if not values:
@@ -43,13 +43,7 @@ def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
         raise SymdynError(f"unknown parameter(s) {', '.join(map(str, unknown))} (robot parameters: {names})")
     numbers = {}
     for k, v in values.items():
-        try:
-            x = float(v)
-        except (TypeError, ValueError):
-            raise SymdynError(f"parameter {k} must be a number, got {v!r}") from None
-        if not math.isfinite(x):
-            raise SymdynError(f"parameter {k} must be finite, got {v!r}")
-        numbers[known[str(k)]] = sp.Float(x, 17)
+        numbers[known[str(k)]] = sp.Float(parameter_number(str(k), v), 17)
     # the values pass the robot file's physical checks (mass >= 0, a possible inertia tensor, ...)
     check_values(robot, numbers)
     old = {s: sp.sympify(v).xreplace(numbers) for s, v in robot.values}

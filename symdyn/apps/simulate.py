@@ -43,6 +43,7 @@ from ..errors import SymdynError
 from . import stepping
 from .compiled import CompiledDynamics, compiled_dynamics, with_parameters
 from .output import write_atomic
+from .singular import divergence_error
 from .stepping import ADAPTIVE, INTEGRATORS, sample_times, torque_rows
 from .trajectory import Trajectory, plot_trajectory
 
@@ -294,10 +295,7 @@ def _in_python(plant, scheme, q, qd, t, h, tau_at, bar):
                 qd = qd + a * hk
                 q = q + qd * hk
             if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
-                raise SymdynError(
-                    f"the simulation diverged at t = {t[k + 1]:.6g} s (the state is no longer finite); "
-                    "try a smaller dt or the rk4 integrator"
-                )
+                raise divergence_error(plant, t[k + 1], Q[k])
             Q[k + 1], QD[k + 1] = q, qd
             bar.update(k + 1, t[k + 1])
         U[steps] = tau_at(t[steps], q, qd)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import SymdynError
 
-__all__ = ["INVERTING", "NotGeneratedError", "guarded"]
+__all__ = ["INVERTING", "NotGeneratedError", "divergence_error", "guarded"]
 
 #: The generated functions that solve with or invert M (docs/generated-code.md).
 INVERTING = frozenset(
@@ -79,6 +79,27 @@ def _message(owner, name: str, q: np.ndarray) -> str:
         f"{name}: the mass matrix M(q) is singular at q = [{', '.join(f'{x:g}' for x in where)}]"
         f"{given} (its smallest eigenvalue is {worst:.3g}), so qdd is undefined; give every link "
         "that moves a joint some mass or inertia"
+    )
+
+
+def divergence_error(owner, t: float, q: np.ndarray) -> SymdynError:
+    """The error of a simulation whose state stopped being finite at time t, q the last finite
+    configuration: a singular M(q) there (smallest eigenvalue at most 1e-12 of the largest) is
+    named as the cause, since no step size helps then; otherwise the step is blamed."""
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 1 and np.isfinite(q).all():
+        with np.errstate(all="ignore"):
+            eig = np.linalg.eigvalsh(np.asarray(owner.mass_matrix(q), dtype=float))
+        if np.isfinite(eig).all() and eig[0] <= 1e-12 * max(abs(eig[-1]), 1e-300):
+            given = "" if owner.p is None else f" with parameters {_listing(owner)}"
+            return SymdynError(
+                f"the simulation stopped at t = {t:.6g} s: the mass matrix M(q) is singular at q = "
+                f"[{', '.join(f'{x:g}' for x in q)}]{given} (its smallest eigenvalue is {eig[0]:.3g}), "
+                "so qdd is undefined there; give every link that moves a joint some mass or inertia"
+            )
+    return SymdynError(
+        f"the simulation diverged at t = {t:.6g} s (the state is no longer finite); "
+        "try a smaller dt or the rk4 integrator"
     )
 
 

@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-from ..errors import SymdynError
 from .compile import CompiledDynamics
+from .singular import divergence_error
 
 __all__ = ["INTEGRATORS", "ADAPTIVE", "SCHEMES", "sample_times", "torque_rows", "run"]
 
@@ -130,10 +130,7 @@ def run(
         k1 = min(k0 + chunk, steps)
         bad = simulate(n, SCHEMES[scheme], k0, k1, *head, *law, *tail)
         if bad >= 0:
-            raise SymdynError(
-                f"the simulation diverged at t = {t[bad]:.6g} s (the state is no longer finite); "
-                "try a smaller dt or the rk4 integrator"
-            )
+            raise divergence_error(plant, t[bad], Q[max(bad - 1, 0)])
         if bar is not None:
             bar.update(k1, t[k1])
     del keep

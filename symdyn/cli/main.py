@@ -285,9 +285,18 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line(text) -> str:
+    """`text` with every control character (newlines, escape sequences that would drive the
+    terminal, line separators) written as a Python escape, so that a message quoting a user's
+    file name or robot name stays one line and cannot clear or recolour the screen."""
+    return "".join(
+        c if c.isprintable() or c == " " else c.encode("unicode_escape").decode("ascii") for c in str(text)
+    )
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     prefix = "symdyn: warning: " if issubclass(category, SymdynWarning) else "warning: "
-    print(f"{prefix}{message}", file=sys.stderr)
+    print(f"{prefix}{_one_line(message)}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -300,17 +309,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         try:
             return args.func(args)
         except SymdynError as exc:
-            print(f"symdyn: error: {exc}", file=sys.stderr)
+            print(f"symdyn: error: {_one_line(exc)}", file=sys.stderr)
             return EXIT_BAD_INPUT
         except OSError as exc:
-            print(f"symdyn: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
+            print(
+                f"symdyn: error: {_one_line(exc.filename or '')}: {_one_line(exc.strerror or exc)}",
+                file=sys.stderr,
+            )
             return EXIT_BAD_INPUT
         except KeyboardInterrupt:
             print("symdyn: interrupted", file=sys.stderr)
             return 130
         except Exception as exc:  # a bug in symdyn: say so in one line, not a traceback
             print(
-                f"symdyn: internal error: {type(exc).__name__}: {exc} (please report it with the robot file)",
+                f"symdyn: internal error: {type(exc).__name__}: {_one_line(exc)} (please report it with the "
+                "robot file)",
                 file=sys.stderr,
             )
             return EXIT_INTERNAL

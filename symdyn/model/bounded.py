@@ -26,6 +26,7 @@ from collections.abc import Callable, Mapping
 import sympy as sp
 
 from ..errors import SymdynError
+from .parameter_names import MAX_MAGNITUDE
 
 __all__ = [
     "MAX_EXPONENT",
@@ -42,7 +43,6 @@ MAX_EXPONENT = 64
 MAX_POWER_BITS = 4096
 MAX_ROOT_BITS = 256
 MAX_NUMBER_BITS = 8192
-MAX_MAGNITUDE = 1e150
 _MAX_MAGNITUDE_INT = 10**150
 
 Fail = Callable[[str], SymdynError]

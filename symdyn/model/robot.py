@@ -38,7 +38,7 @@ from ..spatial.transform import Transform, rot_axis
 from .frames import Frame, check_frame_names, unknown_frame
 from .friction import Friction
 from .limits import check_limits
-from .parameter_names import parameter_names_problem
+from .parameter_names import parameter_names_problem, parameter_number
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
@@ -346,14 +346,7 @@ class Robot:
                     f"{prefix}params has {len(given)} values, expected {len(self.params)} (one per free "
                     f"parameter: {self._listing()})"
                 )
-        values = {}
-        for p, v in zip(self.params, given, strict=True):
-            try:
-                values[p] = float(v)
-            except (TypeError, ValueError):
-                raise SymdynError(f"{prefix}parameter {p} must be a number, got {v!r}") from None
-            if not np.isfinite(values[p]):
-                raise SymdynError(f"{prefix}parameter {p} must be finite, got {v!r}")
+        values = {p: parameter_number(str(p), v, prefix) for p, v in zip(self.params, given, strict=True)}
         return values
 
     def _listing(self) -> str:
