@@ -246,3 +246,31 @@ def test_a_symbolic_mass_on_the_axis_is_still_singular(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", SymdynWarning)
         assert symdyn.derive(symdyn.load_robot(path), simplify=False).singular_joints == ()
+
+
+URDF_ON_AXIS = """<robot name="urdf_arm">
+  <link name="base"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="upper"><inertial><origin xyz="0.25 0 0"/><mass value="1"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/>
+    <origin xyz="0.5 0 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <link name="fore"><inertial><origin xyz="0 0 -0.02"/><mass value="0.5"/>
+    <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+</robot>
+"""
+
+
+def test_a_urdf_joint_is_named_as_the_file_names_it(tmp_path):
+    """A URDF names its joints: the warning gives the joint's own name beside its link's."""
+    path = tmp_path / "urdf_arm.urdf"
+    path.write_text(URDF_ON_AXIS)
+    robot = symdyn.load_urdf(path)
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        symdyn.generate(robot, targets=("python",), out_dir=tmp_path / "out")
+    assert symdyn_warnings(record) == [
+        f"robot 'urdf_arm': M(q) is singular: the joint of link 'fore' (joint 'elbow', link 2) {ON_AXIS}; "
+        "so forward_dynamics is not generated (the other functions are)"
+    ]

@@ -96,6 +96,13 @@ def singular_joints(robot: Robot, M: sp.Matrix) -> tuple[SingularJoint, ...]:
 
 def describe_singular(robot: Robot, joints: Sequence[SingularJoint]) -> str:
     """One sentence naming each singular joint as the robot file does (the joint of link 'X',
-    by the link's name and number) and why: "the joint of link 'l2' (link 2) moves ..."."""
-    names = [f"the joint of link '{robot.links[j.link].name}' (link {j.link + 1})" for j in joints]
+    by the link's name and number, and by its own name where the file names joints: URDF, MJCF)
+    and why: "the joint of link 'l2' (link 2) moves ..."."""
+
+    def name(k: int) -> str:
+        link = robot.links[k]
+        own = "" if link.joint_name is None else f"joint '{link.joint_name}', "
+        return f"the joint of link '{link.name}' ({own}link {k + 1})"
+
+    names = [name(j.link) for j in joints]
     return "; ".join(f"{name} {REASONS[j.reason]}" for name, j in zip(names, joints, strict=True))

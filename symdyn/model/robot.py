@@ -81,6 +81,8 @@ class Link:
     mimic: Mimic | None = None
     #: the joint's range (lower, upper) in rad or m: numbers, or expressions of valued parameters; None: none
     limits: tuple[sp.Expr, sp.Expr] | None = None
+    #: the joint's own name where the file gives joints names (URDF, MJCF), for messages only
+    joint_name: str | None = field(default=None, compare=False, repr=False)
 
     def joint_transform(self, q) -> Transform:
         """parent_T_i(q): the body frame of this link in its parent's body frame."""

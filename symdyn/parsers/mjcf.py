@@ -162,7 +162,7 @@ def _body(walk: _Walk, b: int, body_names: list[str], joint_names: list[str], fl
     first, count = int(model.body_jntadr[b]), int(model.body_jntnum[b])
     for n, j in enumerate(range(first, first + count)):
         _refuse_joint(walk, int(model.jnt_type[j]), name, joint_names[j])
-        T = _joint(walk, j, k, T, name if n == count - 1 else joint_names[j], flags)
+        T = _joint(walk, j, k, T, name if n == count - 1 else joint_names[j], flags, joint_names[j])
         k = len(walk.links) - 1
     walk.owner.append((k, T))
     if not count:
@@ -193,7 +193,9 @@ def _refuse_joint(walk: _Walk, kind: int, body: str, joint: str) -> None:
     )
 
 
-def _joint(walk: _Walk, j: int, parent: int, T: Transform, name: str, flags: set[str]) -> Transform:
+def _joint(
+    walk: _Walk, j: int, parent: int, T: Transform, name: str, flags: set[str], joint_name: str
+) -> Transform:
     """Append the link of joint j, whose MuJoCo body frame sits at T in link `parent`'s frame;
     return that body frame (moved by this joint) in the new link's frame."""
     model = walk.model
@@ -228,6 +230,7 @@ def _joint(walk: _Walk, j: int, parent: int, T: Transform, name: str, flags: set
             "frame": shift.inverse(),
             "parent": parent,
             "limits": limits,
+            "joint_name": joint_name,
         }
     )
     walk.parts.append([])

@@ -230,6 +230,7 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
                 parent=None if parent == i - 1 else parent,
                 mimic=_mimic(reader, j, index, where),
                 limits=j.limits,
+                joint_name=j.name,
             )
         )
     return Robot(
