@@ -45,6 +45,15 @@ C_READ_STATES = r"""    f = fopen(argv[1], "rb");
 #: The end of a harness's main that times the NB benchmarks of run_bench(b, it) with REPS and
 #: TARGET_MS from argv[3], argv[4] and prints `time LABEL ITERATIONS NS...` lines (needs ns, iters,
 #: b, r, reps, target_ns and LABELS). Shared with bench/frames_harness.py.
+#: the C helper that prints one output of a check state: "check LABEL K v1 v2 ..." (full precision)
+C_PRINT_OUT = r"""static void print_out(const char *label, int k, const double *a, int len)
+{
+    int i;
+    printf("check %s %d", label, k);
+    for (i = 0; i < len; ++i) printf(" %.17g", a[i]);
+    printf("\n");
+}"""
+
 C_TIME_MAIN = r"""    reps = argc > 3 ? atoi(argv[3]) : 11;
     if (reps < 1) reps = 1;
     if (reps > MAXREPS) reps = MAXREPS;

@@ -27,7 +27,7 @@ from pathlib import Path
 import casadi_route
 import casadi_route_derivatives as crd
 import numpy as np
-from c_harness import parse_harness, time_compiled
+from c_harness import C_PRINT_OUT, parse_harness, time_compiled
 from machine import C_COMPILER, FLAGS, RESULTS, log, run
 from row import Row
 from states import NCHECK, NSTATES
@@ -130,13 +130,7 @@ static double run_bench(int b, long it)
     return (now_ns() - s) / (double)it;
 }}
 
-static void print_out(const char *label, int k, const double *a, int len)
-{{
-    int i;
-    printf("check %s %d", label, k);
-    for (i = 0; i < len; ++i) printf(" %.17g", a[i]);
-    printf("\n");
-}}
+{print_out}
 
 int main(int argc, char **argv)
 {{
@@ -259,7 +253,9 @@ def bench_derivatives(row: Row, robot, gen_dir: Path, work: Path, states_file: P
     fns = crd.derivative_functions(robot)
     casadi_route.write_c(fns, f"crd_{row.name}", work)
     src = work / f"bench_derivatives_{row.name}.c"
-    text = HARNESS.format(name=row.name, prefix=robot.name, n=robot.n, nstates=NSTATES, ncheck=NCHECK)
+    text = HARNESS.format(
+        name=row.name, prefix=robot.name, n=robot.n, nstates=NSTATES, ncheck=NCHECK, print_out=C_PRINT_OUT
+    )
     src.write_text(text)
     exe = work / f"bench_derivatives_{row.name}"
     t0 = time.perf_counter()

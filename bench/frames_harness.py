@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from c_harness import C_READ_STATES, C_TIME_MAIN
+from c_harness import C_PRINT_OUT, C_READ_STATES, C_TIME_MAIN
 from machine import C_COMPILER, FLAGS, run
 from states import NSTATES
 
@@ -90,13 +90,7 @@ static double run_bench(int b, long it)
     return (now_ns() - s) / (double)it;
 }}
 
-static void print_out(const char *label, int k, const double *v, int len)
-{{
-    int i;
-    printf("check %s %d", label, k);
-    for (i = 0; i < len; ++i) printf(" %.17g", v[i]);
-    printf("\n");
-}}
+{print_out}
 
 int main(int argc, char **argv)
 {{
@@ -147,6 +141,7 @@ def harness_source(prefix: str, n: int, frame: str) -> str:
         cases="\n".join(cases),
         checks="\n".join(checks),
         read_states=C_READ_STATES,
+        print_out=C_PRINT_OUT,
         time_main=C_TIME_MAIN,
     )
 
