@@ -36,6 +36,7 @@ import sympy as sp
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
 from .frames import Frame, check_frame_names, unknown_frame
+from .free_flyer import NQ_BASE, NV_BASE
 from .friction import Friction
 from .limits import check_limits
 from .parameter_names import parameter_names_problem, parameter_number
@@ -139,7 +140,9 @@ class Robot:
 
     `values` holds the parameters the file gave values for (symbol -> SymPy
     number or expression); `params` the free parameter symbols (no value), in
-    order of first appearance in the file. `base` = world_T_base places the base frame in
+    order of first appearance in the file. `floating`: the base is not fixed but joined to the
+    world by a free flyer (symdyn.model.free_flyer; `nq` and `nv` count its coordinates too),
+    and `base` must then be the identity. Otherwise `base` = world_T_base places the base frame in
     the world (identity: the base frame is the world frame) and `gravity` is the gravitational
     acceleration in the world frame; `base_gravity` is it in the base frame, what the dynamics
     use. `frames` are the named frames besides the links' own (symdyn.model.frames).
@@ -155,12 +158,19 @@ class Robot:
     convention: str = "standard"
     frames: tuple[Frame, ...] = ()
     base: Transform = field(default_factory=Transform.identity)
+    #: the base is joined to the world by a free flyer (symdyn.model.free_flyer) instead of fixed
+    floating: bool = False
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
         if problem:
             raise SymdynError(f"robot '{self.name}': {problem}")
         check_frame_names(self.name, [link.name for link in self.links], self.frames, self.nb)
+        if self.floating and self.base != Transform.identity():
+            raise SymdynError(
+                f"robot '{self.name}': a floating base has no fixed placement in the world (its "
+                "position and orientation are coordinates): give 'base: floating' without a placement"
+            )
         for i, link in enumerate(self.links):
             m = link.mimic
             if m is None:
@@ -209,6 +219,16 @@ class Robot:
     def n(self) -> int:
         """Number of independent joint coordinates (degrees of freedom)."""
         return sum(1 for link in self.links if link.mimic is None)
+
+    @property
+    def nq(self) -> int:
+        """Size of the configuration vector: n, or 7 + n on a floating base (position, quaternion)."""
+        return self.n + NQ_BASE if self.floating else self.n
+
+    @property
+    def nv(self) -> int:
+        """Size of the velocity, acceleration and force vectors: n, or 6 + n on a floating base."""
+        return self.n + NV_BASE if self.floating else self.n
 
     @property
     def nb(self) -> int:

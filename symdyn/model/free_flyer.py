@@ -1,0 +1,71 @@
+"""The free-flyer root joint of a floating-base robot: its coordinates, with Pinocchio's conventions.
+
+A floating robot (`Robot.floating`) has its base link joined to the world by a free flyer, a
+six-degree-of-freedom joint, ahead of its n joint coordinates:
+
+    q  = [x, y, z, qx, qy, qz, qw, q_1 .. q_n]      (NQ = 7 + n)
+    v  = [v_x, v_y, v_z, w_x, w_y, w_z, qd_1 .. qd_n] (NV = 6 + n)
+
+(x, y, z) is the base frame's origin in the world frame and (qx, qy, qz, qw) the unit quaternion
+of its orientation, world_R_base, with the scalar last; (v, w) are the linear velocity of the
+base frame's origin and the angular velocity of the base, both in the base frame (the body twist,
+Pinocchio's JointModelFreeFlyer). Accelerations are the time derivatives of v (the spatial
+acceleration of the base in the base frame, then qdd), and the generalized forces are the wrench
+on the base in the base frame, force then moment, then the joint torques: all of size NV.
+
+The base's symbols carry a `_b` suffix, so that they never collide with joint symbols (q1 ..,
+qd1 .., qdd1 ..) or with a robot file's parameters (which may not end in `_b` on a floating
+robot: symdyn.parsers checks).
+
+References: Featherstone, Rigid Body Dynamics Algorithms (2008), sec. 4.2 (the free joint);
+Pinocchio's JointModelFreeFlyer (its configuration and tangent vectors).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+__all__ = [
+    "BASE_POSITION_NAMES",
+    "BASE_VELOCITY_NAMES",
+    "BASE_ACCELERATION_NAMES",
+    "BASE_WRENCH_NAMES",
+    "NQ_BASE",
+    "NV_BASE",
+    "base_symbols",
+    "quaternion_rotation",
+]
+
+#: the free flyer's configuration coordinates: origin, then the quaternion (scalar last)
+BASE_POSITION_NAMES = ("x_b", "y_b", "z_b", "qx_b", "qy_b", "qz_b", "qw_b")
+#: its velocity coordinates: linear then angular velocity of the base, in the base frame
+BASE_VELOCITY_NAMES = ("vx_b", "vy_b", "vz_b", "wx_b", "wy_b", "wz_b")
+#: their time derivatives
+BASE_ACCELERATION_NAMES = ("ax_b", "ay_b", "az_b", "dwx_b", "dwy_b", "dwz_b")
+#: the wrench on the base in the base frame: force then moment
+BASE_WRENCH_NAMES = ("fx_b", "fy_b", "fz_b", "mx_b", "my_b", "mz_b")
+NQ_BASE = len(BASE_POSITION_NAMES)
+NV_BASE = len(BASE_VELOCITY_NAMES)
+
+
+def base_symbols() -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """The column vectors (q_base (7), v_base (6), a_base (6)) of plain SymPy symbols."""
+    return tuple(
+        sp.Matrix([sp.Symbol(s) for s in names])
+        for names in (BASE_POSITION_NAMES, BASE_VELOCITY_NAMES, BASE_ACCELERATION_NAMES)
+    )
+
+
+def quaternion_rotation(qx, qy, qz, qw) -> sp.Matrix:
+    """world_R_base of a unit quaternion (qx, qy, qz, qw), scalar last (Hamilton's convention).
+
+    The polynomial form, exact for a unit quaternion: what it returns for a quaternion of
+    another norm is not a rotation (the generated functions document how they treat one).
+    """
+    return sp.Matrix(
+        [
+            [1 - 2 * (qy**2 + qz**2), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+            [2 * (qx * qy + qz * qw), 1 - 2 * (qx**2 + qz**2), 2 * (qy * qz - qx * qw)],
+            [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx**2 + qy**2)],
+        ]
+    )
