@@ -53,6 +53,11 @@ def _named(T: Transform, program: Program, hint: str) -> Transform:
     return Transform(R, p)
 
 
+def _key(name: str | Frame) -> str:
+    """The cache key of a frame given by name or as a Frame."""
+    return name.name if isinstance(name, Frame) else name
+
+
 def _column(v: v3.Vec) -> sp.ImmutableMatrix:
     return sp.ImmutableMatrix(3, 1, list(v))
 
@@ -74,8 +79,11 @@ class FrameKinematics:
         self._motion: dict[int, tuple[v3.Vec, v3.Vec, v3.Vec]] = {}
         self._cache: dict[tuple, sp.Matrix] = {}
 
-    def frame(self, name: str) -> Frame:
-        """The frame `name` of the robot (Robot.frame: unknown names are refused)."""
+    def frame(self, name: str | Frame) -> Frame:
+        """The frame `name` of the robot (Robot.frame: unknown names are refused), or a Frame
+        given as such (a loop's closure frame, symdyn.model.loops)."""
+        if isinstance(name, Frame):
+            return name
         return self.robot.frame(name, "frame kinematics")
 
     @property
@@ -92,9 +100,9 @@ class FrameKinematics:
     def _link_pose(self, k: int) -> Transform:
         return self.robot.base if k < 0 else self.poses[k]
 
-    def pose(self, name: str) -> sp.Matrix:
+    def pose(self, name: str | Frame) -> sp.Matrix:
         """world_T_F, 4 x 4 (rotation and origin of F in the world)."""
-        key = ("pose", name)
+        key = ("pose", _key(name))
         if key not in self._cache:
             f = self.frame(name)
             T = self._link_pose(f.link) @ f.placement
@@ -103,11 +111,11 @@ class FrameKinematics:
             self._cache[key] = T.matrix()
         return self._cache[key]
 
-    def jacobian(self, name: str, reference: str = "world") -> sp.Matrix:
+    def jacobian(self, name: str | Frame, reference: str = "world") -> sp.Matrix:
         """J (6 x n), rows v_x v_y v_z w_x w_y w_z: world-aligned at F's origin ("world") or in
         F's own axes ("local"). A frame on the base has J = 0."""
         assert reference in ("world", "local"), reference
-        key = (reference, name)
+        key = (reference, _key(name))
         if key not in self._cache:
             f = self.frame(name)
             n = self.robot.n
@@ -155,9 +163,9 @@ class FrameKinematics:
         d = v3.sub(r, v3.vec(self.poses[k].p))
         return v3.add(a, v3.cross(wd, d), v3.cross(w, v3.cross(w, d)))
 
-    def jacobian_dot_qd(self, name: str) -> sp.Matrix:
+    def jacobian_dot_qd(self, name: str | Frame) -> sp.Matrix:
         """Jdot qd = [a_F; wd_F] (6 x 1) at qdd = 0, world-aligned at F's origin."""
-        key = ("drift", name)
+        key = ("drift", _key(name))
         if key not in self._cache:
             f = self.frame(name)
             if f.link < 0:

@@ -49,6 +49,7 @@ __all__ = [
     "COM_FUNCTIONS",
     "FRAME_SUFFIXES",
     "frame_function_names",
+    "with_steps",
 ]
 
 #: The centre-of-mass functions of the kinematics group (an identifier must not shadow them).
@@ -134,7 +135,7 @@ def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
     return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
 
 
-def _with_steps(rows: list[tuple], prog: Program, first: int, cse: str) -> list[FunctionRow]:
+def with_steps(rows: list[tuple], prog: Program, first: int, cse: str) -> list[FunctionRow]:
     """FunctionRows of one CSE group, the first carrying every step after `first` in `prog` that
     the rows need (build_functions gathers the rows' steps into one program)."""
     if not rows:
@@ -209,7 +210,7 @@ def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             _entries(fk.com_jacobian_dot_qd()),
         ),
     ]
-    return _with_steps(rows, prog, first, "kinematics")
+    return with_steps(rows, prog, first, "kinematics")
 
 
 def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
@@ -258,4 +259,4 @@ def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 _entries(os.bias),
             ),
         ]
-    return _with_steps(rows, prog, first, "operational_space")
+    return with_steps(rows, prog, first, "operational_space")

@@ -50,6 +50,7 @@ from .function_rows import (
     joint_matrix_output,
     vector_output,
 )
+from .loop_functions import loop_rows
 from .regressor_functions import regressor_rows
 from .tip_wrench import TIP_WRENCH_DOC, TIP_WRENCH_FUNCTION, tip_wrench_exprs, tip_wrench_symbols
 
@@ -182,6 +183,7 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     derivative_rows,
     kinematics_rows,
     operational_space_rows,
+    loop_rows,
 )
 
 
@@ -209,7 +211,7 @@ def _warn_singular(dyn: Dynamics, families) -> None:
 
 #: The groups of functions `symdyn generate --functions` selects, by the builders of FAMILIES.
 GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] = {
-    "dynamics": (dynamics_rows, forward_dynamics_rows),
+    "dynamics": (dynamics_rows, forward_dynamics_rows, loop_rows),
     "regressor": (regressor_rows,),
     "tip_wrench": (tip_wrench_rows,),
     "derivatives": (derivative_rows,),

@@ -39,6 +39,7 @@ from .frames import Frame, check_frame_names, unknown_frame
 from .free_flyer import NQ_BASE, NV_BASE
 from .friction import Friction
 from .limits import check_limits
+from .loops import Loop, check_loops, loop_path
 from .parameter_names import parameter_names_problem, parameter_number
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
@@ -160,12 +161,18 @@ class Robot:
     base: Transform = field(default_factory=Transform.identity)
     #: the base is joined to the world by a free flyer (symdyn.model.free_flyer) instead of fixed
     floating: bool = False
+    #: closures of kinematic loops over the tree of `links` (symdyn.model.loops)
+    loops: tuple[Loop, ...] = ()
+    #: the links whose joints are driven (indices into links); None: every joint off the loops
+    actuated: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
         if problem:
             raise SymdynError(f"robot '{self.name}': {problem}")
         check_frame_names(self.name, [link.name for link in self.links], self.frames, self.nb)
+        mimics = [link.mimic is not None for link in self.links]
+        check_loops(self.name, [link.name for link in self.links], mimics, self.loops, self.actuated)
         if self.floating and self.base != Transform.identity():
             raise SymdynError(
                 f"robot '{self.name}': a floating base has no fixed placement in the world (its "
@@ -229,6 +236,15 @@ class Robot:
     def nv(self) -> int:
         """Size of the velocity, acceleration and force vectors: n, or 6 + n on a floating base."""
         return self.n + NV_BASE if self.floating else self.n
+
+    @property
+    def actuated_links(self) -> tuple[int, ...]:
+        """The links whose joints are driven: `actuated`, or by default every link with a
+        coordinate of its own that lies on no loop's path (all of them for a tree)."""
+        if self.actuated is not None:
+            return tuple(sorted(self.actuated))
+        on_loops = {i for loop in self.loops for i in loop_path(self.parents, loop.link, loop.to)}
+        return tuple(i for i, link in enumerate(self.links) if link.mimic is None and i not in on_loops)
 
     @property
     def nb(self) -> int:
@@ -414,5 +430,6 @@ class Robot:
             gravity=self.gravity.xreplace(mapping),
             frames=tuple(f.subs(mapping) for f in self.frames),
             base=self.base.subs(mapping),
+            loops=tuple(loop.subs(mapping) for loop in self.loops),
             **changes,
         )

@@ -24,7 +24,7 @@ from ..errors import SymdynError
 from .inputs import NumericModel, body_positions, body_rates, checked_inputs, skew
 from .spatial import joint_poses, subspaces
 
-__all__ = ["FrameState", "frame_state", "center_of_mass"]
+__all__ = ["FrameState", "frame_state", "placed_frame_state", "center_of_mass"]
 
 
 class FrameState(NamedTuple):
@@ -115,6 +115,13 @@ def frame_state(robot, frame: str, q, qd=None, params=None) -> FrameState:
         robot.frame(frame, "frame_state")  # raises, naming the near matches
     f = mdl.frame_names.index(frame)
     return kin.frame(int(mdl.frame_link[f]), _homogeneous(mdl.frame_R[f], mdl.frame_p[f]))
+
+
+def placed_frame_state(robot, link: int, placement: np.ndarray, q, qd=None, params=None) -> FrameState:
+    """`frame_state` of a frame given by its link (-1: the base) and placement k_T_F (4 x 4, in
+    the link's body frame): a loop's closure frame (symdyn.model.loops)."""
+    _, kin = _state("placed_frame_state", robot, q, qd, params)
+    return kin.frame(int(link), np.asarray(placement, dtype=float))
 
 
 def center_of_mass(robot, q, qd=None, params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -26,7 +26,18 @@ from .robot_fields import LINK_NAME, LinkData, RobotFileReader
 
 __all__ = ["POE_TOP_KEYS", "POE_LINK_KEYS", "FRAME_KEYS", "PoeFileReader"]
 
-POE_TOP_KEYS = ("name", "convention", "gravity", "base", "parameters", "links", "end_effector", "frames")
+POE_TOP_KEYS = (
+    "name",
+    "convention",
+    "gravity",
+    "base",
+    "parameters",
+    "links",
+    "end_effector",
+    "frames",
+    "loops",
+    "actuated",
+)
 POE_LINK_KEYS = ("name", "frame", "spatial_inertia", "screw", "limits")
 FRAME_KEYS = ("position", "rotation")
 

@@ -25,6 +25,7 @@ from ..model.robot import JOINT_TYPES
 from ..spatial.transform import Transform
 from .dh import CONVENTIONS
 from .frame_fields import FrameData, read_base, read_frames
+from .loop_fields import LoopData, read_actuated, read_loops
 from .source import did_you_mean
 
 __all__ = [
@@ -38,7 +39,7 @@ __all__ = [
     "RobotFileReader",
 ]
 
-TOP_KEYS = ("name", "convention", "gravity", "base", "parameters", "links", "frames")
+TOP_KEYS = ("name", "convention", "gravity", "base", "parameters", "links", "frames", "loops", "actuated")
 LINK_KEYS = (
     "name",
     "parent",
@@ -109,6 +110,8 @@ class RobotFileReader:
         self.links: list[LinkData] = []
         self.base = Transform.identity()
         self.frames: list[FrameData] = []
+        self.loops: list[LoopData] = []
+        self.actuated: tuple[str, ...] | None = None
 
     # -- helpers
     def error(self, message: str, *, link: LinkData | None = None, field: str | None = None):
@@ -218,6 +221,12 @@ class RobotFileReader:
 
     def _read_frames(self, value: object) -> None:
         self.frames = read_frames(self, value, _LINK_NAME)
+
+    def _read_loops(self, value: object) -> None:
+        self.loops = read_loops(self, value, _LINK_NAME)
+
+    def _read_actuated(self, value: object) -> None:
+        self.actuated = read_actuated(self, value, _LINK_NAME)
 
     def _read_parameters(self, value: object) -> None:
         if value is None:

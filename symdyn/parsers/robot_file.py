@@ -38,6 +38,7 @@ from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
 from .frame_fields import model_frames
+from .loop_fields import model_actuated, model_loops
 from .poe_file import PoeFileReader
 from .robot_fields import LinkData, RobotFileReader
 from .robot_tree import link_mimics, link_parents
@@ -214,6 +215,8 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
         convention=reader.convention,
         frames=frames,
         base=reader.base,
+        loops=model_loops(reader, reader.loops, links),
+        actuated=model_actuated(reader, reader.actuated, links),
     )
 
 
