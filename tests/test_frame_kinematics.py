@@ -9,7 +9,7 @@ from functools import cache
 
 import numpy as np
 import pytest
-from robots import EXAMPLES_DIR, example, rpy, y_robot
+from robots import EXAMPLES_DIR, example, pinocchio_model, rpy, y_robot
 from scipy.linalg import logm
 
 import symdyn
@@ -110,44 +110,6 @@ def test_urdf_frames_agree_with_pinocchio(name):
     pin = pytest.importorskip("pinocchio")
     path, dyn = urdf_dynamics(name)
     _check_pinocchio(pin, pin.buildModelFromUrdf(path), dyn, URDFS[name][1])
-
-
-def pinocchio_model(pin, robot):
-    """A Pinocchio model built joint by joint from a numeric symdyn Robot without mimic joints:
-    each joint's placement, axis and inertia, the base placement, and every frame."""
-    r = robot.numeric()
-    model = pin.Model()
-    model.gravity.linear = np.array(r.gravity, dtype=float).reshape(3)
-    base = pin.SE3(np.array(r.base.R, dtype=float), np.array(r.base.p, dtype=float).reshape(3))
-    ids = []
-    for i, lk in enumerate(r.links):
-        parent = r.parents[i]
-        placement = pin.SE3(
-            np.array(lk.placement.R, dtype=float), np.array(lk.placement.p, dtype=float).reshape(3)
-        )
-        axis = np.array(lk.axis, dtype=float).reshape(3)
-        joint = (
-            pin.JointModelRevoluteUnaligned(axis)
-            if lk.joint == "revolute"
-            else pin.JointModelPrismaticUnaligned(axis)
-        )
-        jid = model.addJoint(
-            0 if parent < 0 else ids[parent], joint, base * placement if parent < 0 else placement, lk.name
-        )
-        inertia = pin.Inertia(
-            float(lk.mass), np.array(lk.com, dtype=float).reshape(3), np.array(lk.inertia, dtype=float)
-        )
-        model.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
-        ids.append(jid)
-    placed = [(lk.name, i, lk.frame) for i, lk in enumerate(r.links)] + [
-        (f.name, f.link, f.placement) for f in r.frames
-    ]
-    for name, k, T in placed:
-        se3 = pin.SE3(np.array(T.R, dtype=float), np.array(T.p, dtype=float).reshape(3))
-        model.addFrame(
-            pin.Frame(name, 0 if k < 0 else ids[k], base * se3 if k < 0 else se3, pin.FrameType.OP_FRAME)
-        )
-    return model
 
 
 HUNG = """

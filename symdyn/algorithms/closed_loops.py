@@ -9,9 +9,13 @@ closes it at two frames A (on `link`) and B (on `to`), world axes:
     weld:   phi = [p_A - p_B;  1/2 vee(R_A R_B^T - R_B R_A^T)]       (6 rows: x y z, rx ry rz)
 
 The rotation rows vanish when R_A = R_B and equal the rotation vector of R_A R_B^T to first
-order. The closure Jacobian K = J_A - J_B (world-aligned frame Jacobians, rows v then w;
-symdyn.algorithms.frame_kinematics), so that phi_dot = K qd on the closure, and the drift
-Kdot qd = (Jdot qd)_A - (Jdot qd)_B at qdd = 0. Rows that depend on the others (a planar
+order. Every row is then expressed in B's axes (phi <- R_B^T phi per block of three), so that a
+loop that stays in a plane of its `to` link (a parallelogram behind a waist joint) keeps the
+same dependent rows at every configuration. The closure Jacobian is K = R_B^T (J_A - J_B)
+(world-aligned frame Jacobians, rows v then w; symdyn.algorithms.frame_kinematics), so that
+phi_dot = K qd on the closure, and the drift, with w_B the angular velocity of B (world),
+
+    Kdot qd = R_B^T ((Jdot qd)_A - (Jdot qd)_B - w_B x (J_A - J_B) qd)       (at qdd = 0). Rows that depend on the others (a planar
 loop's out-of-plane rows, a loop whose constraints repeat another's) are dropped: `analyse`
 assembles the loops numerically (damped Gauss-Newton on phi from several seeded random
 starts) and keeps, in order, the rows that raise the numeric rank of K at the assembled
@@ -56,23 +60,36 @@ def _vee_skew(A: sp.Matrix) -> list[sp.Expr]:
     return [(A[2, 1] - A[1, 2]) / 2, (A[0, 2] - A[2, 0]) / 2, (A[1, 0] - A[0, 1]) / 2]
 
 
+def _cross(a, b) -> list:
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
 def closure(fk: FrameKinematics, robot: Robot, drift: bool = True):
     """Every row of every loop (module docstring): (phi, K, Kdot qd or None), lists of rows,
-    K's rows as lists of n entries, over fk's program and its q, qd."""
+    K's rows as lists of n entries, in B's axes, over fk's program and its q, qd."""
     phi, K, kd = [], [], []
+    n = robot.n
+    qd = sp.Matrix(fk.qd)
     for loop in robot.loops:
         A, B = loop.frames()
         TA, TB = fk.pose(A), fk.pose(B)
-        JA, JB = fk.jacobian(A), fk.jacobian(B)
-        phi += [TA[i, 3] - TB[i, 3] for i in range(3)]
-        rows = range(loop.equations)
+        Kw = fk.jacobian(A) - fk.jacobian(B)
+        RBt = TB[:3, :3].T
+        d = RBt * (TA[:3, 3] - TB[:3, 3])
+        phi += list(d)
         if loop.type == "weld":
-            RA, RB = TA[:3, :3], TB[:3, :3]
-            phi += _vee_skew(RA * RB.T)
-        K += [[JA[i, j] - JB[i, j] for j in range(robot.n)] for i in rows]
+            phi += _vee_skew(RBt * TA[:3, :3])
+        blocks = range(loop.equations // 3)
+        for b in blocks:
+            rows = RBt * Kw[3 * b : 3 * b + 3, :]
+            K += [[rows[i, j] for j in range(n)] for i in range(3)]
         if drift:
-            dA, dB = fk.jacobian_dot_qd(A), fk.jacobian_dot_qd(B)
-            kd += [dA[i] - dB[i] for i in rows]
+            wB = list(fk.jacobian(B)[3:, :] * qd)
+            rel = Kw * qd
+            dw = fk.jacobian_dot_qd(A) - fk.jacobian_dot_qd(B)
+            for b in blocks:
+                turn = _cross(wB, rel[3 * b : 3 * b + 3])
+                kd += list(RBt * sp.Matrix([dw[3 * b + i] - turn[i] for i in range(3)]))
     return phi, K, (kd if drift else None)
 
 

@@ -38,18 +38,27 @@ def _placement(point) -> np.ndarray:
 
 
 def closure(robot, q, qd=None, params=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(phi, K, Kdot qd) over every row of every loop (3 per point loop, 6 per weld), world axes."""
+    """(phi, K, Kdot qd) over every row of every loop (3 per point loop, 6 per weld), each block
+    of three rows in the axes of the loop's frame B: phi = R_B^T (p_A - p_B) (and
+    1/2 vee(R_B^T R_A - R_A^T R_B)), K = R_B^T (J_A - J_B), and the derivative of K qd at
+    qdd = 0, R_B^T ((Jdot qd)_A - (Jdot qd)_B - w_B x (J_A - J_B) qd)."""
     num = robot.numeric(params)
+    qd = np.zeros(num.n) if qd is None else np.asarray(qd, dtype=float)
     phi, K, drift = [], [], []
     for loop in num.loops:
         A = placed_frame_state(num, loop.link, _placement(loop.point), q, qd)
         B = placed_frame_state(num, loop.to, _placement(loop.to_point), q, qd)
-        rows = loop.equations
-        phi.append(A.pose[:3, 3] - B.pose[:3, 3])
+        R = B.pose[:3, :3]
+        phi.append(R.T @ (A.pose[:3, 3] - B.pose[:3, 3]))
         if loop.type == "weld":
-            phi.append(_vee(A.pose[:3, :3] @ B.pose[:3, :3].T))
-        K.append((A.jacobian - B.jacobian)[:rows])
-        drift.append((A.drift - B.drift)[:rows])
+            phi.append(_vee(R.T @ A.pose[:3, :3]))
+        Kw = A.jacobian - B.jacobian
+        rel, wB = Kw @ qd, B.jacobian[3:] @ qd
+        dw = A.drift - B.drift
+        for b in range(loop.equations // 3):
+            block = slice(3 * b, 3 * b + 3)
+            K.append(R.T @ Kw[block])
+            drift.append(R.T @ (dw[block] - np.cross(wB, rel[block])))
     return np.concatenate(phi), np.vstack(K), np.concatenate(drift)
 
 

@@ -158,6 +158,7 @@ def c_names(ctx: RenderContext) -> CNames:
         + [m for m, _ in param_macros]
         + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
         + ([f"{name}_NFRAMES"] if ctx.frames else [])
+        + ([f"{name}_NACT", f"{name}_NPAS"] if "loop_newton_step" in functions else [])
     )
     taken = set(written) | set(functions.values()) | {guard} | set(sincos.values())
     aliases = _aliases(written, taken)

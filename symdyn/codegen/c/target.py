@@ -18,6 +18,7 @@ from __future__ import annotations
 from ...errors import SymdynError
 from ..frame_functions import comment_text
 from ..functions import FunctionSpec
+from ..loop_solve import loop_solve_view
 from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
@@ -26,8 +27,10 @@ from .sincos import BLOCK, gather
 
 __all__ = ["render", "render_context", "TOOLS"]
 
-#: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6).
+#: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6) or one
+#: value per actuated joint (NAME_NACT, ACTUATED_INPUTS: robots with loops).
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
+ACTUATED_INPUTS = ("qda", "qdda", "tau_a")
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
 TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
@@ -75,6 +78,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     for inp in spec.inputs:
         used = [s for s in inp.symbols if s in used_symbols]
         size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+        size = names.dims["nact"] if inp.name in ACTUATED_INPUTS else size
         inputs.append({"name": inp.name, "read": bool(used), "size": size})
         if not used:
             unused.append(inp.name)
@@ -134,6 +138,26 @@ def render_context(ctx: RenderContext) -> dict:
         "column_sizes": _column_sizes(ctx, names),
         "frames": [(comment_text(name), ident, link) for name, ident, link in ctx.frames],
         "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
+        "loops": _loops_view(ctx, names),
+    }
+
+
+def _loops_view(ctx: RenderContext, names: CNames) -> dict | None:
+    """NAME_solve_loops' data (templates/c/dynamics.c.j2) for a robot with loops: sizes, the
+    coordinates it sets and solves, its tolerance and iteration bound (symdyn.codegen.loop_solve)."""
+    step = next((f for f in ctx.functions if f.name == "loop_newton_step"), None)
+    if step is None:
+        return None
+    view = loop_solve_view(ctx.robot, step.results[0].rows)
+    suffix = CConfig(ctx.precision).literal_suffix
+    return {
+        **view,
+        "nact": names.dims["nact"],
+        "npas": names.dims["npas"],
+        "tol": f"{view['tol'][ctx.precision]}{suffix}",
+        "abs": "fabsf" if ctx.precision == "float" else "fabs",
+        "step": names.functions["loop_newton_step"],
+        "c_name": f"{ctx.name}_solve_loops",
     }
 
 
