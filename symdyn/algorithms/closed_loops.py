@@ -15,10 +15,11 @@ same dependent rows at every configuration. The closure Jacobian is K = R_B^T (J
 (world-aligned frame Jacobians, rows v then w; symdyn.algorithms.frame_kinematics), so that
 phi_dot = K qd on the closure, and the drift, with w_B the angular velocity of B (world),
 
-    Kdot qd = R_B^T ((Jdot qd)_A - (Jdot qd)_B - w_B x (J_A - J_B) qd)       (at qdd = 0). Rows that depend on the others (a planar
-loop's out-of-plane rows, a loop whose constraints repeat another's) are dropped: `analyse`
-assembles the loops numerically (damped Gauss-Newton on phi from several seeded random
-starts) and keeps, in order, the rows that raise the numeric rank of K at the assembled
+    Kdot qd = R_B^T ((Jdot qd)_A - (Jdot qd)_B - w_B x (J_A - J_B) qd)       (at qdd = 0).
+
+Rows that depend on the others (a planar loop's out-of-plane rows, a loop whose constraints
+repeat another's) are dropped: `analyse` assembles the loops numerically (damped Gauss-Newton
+on phi from several seeded random starts) and keeps, in order, the rows that raise the numeric rank of K at the assembled
 configurations. The mobility is n - rank K; with q split into the actuated q_a (Robot.
 actuated_links) and the passive q_p, K = [K_a K_p] and K_p must be square and invertible:
 
@@ -242,9 +243,10 @@ def _coordinate_names(robot: Robot, coords: Sequence[int]) -> list[str]:
     return [own[j] for j in coords]
 
 
-def spd_solve(M: sp.Matrix, B: sp.Matrix, program: Program, hint: str) -> sp.Matrix:
-    """X = M^-1 B for a symmetric positive definite M (k x k), B (k x c): M = L D L^T unrolled
-    (symdyn.algorithms.derivatives.ldlt_factor), then L y = b, L^T x = D^-1 y; entries named."""
+def spd_solve(M: sp.Matrix, B: sp.Matrix, program: Program, hint: str) -> tuple[sp.Matrix, list[sp.Expr]]:
+    """(X, D): X = M^-1 B for a symmetric positive definite M (k x k), B (k x c), by M = L D L^T
+    unrolled (symdyn.algorithms.derivatives.ldlt_factor), then L y = b, L^T x = D^-1 y; entries
+    named; D the pivots."""
     k = M.rows
     L, D = ldlt_factor(M, program, hint)
     X = sp.zeros(k, B.cols)
@@ -255,16 +257,18 @@ def spd_solve(M: sp.Matrix, B: sp.Matrix, program: Program, hint: str) -> sp.Mat
         for i in reversed(range(k)):
             s = y[i] / D[i] - sum((L[j, i] * X[j, c] for j in range(i + 1, k)), sp.S.Zero)
             X[i, c] = program.let(s, f"{hint}x")
-    return X
+    return X, D
 
 
-def solve_columns(A: sp.Matrix, B: sp.Matrix, program: Program, hint: str) -> sp.Matrix:
-    """X = A^-1 B for a square invertible A (k x k) and B (k x c), through the normal equations
-    A^T A X = A^T B (`spd_solve`; module docstring); entries named."""
+def solve_columns(A: sp.Matrix, B: sp.Matrix, program: Program, hint: str) -> tuple[sp.Matrix, list[sp.Expr]]:
+    """(X, r): X = A^-1 B for a square invertible A (k x k) and B (k x c), through the normal
+    equations A^T A X = A^T B (`spd_solve`; module docstring), entries named; r the relative
+    pivots D_j / (A^T A)_jj, in (0, 1] and near 0 only where A is near singular."""
     k = A.rows
 
     def product(P: sp.Matrix, i: int, j: int) -> sp.Expr:
         return program.let(sum((A[r, i] * P[r, j] for r in range(k)), sp.S.Zero), f"{hint}N")
 
     N = sp.Matrix(k, k, lambda i, j: product(A, i, j))
-    return spd_solve(N, sp.Matrix(k, B.cols, lambda i, j: product(B, i, j)), program, hint)
+    X, D = spd_solve(N, sp.Matrix(k, B.cols, lambda i, j: product(B, i, j)), program, hint)
+    return X, [program.let(d / N[j, j], f"{hint}r") for j, d in enumerate(D)]

@@ -4,7 +4,7 @@
 
     loop_residual(q, p, phi)                       phi(q), the kept closure rows (npas)
     loop_jacobian(q, p, K)                         K = dphi/dq, npas x n
-    loop_newton_step(q, p, phi, dqp)               phi and the Newton step dq_p = -K_p^-1 phi
+    loop_newton_step(q, p, phi, dqp, pivots)       phi, the Newton step dq_p = -K_p^-1 phi, its pivots
     loop_motion(q, qda, qdda, p, qd, qdd)          qd = W qd_a, qdd = W qdd_a - [0; K_p^-1 Kdot qd]
     actuated_inverse_dynamics(q, qda, qdda, p, tau_a)      tau_a = W^T tau(q, qd, qdd)
     actuated_mass_matrix(q, p, Ma)                 M_a = W^T M W
@@ -84,8 +84,9 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     phi = sp.Matrix([prog.let(phi_all[r], "phi") for r in an.rows])
     K = sp.Matrix([[prog.let(e, "K") for e in K_all[r]] for r in an.rows])
     Kp, Ka = K.extract(list(range(npas)), pas), K.extract(list(range(npas)), act)
-    X = solve_columns(Kp, Ka, prog, "Lw")
-    dqp = -solve_columns(Kp, phi, prog, "Lw")
+    X = solve_columns(Kp, Ka, prog, "Lw")[0]
+    step, pivots = solve_columns(Kp, phi, prog, "Lw")
+    dqp = -step
 
     qd = [sp.S.Zero] * n
     for k, a in enumerate(act):
@@ -94,7 +95,7 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
         qd[p] = prog.let(-sum((X[i, k] * qda.symbols[k] for k in range(na)), sp.S.Zero), "vqd")
     moving = FrameKinematics(robot, list(dyn.q), qd, prog)
     drift_all = closure(moving, robot)[2]
-    gamma = solve_columns(Kp, sp.Matrix([prog.let(drift_all[r], "Kd") for r in an.rows]), prog, "Lw")
+    gamma = solve_columns(Kp, sp.Matrix([prog.let(drift_all[r], "Kd") for r in an.rows]), prog, "Lw")[0]
 
     def accelerations(qdd_a) -> list:
         out = [sp.S.Zero] * n
@@ -109,7 +110,7 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     replaced = {**dict(zip(dyn.qd, qd, strict=True)), **dict(zip(dyn.qdd, qdd, strict=True))}
     tau = substitute(prog, list(c["tau"]), replaced, "Lt")
     tau_act = _project(tau, X, act, pas, prog, "ta")
-    lam = solve_columns(Kp.T, sp.Matrix([tau[p] for p in pas]), prog, "Ll")
+    lam = solve_columns(Kp.T, sp.Matrix([tau[p] for p in pas]), prog, "Ll")[0]
     M = c["M"]
     W = sp.zeros(n, na)
     for k, a in enumerate(act):
@@ -124,7 +125,7 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     zero = {**dict(zip(dyn.qd, qd, strict=True)), **dict(zip(dyn.qdd, accelerations([0] * na), strict=True))}
     bias = _project(substitute(prog, list(c["tau"]), zero, "Lb"), X, act, pas, prog, "ba")
     rhs = sp.Matrix([prog.let(tau_a.symbols[k] - bias[k], "fb") for k in range(na)])
-    qdda_out = spd_solve(Ma, rhs, prog, "La")
+    qdda_out = spd_solve(Ma, rhs, prog, "La")[0]
 
     def out(name, rows, cols, doc, dims):
         return Output(name, rows, cols, doc, dims)
@@ -146,13 +147,15 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
         ),
         (
             "loop_newton_step",
-            "phi(q) and the Newton step dq_p = -K_p^-1 phi on the passive coordinates",
+            "phi(q), the Newton step dq_p = -K_p^-1 phi on the passive coordinates, and the relative "
+            "pivots D_j / N_jj of its solve (N = K_p^T K_p; near 0: K_p near singular)",
             (x.q, x.p),
             (
                 out("phi", npas, 1, "closure residual phi(q)", ("npas", "1")),
                 out("dqp", npas, 1, "Newton step of the passive coordinates", ("npas", "1")),
+                out("pivots", npas, 1, "relative pivots of the step's solve, in (0, 1]", ("npas", "1")),
             ),
-            _entries(phi, dqp),
+            _entries(phi, dqp, sp.Matrix(pivots)),
         ),
         (
             "loop_motion",

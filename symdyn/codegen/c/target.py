@@ -155,6 +155,7 @@ def _loops_view(ctx: RenderContext, names: CNames) -> dict | None:
         "nact": names.dims["nact"],
         "npas": names.dims["npas"],
         "tol": f"{view['tol'][ctx.precision]}{suffix}",
+        "pivot": f"{view['pivot'][ctx.precision]}{suffix}",
         "abs": "fabsf" if ctx.precision == "float" else "fabs",
         "step": names.functions["loop_newton_step"],
         "c_name": f"{ctx.name}_solve_loops",

@@ -71,7 +71,7 @@ def _loops(ctx: RenderContext) -> dict | None:
     if step is None:
         return None
     view = loop_solve_view(ctx.robot, step.results[0].rows)
-    return {**view, "tol": view["tol"][ctx.precision]}
+    return {**view, "tol": view["tol"][ctx.precision], "pivot": view["pivot"][ctx.precision]}
 
 
 def render(ctx: RenderContext) -> dict[str, str]:

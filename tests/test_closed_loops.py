@@ -1,0 +1,340 @@
+"""Closed kinematic loops (symdyn.model.loops, symdyn.algorithms.closed_loops,
+symdyn.codegen.loop_functions): robot files, bad input, and the generated functions against the
+NumPy oracle (symdyn.oracle.closed_loops), the four-bar's textbook closed forms, virtual work,
+finite differences of the solved loop, energy conservation and Pinocchio's constrained dynamics."""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.util
+import math
+import warnings
+from functools import cache
+
+import numpy as np
+import pytest
+import yaml
+from cbuild import compile_shared, write_files
+from robots import EXAMPLES_DIR, pinocchio_model
+from timebound import refused
+
+import symdyn
+from symdyn.algorithms.closed_loops import analyse
+from symdyn.codegen import render
+from symdyn.errors import SymdynError
+from symdyn.oracle import closed_loops as oc
+from symdyn.parsers import robot_from_data
+from symdyn.rnea import kinetic_energy, potential_energy, rnea
+
+EXAMPLES = ("fourbar", "fivebar", "delta", "parallelogram_arm")
+
+
+def _load(name: str):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return symdyn.load_robot(EXAMPLES_DIR / f"{name}.yaml")
+
+
+@cache
+def generated(name: str, targets=("python",)):
+    """The example's robot, its generated NumPy module and (with "c" in targets) the C files."""
+    robot = _load(name)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        files = render(robot, targets=targets)
+    return robot, files
+
+
+def numpy_module(name: str, tmp_path_factory, targets=("python",)):
+    robot, files = generated(name, targets)
+    folder = tmp_path_factory.mktemp(name)
+    path = folder / f"{name}_numpy.py"
+    path.write_text(files[f"{name}_numpy.py"])
+    spec = importlib.util.spec_from_file_location(f"_loops_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return robot, module
+
+
+def closed_state(robot, module, seed: int):
+    """A closed q near an assembled configuration, and random actuated rates and accelerations."""
+    rng = np.random.default_rng(seed)
+    an = analyse(robot.resolved())
+    q0 = np.array(an.assembled[0])
+    act, _ = oc.split(robot)
+    it, q = module.solve_loops(q0[act] + 0.05 * rng.standard_normal(len(act)), q0)
+    assert it >= 0
+    return q, rng.standard_normal(len(act)), rng.standard_normal(len(act))
+
+
+# -- robot files and bad input
+
+
+def _fourbar_data() -> dict:
+    return yaml.safe_load((EXAMPLES_DIR / "fourbar.yaml").read_text())
+
+
+def test_the_four_bar_file_gives_its_loop_and_actuated_joint():
+    robot = _load("fourbar")
+    (loop,) = robot.loops
+    assert (loop.name, loop.link, loop.to, loop.type) == ("B", 1, 2, "point")
+    assert robot.actuated == (0,) and robot.actuated_links == (0,)
+    an = analyse(robot.resolved())
+    assert an.rows == (0, 1) and an.actuated == (0,) and an.passive == (1, 2)
+    assert an.notes == ("robot 'fourbar': closure rows B.z depend on the others and are dropped",)
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (lambda d: d["loops"][0].update(link="nope"), ("loops[0] (B).link", "no link named 'nope'")),
+        (lambda d: d["loops"][0].update(to="rockr"), ("loops[0] (B).to", "did you mean 'rocker'")),
+        (lambda d: d["loops"][0].update(point=[1, 2]), ("loops[0] (B).point", "got 2 entries")),
+        (lambda d: d["loops"][0].update(type="hinge"), ("loops[0] (B).type", "point, weld")),
+        (
+            lambda d: d["loops"][0].update(to="coupler"),
+            ("loops[0] (B).to", "closes link 'coupler' on itself"),
+        ),
+        (lambda d: d["loops"][0].pop("to_point"), ("loops[0] (B).to_point", "missing required field")),
+        (lambda d: d["loops"][0].update(colour="red"), ("loops[0].colour",)),
+        (lambda d: d.update(loops={"B": 1}), ("'loops'", "expected a list of loops")),
+        (lambda d: d.update(actuated=["crank", "crank"]), ("actuated[1]", "listed twice")),
+        (lambda d: d.update(actuated=["arm"]), ("actuated[0]", "no link named 'arm'")),
+    ],
+)
+def test_bad_loops_and_actuated_fields_are_refused_naming_file_loop_and_field(change, words):
+    data = _fourbar_data()
+    change(data)
+    with pytest.raises(SymdynError) as err:
+        robot_from_data(data, "fourbar.yaml")
+    text = str(err.value)
+    assert text.startswith("fourbar.yaml: ") and "\n" not in text
+    for w in words:
+        assert w in text, text
+
+
+def _refused_generate(capsys, tmp_path, data: dict) -> str:
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(data))
+    out = tmp_path / "out"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        line = refused(capsys, "generate", str(path), "--target", "c", "--out", str(out), seconds=60)
+    assert not out.exists()
+    return line
+
+
+def test_a_loop_whose_lengths_never_meet_is_refused_and_nothing_written(capsys, tmp_path):
+    data = _fourbar_data()
+    data["parameters"]["d"] = 2.0  # ground longer than the other three bars together
+    line = _refused_generate(capsys, tmp_path, data)
+    assert "bad.yaml" in line and "loop 'B': cannot close" in line and "'loops'" in line
+
+
+def test_an_actuated_list_that_does_not_match_the_mobility_is_refused(capsys, tmp_path):
+    data = _fourbar_data()
+    data["actuated"] = ["crank", "rocker"]
+    line = _refused_generate(capsys, tmp_path, data)
+    assert "field 'actuated': 2 actuated joints (crank, rocker)" in line and "leave 1 degrees" in line
+    data["actuated"] = None  # the default: the joints on no loop (none here)
+    assert "0 actuated joints (none)" in _refused_generate(capsys, tmp_path, data)
+
+
+# -- the four-bar against its textbook closed forms
+
+
+def _freudenstein(a, b, c, d, t2):
+    """The rocker angles theta4 of a four-bar at crank angle theta2, both branches (R. L.
+    Norton, Design of Machinery (5th ed.), eq. 4.10: K1 = d/a, K2 = d/c, K3 = (a^2 - b^2 + c^2
+    + d^2)/(2 a c); theta4 = 2 atan2(-B -+ sqrt(B^2 - 4 A C), 2 A))."""
+    K1, K2, K3 = d / a, d / c, (a * a - b * b + c * c + d * d) / (2 * a * c)
+    A = math.cos(t2) - K1 - K2 * math.cos(t2) + K3
+    B = -2 * math.sin(t2)
+    C = K1 - (K2 + 1) * math.cos(t2) + K3
+    root = math.sqrt(B * B - 4 * A * C)
+    return [2 * math.atan2(-B - s * root, 2 * A) for s in (1, -1)]
+
+
+FOURBAR = {"a": 0.1, "b": 0.35, "c": 0.3, "d": 0.4, "m2": 0.5, "m3": 1.2, "m4": 1.0}
+
+
+def test_the_four_bar_closes_at_freudensteins_angle_with_the_textbook_inertia(tmp_path_factory):
+    robot, m = numpy_module("fourbar", tmp_path_factory)
+    a, b, c, d = (FOURBAR[k] for k in "abcd")
+    m2, m3, m4 = FOURBAR["m2"], FOURBAR["m3"], FOURBAR["m4"]
+    for t2 in np.linspace(0, 2 * np.pi, 7, endpoint=False):
+        it, q = m.solve_loops([t2], [t2, 0.3 - t2, 1.8])
+        assert 0 <= it <= 8
+        t3, t4 = q[0] + q[1], q[2]
+        assert min(abs(math.remainder(t4 - w, 2 * math.pi)) for w in _freudenstein(a, b, c, d, t2)) < 1e-12
+        # velocity ratios (Norton eq. 6.18): w3/w2, w4/w2
+        k3 = a * math.sin(t4 - t2) / (b * math.sin(t3 - t4))
+        k4 = a * math.sin(t2 - t3) / (c * math.sin(t4 - t3))
+        qd, _ = m.loop_motion(q, [1.0], [0.0])
+        np.testing.assert_allclose(qd, [1.0, k3 - 1.0, k4], rtol=1e-12, atol=1e-12)
+        # inertia reduced to the crank (bars about an end: m l^2/3):
+        # I_O2 + m3 |v_G3/w2|^2 + I_G3 k3^2 + I_O4 k4^2
+        vA = a * np.array([-math.sin(t2), math.cos(t2)])
+        vG3 = vA + k3 * b / 2 * np.array([-math.sin(t3), math.cos(t3)])
+        Ma = m2 * a * a / 3 + m3 * vG3 @ vG3 + m3 * b * b / 12 * k3**2 + m4 * c * c / 3 * k4**2
+        np.testing.assert_allclose(m.actuated_mass_matrix(q), [[Ma]], rtol=1e-12)
+
+
+def test_newton_gives_minus_one_at_a_singular_or_hopeless_guess(tmp_path_factory):
+    robot, m = numpy_module("fourbar", tmp_path_factory)
+    # coupler and rocker aligned (theta3 = theta4): K_p is singular
+    assert m.solve_loops([0.0], [0.0, 1.0, 1.0])[0] == -1
+    assert m.solve_loops([0.5], [0.5, np.nan, 1.0])[0] == -1
+
+
+# -- every example against the oracle
+
+
+@pytest.mark.parametrize("name", EXAMPLES)
+def test_generated_numpy_agrees_with_the_oracle(name, tmp_path_factory):
+    robot, m = numpy_module(name, tmp_path_factory)
+    for seed in (1, 2):
+        q, qda, qdda = closed_state(robot, m, seed)
+        assert np.abs(oc.closure(robot, q)[0]).max() < 1e-12
+        s = oc.loop_state(robot, q, qda, qdda)
+        qd, qdd = m.loop_motion(q, qda, qdda)
+        np.testing.assert_allclose(qd, s.qd, atol=1e-12)
+        np.testing.assert_allclose(qdd, s.qdd, atol=1e-10)
+        np.testing.assert_allclose(m.actuated_inverse_dynamics(q, qda, qdda), s.tau_a, atol=1e-10)
+        np.testing.assert_allclose(m.actuated_mass_matrix(q), s.Ma, atol=1e-11)
+        np.testing.assert_allclose(m.actuated_forward_dynamics(q, qda, s.tau_a), qdda, atol=1e-9)
+        # the closure forces: K^T lambda are the tree's efforts the motors do not give
+        applied = np.zeros(robot.n)
+        applied[s.act] = s.tau_a
+        K = m.loop_jacobian(q)
+        np.testing.assert_allclose(K.T @ m.loop_forces(q, qda, qdda), s.tau - applied, atol=1e-10)
+        # virtual work: the motors' power is the tree's power at the same motion
+        assert s.tau_a @ qda == pytest.approx(rnea(robot, q, qd, qdd) @ qd, abs=1e-10)
+        assert m.actuated_inverse_dynamics(q, qda, qdda) @ qda == pytest.approx(s.tau @ s.qd, abs=1e-10)
+
+
+@pytest.mark.parametrize("name", ["fourbar", "delta"])
+def test_finite_differences_of_the_solved_loop_give_W_and_the_passive_accelerations(name, tmp_path_factory):
+    robot, m = numpy_module(name, tmp_path_factory)
+    q, qda, qdda = closed_state(robot, m, 3)
+    act, _ = oc.split(robot)
+
+    def solved(t: float) -> np.ndarray:
+        it, out = m.solve_loops(q[act] + qda * t + qdda * t * t / 2, q)
+        assert it >= 0
+        return out
+
+    h = 2e-4
+    qd, qdd = m.loop_motion(q, qda, qdda)
+    np.testing.assert_allclose((solved(h) - solved(-h)) / (2 * h), qd, atol=1e-6)
+    np.testing.assert_allclose(
+        (solved(h) - 2 * q + solved(-h)) / h**2, qdd, atol=1e-4 * max(1, np.abs(qdd).max())
+    )
+
+
+def test_energy_is_conserved_when_the_four_bar_swings_freely(tmp_path_factory):
+    robot, m = numpy_module("fourbar", tmp_path_factory)
+    it, q = m.solve_loops([0.3], [0.3, -0.2, 1.6])
+    qa, qda = q[:1].copy(), np.array([2.0])
+    act = [0]
+
+    def energy(qa, qda, guess):
+        it, q = m.solve_loops(qa, guess)
+        assert it >= 0
+        qd, _ = m.loop_motion(q, qda, [0.0])
+        return kinetic_energy(robot, q, qd) + potential_energy(robot, q), q
+
+    def accel(qa, qda, guess):
+        it, q = m.solve_loops(qa, guess)
+        return m.actuated_forward_dynamics(q, qda, [0.0]), q
+
+    e0, _ = energy(qa, qda, q)
+    dt = 2e-3
+    for _ in range(250):  # RK4 on (q_a, qd_a), the loop solved at every stage (warm-started)
+        k1, q = accel(qa, qda, q)
+        k2, _ = accel(qa + dt / 2 * qda, qda + dt / 2 * k1, q)
+        k3, _ = accel(qa + dt / 2 * (qda + dt / 2 * k1), qda + dt / 2 * k2, q)
+        k4, _ = accel(qa + dt * (qda + dt / 2 * k2), qda + dt * k3, q)
+        qa = qa + dt * (qda + dt / 6 * (k1 + k2 + k3))
+        qda = qda + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    e1, q = energy(qa, qda, q)
+    assert abs(qa[0] - 0.3) > 0.5  # it moved
+    assert e1 == pytest.approx(e0, abs=1e-7 * max(1.0, abs(e0)))
+    del act
+
+
+# -- Pinocchio's constrained dynamics
+
+
+def _pinocchio_forward(pin, robot, q, qd, tau):
+    model = pinocchio_model(pin, robot)
+    data = model.createData()
+    num = robot.numeric()
+    models = []
+    for loop in num.loops:
+        pa = pin.SE3(np.eye(3), np.array(loop.point, dtype=float).reshape(3))
+        pb = pin.SE3(np.eye(3), np.array(loop.to_point, dtype=float).reshape(3))
+        models.append(
+            pin.RigidConstraintModel(
+                pin.ContactType.CONTACT_3D,
+                model,
+                loop.link + 1,
+                pa,
+                loop.to + 1,
+                pb,
+                pin.ReferenceFrame.LOCAL,
+            )
+        )
+    models = pin.StdVec_RigidConstraintModel(models)
+    datas = pin.StdVec_RigidConstraintData([c.createData() for c in models])
+    pin.initConstraintDynamics(model, data, models, datas)
+    settings = pin.ProximalSettings(1e-14, 1e-10, 100)
+    return pin.constraintDynamics(model, data, q, qd, tau, models, datas, settings)
+
+
+@pytest.mark.parametrize("name", ["fourbar", "fivebar", "parallelogram_arm"])
+def test_actuated_forward_dynamics_agrees_with_pinocchios_constraint_dynamics(name, tmp_path_factory):
+    pin = pytest.importorskip("pinocchio")
+    robot, m = numpy_module(name, tmp_path_factory)
+    q, qda, _ = closed_state(robot, m, 4)
+    tau_a = np.random.default_rng(5).standard_normal(len(qda))
+    qd, _ = m.loop_motion(q, qda, np.zeros(len(qda)))
+    tau = np.zeros(robot.n)
+    act, _ = oc.split(robot)
+    tau[act] = tau_a
+    qdd = _pinocchio_forward(pin, robot, q, qd, tau)
+    qdda = m.actuated_forward_dynamics(q, qda, tau_a)
+    np.testing.assert_allclose(qdda, qdd[act], rtol=1e-7, atol=1e-7)
+    _, qdd_all = m.loop_motion(q, qda, qdda)
+    np.testing.assert_allclose(qdd_all, qdd, rtol=1e-7, atol=1e-7)
+
+
+# -- the generated C
+
+
+def test_generated_c_compiles_strictly_and_agrees_with_the_oracle(tmp_path):
+    robot, files = generated("fourbar", ("c",))
+    write_files(files, tmp_path)
+    lib = ctypes.CDLL(str(compile_shared([tmp_path / "fourbar_dynamics.c"], tmp_path / "libfourbar.so")))
+    header = files["fourbar_dynamics.h"]
+    assert "#define fourbar_NACT 1" in header and "#define fourbar_NPAS 2" in header
+    P = ctypes.POINTER(ctypes.c_double)
+
+    def ptr(a):
+        return a.ctypes.data_as(P)
+
+    q, guess = np.zeros(3), np.array([0.7, -0.2, 1.6])
+    solve = lib.fourbar_solve_loops
+    solve.restype = ctypes.c_int
+    assert solve(ptr(np.array([0.7])), ptr(guess), None, ptr(q)) >= 0
+    assert np.abs(oc.closure(robot, q)[0]).max() < 1e-12
+    assert solve(ptr(np.array([0.0])), ptr(np.array([0.0, 1.0, 1.0])), None, ptr(np.zeros(3))) == -1
+    qda, qdda = np.array([1.3]), np.array([-0.4])
+    s = oc.loop_state(robot, q, qda, qdda)
+    out = np.zeros(1)
+    lib.fourbar_actuated_inverse_dynamics(ptr(q), ptr(qda), ptr(qdda), None, ptr(out))
+    np.testing.assert_allclose(out, s.tau_a, atol=1e-12)
+    lib.fourbar_actuated_mass_matrix(ptr(q), None, ptr(out))
+    np.testing.assert_allclose(out, s.Ma.ravel(), atol=1e-12)
+    lib.fourbar_actuated_forward_dynamics(ptr(q), ptr(qda), ptr(s.tau_a.copy()), None, ptr(out))
+    np.testing.assert_allclose(out, qdda, atol=1e-11)
