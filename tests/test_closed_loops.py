@@ -27,12 +27,13 @@ from symdyn.parsers import robot_from_data
 from symdyn.rnea import kinetic_energy, potential_energy, rnea
 
 EXAMPLES = ("fourbar", "fivebar", "delta", "parallelogram_arm")
+LOOPS_DIR = EXAMPLES_DIR / "closed_loops"
 
 
 def _load(name: str):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return symdyn.load_robot(EXAMPLES_DIR / f"{name}.yaml")
+        return symdyn.load_robot(LOOPS_DIR / f"{name}.yaml")
 
 
 @cache
@@ -71,7 +72,7 @@ def closed_state(robot, module, seed: int):
 
 
 def _fourbar_data() -> dict:
-    return yaml.safe_load((EXAMPLES_DIR / "fourbar.yaml").read_text())
+    return yaml.safe_load((LOOPS_DIR / "fourbar.yaml").read_text())
 
 
 def test_the_four_bar_file_gives_its_loop_and_actuated_joint():
