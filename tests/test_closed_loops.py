@@ -8,6 +8,8 @@ from __future__ import annotations
 import ctypes
 import importlib.util
 import math
+import shutil
+import subprocess
 import warnings
 from functools import cache
 
@@ -339,3 +341,55 @@ def test_generated_c_compiles_strictly_and_agrees_with_the_oracle(tmp_path):
     np.testing.assert_allclose(out, s.Ma.ravel(), atol=1e-12)
     lib.fourbar_actuated_forward_dynamics(ptr(q), ptr(qda), ptr(s.tau_a.copy()), None, ptr(out))
     np.testing.assert_allclose(out, qdda, atol=1e-11)
+
+
+# -- CasADi, MATLAB/Octave and LaTeX
+
+
+def test_casadi_solves_the_loops_with_unrolled_steps_and_agrees_with_the_oracle(tmp_path):
+    pytest.importorskip("casadi")
+    robot, files = generated("fourbar", ("casadi", "matlab", "latex"))
+    write_files({k: v for k, v in files.items() if k.endswith(".py")}, tmp_path)
+    spec = importlib.util.spec_from_file_location("_loops_fourbar_casadi", tmp_path / "fourbar_casadi.py")
+    m = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(m)
+    solve = m.build_solve_loops()
+    q, it = solve([0.7], [0.7, -0.2, 1.6], [])
+    q = np.array(q).ravel()
+    assert 0 < int(it) <= 8 and np.abs(oc.closure(robot, q)[0]).max() < 1e-12
+    assert int(solve([0.0], [0.0, 1.0, 1.0], [])[1]) == -1  # K_p singular
+    assert int(solve([0.5], [0.5, np.nan, 1.0], [])[1]) == -1
+    s = oc.loop_state(robot, q, [1.3], [-0.4])
+    f = m.functions()
+    assert float(f["actuated_inverse_dynamics"](q, 1.3, -0.4, [])) == pytest.approx(s.tau_a[0], abs=1e-12)
+    assert float(f["actuated_forward_dynamics"](q, 1.3, s.tau_a, [])) == pytest.approx(-0.4, abs=1e-11)
+
+
+@pytest.mark.skipif(shutil.which("octave-cli") is None, reason="GNU Octave (octave-cli) is not installed")
+def test_octave_solves_the_loops_and_agrees_with_the_oracle(tmp_path):
+    robot, files = generated("fourbar", ("casadi", "matlab", "latex"))
+    write_files({k: v for k, v in files.items() if k.endswith(".m")}, tmp_path)
+    script = (
+        "[q, it] = fourbar_solve_loops(0.7, [0.7 -0.2 1.6]); [~, bad] = fourbar_solve_loops(0, [0 1 1]);"
+        "tau = fourbar_actuated_inverse_dynamics(q, 1.3, -0.4, []);"
+        "printf('%d %d %.17g %.17g %.17g %.17g\\n', it, bad, q, tau);"
+    )
+    out = subprocess.run(
+        ["octave-cli", "--no-gui", "-q", "--eval", script],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    it, bad, *values = out.stdout.split()
+    assert 0 < int(it) <= 8 and int(bad) == -1
+    q, tau = np.array(values[:3], dtype=float), float(values[3])
+    assert np.abs(oc.closure(robot, q)[0]).max() < 1e-12
+    assert tau == pytest.approx(oc.loop_state(robot, q, [1.3], [-0.4]).tau_a[0], abs=1e-12)
+
+
+def test_latex_prints_the_closure_and_its_jacobian():
+    _, files = generated("fourbar", ("casadi", "matlab", "latex"))
+    tex = files["fourbar_dynamics.tex"]
+    assert "\\section*{Closed loops}" in tex and "Loop \\texttt{B}: a point of \\texttt{coupler}" in tex
+    assert "phi_{2} &=" in tex and "K_{2,3} &=" in tex and "phi_{3}" not in tex

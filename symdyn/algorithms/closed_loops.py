@@ -19,9 +19,10 @@ phi_dot = K qd on the closure, and the drift, with w_B the angular velocity of B
 
 Rows that depend on the others (a planar loop's out-of-plane rows, a loop whose constraints
 repeat another's) are dropped: `analyse` assembles the loops numerically (damped Gauss-Newton
-on phi from several seeded random starts) and keeps, in order, the rows that raise the numeric rank of K at the assembled
-configurations. The mobility is n - rank K; with q split into the actuated q_a (Robot.
-actuated_links) and the passive q_p, K = [K_a K_p] and K_p must be square and invertible:
+on phi from several seeded random starts) and keeps, in order, the rows that raise the
+numeric rank of K at the assembled configurations. The mobility is n - rank K; with q split
+into the actuated q_a (Robot.actuated_links) and the passive q_p, K = [K_a K_p] and K_p
+must be square and invertible:
 
     qd = W qd_a,  W = [I; -K_p^-1 K_a]         qdd = W qdd_a - [0; K_p^-1 Kdot qd]
 

@@ -9,7 +9,7 @@
     actuated_inverse_dynamics(q, qda, qdda, p, tau_a)      tau_a = W^T tau(q, qd, qdd)
     actuated_mass_matrix(q, p, Ma)                 M_a = W^T M W
     actuated_forward_dynamics(q, qda, tau_a, p, qdda)      M_a qdd_a = tau_a - W^T tau(q, qd, qdd|qdd_a=0)
-    loop_forces(q, qda, qdda, p, lambda)           lambda = K_p^-T tau_p(q, qd, qdd)
+    loop_forces(q, qda, qdda, p, lam)              lambda = K_p^-T tau_p(q, qd, qdd) (lam: Python keyword)
 
 q is the whole tree's configuration (closed: phi(q) = 0), qda, qdda and tau_a the actuated
 coordinates' rates, accelerations and efforts in coordinate order. tau(q, qd, qdd) is the
@@ -192,7 +192,7 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             "loop_forces",
             "lambda = K_p^-T tau_p, the closure forces (world axes, on the loop's link side)",
             (x.q, qda, qdda, x.p),
-            (out("lambda", npas, 1, "closure forces; K^T lambda are their joint efforts", ("npas", "1")),),
+            (out("lam", npas, 1, "closure forces; K^T lambda are their joint efforts", ("npas", "1")),),
             _entries(lam),
         ),
     ]

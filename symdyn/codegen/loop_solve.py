@@ -15,8 +15,9 @@ template spells the loop from `loop_solve_view`.
 from __future__ import annotations
 
 from ..model.robot import Robot
+from .render import RenderContext
 
-__all__ = ["MAX_ITERATIONS", "TOLERANCE", "PIVOT", "loop_solve_view"]
+__all__ = ["MAX_ITERATIONS", "TOLERANCE", "PIVOT", "loop_solve_view", "loop_solve_context"]
 
 #: The bound on Newton steps of NAME_solve_loops.
 MAX_ITERATIONS = 50
@@ -39,3 +40,14 @@ def loop_solve_view(robot: Robot, npas: int) -> dict:
         "tol": dict(TOLERANCE),
         "pivot": dict(PIVOT),
     }
+
+
+def loop_solve_context(ctx: RenderContext, precision: str | None = None) -> dict | None:
+    """`loop_solve_view` with the tolerance and pivot bound of `precision` (ctx's by default),
+    for a rendering whose functions include loop_newton_step; None otherwise."""
+    step = next((f for f in ctx.functions if f.name == "loop_newton_step"), None)
+    if step is None:
+        return None
+    view = loop_solve_view(ctx.robot, step.results[0].rows)
+    precision = precision or ctx.precision
+    return {**view, "tol": view["tol"][precision], "pivot": view["pivot"][precision]}

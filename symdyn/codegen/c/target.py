@@ -18,7 +18,7 @@ from __future__ import annotations
 from ...errors import SymdynError
 from ..frame_functions import comment_text
 from ..functions import FunctionSpec
-from ..loop_solve import loop_solve_view
+from ..loop_solve import loop_solve_context
 from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
@@ -145,17 +145,16 @@ def render_context(ctx: RenderContext) -> dict:
 def _loops_view(ctx: RenderContext, names: CNames) -> dict | None:
     """NAME_solve_loops' data (templates/c/dynamics.c.j2) for a robot with loops: sizes, the
     coordinates it sets and solves, its tolerance and iteration bound (symdyn.codegen.loop_solve)."""
-    step = next((f for f in ctx.functions if f.name == "loop_newton_step"), None)
-    if step is None:
+    view = loop_solve_context(ctx)
+    if view is None:
         return None
-    view = loop_solve_view(ctx.robot, step.results[0].rows)
     suffix = CConfig(ctx.precision).literal_suffix
     return {
         **view,
         "nact": names.dims["nact"],
         "npas": names.dims["npas"],
-        "tol": f"{view['tol'][ctx.precision]}{suffix}",
-        "pivot": f"{view['pivot'][ctx.precision]}{suffix}",
+        "tol": f"{view['tol']}{suffix}",
+        "pivot": f"{view['pivot']}{suffix}",
         "abs": "fabsf" if ctx.precision == "float" else "fabs",
         "step": names.functions["loop_newton_step"],
         "c_name": f"{ctx.name}_solve_loops",

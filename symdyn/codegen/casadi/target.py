@@ -27,6 +27,7 @@ from dataclasses import asdict, replace
 from ...errors import SymdynError
 from ...loading import load_module
 from ..functions import FunctionSpec
+from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
 from .printer import CasadiPrinter, input_names
 
@@ -99,6 +100,7 @@ def render_module(ctx: RenderContext) -> str:
         params=[str(p) for p in ctx.dynamics.params],
         functions=views,
         uses_math=uses_math,
+        loops=loop_solve_context(ctx, "double"),
     )
 
 

@@ -15,7 +15,7 @@ import sympy as sp
 from ..frame_functions import comment_text, frame_function_names
 from ..render import RenderContext, environment
 
-__all__ = ["frames_latex"]
+__all__ = ["frames_latex", "function_blocks", "tex_text"]
 
 
 def _tex(text: str) -> str:
@@ -24,12 +24,23 @@ def _tex(text: str) -> str:
     return re.sub(r"([_#%&{}$])", r"\\\1", re.sub(r"[\^~\\]", "?", comment_text(text)))
 
 
+tex_text = _tex
+
+
 def frames_latex(ctx: RenderContext) -> str:
     """The section of ctx's frame functions (empty without them)."""
     known = frame_function_names(ctx.frames) if ctx.frames else set()
     names = [f.name for f in ctx.functions if f.name in known]
     if not names:
         return ""
+    blocks = function_blocks(ctx, names)
+    frames = [(_tex(n), _tex(i), comment_text(link)) for n, i, link in ctx.frames]
+    return environment().get_template("latex/frames.tex.j2").render(blocks=blocks, frames=frames)
+
+
+def function_blocks(ctx: RenderContext, names: list[str]) -> list[dict]:
+    """One block per generated function of `names`: its name, doc and align rows (the
+    definitions x_k, then every output entry)."""
     dyn = ctx.dynamics
     symbols = {}
     for head, v in (("q", dyn.q), ("\\dot{q}", dyn.qd)):
@@ -47,5 +58,4 @@ def frames_latex(ctx: RenderContext) -> str:
                 index = f"{i + 1},{j + 1}" if r.matrix else f"{i + 1}"
                 rows.append(f"{label}_{{{index}}} &= {sp.latex(sp.sympify(e), symbol_names=local)}")
         blocks.append({"name": _tex(name), "doc": comment_text(spec.doc), "rows": rows})
-    frames = [(_tex(n), _tex(i), comment_text(link)) for n, i, link in ctx.frames]
-    return environment().get_template("latex/frames.tex.j2").render(blocks=blocks, frames=frames)
+    return blocks

@@ -34,6 +34,7 @@ from ...symbolic.simplify import eliminate
 from ..render import RenderContext, environment, header_lines
 from .base_parameters import base_parameters_latex
 from .frames import frames_latex
+from .loops import loops_latex
 from .notation import MATRIX_WIDTH, Notation, escape_text, width
 from .product import product_blocks, product_choice
 
@@ -177,6 +178,7 @@ def render(ctx: RenderContext) -> dict[str, str]:
     if any(f.name == "base_regressor" for f in ctx.functions):
         body += base_parameters_latex(ctx.dynamics)
     body += frames_latex(ctx)
+    body += loops_latex(ctx)
     text = (
         environment()
         .get_template("latex/dynamics.tex.j2")

@@ -19,6 +19,7 @@ import re
 
 from ...errors import SymdynError
 from ..functions import FunctionSpec
+from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, MatlabNames, matlab_names
 from .printer import MatlabPrinter
@@ -83,5 +84,21 @@ def render(ctx: RenderContext) -> dict[str, str]:
         view = function_view(ctx, names, spec)
         files[f"{view['name']}.m"] = template.render(
             f=view, header_lines=header_lines(ctx), n=ctx.robot.n, params=params
+        )
+    loops = loop_solve_context(ctx)
+    if loops is not None:
+        name = f"{ctx.name}_solve_loops"
+        files[f"{name}.m"] = (
+            environment()
+            .get_template("matlab/solve_loops.m.j2")
+            .render(
+                name=name,
+                step=names.functions["loop_newton_step"],
+                loops=loops,
+                header_lines=header_lines(ctx),
+                n=ctx.robot.n,
+                actuated=[j + 1 for j in loops["actuated"]],
+                passive=[j + 1 for j in loops["passive"]],
+            )
         )
     return files

@@ -17,7 +17,7 @@ expressions); every Python statement is spelled in templates/python/module.py.j2
 from __future__ import annotations
 
 from ..functions import FunctionSpec
-from ..loop_solve import loop_solve_view
+from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
 from .printer import NumpyPrinter, dtype, local_names
 
@@ -65,15 +65,6 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
     }
 
 
-def _loops(ctx: RenderContext) -> dict | None:
-    """solve_loops' data (symdyn.codegen.loop_solve) for a robot with loops, else None."""
-    step = next((f for f in ctx.functions if f.name == "loop_newton_step"), None)
-    if step is None:
-        return None
-    view = loop_solve_view(ctx.robot, step.results[0].rows)
-    return {**view, "tol": view["tol"][ctx.precision], "pivot": view["pivot"][ctx.precision]}
-
-
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_numpy.py: module text} for the robot of `ctx`."""
     printer = NumpyPrinter(local_names(ctx))
@@ -87,7 +78,7 @@ def render(ctx: RenderContext) -> dict[str, str]:
             param_names=[s.name for s in ctx.dynamics.params],
             dtype=dtype(ctx.precision),
             functions=[_function(spec, printer) for spec in ctx.functions],
-            loops=_loops(ctx),
+            loops=loop_solve_context(ctx),
         )
     )
     return {file_name(ctx.name): text}
