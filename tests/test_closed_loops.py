@@ -393,3 +393,44 @@ def test_latex_prints_the_closure_and_its_jacobian():
     tex = files["fourbar_dynamics.tex"]
     assert "\\section*{Closed loops}" in tex and "Loop \\texttt{B}: a point of \\texttt{coupler}" in tex
     assert "phi_{2} &=" in tex and "K_{2,3} &=" in tex and "phi_{3}" not in tex
+
+
+# -- symdyn simulate
+
+
+def test_simulate_integrates_the_actuated_joints_and_closes_the_loops_every_step(capsys, tmp_path):
+    from symdyn.cli.main import main
+
+    robot = _load("fourbar")
+    out = tmp_path / "fb.csv"
+    args = ["simulate", str(LOOPS_DIR / "fourbar.yaml"), "--q0", "0.7", "-0.2", "1.6", "--qd0", "2", "0", "0"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main([*args, "--tau", "0.05", "--duration", "0.2", "--dt", "0.005", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].startswith(f"{out}: 41 samples") and "1 actuated joints" in printed[0]
+    assert printed[1].startswith("largest closure residual max |phi|: ")
+    assert float(printed[1].split()[-1]) <= 1e-12
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    for row in data[::10]:
+        q, qd = row[1:4], row[4:7]
+        phi, K, _ = oc.closure(robot, q)
+        assert np.abs(phi).max() < 1e-11 and np.abs(K @ qd).max() < 1e-10
+    # the crank's power equals the rate of change of the energy (no friction): E(t) - E(0) = tau int qd1
+    energy = [kinetic_energy(robot, r[1:4], r[4:7]) + potential_energy(robot, r[1:4]) for r in data]
+    work = 0.05 * (data[-1, 1] - data[0, 1])
+    assert energy[-1] - energy[0] == pytest.approx(work, abs=1e-7)
+    line = refused(
+        capsys,
+        *args,
+        "--integrator",
+        "rk45",
+        "--duration",
+        "0.1",
+        "--dt",
+        "0.01",
+        "--out",
+        str(out),
+        seconds=60,
+    )
+    assert "integrated with rk4 or semi-implicit, not 'rk45'" in line

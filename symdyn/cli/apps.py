@@ -218,6 +218,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             progress=True if args.progress else None,
             **tolerances,
         )
+    elif "actuated_forward_dynamics" in plant.functions:
+        return _simulate_loops(args, plant)
     else:
         q0 = _vector(args.q0, n, "--q0", default=np.zeros(n))
         qd0 = _vector(args.qd0, n, "--qd0", default=np.zeros(n))
@@ -249,6 +251,35 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             + "; maximum over the last half "
             + ", ".join(f"{x:.3g}" for x in err[len(err) // 2 :].max(axis=0))
         )
+    if args.plot:
+        print(args.plot)
+    return 0
+
+
+def _simulate_loops(args: argparse.Namespace, plant) -> int:
+    """simulate for a robot with closed loops (symdyn.apps.loop_simulate): --q0 every joint (a
+    closed configuration or a guess near one), --qd0 every joint (its actuated entries used),
+    --tau the actuated joints' efforts."""
+    from ..apps.loop_simulate import simulate_loops
+    from ..apps.output import write_atomic
+    from ..apps.trajectory import plot_trajectory
+
+    n, nact = plant.n, len(plant.module.ACTUATED)
+    q0 = _vector(args.q0, n, "--q0", default=np.zeros(n))
+    qd0 = _vector(args.qd0, n, "--qd0", default=np.zeros(n))
+    tau = None if args.tau is None else _torques(args.tau, nact)
+    traj, residual = simulate_loops(
+        plant, q0, qd0, duration=args.duration, dt=args.dt, tau=tau, integrator=args.integrator
+    )
+    image = plot_trajectory(traj) if args.plot else None
+    write_atomic(args.out, traj.csv_bytes())
+    if image is not None:
+        write_atomic(args.plot, image)
+    print(
+        f"{args.out}: {len(traj.t)} samples, t = 0 .. {traj.t[-1]:g} s, dt = {args.dt:g} s, "
+        f"integrator {traj.integrator}, {nact} actuated joints"
+    )
+    print(f"largest closure residual max |phi|: {residual:.3g}")
     if args.plot:
         print(args.plot)
     return 0
