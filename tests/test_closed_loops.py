@@ -434,3 +434,51 @@ def test_simulate_integrates_the_actuated_joints_and_closes_the_loops_every_step
         seconds=60,
     )
     assert "integrated with rk4 or semi-implicit, not 'rk45'" in line
+
+
+def test_a_weld_closes_position_and_orientation_and_agrees_with_the_oracle(tmp_path_factory):
+    """Four planar bars from the base whose last frame is welded back to the base frame: 6
+    closure rows, 3 out of the plane dropped, mobility 1 (the weld's rotation rows and drift)."""
+    bar = {
+        "joint": "revolute",
+        "a": 0.3,
+        "mass": 1.0,
+        "com": [0.15, 0, 0],
+        "inertia": {"iyy": 0.01, "izz": 0.01},
+    }
+    data = {
+        "name": "welded",
+        "convention": "modified",
+        "links": [{"name": "b1", **{**bar, "a": 0}}]
+        + [{"name": f"b{i}", "parent": f"b{i - 1}", **bar} for i in range(2, 5)],
+        "loops": [
+            {
+                "name": "W",
+                "link": "b4",
+                "point": [0.3, 0, 0],
+                "to": "base",
+                "to_point": [0.5, 0, 0],
+                "type": "weld",
+            }
+        ],
+        "actuated": ["b1"],
+    }
+    robot = robot_from_data(data, "welded.yaml")
+    an = analyse(robot.resolved())
+    assert an.rows == (0, 1, 5) and an.passive == (1, 2, 3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        files = render(robot, targets=("python",))
+    path = tmp_path_factory.mktemp("welded") / "welded_numpy.py"
+    path.write_text(files["welded_numpy.py"])
+    spec = importlib.util.spec_from_file_location("_loops_welded", path)
+    m = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(m)
+    q, qda, qdda = closed_state(robot, m, 6)
+    phi, _, _ = oc.closure(robot, q)
+    assert np.abs(phi).max() < 1e-12  # the oracle's closure: positions and the rotation vector
+    assert abs(math.remainder(q.sum(), 2 * math.pi)) < 1e-12  # the frames' orientations agree
+    s = oc.loop_state(robot, q, qda, qdda)
+    np.testing.assert_allclose(m.loop_motion(q, qda, qdda)[1], s.qdd, atol=1e-10)
+    np.testing.assert_allclose(m.actuated_inverse_dynamics(q, qda, qdda), s.tau_a, atol=1e-10)
+    np.testing.assert_allclose(m.actuated_forward_dynamics(q, qda, s.tau_a), qdda, atol=1e-9)
