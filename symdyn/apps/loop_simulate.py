@@ -31,6 +31,17 @@ __all__ = ["LOOP_INTEGRATORS", "close_loops", "simulate_loops"]
 LOOP_INTEGRATORS = ("rk4", "semi-implicit")
 
 
+def _joints(values, n: int, name: str) -> np.ndarray:
+    """n finite numbers, or a SymdynError naming `name`."""
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise SymdynError(f"{name} must hold numbers, got {values!r}") from None
+    if a.shape != (n,) or not np.all(np.isfinite(a)):
+        raise SymdynError(f"{name} must be {n} finite numbers (one per joint), got shape {a.shape}")
+    return a
+
+
 def close_loops(plant: CompiledDynamics, qa: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, float]:
     """(q, max |phi|): q with q[ACTUATED] = qa and the passive joints solved by Newton's method
     from `guess` (the generated module's LOOP_TOL, LOOP_MAX_ITERATIONS and LOOP_PIVOT).
@@ -75,8 +86,8 @@ def simulate_loops(
             raise SymdynError(f"{name} must be a positive number, got {v!r}")
     m = plant.module
     act, n = list(m.ACTUATED), plant.n
-    q = np.asarray(q0, dtype=float).reshape(n)
-    qda = np.zeros(len(act)) if qd0 is None else np.asarray(qd0, dtype=float).reshape(n)[act]
+    q = _joints(q0, n, "q0")
+    qda = np.zeros(len(act)) if qd0 is None else _joints(qd0, n, "qd0")[act]
     torque = torque_function(tau, len(act))
     t, h = sample_times(duration, dt)
     q, worst = close_loops(plant, q[act], q)
