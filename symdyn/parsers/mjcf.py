@@ -31,7 +31,8 @@ by symdyn's free flyer, whose coordinates are Pinocchio's (symdyn.model.free_fly
 welded to the world are the scenery and are left out.
 
 Refused, naming the file, body and joint: ball joints; a free joint below the root, or more than
-one; a floating model with joints outside the floating body's tree. Warned about and ignored: joint stiffness (springs), gravity compensation and
+one; a floating model with joints outside the floating body's tree.
+Warned about and ignored: joint stiffness (springs), gravity compensation and
 equality constraints, which symdyn does not model. Every number is a compiled double
 (symdyn.parsers.mjcf_values: rotations snapped to exact multiples of pi/2 within 1e-9 rad).
 """

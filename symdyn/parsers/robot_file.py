@@ -31,10 +31,10 @@ from ..errors import SymdynError, link_fields
 from ..model.angles import constant_angle
 from ..model.bounded import bounded_subs
 from ..model.frames import Frame
+from ..model.free_flyer import BASE_NAMES
 from ..model.friction import coulomb_fields
 from ..model.inertia import tensor_from_components
 from ..model.physical import check_link_numbers
-from ..model.free_flyer import BASE_NAMES
 from ..model.robot import DEFAULT_GRAVITY, BaseBody, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
