@@ -7,9 +7,9 @@ configurations with random unit quaternions the oracle's rnea, mass_matrix, bias
 gravity_torque, gravity_torque must equal Pinocchio's rnea, crba, nonLinearEffects and
 computeGeneralizedGravity, and forward_dynamics Pinocchio's aba (within the conditioning of M: the
 two round differently; Pinocchio's rnea takes the oracle's acceleration back to tau). Joints are
-matched by name (as in tests/test_urdf_sweep.py, whose helpers this reuses); where Pinocchio cannot place the mimic
-joints its model without them is projected onto the independent coordinates. The worst error per
-file prints with `pytest -s`.
+matched by name (as in tests/test_urdf_sweep.py, whose helpers this reuses); where Pinocchio
+cannot place the mimic joints its model without them is projected onto the independent
+coordinates. The worst error per file prints with `pytest -s`.
 """
 
 from __future__ import annotations
