@@ -6,13 +6,17 @@ prismatic joint, products of inertia) and Solo-12 (whose dynamics Pinocchio comp
 
 from __future__ import annotations
 
+import ctypes
+import types
 from pathlib import Path
 
 import numpy as np
 import pytest
+from cbuild import compile_shared, header_macros, write_files
 
 import symdyn
 from symdyn import SymdynError
+from symdyn.codegen import render
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import bias_torque, friction_torque, gravity_torque, mass_matrix
 
@@ -115,3 +119,88 @@ def test_bad_input(arm):
         dyn.evaluate("M", np.zeros(5))
     with pytest.raises(SymdynError, match=r"rnea: v has 3 entries, expected 9 \(NV = 6 \+ joints"):
         symdyn.rnea(robot, np.zeros(10), np.zeros(3), np.zeros(9))
+
+
+# --------------------------------------------------------------------------- generated code
+
+SIGNATURES = {
+    "inverse_dynamics": (("q", "qd", "qdd"), "v"),
+    "mass_matrix": (("q",), "M"),
+    "coriolis": (("q", "qd"), "v"),
+    "gravity": (("q",), "v"),
+    "friction": (("qd",), "v"),
+    "forward_dynamics": (("q", "qd", "tau"), "v"),
+}
+
+
+def _module(text: str, name: str) -> types.ModuleType:
+    module = types.ModuleType(name)
+    exec(compile(text, name, "exec"), module.__dict__)  # symdyn's own output
+    return module
+
+
+class _C:
+    """The compiled functions of a floating robot, called with NumPy arrays (q of NQ, others NV)."""
+
+    def __init__(self, files, out: Path, name: str):
+        write_files({k: v for k, v in files.items() if k.startswith(f"{name}_dynamics.")}, out)
+        self.macros = header_macros((out / f"{name}_dynamics.h").read_text())
+        lib = ctypes.CDLL(str(compile_shared([out / f"{name}_dynamics.c"], out / f"lib{name}.so")))
+        self.nq, self.nv = int(self.macros[f"{name}_NQ"]), int(self.macros[f"{name}_NV"])
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self.functions = {}
+        for fname, (args, _) in SIGNATURES.items():
+            f = getattr(lib, f"{name}_{fname}")
+            f.argtypes = [ptr] * (len(args) + 2)
+            self.functions[fname] = f
+        self.ptr = ptr
+
+    def __call__(self, fname, *args):
+        names, kind = SIGNATURES[fname]
+        arrays = [np.ascontiguousarray(x, dtype=float) for x in args]
+        for name, a in zip(names, arrays, strict=True):
+            assert a.shape == ((self.nq,) if name == "q" else (self.nv,))
+        out = np.full((self.nv, self.nv) if kind == "M" else (self.nv,), np.nan)
+        self.functions[fname](
+            *(a.ctypes.data_as(self.ptr) for a in arrays), None, out.ctypes.data_as(self.ptr)
+        )
+        return out
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory):
+    robot = symdyn.load_robot(ARM)
+    files = render(robot, targets=("c", "python", "casadi", "matlab"))
+    return robot, files, _C(files, tmp_path_factory.mktemp("floating_c"), robot.name)
+
+
+def test_generated_functions_equal_the_oracle(generated):
+    robot, files, c = generated
+    assert (c.nq, c.nv, int(c.macros["floating_arm_NDOF"])) == (robot.n + 7, robot.n + 6, robot.n + 6)
+    assert "coriolis_matrix" not in files["floating_arm_numpy.py"]
+    numpy_module = _module(files["floating_arm_numpy.py"], "floating_numpy")
+    assert (numpy_module.NQ, numpy_module.NV, numpy_module.NDOF) == (10, 9, 9)
+    casadi_functions = _module(files["floating_arm_casadi.py"], "floating_casadi").functions()
+    rng = np.random.default_rng(8)
+    q, v, a = _state(robot, rng)
+    tau = symdyn.rnea(robot, q, v, a)
+    expected = {
+        "inverse_dynamics": ((q, v, a), tau),
+        "mass_matrix": ((q,), mass_matrix(robot, q)),
+        "coriolis": ((q, v), bias_torque(robot, q, v)),
+        "gravity": ((q,), gravity_torque(robot, q)),
+        "friction": ((v,), friction_torque(robot, v)),
+        "forward_dynamics": ((q, v, tau), a),
+    }
+    for fname, (args, value) in expected.items():
+        np.testing.assert_allclose(c(fname, *args), value, atol=1e-10, err_msg=f"C {fname}")
+        np.testing.assert_allclose(getattr(numpy_module, fname)(*args), value, atol=1e-10, err_msg=fname)
+        got = np.array(casadi_functions[fname](*args, np.zeros(0))).reshape(np.shape(value))
+        np.testing.assert_allclose(got, value, atol=1e-10, err_msg=f"CasADi {fname}")
+    assert "floating_arm_forward_dynamics.m" in files
+
+
+def test_other_function_groups_are_refused_on_a_floating_robot(arm):
+    robot, _ = arm
+    with pytest.raises(SymdynError, match=r"floating base: the regressor functions are not generated"):
+        render(robot, targets=("python",), functions=["dynamics", "regressor"])
