@@ -232,7 +232,7 @@ FLOATING_GROUPS = ("dynamics",)
 
 def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
     """The groups of a floating robot: FLOATING_GROUPS by default; any other is a SymdynError."""
-    if groups is None:
+    if groups is None or set(groups) == set(GROUPS):  # the default, or --functions all
         return FLOATING_GROUPS
     other = [g for g in groups if g not in FLOATING_GROUPS]
     if other:
