@@ -49,7 +49,7 @@ from .algorithms.configuration_space import ConfigurationSpace, configuration_sp
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
-from .algorithms.floating import floating_newton_euler_terms
+from .algorithms.floating import floating_lagrange_terms, floating_newton_euler_terms
 from .algorithms.frame_kinematics import FrameKinematics
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
@@ -620,14 +620,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
     r = robot.resolved()
     q, qd, qdd = state_symbols(r)
     program = Program()
-    if r.floating and method != "newton-euler":
-        raise SymdynError(
-            f"derive: robot '{r.name}' has a floating base: derive it by the newton-euler method "
-            "(the Lagrange route does not handle a floating base yet)"
-        )
     with distribute(False):
         if r.floating:
-            terms = floating_newton_euler_terms(r, q, qd, qdd, program)
+            route = floating_newton_euler_terms if method == "newton-euler" else floating_lagrange_terms
+            terms = route(r, q, qd, qdd, program)
         elif method == "newton-euler":
             terms = _newton_euler_terms(r, q, qd, qdd, program)
         else:
@@ -637,10 +633,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         if r.floating:
             F = sp.Matrix.vstack(sp.zeros(6, 1), F)
         terms["F"] = F
-        if method == "lagrange":
+        if method == "lagrange" and not r.floating:
             terms["tau"] = terms["M"] * qdd + terms["V"] + terms["G"] + F
             terms["bias"] = terms["V"] + terms["G"] + F
-        else:
+        else:  # the Newton-Euler route, or the floating Lagrange route (tau and bias without F)
             terms["tau"] = terms["tau"] + F
             terms["bias"] = terms["bias"] + F
     if simplify is None:
