@@ -150,7 +150,7 @@ def generate(path: Path, out: Path) -> tuple[float, float]:
     """Wall and CPU seconds of `symdyn generate PATH --floating --functions dynamics --target c`."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    cmd = [sys.executable, "-m", "symdyn", "generate", str(path), "--floating", "--functions", "dynamics"]
+    cmd = [sys.executable, "-m", "symdyn.cli", "generate", str(path), "--floating", "--functions", "dynamics"]
     subprocess.run([*cmd, "--target", "c", "--out", str(out)], check=True, capture_output=True)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
