@@ -5,20 +5,31 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METHODS"]
+__all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METHODS", "FLOATING_COMMANDS"]
 
 #: symdyn.dynamics.METHODS, spelled here so that building the parser imports no SymPy
 #: (tests/test_cli.py checks that the two agree).
 METHODS = ("newton-euler", "lagrange")
+#: the commands that handle a floating robot (docs/floating-base.md)
+FLOATING_COMMANDS = ("derive", "generate")
 
 
 def load_robot_argument(args: argparse.Namespace):
     """A robot from a robot file, an MJCF file, or a URDF file with --base/--tip (a xacro file with
     --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.loading), whatever
     its name."""
+    from ..errors import SymdynError
     from ..parsers import load
 
-    return load(args.robot, base=args.base, tip=args.tip, **xacro_arguments(args))
+    floating = getattr(args, "floating", False)
+    robot = load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
+    command = getattr(args, "command", None)
+    if robot.floating and command not in FLOATING_COMMANDS:
+        raise SymdynError(
+            f"symdyn {command}: robot '{robot.name}' has a floating base, which this command does not "
+            f"handle yet ({', '.join(FLOATING_COMMANDS)} do: docs/floating-base.md)"
+        )
+    return robot
 
 
 def xacro_arguments(args: argparse.Namespace) -> dict:
@@ -49,6 +60,12 @@ def add_robot_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--tip",
         help="URDF: load only the chain from the base to this link (default: the whole tree)",
+    )
+    parser.add_argument(
+        "--floating",
+        action="store_true",
+        help="the robot's base floats, joined to the world by a free flyer (q = [x y z qx qy qz qw, "
+        "joints], v = [base twist in the base frame, joint rates]; docs/floating-base.md)",
     )
     parser.add_argument(
         "--xacro-arg",

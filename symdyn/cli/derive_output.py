@@ -52,9 +52,14 @@ FORMS = ("configuration", "compact", "expanded")
 PRINTED = ("M", "C", "V", "G", "F")
 
 
+def floating_note(dyn: Dynamics) -> str:
+    """ " and a floating base (NV = ..)" after the number of joints of a floating robot, else ""."""
+    return f" and a floating base (NV = {dyn.n})" if dyn.robot.floating else ""
+
+
 def header(dyn: Dynamics, equation: str) -> list[str]:
     return [
-        f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
+        f"# {dyn.robot.name}: {dyn.robot.n} joints{floating_note(dyn)}, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
         + (", ".join(map(str, dyn.params)) or "none"),
         f"# {equation}",

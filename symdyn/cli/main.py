@@ -35,8 +35,10 @@ def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
 def _derive_text(dyn) -> str:
     import sympy as sp
 
+    from .derive_output import floating_note as _floating_note
+
     lines = [
-        f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
+        f"# {dyn.robot.name}: {dyn.robot.n} joints{_floating_note(dyn)}, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
         + (", ".join(map(str, dyn.params)) or "none"),
         "# tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd",
@@ -96,6 +98,13 @@ def cmd_derive(args: argparse.Namespace) -> int:
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
     frames = out.frame_names(dyn, args.frames)
+    if robot.floating:  # trigonometric polynomials in the joint angles: not with a quaternion
+        if args.form not in (None, "compact") or args.lumped or args.prune is not None:
+            raise SymdynError(
+                "derive: a floating robot prints --form compact (no configuration or product form, "
+                "--lumped or --prune)"
+            )
+        args.form = "compact"
     if args.form is None:
         args.form = "configuration"
         if not dyn.configuration_space.readable:

@@ -34,7 +34,7 @@ from collections.abc import Callable, Sequence
 import sympy as sp
 
 from ..dynamics import QUANTITIES, Dynamics, singular_message
-from ..errors import SymdynWarning
+from ..errors import SymdynError, SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
@@ -134,7 +134,10 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     c = dyn.compact
     fd = Program()
     b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
-    order = list(range(n)) if dyn.robot.is_chain else list(reversed(range(n)))
+    # a floating base is the root of the tree, its six coordinates first: eliminating the last
+    # coordinate first leaves its 6 x 6 block, dense, for the end and fills nothing else in
+    chain = dyn.robot.is_chain and not dyn.robot.floating
+    order = list(range(n)) if chain else list(reversed(range(n)))
     solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
     qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
@@ -223,6 +226,23 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
 FRAME_GROUPS = ("kinematics", "operational_space")
 
 
+#: the groups generated for a floating robot (docs/floating-base.md)
+FLOATING_GROUPS = ("dynamics",)
+
+
+def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
+    """The groups of a floating robot: FLOATING_GROUPS by default; any other is a SymdynError."""
+    if groups is None or set(groups) == set(GROUPS):  # the default, or --functions all
+        return FLOATING_GROUPS
+    other = [g for g in groups if g not in FLOATING_GROUPS]
+    if other:
+        raise SymdynError(
+            f"robot '{dyn.robot.name}' has a floating base: the {other[0]} functions are not generated "
+            f"for a floating robot (available: {', '.join(FLOATING_GROUPS)})"
+        )
+    return groups
+
+
 def build_functions(
     dyn: Dynamics, groups: Sequence[str] | None = None, frames: FrameChoice | None = None
 ) -> list[FunctionSpec]:
@@ -243,6 +263,8 @@ def build_functions(
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
+    if dyn.robot.floating:
+        groups = _floating_groups(dyn, groups)
     per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
     chosen = set(FAMILIES) - per_frame if groups is None else {b for g in groups for b in GROUPS[g]}
     if frames is None and chosen & per_frame:

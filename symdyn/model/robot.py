@@ -36,7 +36,7 @@ import sympy as sp
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
 from .frames import Frame, check_frame_names, unknown_frame
-from .free_flyer import NQ_BASE, NV_BASE
+from .free_flyer import NQ_BASE, NV_BASE, BaseBody
 from .friction import Friction
 from .limits import check_limits
 from .loops import Loop, check_loops, loop_path
@@ -44,7 +44,17 @@ from .parameter_names import parameter_names_problem, parameter_number
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
-__all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "Frame", "JOINT_TYPES", "DEFAULT_GRAVITY"]
+__all__ = [
+    "Friction",
+    "Motor",
+    "Link",
+    "Robot",
+    "Mimic",
+    "Frame",
+    "BaseBody",
+    "JOINT_TYPES",
+    "DEFAULT_GRAVITY",
+]
 
 JOINT_TYPES = ("revolute", "prismatic")
 #: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
@@ -165,6 +175,8 @@ class Robot:
     loops: tuple[Loop, ...] = ()
     #: the links whose joints are driven (indices into links); None: every joint off the loops
     actuated: tuple[int, ...] | None = None
+    #: the body the free flyer moves (its mass and inertia): used only when `floating`
+    base_body: BaseBody = field(default_factory=BaseBody)
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
@@ -431,5 +443,6 @@ class Robot:
             frames=tuple(f.subs(mapping) for f in self.frames),
             base=self.base.subs(mapping),
             loops=tuple(loop.subs(mapping) for loop in self.loops),
+            base_body=self.base_body.subs(mapping),
             **changes,
         )

@@ -79,6 +79,8 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         used = [s for s in inp.symbols if s in used_symbols]
         size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
         size = names.dims["nact"] if inp.name in ACTUATED_INPUTS else size
+        if inp.name == "q" and names.nq is not None:
+            size = names.nq
         inputs.append({"name": inp.name, "read": bool(used), "size": size})
         if not used:
             unused.append(inp.name)
@@ -128,7 +130,12 @@ def render_context(ctx: RenderContext) -> dict:
         "source_file": names.source_file,
         "guard": names.guard,
         "ndof": names.ndof,
-        "n": ctx.robot.n,
+        "n": ctx.robot.nv,
+        "floating": ctx.robot.floating,
+        "joints": ctx.robot.n,
+        "nq_macro": names.nq,
+        "nv_macro": names.nv,
+        "nq": ctx.robot.nq,
         "nparam": names.nparam,
         "k": len(ctx.dynamics.params),
         "param_pattern": names.param_pattern,

@@ -34,7 +34,14 @@ def file_name(name: str) -> str:
     return f"{name}_numpy.py"
 
 
-def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
+def _size(inp, floating: bool) -> str:
+    """An input's size: NDOF for the joint vectors (NQ for a floating robot's q), else a number."""
+    if inp.name == "q" and floating:
+        return "NQ"
+    return "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+
+
+def _function(spec: FunctionSpec, printer: NumpyPrinter, floating: bool = False) -> dict:
     """One function as data: arguments (and their sizes: NDOF or a number), the input elements
     it reads, temporaries, output entries."""
     free = spec.free_symbols
@@ -42,9 +49,7 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
         "name": spec.name,
         "doc": spec.doc,
         "inputs": [inp.name for inp in spec.inputs if inp.name != "p"],
-        "sizes": {
-            inp.name: "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols)) for inp in spec.inputs
-        },
+        "sizes": {inp.name: _size(inp, floating) for inp in spec.inputs},
         "has_p": any(inp.name == "p" for inp in spec.inputs),
         "lead": [inp.name for inp in spec.inputs],
         "unpack": [
@@ -74,10 +79,11 @@ def render(ctx: RenderContext) -> dict[str, str]:
         .render(
             header=header_lines(ctx),
             name=ctx.name,
-            ndof=ctx.robot.n,
+            ndof=ctx.robot.nv,
+            nq=ctx.robot.nq if ctx.robot.floating else None,
             param_names=[s.name for s in ctx.dynamics.params],
             dtype=dtype(ctx.precision),
-            functions=[_function(spec, printer) for spec in ctx.functions],
+            functions=[_function(spec, printer, ctx.robot.floating) for spec in ctx.functions],
             loops=loop_solve_context(ctx),
         )
     )
