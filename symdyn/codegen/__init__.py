@@ -30,7 +30,14 @@ from .render import PRECISIONS, RenderContext
 
 __all__ = ["generate", "render", "file_tools", "TARGETS", "FUNCTION_NAMES"]
 
-TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex", "matlab": "matlab"}
+TARGETS = {
+    "c": "c",
+    "casadi": "casadi",
+    "python": "python",
+    "jax": "jax",
+    "latex": "latex",
+    "matlab": "matlab",
+}
 
 
 def _target_module(name: str):
