@@ -169,6 +169,10 @@ def test_constant_entries_get_the_batch_shape(generated):
     assert mod.coriolis_matrix(np.zeros((4, 3)), qd).shape == (4, 3, 3)
     assert mod.mass_matrix(np.zeros(3)).shape == (3, 3)
     assert mod.gravity([0.1, 0.2, 0.3]).shape == (3,)
+    # an array-like that is no array of the standard is read by NumPy, as np.asarray reads it
+    import array
+
+    assert type(mod.gravity(array.array("d", [0.1, 0.2, 0.3]))) is np.ndarray
 
 
 def test_bad_input_is_a_clear_error(generated):

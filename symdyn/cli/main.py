@@ -253,7 +253,7 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
 #: Every subcommand, in the order `symdyn --help` lists them: name -> (help, adds its arguments).
 COMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
     "derive": ("print M, C, V, G, F of a robot", _derive_arguments),
-    "generate": ("generate code (C, CasADi, NumPy, LaTeX)", _generate_arguments),
+    "generate": ("generate code (C, CasADi, NumPy, JAX, LaTeX, MATLAB)", _generate_arguments),
     **APPLICATIONS,  # simulate, analyze, check, cache (the lecture's applications)
     **IDENTIFICATION,  # identify, excite
 }
