@@ -25,12 +25,12 @@ a batch, all of dtype float64 (DTYPE for NumPy).
 Written against the Python array API standard: the arrays given pick the
 namespace (array_api_compat.array_namespace), so the same file runs on NumPy,
 JAX, PyTorch or CuPy arrays and returns arrays of the same library, on the same
-device; NumPy arrays, lists and numbers are computed with NumPy. Needs numpy
+device; NumPy arrays, lists, numbers and other array-likes are computed with NumPy. Needs numpy
 and array-api-compat.
 """
 
 import numpy as np
-from array_api_compat import array_namespace
+from array_api_compat import array_namespace, is_array_api_obj
 from array_api_compat import device as _array_device
 
 NDOF = 12
@@ -43,8 +43,9 @@ _NUMPY_INPUTS = (np.ndarray, np.generic, list, tuple, int, float)
 
 
 def _namespace(*args):
-    """The array namespace and device of the inputs: NumPy's for NumPy arrays, lists and numbers."""
-    arrays = [a for a in args if a is not None and not isinstance(a, _NUMPY_INPUTS)]
+    """The array namespace and device of the inputs' arrays; NumPy's for NumPy arrays, lists, numbers
+    and whatever else is no array of the standard (np.asarray reads it, as before)."""
+    arrays = [a for a in args if not isinstance(a, _NUMPY_INPUTS) and is_array_api_obj(a)]
     if not arrays:
         return _NUMPY, None
     return array_namespace(*arrays), _array_device(arrays[0])
