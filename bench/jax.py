@@ -10,9 +10,10 @@ merged into link 7) is generated in double precision for the targets python and 
 * JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit) on the batch, the
   arrays already on the device, after a first call that compiles (its time is listed);
 * ADAM (adam-robotics, its JAX backend) on the same URDF and the same batch, jax.jit(jax.vmap(..)):
-  M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + bias_force
-  (ADAM's RNEA takes no accelerations) and forward dynamics jnp.linalg.solve(M, tau - h)
-  (its aba is floating-base), all with the base fixed at the identity and at rest.
+  M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + h, h its
+  bias_force plus the URDF's joint damping b qd (ADAM's RNEA takes no accelerations, and it
+  ignores damping, which symdyn reads as viscous friction), and forward dynamics
+  jnp.linalg.solve(M, tau - h) (its aba is floating-base), the base fixed at the identity, at rest.
 ADAM 0.5 requires jax <= 0.6 while symdyn pins a newer jax, so ADAM runs in another Python
 given by --adam-python (a virtual environment with `pip install "adam-robotics[jax]==0.5.0"`),
 which times the symdyn JAX module there as well, for a ratio under one jax version. Without it
@@ -88,38 +89,44 @@ def _jax_timing(fn, args, count: int, reps: int) -> tuple[float, float]:
     return compile_s, statistics.median(times) / count
 
 
-def _fixed_fingers(urdf: str, folder: str) -> str:
+def _fixed_fingers(urdf: str, folder: str) -> tuple[str, list[float]]:
     """A copy of the URDF whose joints other than JOINTS are fixed: ADAM 0.5.0 fails on a prismatic
     joint anywhere in the file (its prismatic motion subspace stacks arrays of unequal shapes),
-    and it holds every joint outside its list at 0 anyway, as symdyn's cut at panda_hand does."""
+    and it holds every joint outside its list at 0 anyway, as symdyn's cut at panda_hand does.
+    Also the viscous damping of JOINTS, which symdyn reads as friction and ADAM ignores."""
     import xml.etree.ElementTree as ET
 
     tree = ET.parse(urdf)
+    damping = {}
     for joint in tree.getroot().iter("joint"):
         if joint.get("name") not in JOINTS:
             joint.set("type", "fixed")
+        else:
+            dynamics = joint.find("dynamics")
+            damping[joint.get("name")] = float(dynamics.get("damping", 0.0)) if dynamics is not None else 0.0
     path = str(Path(folder) / "panda_fixed_fingers.urdf")
     tree.write(path)
-    return path
+    return path, [damping[j] for j in JOINTS]
 
 
 def adam_functions(urdf: str, gravity: list[float]):
     """ADAM's joint-space M, inverse and forward dynamics of one state (the base fixed, at rest),
-    with symdyn's gravity (ADAM's default is 9.80665 m/s^2, the URDF loader's 9.81)."""
+    with symdyn's gravity (ADAM's default is 9.80665 m/s^2, the URDF loader's 9.81) and the URDF's
+    viscous damping added as symdyn adds it (F = b qd)."""
     import jax.numpy as jnp
     from adam.jax import KinDynComputations
 
     with tempfile.TemporaryDirectory() as folder:
-        kd = KinDynComputations(
-            _fixed_fingers(urdf, folder), list(JOINTS), gravity=jnp.array([*gravity, 0, 0, 0])
-        )
+        fixed, damping = _fixed_fingers(urdf, folder)
+        kd = KinDynComputations(fixed, list(JOINTS), gravity=jnp.array([*gravity, 0, 0, 0]))
+    b = jnp.array(damping)
     base, rest = jnp.eye(4), jnp.zeros(6)
 
     def mass_matrix(q):
         return kd.mass_matrix(base, q)[6:, 6:]
 
     def bias(q, qd):
-        return kd.bias_force(base, q, rest, qd)[6:]
+        return kd.bias_force(base, q, rest, qd)[6:] + b * qd
 
     def inverse_dynamics(q, qd, qdd):
         return mass_matrix(q) @ qdd + bias(q, qd)
