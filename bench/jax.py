@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -46,6 +47,8 @@ TIP = "panda_hand"
 JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
 NCHECK = 8
+#: XLA's CPU fusion emitters (the default in recent jax) can make a large fused function far slower
+NO_EMITTERS = "--xla_cpu_use_fusion_emitters=false"
 
 
 def _module(path: str, name: str):
@@ -156,9 +159,9 @@ def worker(module_path: str, urdf: str | None, count: int, reps: int, reference:
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in FUNCTIONS}}
     if urdf is not None:
-        import adam
+        from importlib.metadata import version
 
-        out["adam_version"] = getattr(adam, "__version__", "?")
+        out["adam_version"] = version("adam-robotics")
         routes["adam"] = {f: jax.jit(jax.vmap(g)) for f, g in adam_functions(urdf, gravity).items()}
     for route, fns in routes.items():
         for f in FUNCTIONS:
@@ -167,6 +170,18 @@ def worker(module_path: str, urdf: str | None, count: int, reps: int, reference:
             out["error"][f"{route} {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
             out[route][f] = _jax_timing(fns[f], _arguments(device, f), count, reps)
     return out
+
+
+def _external(python: str, payload: dict, tmp: str, **env) -> dict:
+    """worker(**payload) run by another Python (or this one with other XLA flags)."""
+    path = Path(tmp) / "worker.json"
+    path.write_text(json.dumps(payload))
+    done = subprocess.run(
+        [python, __file__, "--worker", path], capture_output=True, text=True, env={**os.environ, **env}
+    )
+    if done.returncode != 0:
+        raise SystemExit(f"the run of {python} failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def _numpy_timing(arm, states, function: str, reps: int) -> tuple[float, float]:
@@ -202,17 +217,17 @@ def _row(cells, widths) -> str:
 
 
 def table(results: dict, opts) -> list[str]:
-    here, there = results["here"], results.get("there")
+    here, plain, there = results["here"], results["plain"], results.get("there")
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
-    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX (jax {here['jax']})"]
+    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX (jax {here['jax']})", "same, emitters off"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
     head += ["JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
     rows = [head]
     for f in FUNCTIONS:
         one, batch = results["numpy"][f]
-        jx = here["symdyn"][f][1]
-        row = [f, ns(one), ns(batch), ns(jx)]
+        jx = min(here["symdyn"][f][1], plain["symdyn"][f][1])
+        row = [f, ns(one), ns(batch), ns(here["symdyn"][f][1]), ns(plain["symdyn"][f][1])]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
         row += [f"{jx / batch:.2f}x"]
@@ -227,8 +242,12 @@ def table(results: dict, opts) -> list[str]:
         _row(["-" * w for w in widths], widths),
         *(_row(r, widths) for r in rows[1:]),
         "",
+        f"JAX/NumPy batch: the faster JAX column; emitters off: XLA_FLAGS={NO_EMITTERS}; "
+        "JAX/ADAM: both under ADAM's jax",
         "compile time of the first batch call (s): "
         + ", ".join(f"{f} {here['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
+        + "; emitters off "
+        + ", ".join(f"{f} {plain['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
         + ("; ADAM " + ", ".join(f"{f} {there['adam'][f][0]:.1f}" for f in FUNCTIONS) if there else ""),
         "largest relative error against symdyn.rnea on 8 states: "
         + ", ".join(f"{k} {v:.1e}" for k, v in {**here["error"], **(there or {}).get("error", {})}.items()),
@@ -284,20 +303,15 @@ def main(argv=None) -> int:
         log("JAX (this Python)")
         args = {"module_path": str(jax_path), "urdf": None, "count": opts.batch, "reps": opts.reps}
         results["here"] = worker(**args, reference=reference)
+        log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
+        flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()
+        results["plain"] = _external(sys.executable, {**args, "reference": reference}, tmp, XLA_FLAGS=flags)
         if opts.adam_python:
             log(f"JAX and ADAM ({opts.adam_python})")
-            payload = Path(tmp) / "worker.json"
             gravity = [float(g) for g in robot.gravity]
-            payload.write_text(
-                json.dumps({**args, "urdf": str(urdf), "reference": reference, "gravity": gravity})
-            )
-            done = subprocess.run(
-                [opts.adam_python, __file__, "--worker", payload], capture_output=True, text=True
-            )
-            if done.returncode != 0:
-                raise SystemExit(f"the ADAM run failed:\n{done.stderr[-3000:]}")
-            results["there"] = json.loads(done.stdout.strip().splitlines()[-1])
-    for route in ("here", "there"):
+            payload = {**args, "urdf": str(urdf), "reference": reference, "gravity": gravity}
+            results["there"] = _external(opts.adam_python, payload, tmp)
+    for route in ("here", "plain", "there"):
         for key, err in results.get(route, {}).get("error", {}).items():
             assert err < 1e-9, (route, key, err)
     results.update(machine=machine(), load=(load_before, load_averages()), wall=time.perf_counter() - start)
