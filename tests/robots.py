@@ -655,3 +655,22 @@ def pinocchio_model(pin, robot):
             pin.Frame(name, 0 if k < 0 else ids[k], base * se3 if k < 0 else se3, pin.FrameType.OP_FRAME)
         )
     return model
+
+
+# --------------------------------------------------------------------------- generated functions
+
+
+def spec_arguments(spec, rng: np.random.Generator, batch: tuple[int, ...] = ()) -> dict[str, np.ndarray]:
+    """Random inputs of a generated function (symdyn.codegen.functions.FunctionSpec) by name,
+    p excepted, each of shape batch + (its size,): angles over a full turn, rates and torques
+    of a few units, joint rates kept away from the jump of sign(qd)."""
+    args = {}
+    for inp in spec.inputs:
+        if inp.name == "p":
+            continue
+        shape = (*batch, len(inp.symbols))
+        value = rng.uniform(-np.pi, np.pi, shape) if inp.name == "q" else rng.normal(0.0, 1.5, shape)
+        if inp.name == "qd":
+            value = np.where(np.abs(value) < 1e-3, 0.5, value)
+        args[inp.name] = value
+    return args

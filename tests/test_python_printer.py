@@ -30,15 +30,40 @@ x, y, z = sp.symbols("x y z")
 NAMES = {x: "p_x", y: "y", z: "z"}
 
 
-def test_printed_expressions_compute_sympys_values_on_a_batch():
-    printer = NumpyPrinter(NAMES)
+#: functions and constants the generated modules may meet, with those of test_c_printer
+MORE_EXPRESSIONS = [
+    sp.Heaviside(y - z, 0),
+    sp.Heaviside(-y, 0) * x,
+    sp.sin(sp.pi / 7) * x,
+    -sp.sqrt(2) * y,
+    x * sp.cos(sp.pi / 5) - sp.sqrt(3),
+]
+
+
+@pytest.mark.parametrize("library", ["numpy", "array_api_strict", "jax.numpy"])
+def test_printed_expressions_compute_sympys_values_on_a_batch(library):
+    """The text evaluates to SymPy's 30-digit values with NumPy, with array-api-strict (which
+    refuses anything outside the array API standard) and with jax.numpy (as `jnp`)."""
+    xp = importlib.import_module(library)
+    module = "jnp" if library == "jax.numpy" else "xp"
+    printer = NumpyPrinter(NAMES, module=module)
     columns = np.array(POINTS).T
-    env = {"np": np, "p_x": columns[0], "y": columns[1], "z": columns[2]}
-    for e in EXPRESSIONS:
+    env = {module: xp, **{name: xp.asarray(c) for name, c in zip(("p_x", "y", "z"), columns, strict=True)}}
+    rtol = 1e-13 if np.asarray(env["y"]).dtype == np.float64 else 1e-5  # JAX without x64: float32
+    for e in EXPRESSIONS + MORE_EXPRESSIONS:
         text = printer.doprint(e)
-        got = np.broadcast_to(eval(text, env), (len(POINTS),))  # our own printer's text
+        got = np.broadcast_to(np.asarray(eval(text, env)), (len(POINTS),))  # our own printer's text
         want = [float(e.evalf(30, subs=dict(zip((x, y, z), point, strict=True)))) for point in POINTS]
-        np.testing.assert_allclose(got, want, rtol=1e-13, atol=1e-13, err_msg=f"{e} printed as {text}")
+        np.testing.assert_allclose(got, want, rtol=rtol, atol=rtol, err_msg=f"{e} printed as {text}")
+
+
+def test_sign_and_heaviside_at_zero():
+    """sign(0) = 0 as in SymPy; Heaviside(x, 0) is 0 at 0 (and 1 above, 0 below)."""
+    printer = NumpyPrinter(NAMES)
+    env = {"xp": np, "y": np.array([-2.0, -0.0, 0.0, 3.0])}
+    assert list(eval(printer.doprint(sp.sign(y)), env)) == [-1, 0, 0, 1]
+    assert list(eval(printer.doprint(sp.Heaviside(y, 0)), env)) == [0, 0, 0, 1]
+    assert list(eval(printer.doprint(sp.Heaviside(-y, 0)), env)) == [1, 0, 0, 0]
 
 
 def test_small_integer_powers_are_products():
@@ -56,13 +81,13 @@ def test_literals_round_trip_a_double():
     for v in values:
         assert float(printer.doprint(sp.Float(v))) == v
     assert float(printer.doprint(sp.Rational(2, 7))) == 2 / 7
-    assert printer.doprint(sp.sign(y)) == "np.sign(y)"  # sign(0) = 0 as in SymPy
-    assert printer.doprint(sp.Heaviside(y, 0)) == "np.heaviside(y, 0.0)"  # 0 at 0
-    assert printer.doprint(sp.Heaviside(-y, 0)) == "np.heaviside(-y, 0.0)"
+    for constant in (sp.pi, sp.sqrt(2), sp.E, sp.sin(sp.pi / 7)):  # printed as the nearest double
+        assert float(printer.doprint(constant)) == float(constant.evalf(30))
 
 
 def test_parameter_names_that_clash_in_python(tmp_path):
-    clashing = ["np", "p", "q", "qd", "tau", "x1", "NDOF", "p_np", "p_p", "p_x1_", "DTYPE"]
+    clashing = ["np", "p", "q", "qd", "tau", "x1", "NDOF", "p_np", "p_p", "p_x1_", "DTYPE", "xp", "jnp"]
+    clashing += ["device", "jax"]
     robot = robot_with_parameters(clashing + ["m", "izz"])
     ctx = symdyn.codegen.context(robot)
     names = local_names(ctx)
@@ -71,7 +96,8 @@ def test_parameter_names_that_clash_in_python(tmp_path):
     generated = re.compile(r"(x|q|qd|qdd|tau)[0-9]+\Z")
     for s, name in names.items():
         assert name.isidentifier() and not keyword.iskeyword(name) and not generated.match(name), name
-        assert name not in {"np", "q", "qd", "qdd", "tau", "p", "_vector", "_params", "_assemble", "_lead"}
+        assert name not in {"np", "xp", "jnp", "jax", "device", "q", "qd", "qdd", "tau", "p", "_vector"}
+        assert name not in {"_params", "_assemble", "_lead", "_namespace", "_batch"}
         assert name == s.name or s.name in clashing
     ((fname, text),) = numpy_backend.render(ctx).items()
     (tmp_path / fname).write_text(text)

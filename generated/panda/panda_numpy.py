@@ -29,36 +29,56 @@ Every function takes one state (vectors of shape (NDOF,)) or a batch with a
 leading axis (shape (N, NDOF)); p, the free parameters in PARAM_NAMES order,
 is (NPARAM,) or (N, NPARAM) and may be None when NPARAM is 0. Outputs have
 shape (NDOF,) or (NDOF, NDOF) for one state, (N, NDOF) or (N, NDOF, NDOF) for
-a batch, all of dtype DTYPE. Needs only numpy.
+a batch, all of dtype float64 (DTYPE for NumPy).
+
+Written against the Python array API standard: the arrays given pick the
+namespace (array_api_compat.array_namespace), so the same file runs on NumPy,
+JAX, PyTorch or CuPy arrays and returns arrays of the same library, on the same
+device; NumPy arrays, lists, numbers and other array-likes are computed with NumPy. Needs numpy
+and array-api-compat.
 """
 
 import numpy as np
+from array_api_compat import array_namespace, is_array_api_obj
+from array_api_compat import device as _array_device
 
 NDOF = 7
 NPARAM = 0
 PARAM_NAMES = ()
 DTYPE = np.float64
+#: NumPy's own namespace follows the standard from NumPy 2 on; before, array-api-compat's wraps it
+_NUMPY = np if int(np.__version__.split(".")[0]) >= 2 else array_namespace(np.zeros(0))
+_NUMPY_INPUTS = (np.ndarray, np.generic, list, tuple, int, float)
 
 
-def _vector(x, size, name):
-    a = np.asarray(x, dtype=DTYPE)
+def _namespace(*args):
+    """The array namespace and device of the inputs' arrays; NumPy's for NumPy arrays, lists, numbers
+    and whatever else is no array of the standard (np.asarray reads it, as before)."""
+    arrays = [a for a in args if not isinstance(a, _NUMPY_INPUTS) and is_array_api_obj(a)]
+    if not arrays:
+        return _NUMPY, None
+    return array_namespace(*arrays), _array_device(arrays[0])
+
+
+def _vector(xp, device, x, size, name):
+    a = xp.asarray(x, dtype=xp.float64, device=device)
     if a.ndim == 0 or a.shape[-1] != size:
-        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {a.shape}")
+        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {tuple(a.shape)}")
     return a
 
 
-def _params(p):
+def _params(xp, device, p):
     if p is None:
         if NPARAM:
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
-        return np.zeros(0, dtype=DTYPE)
-    return _vector(p, NPARAM, "p")
+        return xp.zeros((0,), dtype=xp.float64, device=device)
+    return _vector(xp, device, p, NPARAM, "p")
 
 
-def _assemble(lead, shape, entries):
+def _assemble(xp, device, lead, shape, entries):
     """Broadcast every entry (a number or an array) to the leading shape and stack them."""
-    columns = [np.broadcast_to(np.asarray(e, dtype=DTYPE), lead) for e in entries]
-    return np.stack(columns, axis=-1).reshape(lead + shape)
+    columns = [xp.broadcast_to(xp.asarray(e, dtype=xp.float64, device=device), lead) for e in entries]
+    return xp.reshape(xp.stack(columns, axis=-1), lead + shape)
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -66,10 +86,11 @@ def inverse_dynamics(q, qd, qdd, p=None):
 
     Returns tau of shape (7,) for one state, (N, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -91,10 +112,10 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
     qdd7 = qdd[..., 6]
-    x0 = np.sin(q2)
-    x1 = np.cos(q2)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
+    x0 = xp.sin(q2)
+    x1 = xp.cos(q2)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
     x4 = qd1*x0
     x5 = qd1*x1
     x6 = 0.0007689361029464*qd2 + 0.00398335888393552*x4 - 0.028124284712194955*x5
@@ -107,8 +128,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x13 = qd2*x4
     x14 = -qdd1*x1 + x13
     x15 = 0.01026110182100817*qdd2 + 0.0022610063699999997*x10 + 0.00850351162402155*x12 - 0.00398335888393552*x14 - x7 - x9
-    x16 = np.cos(q4)
-    x17 = np.sin(q4)
+    x16 = xp.cos(q4)
+    x17 = xp.sin(q4)
     x18 = qd3 + x5
     x19 = qd2*x3
     x20 = x2*x4
@@ -138,8 +159,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x44 = 0.316*x43
     x45 = -x2*x44 - x3*x42
     x46 = x24*x33 - x26 - x32 + 0.05649492601407083*x35 - 0.008248333140675744*x37 - 0.005487648106562256*x38 + 0.214708623208*x45
-    x47 = np.cos(q5)
-    x48 = np.sin(q5)
+    x47 = xp.cos(q5)
+    x48 = xp.sin(q5)
     x49 = qd4 - x24
     x50 = x16*x21 + x17*x18
     x51 = x16*x18 - x17*x21
@@ -165,8 +186,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x71 = x38 + x70
     x72 = x45 + 0.0825*x71
     x73 = x51*x54 - x53 + 0.06767727025085991*x56 + 0.02771584317362585*x58 + 0.0039053550262761003*x59 - 0.09850206933*x69 - 0.374644408005*x72
-    x74 = np.sin(q6)
-    x75 = np.cos(q6)
+    x74 = xp.sin(q6)
+    x75 = xp.cos(q6)
     x76 = -x47*x49 - x48*x50
     x77 = qd5 + x51
     x78 = x47*x50 - x48*x49
@@ -198,8 +219,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x104 = x59 + x92
     x105 = -x103 - 0.0825*x104 + x69
     x106 = 0.047121686402*x100 + 0.05034347249*x105 + x81 + 0.03942757095803552*x83 - 0.0015152444733270301*x85 - 0.004600245517563105*x86
-    x107 = np.sin(q7)
-    x108 = np.cos(q7)
+    x107 = xp.sin(q7)
+    x108 = xp.cos(q7)
     x109 = -x74*x78 + x75*x77
     x110 = qd6 - x76
     x111 = x74*x77 + x75*x78
@@ -387,6 +408,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x293 = x2*x267 - x278*x3
     x294 = x2*x261 + x237*x3 + x292 + 0.316*x293
     return _assemble(
+        xp,
+        device,
         _lead,
         (7,),
         [
@@ -406,8 +429,9 @@ def mass_matrix(q, p=None):
 
     Returns M of shape (7, 7) for one state, (N, 7, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -415,19 +439,19 @@ def mass_matrix(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.cos(q5)
-    x3 = np.sin(q6)
-    x4 = np.cos(q6)
-    x5 = np.sin(q7)
-    x6 = np.cos(q7)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.cos(q5)
+    x3 = xp.sin(q6)
+    x4 = xp.cos(q6)
+    x5 = xp.sin(q7)
+    x6 = xp.cos(q7)
     x7 = 0.0031274395439999996*x5 + 0.007735484874*x6
     x8 = x7 + 0.16496755269500002
     x9 = 0.068832705569*x3 + x4*x8
     x10 = x9 - 0.014653732538
     x11 = x10*x2
-    x12 = np.sin(q5)
+    x12 = xp.sin(q5)
     x13 = 0.007735484874*x5
     x14 = 0.0031274395439999996*x6
     x15 = x13 - x14
@@ -489,8 +513,8 @@ def mass_matrix(q, p=None):
     x71 = x61*x70 + x63*x69
     x72 = x27 + x44 + x71 + 0.06736254418002012
     x73 = x72 + 0.028124284712194955
-    x74 = np.sin(q2)
-    x75 = np.cos(q2)
+    x74 = xp.sin(q2)
+    x75 = xp.cos(q2)
     x76 = x74*x75
     x77 = 2*x76
     x78 = x0*x25 + x1*x20
@@ -500,8 +524,8 @@ def mass_matrix(q, p=None):
     x82 = x28 + x45 + x48 + x59 + 0.6372531400842897
     x83 = x27 + x82 + 0.10199172388710612
     x84 = x81 - x83
-    x85 = np.cos(q3)
-    x86 = np.sin(q3)
+    x85 = xp.cos(q3)
+    x86 = xp.sin(q3)
     x87 = x85*x86
     x88 = 2*x87
     x89 = -x10*x12 - x17*x2
@@ -600,6 +624,8 @@ def mass_matrix(q, p=None):
     x182 = x155*x86 + x170*x85
     x183 = x164*x86 + x169*x85 + 0.316*x182
     return _assemble(
+        xp,
+        device,
         _lead,
         (7, 7),
         [
@@ -661,9 +687,10 @@ def coriolis_matrix(q, qd, p=None):
 
     Returns C of shape (7, 7) for one state, (N, 7, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -678,16 +705,16 @@ def coriolis_matrix(q, qd, p=None):
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
     qd7 = qd[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.sin(q3)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.sin(q3)
     x3 = qd2*x2
-    x4 = np.cos(q3)
-    x5 = np.sin(q2)
+    x4 = xp.cos(q3)
+    x5 = xp.sin(q2)
     x6 = qd1*x5
     x7 = x4*x6
     x8 = x3 - x7
-    x9 = np.cos(q2)
+    x9 = xp.cos(q2)
     x10 = qd1*x9
     x11 = qd3 + x10
     x12 = x0*x11 - x1*x8
@@ -699,8 +726,8 @@ def coriolis_matrix(q, qd, p=None):
     x18 = 0.316*x13 + 0.316*x14
     x19 = x0*x18 - x1*x17
     x20 = 0.049251034665*x12 - 0.1873222040025*x16 + 1.7939475*x19
-    x21 = np.cos(q5)
-    x22 = np.sin(q5)
+    x21 = xp.cos(q5)
+    x22 = xp.sin(q5)
     x23 = x0*x8 + x1*x11
     x24 = -x16*x21 - x22*x23
     x25 = 0.023560843201*x24
@@ -712,8 +739,8 @@ def coriolis_matrix(q, qd, p=None):
     x31 = 0.0825*x12 + 0.384*x23 + x30
     x32 = x21*x28 - x22*x31
     x33 = -x25 - x27 + 0.612973*x32
-    x34 = np.sin(q6)
-    x35 = np.cos(q6)
+    x34 = xp.sin(q6)
+    x35 = xp.cos(q6)
     x36 = -x16*x22 + x21*x23
     x37 = x26*x35 - x34*x36
     x38 = qd6 - x24
@@ -721,8 +748,8 @@ def coriolis_matrix(q, qd, p=None):
     x40 = -0.0825*x16 + x39
     x41 = x32*x35 + x34*x40
     x42 = -0.008763579467500001*x37 + 0.0117633784675*x38 + 0.8332775*x41
-    x43 = np.sin(q7)
-    x44 = np.cos(q7)
+    x43 = xp.sin(q7)
+    x44 = xp.cos(q7)
     x45 = x26*x34 + x35*x36
     x46 = x38*x44 - x43*x45
     x47 = qd7 - x37
@@ -1327,6 +1354,8 @@ def coriolis_matrix(q, qd, p=None):
     x646 = x24*x628 + x262*x32 - x298*x36 + x48*x623 + x613
     x647 = x37*x626 - x45*x627 + x57*x622 + x614
     return _assemble(
+        xp,
+        device,
         _lead,
         (7, 7),
         [
@@ -1388,9 +1417,10 @@ def coriolis(q, qd, p=None):
 
     Returns V of shape (7,) for one state, (N, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1405,10 +1435,10 @@ def coriolis(q, qd, p=None):
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
     qd7 = qd[..., 6]
-    x0 = np.sin(q2)
-    x1 = np.cos(q2)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
+    x0 = xp.sin(q2)
+    x1 = xp.cos(q2)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
     x4 = qd1*x1
     x5 = qd2*x4
     x6 = qd1*x0
@@ -1418,8 +1448,8 @@ def coriolis(q, qd, p=None):
     x10 = 0.026534991901690206*qd2 - 0.0007689361029464*x4 - 0.01026110182100817*x6
     x11 = x10*x4
     x12 = x11 + 0.00850351162402155*x5 + 0.00398335888393552*x7 + x9
-    x13 = np.cos(q4)
-    x14 = np.sin(q4)
+    x13 = xp.cos(q4)
+    x14 = xp.sin(q4)
     x15 = qd3 + x4
     x16 = qd2*x3
     x17 = x2*x6
@@ -1445,8 +1475,8 @@ def coriolis(q, qd, p=None):
     x37 = 0.632*x25
     x38 = x3*x36 + x37
     x39 = x31 - 0.040046415889728*x34 + 0.214708623208*x38
-    x40 = np.cos(q5)
-    x41 = np.sin(q5)
+    x40 = xp.cos(q5)
+    x41 = xp.sin(q5)
     x42 = qd4 - x21
     x43 = x13*x18 + x14*x15
     x44 = x13*x15 - x14*x18
@@ -1476,8 +1506,8 @@ def coriolis(q, qd, p=None):
     x68 = 0.0825*x67
     x69 = x38 + x68
     x70 = -x52 - 0.09850206933*x65 - 0.374644408005*x69
-    x71 = np.sin(q6)
-    x72 = np.cos(q6)
+    x71 = xp.sin(q6)
+    x72 = xp.cos(q6)
     x73 = -x40*x42 - x41*x43
     x74 = qd5 + x44
     x75 = x40*x43 - x41*x42
@@ -1512,8 +1542,8 @@ def coriolis(q, qd, p=None):
     x104 = x102 + 0.0825*x103
     x105 = -x104 + x65
     x106 = 0.05034347249*x105 + x83 + 0.047121686402*x99
-    x107 = np.sin(q7)
-    x108 = np.cos(q7)
+    x107 = xp.sin(q7)
+    x108 = xp.cos(q7)
     x109 = -x71*x75 + x72*x74
     x110 = qd6 - x73
     x111 = x71*x74 + x72*x75
@@ -1725,6 +1755,8 @@ def coriolis(q, qd, p=None):
     x317 = x2*x290 - x3*x303
     x318 = x2*x283 + x254*x3 + x316 + 0.316*x317
     return _assemble(
+        xp,
+        device,
         _lead,
         (7,),
         [
@@ -1744,8 +1776,9 @@ def gravity(q, p=None):
 
     Returns G of shape (7,) for one state, (N, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1753,21 +1786,21 @@ def gravity(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q3)
-    x1 = np.sin(q3)
-    x2 = np.cos(q4)
-    x3 = np.sin(q4)
-    x4 = np.cos(q5)
-    x5 = np.sin(q6)
-    x6 = np.cos(q6)
-    x7 = np.sin(q7)
-    x8 = np.cos(q7)
+    x0 = xp.cos(q3)
+    x1 = xp.sin(q3)
+    x2 = xp.cos(q4)
+    x3 = xp.sin(q4)
+    x4 = xp.cos(q5)
+    x5 = xp.sin(q6)
+    x6 = xp.cos(q6)
+    x7 = xp.sin(q7)
+    x8 = xp.cos(q7)
     x9 = 0.0031274395439999996*x7 + 0.007735484874*x8
     x10 = x9 + 0.16496755269500002
     x11 = x10*x6 + 0.068832705569*x5
     x12 = x11 - 0.014653732538
     x13 = x12*x4
-    x14 = np.sin(q5)
+    x14 = xp.sin(q5)
     x15 = 0.007735484874*x7
     x16 = 0.0031274395439999996*x8
     x17 = x15 - x16
@@ -1791,9 +1824,9 @@ def gravity(q, p=None):
     x35 = x2*x27 + x22*x3
     x36 = x35 - 0.214708623208
     x37 = -x36 - 3.3190486667199997
-    x38 = np.sin(q2)
+    x38 = xp.sin(q2)
     x39 = 9.81*x38
-    x40 = np.cos(q2)
+    x40 = xp.cos(q2)
     x41 = 9.81*x40
     x42 = x0*x39
     x43 = x1*x39
@@ -1806,6 +1839,8 @@ def gravity(q, p=None):
     x50 = -x47*x7 + x48*x8
     x51 = -x47*x8 - x48*x7
     return _assemble(
+        xp,
+        device,
         _lead,
         (7,),
         [
@@ -1825,10 +1860,13 @@ def friction(qd, p=None):
 
     Returns F of shape (7,) for one state, (N, 7) for a batch.
     """
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(qd, p)
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
     return _assemble(
+        xp,
+        device,
         _lead,
         (7,),
         [
@@ -1848,10 +1886,11 @@ def forward_dynamics(q, qd, tau, p=None):
 
     Returns qdd of shape (7,) for one state, (N, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1873,19 +1912,19 @@ def forward_dynamics(q, qd, tau, p=None):
     tau5 = tau[..., 4]
     tau6 = tau[..., 5]
     tau7 = tau[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.cos(q5)
-    x3 = np.sin(q6)
-    x4 = np.cos(q6)
-    x5 = np.sin(q7)
-    x6 = np.cos(q7)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.cos(q5)
+    x3 = xp.sin(q6)
+    x4 = xp.cos(q6)
+    x5 = xp.sin(q7)
+    x6 = xp.cos(q7)
     x7 = 0.0031274395439999996*x5 + 0.007735484874*x6
     x8 = x7 + 0.16496755269500002
     x9 = 0.068832705569*x3 + x4*x8
     x10 = x9 - 0.014653732538
     x11 = x10*x2
-    x12 = np.sin(q5)
+    x12 = xp.sin(q5)
     x13 = 0.007735484874*x5
     x14 = 0.0031274395439999996*x6
     x15 = x13 - x14
@@ -1947,8 +1986,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x71 = x61*x70 + x63*x69
     x72 = x27 + x44 + x71 + 0.06736254418002012
     x73 = x72 + 0.028124284712194955
-    x74 = np.sin(q2)
-    x75 = np.cos(q2)
+    x74 = xp.sin(q2)
+    x75 = xp.cos(q2)
     x76 = x74*x75
     x77 = 2*x76
     x78 = x0*x25 + x1*x20
@@ -1958,8 +1997,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x82 = x28 + x45 + x48 + x59 + 0.6372531400842897
     x83 = x27 + x82 + 0.10199172388710612
     x84 = x81 - x83
-    x85 = np.cos(q3)
-    x86 = np.sin(q3)
+    x85 = xp.cos(q3)
+    x86 = xp.sin(q3)
     x87 = x85*x86
     x88 = 2*x87
     x89 = -x10*x12 - x17*x2
@@ -2438,6 +2477,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x562 = x495*x547 - x499*x557 - x501*x561 - x509*x560 - x519*x559 - x531*x558
     x563 = x113*x425 - x433*x562 - x435*x561 - x441*x560 - x454*x559 - x470*x558 - x492*x557
     return _assemble(
+        xp,
+        device,
         _lead,
         (7,),
         [
@@ -2457,10 +2498,11 @@ def regressor(q, qd, qdd, p=None):
 
     Returns Y of shape (7, 91) for one state, (N, 7, 91) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -2482,9 +2524,9 @@ def regressor(q, qd, qdd, p=None):
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
     qdd7 = qdd[..., 6]
-    x0 = np.sign(qd1)
-    x1 = np.sin(q2)
-    x2 = np.cos(q2)
+    x0 = xp.sign(qd1)
+    x1 = xp.sin(q2)
+    x2 = xp.cos(q2)
     x3 = 9.81*x1
     x4 = 9.81*x2
     x5 = -x1*x4 + x2*x3
@@ -2502,11 +2544,11 @@ def regressor(q, qd, qdd, p=None):
     x17 = -qdd2*x1 - x15*x2 - x16*x6
     x18 = -qdd2*x2 + x1*x15 - x16*x8
     x19 = qd2*x16
-    x20 = np.cos(q3)
+    x20 = xp.cos(q3)
     x21 = x6*x8
     x22 = -qdd2 + x21
     x23 = -0.316*x22 - x3
-    x24 = np.sin(q3)
+    x24 = xp.sin(q3)
     x25 = 0.316*x24
     x26 = x10 - x9
     x27 = x20*x23 - x25*x26
@@ -2550,8 +2592,8 @@ def regressor(q, qd, qdd, p=None):
     x65 = x2*x56 - x32*x38 + x35*x64 + x44*x59
     x66 = x2*x53 + x30*x38 + x36*x64 + x44*x61
     x67 = x2*x38 + x44*x64
-    x68 = np.cos(q4)
-    x69 = np.sin(q4)
+    x68 = xp.cos(q4)
+    x69 = xp.sin(q4)
     x70 = x52 - x53
     x71 = x42 + 0.0825*x70
     x72 = x27 + 0.0825*x46
@@ -2598,8 +2640,8 @@ def regressor(q, qd, qdd, p=None):
     x113 = x101*x84 + x107*x86 + x112*x81 - x30*x97
     x114 = x109*x86 + x112*x82 - x30*x88 + x84*x93
     x115 = x112*x86 - x30*x84
-    x116 = np.cos(q5)
-    x117 = np.sin(q5)
+    x116 = xp.cos(q5)
+    x117 = xp.sin(q5)
     x118 = x73 - 0.0825*x92 + 0.384*x95
     x119 = 0.0825*x89
     x120 = -x119 + x75 + 0.384*x98
@@ -2648,8 +2690,8 @@ def regressor(q, qd, qdd, p=None):
     x163 = x131*x162 + x134*x151 + x136*x157 + x147*x93
     x164 = x132*x162 + x134*x143 + x136*x159 + x138*x93
     x165 = x134*x93 + x136*x162
-    x166 = np.cos(q6)
-    x167 = np.sin(q6)
+    x166 = xp.cos(q6)
+    x167 = xp.sin(q6)
     x168 = x126*x166 + x127*x167
     x169 = -x126*x167 + x127*x166
     x170 = x128*x166 + x129*x167
@@ -2690,8 +2732,8 @@ def regressor(q, qd, qdd, p=None):
     x205 = -x143*x189 + x173*x204 + x176*x193 + x178*x199
     x206 = -x143*x180 + x174*x204 + x176*x185 + x178*x201
     x207 = -x143*x176 + x178*x204
-    x208 = np.cos(q7)
-    x209 = np.sin(q7)
+    x208 = xp.cos(q7)
+    x209 = xp.sin(q7)
     x210 = x168 + 0.088*x184
     x211 = -x121 + 0.088*x181
     x212 = x208*x210 + x209*x211
@@ -2740,7 +2782,7 @@ def regressor(q, qd, qdd, p=None):
     x255 = x40 - (x8*x8)
     x256 = x10 + x9
     x257 = x12 - x7
-    x258 = np.sign(qd2)
+    x258 = xp.sign(qd2)
     x259 = -x25*x29 + x27*x28
     x260 = -x20*x42 - x25*x39 + x28*x46
     x261 = x24*x42 - x25*x50 + x28*x48
@@ -2830,7 +2872,7 @@ def regressor(q, qd, qdd, p=None):
     x345 = -x43 + x49
     x346 = -x55 + x56
     x347 = x52 + x53
-    x348 = np.sign(qd3)
+    x348 = xp.sign(qd3)
     x349 = -x119 - x68*x75
     x350 = x69*x75 - 0.0825*x98
     x351 = -0.0825*x105 + x68*x73 - x69*x74
@@ -2899,7 +2941,7 @@ def regressor(q, qd, qdd, p=None):
     x414 = -x90 + x99
     x415 = -x96 + x97
     x416 = x87 + x88
-    x417 = np.sign(qd4)
+    x417 = xp.sign(qd4)
     x418 = 0.384*x116
     x419 = 0.384*x117
     x420 = x121*x419 - x126*x418 - 0.0825*x127
@@ -2952,7 +2994,7 @@ def regressor(q, qd, qdd, p=None):
     x467 = -x140 + x149
     x468 = -x146 + x147
     x469 = x137 + x138
-    x470 = np.sign(qd5)
+    x470 = xp.sign(qd5)
     x471 = x121*x166
     x472 = x121*x167
     x473 = x166*x168 - x167*x169
@@ -2984,7 +3026,7 @@ def regressor(q, qd, qdd, p=None):
     x499 = -x182 + x191
     x500 = -x188 + x189
     x501 = x179 + x180
-    x502 = np.sign(qd6)
+    x502 = xp.sign(qd6)
     x503 = -x208*x214 - 0.088*x228
     x504 = x209*x214 - 0.088*x237
     x505 = x208*x212 - x209*x213 - 0.088*x244
@@ -2998,8 +3040,10 @@ def regressor(q, qd, qdd, p=None):
     x513 = -x229 + x238
     x514 = -x235 + x236
     x515 = x226 + x227
-    x516 = np.sign(qd7)
+    x516 = xp.sign(qd7)
     return _assemble(
+        xp,
+        device,
         _lead,
         (7, 91),
         [
@@ -3649,10 +3693,11 @@ def base_regressor(q, qd, qdd, p=None):
 
     Returns Yb of shape (7, 62) for one state, (N, 7, 62) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -3674,9 +3719,9 @@ def base_regressor(q, qd, qdd, p=None):
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
     qdd7 = qdd[..., 6]
-    x0 = np.sign(qd1)
-    x1 = np.sin(q2)
-    x2 = np.cos(q2)
+    x0 = xp.sign(qd1)
+    x1 = xp.sin(q2)
+    x2 = xp.cos(q2)
     x3 = qd1*x1
     x4 = qd2*x3
     x5 = qd1*x2
@@ -3690,13 +3735,13 @@ def base_regressor(q, qd, qdd, p=None):
     x13 = -qdd2*x1 - x11*x2 - x12*x3
     x14 = -qdd2*x2 + x1*x11 - x12*x5
     x15 = qd2*x12
-    x16 = np.sin(q3)
+    x16 = xp.sin(q3)
     x17 = x1*x16
     x18 = 9.81*x1
     x19 = x3*x5
     x20 = -qdd2 + x19
     x21 = -x18 - 0.316*x20
-    x22 = np.cos(q3)
+    x22 = xp.cos(q3)
     x23 = 0.316*x22
     x24 = -x6 + x7
     x25 = -x16*x21 - x23*x24
@@ -3733,8 +3778,8 @@ def base_regressor(q, qd, qdd, p=None):
     x56 = x2*x50 + x26*x55 - x29*x40 + x36*x49
     x57 = x17*x29 + x2*x53 + x27*x55 + x36*x52
     x58 = x2*x29 + x36*x55
-    x59 = np.cos(q4)
-    x60 = np.sin(q4)
+    x59 = xp.cos(q4)
+    x60 = xp.sin(q4)
     x61 = x26*x59 + x36*x60
     x62 = -x26*x60 + x36*x59
     x63 = x61*x62
@@ -3776,8 +3821,8 @@ def base_regressor(q, qd, qdd, p=None):
     x99 = -x17*x87 + x61*x98 + x64*x92 + x66*x94
     x100 = -x17*x68 + x62*x98 + x64*x79 + x66*x96
     x101 = -x17*x64 + x66*x98
-    x102 = np.cos(q5)
-    x103 = np.sin(q5)
+    x102 = xp.cos(q5)
+    x103 = xp.sin(q5)
     x104 = x102*x61 - x103*x66
     x105 = -x102*x66 - x103*x61
     x106 = x104*x105
@@ -3819,8 +3864,8 @@ def base_regressor(q, qd, qdd, p=None):
     x142 = x104*x141 + x107*x135 + x109*x137 + x130*x79
     x143 = x105*x141 + x107*x121 + x109*x139 + x111*x79
     x144 = x107*x79 + x109*x141
-    x145 = np.cos(q6)
-    x146 = np.sin(q6)
+    x145 = xp.cos(q6)
+    x146 = xp.sin(q6)
     x147 = x104*x145 + x109*x146
     x148 = -x104*x146 + x109*x145
     x149 = x147*x148
@@ -3855,8 +3900,8 @@ def base_regressor(q, qd, qdd, p=None):
     x178 = -x121*x166 + x147*x177 + x150*x171 + x152*x173
     x179 = -x121*x154 + x148*x177 + x150*x160 + x152*x175
     x180 = -x121*x150 + x152*x177
-    x181 = np.cos(q7)
-    x182 = np.sin(q7)
+    x181 = xp.cos(q7)
+    x182 = xp.sin(q7)
     x183 = x147*x181 + x152*x182
     x184 = -x147*x182 + x152*x181
     x185 = x183*x184
@@ -3899,7 +3944,7 @@ def base_regressor(q, qd, qdd, p=None):
     x222 = x32 - (x5*x5)
     x223 = x6 + x7
     x224 = -x4 + x9
-    x225 = np.sign(qd2)
+    x225 = xp.sign(qd2)
     x226 = -x22*x34 + x23*x38 - x30*x43
     x227 = x16*x34 + x23*x45 - x43*x47
     x228 = x16*x50 + x22*x70
@@ -3974,7 +4019,7 @@ def base_regressor(q, qd, qdd, p=None):
     x297 = -x35 + x46
     x298 = -x229 + x50
     x299 = x53 + x70
-    x300 = np.sign(qd3)
+    x300 = xp.sign(qd3)
     x301 = -x114 - x59*x75
     x302 = x60*x75 - 0.0825*x88
     x303 = x59*x67 + x60*x87
@@ -4031,7 +4076,7 @@ def base_regressor(q, qd, qdd, p=None):
     x354 = -x76 + x90
     x355 = -x86 + x87
     x356 = x67 + x68
-    x357 = np.sign(qd4)
+    x357 = xp.sign(qd4)
     x358 = 0.384*x102
     x359 = 0.384*x103
     x360 = x102*x117 + x108*x359 - 0.0825*x112 - x120*x358
@@ -4075,7 +4120,7 @@ def base_regressor(q, qd, qdd, p=None):
     x398 = -x118 + x133
     x399 = -x129 + x130
     x400 = x110 + x111
-    x401 = np.sign(qd5)
+    x401 = xp.sign(qd5)
     x402 = x116*x145
     x403 = x116*x146
     x404 = x145*x153 + x146*x166
@@ -4102,7 +4147,7 @@ def base_regressor(q, qd, qdd, p=None):
     x425 = -x157 + x169
     x426 = -x165 + x166
     x427 = x153 + x154
-    x428 = np.sign(qd6)
+    x428 = xp.sign(qd6)
     x429 = -x181*x195 - 0.088*x191
     x430 = x182*x195 - 0.088*x208
     x431 = x181*x189 + x182*x207
@@ -4114,8 +4159,10 @@ def base_regressor(q, qd, qdd, p=None):
     x437 = -x196 + x210
     x438 = -x206 + x207
     x439 = x189 + x190
-    x440 = np.sign(qd7)
+    x440 = xp.sign(qd7)
     return _assemble(
+        xp,
+        device,
         _lead,
         (7, 62),
         [
@@ -4562,10 +4609,11 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
 
     Returns the tuple (dtau_dq, dtau_dqd) of shapes (7, 7), (7, 7) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -4587,18 +4635,18 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
     qdd7 = qdd[..., 6]
-    x0 = np.sin(q2)
-    x1 = np.cos(q2)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
-    x4 = np.cos(q4)
-    x5 = np.sin(q4)
-    x6 = np.cos(q5)
-    x7 = np.sin(q5)
-    x8 = np.sin(q6)
-    x9 = np.cos(q6)
-    x10 = np.sin(q7)
-    x11 = np.cos(q7)
+    x0 = xp.sin(q2)
+    x1 = xp.cos(q2)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
+    x4 = xp.cos(q4)
+    x5 = xp.sin(q4)
+    x6 = xp.cos(q5)
+    x7 = xp.sin(q5)
+    x8 = xp.sin(q6)
+    x9 = xp.cos(q6)
+    x10 = xp.sin(q7)
+    x11 = xp.cos(q7)
     x12 = qd2*x3
     x13 = qd1*x0
     x14 = x13*x2
@@ -6555,6 +6603,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x1965 = 2*x1741
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (7, 7),
             [
@@ -6610,6 +6660,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (7, 7),
             [
@@ -6672,10 +6724,11 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
 
     Returns the tuple (dqdd_dq, dqdd_dqd, Minv) of shapes (7, 7), (7, 7), (7, 7) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -6697,19 +6750,19 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     tau5 = tau[..., 4]
     tau6 = tau[..., 5]
     tau7 = tau[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.cos(q5)
-    x3 = np.sin(q6)
-    x4 = np.cos(q6)
-    x5 = np.sin(q7)
-    x6 = np.cos(q7)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.cos(q5)
+    x3 = xp.sin(q6)
+    x4 = xp.cos(q6)
+    x5 = xp.sin(q7)
+    x6 = xp.cos(q7)
     x7 = 0.0031274395439999996*x5 + 0.007735484874*x6
     x8 = x7 + 0.16496755269500002
     x9 = 0.068832705569*x3 + x4*x8
     x10 = x9 - 0.014653732538
     x11 = x10*x2
-    x12 = np.sin(q5)
+    x12 = xp.sin(q5)
     x13 = 0.007735484874*x5
     x14 = 0.0031274395439999996*x6
     x15 = x13 - x14
@@ -6771,8 +6824,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x71 = x61*x70 + x63*x69
     x72 = x27 + x44 + x71 + 0.06736254418002012
     x73 = x72 + 0.028124284712194955
-    x74 = np.sin(q2)
-    x75 = np.cos(q2)
+    x74 = xp.sin(q2)
+    x75 = xp.cos(q2)
     x76 = x74*x75
     x77 = 2*x76
     x78 = x0*x25 + x1*x20
@@ -6782,8 +6835,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x82 = x28 + x45 + x48 + x59 + 0.6372531400842897
     x83 = x27 + x82 + 0.10199172388710612
     x84 = x81 - x83
-    x85 = np.cos(q3)
-    x86 = np.sin(q3)
+    x85 = xp.cos(q3)
+    x86 = xp.sin(q3)
     x87 = x85*x86
     x88 = 2*x87
     x89 = -x10*x12 - x17*x2
@@ -9019,6 +9072,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x2319 = -x2240*x232 + 2*x2244*x880 - x2252*x870 - x2259*x829 - x2265*x833 - x2272*x805 - x2276*x233
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (7, 7),
             [
@@ -9074,6 +9129,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (7, 7),
             [
@@ -9129,6 +9186,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (7, 7),
             [
@@ -9191,8 +9250,9 @@ def mass_matrix_inverse(q, p=None):
 
     Returns Minv of shape (7, 7) for one state, (N, 7, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -9200,19 +9260,19 @@ def mass_matrix_inverse(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.cos(q5)
-    x3 = np.sin(q6)
-    x4 = np.cos(q6)
-    x5 = np.sin(q7)
-    x6 = np.cos(q7)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.cos(q5)
+    x3 = xp.sin(q6)
+    x4 = xp.cos(q6)
+    x5 = xp.sin(q7)
+    x6 = xp.cos(q7)
     x7 = 0.0031274395439999996*x5 + 0.007735484874*x6
     x8 = x7 + 0.16496755269500002
     x9 = 0.068832705569*x3 + x4*x8
     x10 = x9 - 0.014653732538
     x11 = x10*x2
-    x12 = np.sin(q5)
+    x12 = xp.sin(q5)
     x13 = 0.007735484874*x5
     x14 = 0.0031274395439999996*x6
     x15 = x13 - x14
@@ -9274,8 +9334,8 @@ def mass_matrix_inverse(q, p=None):
     x71 = x61*x70 + x63*x69
     x72 = x27 + x44 + x71 + 0.06736254418002012
     x73 = x72 + 0.028124284712194955
-    x74 = np.sin(q2)
-    x75 = np.cos(q2)
+    x74 = xp.sin(q2)
+    x75 = xp.cos(q2)
     x76 = x74*x75
     x77 = 2*x76
     x78 = x0*x25 + x1*x20
@@ -9285,8 +9345,8 @@ def mass_matrix_inverse(q, p=None):
     x82 = x28 + x45 + x48 + x59 + 0.6372531400842897
     x83 = x27 + x82 + 0.10199172388710612
     x84 = x81 - x83
-    x85 = np.cos(q3)
-    x86 = np.sin(q3)
+    x85 = xp.cos(q3)
+    x86 = xp.sin(q3)
     x87 = x85*x86
     x88 = 2*x87
     x89 = -x10*x12 - x17*x2
@@ -9486,6 +9546,8 @@ def mass_matrix_inverse(q, p=None):
     x283 = x229*x237
     x284 = x228 + x229*x283
     return _assemble(
+        xp,
+        device,
         _lead,
         (7, 7),
         [
@@ -9547,10 +9609,11 @@ def linearize(q, qd, tau, p=None):
 
     Returns the tuple (A, B) of shapes (14, 14), (14, 7) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -9572,19 +9635,19 @@ def linearize(q, qd, tau, p=None):
     tau5 = tau[..., 4]
     tau6 = tau[..., 5]
     tau7 = tau[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.cos(q5)
-    x3 = np.sin(q6)
-    x4 = np.cos(q6)
-    x5 = np.sin(q7)
-    x6 = np.cos(q7)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.cos(q5)
+    x3 = xp.sin(q6)
+    x4 = xp.cos(q6)
+    x5 = xp.sin(q7)
+    x6 = xp.cos(q7)
     x7 = 0.0031274395439999996*x5 + 0.007735484874*x6
     x8 = x7 + 0.16496755269500002
     x9 = 0.068832705569*x3 + x4*x8
     x10 = x9 - 0.014653732538
     x11 = x10*x2
-    x12 = np.sin(q5)
+    x12 = xp.sin(q5)
     x13 = 0.007735484874*x5
     x14 = 0.0031274395439999996*x6
     x15 = x13 - x14
@@ -9646,8 +9709,8 @@ def linearize(q, qd, tau, p=None):
     x71 = x61*x70 + x63*x69
     x72 = x27 + x44 + x71 + 0.06736254418002012
     x73 = x72 + 0.028124284712194955
-    x74 = np.sin(q2)
-    x75 = np.cos(q2)
+    x74 = xp.sin(q2)
+    x75 = xp.cos(q2)
     x76 = x74*x75
     x77 = 2*x76
     x78 = x0*x25 + x1*x20
@@ -9657,8 +9720,8 @@ def linearize(q, qd, tau, p=None):
     x82 = x28 + x45 + x48 + x59 + 0.6372531400842897
     x83 = x27 + x82 + 0.10199172388710612
     x84 = x81 - x83
-    x85 = np.cos(q3)
-    x86 = np.sin(q3)
+    x85 = xp.cos(q3)
+    x86 = xp.sin(q3)
     x87 = x85*x86
     x88 = 2*x87
     x89 = -x10*x12 - x17*x2
@@ -11894,6 +11957,8 @@ def linearize(q, qd, tau, p=None):
     x2319 = -x2204*x232 + 2*x2208*x880 - x2216*x870 - x2223*x829 - x2229*x833 - x2236*x805 - x2240*x233
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (14, 14),
             [
@@ -12096,6 +12161,8 @@ def linearize(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (14, 7),
             [
@@ -12207,8 +12274,9 @@ def link7_pose(q, p=None):
 
     Returns T of shape (4, 4) for one state, (N, 4, 4) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -12217,26 +12285,26 @@ def link7_pose(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q7)
-    x1 = np.sin(q7)
-    x2 = np.sin(q5)
-    x3 = np.cos(q5)
-    x4 = np.cos(q3)
-    x5 = np.sin(q3)
-    x6 = np.sin(q1)
-    x7 = np.cos(q2)
-    x8 = np.cos(q1)
+    x0 = xp.cos(q7)
+    x1 = xp.sin(q7)
+    x2 = xp.sin(q5)
+    x3 = xp.cos(q5)
+    x4 = xp.cos(q3)
+    x5 = xp.sin(q3)
+    x6 = xp.sin(q1)
+    x7 = xp.cos(q2)
+    x8 = xp.cos(q1)
     x9 = x7*x8
     x10 = -x4*x6 - x5*x9
-    x11 = np.sin(q4)
-    x12 = np.cos(q4)
-    x13 = np.sin(q2)
+    x11 = xp.sin(q4)
+    x12 = xp.cos(q4)
+    x13 = xp.sin(q2)
     x14 = x13*x8
     x15 = x4*x9 - x5*x6
     x16 = x11*x14 + x12*x15
     x17 = x10*x3 - x16*x2
-    x18 = np.sin(q6)
-    x19 = np.cos(q6)
+    x18 = xp.sin(q6)
+    x19 = xp.cos(q6)
     x20 = -x11*x15 + x12*x14
     x21 = x10*x2 + x16*x3
     x22 = x18*x20 + x19*x21
@@ -12278,6 +12346,8 @@ def link7_pose(q, p=None):
     x58 = -0.0825*x48 + 0.384*x50 + x57
     x59 = 0.088*x52 + x58
     return _assemble(
+        xp,
+        device,
         _lead,
         (4, 4),
         [
@@ -12306,8 +12376,9 @@ def link7_jacobian(q, p=None):
 
     Returns J of shape (6, 7) for one state, (N, 6, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -12315,15 +12386,15 @@ def link7_jacobian(q, p=None):
     q4 = q[..., 3]
     q5 = q[..., 4]
     q6 = q[..., 5]
-    x0 = np.sin(q4)
-    x1 = np.cos(q4)
-    x2 = np.sin(q2)
-    x3 = np.sin(q1)
+    x0 = xp.sin(q4)
+    x1 = xp.cos(q4)
+    x2 = xp.sin(q2)
+    x3 = xp.sin(q1)
     x4 = x2*x3
-    x5 = np.cos(q3)
-    x6 = np.sin(q3)
-    x7 = np.cos(q1)
-    x8 = np.cos(q2)
+    x5 = xp.cos(q3)
+    x6 = xp.sin(q3)
+    x7 = xp.cos(q1)
+    x8 = xp.cos(q2)
     x9 = x3*x8
     x10 = x5*x9 + x6*x7
     x11 = x0*x4 + x1*x10
@@ -12331,10 +12402,10 @@ def link7_jacobian(q, p=None):
     x13 = 0.316*x4
     x14 = 0.0825*x10 + x13
     x15 = -0.0825*x11 + 0.384*x12 + x14
-    x16 = np.sin(q6)
-    x17 = np.cos(q6)
-    x18 = np.sin(q5)
-    x19 = np.cos(q5)
+    x16 = xp.sin(q6)
+    x17 = xp.cos(q6)
+    x18 = xp.sin(q5)
+    x19 = xp.cos(q5)
     x20 = x5*x7 - x6*x9
     x21 = x11*x19 + x18*x20
     x22 = x12*x16 + x17*x21
@@ -12393,6 +12464,8 @@ def link7_jacobian(q, p=None):
     x75 = x12*x17 - x16*x21
     x76 = -x16*x28 + x17*x25
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 7),
         [
@@ -12447,8 +12520,9 @@ def link7_jacobian_local(q, p=None):
 
     Returns J of shape (6, 7) for one state, (N, 6, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -12456,16 +12530,16 @@ def link7_jacobian_local(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.sin(q4)
-    x1 = np.cos(q4)
-    x2 = np.sin(q6)
-    x3 = np.sin(q7)
+    x0 = xp.sin(q4)
+    x1 = xp.cos(q4)
+    x2 = xp.sin(q6)
+    x3 = xp.sin(q7)
     x4 = x2*x3
-    x5 = np.sin(q5)
-    x6 = np.cos(q7)
+    x5 = xp.sin(q5)
+    x6 = xp.cos(q7)
     x7 = x5*x6
-    x8 = np.cos(q5)
-    x9 = np.cos(q6)
+    x8 = xp.cos(q5)
+    x9 = xp.cos(q6)
     x10 = x3*x9
     x11 = x10*x8
     x12 = -x11 + x7
@@ -12483,10 +12557,10 @@ def link7_jacobian_local(q, p=None):
     x24 = 0.0825*x20 + 0.384*x9
     x25 = -0.0825*x22 - 0.0825*x23 + x24
     x26 = -0.316*x21 + x25
-    x27 = np.sin(q2)
-    x28 = np.cos(q2)
-    x29 = np.cos(q3)
-    x30 = np.sin(q3)
+    x27 = xp.sin(q2)
+    x28 = xp.cos(q2)
+    x29 = xp.cos(q3)
+    x30 = xp.sin(q3)
     x31 = x10*x5 + x6*x8
     x32 = x14 + x15
     x33 = x29*x32 + x30*x31
@@ -12531,6 +12605,8 @@ def link7_jacobian_local(q, p=None):
     x72 = -x16*x46 + x4*x54
     x73 = -x16*x3 - x54*x6
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 7),
         [
@@ -12585,9 +12661,10 @@ def link7_jacobian_dot_qd(q, qd, p=None):
 
     Returns a of shape (6,) for one state, (N, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -12602,30 +12679,30 @@ def link7_jacobian_dot_qd(q, qd, p=None):
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
     qd7 = qd[..., 6]
-    x0 = np.cos(q2)
-    x1 = np.sin(q4)
-    x2 = np.cos(q4)
-    x3 = np.sin(q2)
-    x4 = np.cos(q3)
+    x0 = xp.cos(q2)
+    x1 = xp.sin(q4)
+    x2 = xp.cos(q4)
+    x3 = xp.sin(q2)
+    x4 = xp.cos(q3)
     x5 = x3*x4
     x6 = x0*x1 - x2*x5
     x7 = x0*x2 + x1*x5
     x8 = 0.316*x0 + 0.333
     x9 = -0.0825*x5 + x8
     x10 = -0.0825*x6 + 0.384*x7 + x9
-    x11 = np.sin(q6)
-    x12 = np.cos(q6)
-    x13 = np.sin(q5)
-    x14 = np.cos(q5)
-    x15 = np.sin(q3)
+    x11 = xp.sin(q6)
+    x12 = xp.cos(q6)
+    x13 = xp.sin(q5)
+    x14 = xp.cos(q5)
+    x15 = xp.sin(q3)
     x16 = x15*x3
     x17 = x13*x16 + x14*x6
     x18 = x11*x7 + x12*x17
     x19 = x10 + 0.088*x18
     x20 = -x10 + x19
-    x21 = np.sin(q1)
+    x21 = xp.sin(q1)
     x22 = x21*x3
-    x23 = np.cos(q1)
+    x23 = xp.cos(q1)
     x24 = x0*x21
     x25 = x15*x23 + x24*x4
     x26 = x1*x22 + x2*x25
@@ -12735,6 +12812,8 @@ def link7_jacobian_dot_qd(q, qd, p=None):
     x130 = x102 + x126*x58 - x129*x78
     x131 = x104 - x124*x58 + x129*x68
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [
@@ -12753,8 +12832,9 @@ def com(q, p=None):
 
     Returns c of shape (3,) for one state, (N, 3) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -12763,33 +12843,33 @@ def com(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q1)
-    x1 = np.sin(q1)
-    x2 = np.cos(q2)
+    x0 = xp.cos(q1)
+    x1 = xp.sin(q1)
+    x2 = xp.cos(q2)
     x3 = x0*x2
-    x4 = np.sin(q2)
+    x4 = xp.sin(q2)
     x5 = x0*x4
-    x6 = np.cos(q3)
-    x7 = np.sin(q3)
+    x6 = xp.cos(q3)
+    x7 = xp.sin(q3)
     x8 = -x1*x7 + x3*x6
     x9 = -x1*x6 - x3*x7
-    x10 = np.sin(q4)
-    x11 = np.cos(q4)
+    x10 = xp.sin(q4)
+    x11 = xp.cos(q4)
     x12 = x10*x5 + x11*x8
     x13 = -x10*x8 + x11*x5
     x14 = 0.316*x5
     x15 = x14 + 0.0825*x8
-    x16 = np.sin(q5)
-    x17 = np.cos(q5)
+    x16 = xp.sin(q5)
+    x17 = xp.cos(q5)
     x18 = x12*x17 + x16*x9
     x19 = -x12*x16 + x17*x9
     x20 = -0.0825*x12 + 0.384*x13 + x15
-    x21 = np.sin(q6)
-    x22 = np.cos(q6)
+    x21 = xp.sin(q6)
+    x22 = xp.cos(q6)
     x23 = x13*x21 + x18*x22
     x24 = x13*x22 - x18*x21
-    x25 = np.cos(q7)
-    x26 = np.sin(q7)
+    x25 = xp.cos(q7)
+    x26 = xp.sin(q7)
     x27 = -x19*x26 + x23*x25
     x28 = -x19*x25 - x23*x26
     x29 = x20 + 0.088*x23
@@ -12827,6 +12907,8 @@ def com(q, p=None):
     x61 = 0.088*x54 + x60
     x62 = -0.01221063981344444*x2 + 0.00012650839664373321*x4 - 0.005531315822332925*x48 + 0.0017573691262156238*x49 - 0.011876902589892798*x50 + 0.020390986800693706*x51 - 0.0009123155343263272*x52 + 0.004225505768785861*x53 + 0.006240866199767254*x54 - 0.004285402807609849*x55 + 0.00048159764058718974*x56 - 0.0001947088682872236*x57 + 0.2010071888339605*x58 + 0.22337601259907464*x59 + 0.18008200903840163*x60 + 0.04579230204309116*x61 + 0.1164642483326622
     return _assemble(
+        xp,
+        device,
         _lead,
         (3,),
         [
@@ -12842,8 +12924,9 @@ def com_jacobian(q, p=None):
 
     Returns Jc of shape (3, 7) for one state, (N, 3, 7) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -12852,33 +12935,33 @@ def com_jacobian(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q1)
-    x1 = np.sin(q1)
-    x2 = np.cos(q2)
+    x0 = xp.cos(q1)
+    x1 = xp.sin(q1)
+    x2 = xp.cos(q2)
     x3 = x1*x2
-    x4 = np.sin(q2)
+    x4 = xp.sin(q2)
     x5 = x1*x4
-    x6 = np.cos(q3)
-    x7 = np.sin(q3)
+    x6 = xp.cos(q3)
+    x7 = xp.sin(q3)
     x8 = x0*x7 + x3*x6
     x9 = x0*x6 - x3*x7
-    x10 = np.sin(q4)
-    x11 = np.cos(q4)
+    x10 = xp.sin(q4)
+    x11 = xp.cos(q4)
     x12 = x10*x5 + x11*x8
     x13 = -x10*x8 + x11*x5
     x14 = 0.316*x5
     x15 = x14 + 0.0825*x8
-    x16 = np.sin(q5)
-    x17 = np.cos(q5)
+    x16 = xp.sin(q5)
+    x17 = xp.cos(q5)
     x18 = x12*x17 + x16*x9
     x19 = -x12*x16 + x17*x9
     x20 = -0.0825*x12 + 0.384*x13 + x15
-    x21 = np.sin(q6)
-    x22 = np.cos(q6)
+    x21 = xp.sin(q6)
+    x22 = xp.cos(q6)
     x23 = x13*x21 + x18*x22
     x24 = x13*x22 - x18*x21
-    x25 = np.cos(q7)
-    x26 = np.sin(q7)
+    x25 = xp.cos(q7)
+    x26 = xp.sin(q7)
     x27 = -x19*x26 + x23*x25
     x28 = -x19*x25 - x23*x26
     x29 = x20 + 0.088*x23
@@ -13036,6 +13119,8 @@ def com_jacobian(q, p=None):
     x181 = -0.04579230204309116*x75
     x182 = -x129*x181 + x180*x24
     return _assemble(
+        xp,
+        device,
         _lead,
         (3, 7),
         [
@@ -13069,9 +13154,10 @@ def com_jacobian_dot_qd(q, qd, p=None):
 
     Returns a of shape (3,) for one state, (N, 3) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -13087,37 +13173,37 @@ def com_jacobian_dot_qd(q, qd, p=None):
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
     qd7 = qd[..., 6]
-    x0 = np.cos(q1)
+    x0 = xp.cos(q1)
     x1 = qd2*x0
-    x2 = np.sin(q2)
-    x3 = np.cos(q2)
+    x2 = xp.sin(q2)
+    x3 = xp.cos(q2)
     x4 = 0.003141*x2 + 0.02872*x3
     x5 = 0.04027647139246521*x4
-    x6 = np.cos(q3)
+    x6 = xp.cos(q3)
     x7 = x2*x6
-    x8 = np.sin(q3)
+    x8 = xp.sin(q3)
     x9 = x2*x8
     x10 = 0.066502*x3 + 0.027518*x7 - 0.039252*x9
     x11 = -0.2010071888339605*x10
-    x12 = np.sin(q4)
-    x13 = np.cos(q4)
+    x12 = xp.sin(q4)
+    x13 = xp.cos(q4)
     x14 = x12*x3 - x13*x7
     x15 = x12*x7 + x13*x3
     x16 = 0.05317*x14 - 0.104419*x15 + 0.027454*x9
     x17 = -0.22337601259907464*x16
-    x18 = np.sin(q5)
-    x19 = np.cos(q5)
+    x18 = xp.sin(q5)
+    x19 = xp.cos(q5)
     x20 = x14*x19 + x18*x9
     x21 = -x14*x18 + x19*x9
     x22 = 0.038437*x15 + 0.011953*x20 - 0.041065*x21
     x23 = -0.07632523503106561*x22
-    x24 = np.sin(q6)
-    x25 = np.cos(q6)
+    x24 = xp.sin(q6)
+    x25 = xp.cos(q6)
     x26 = x15*x24 + x20*x25
     x27 = x15*x25 - x20*x24
     x28 = 0.010517*x21 + 0.060149*x26 - 0.014117*x27
     x29 = 0.103756774007336*x28
-    x30 = np.sin(q1)
+    x30 = xp.sin(q1)
     x31 = x3*x30
     x32 = x0*x6 - x31*x8
     x33 = x2*x30
@@ -13130,8 +13216,8 @@ def com_jacobian_dot_qd(q, qd, p=None):
     x40 = -x24*x38 + x25*x37
     x41 = 0.010517*x36 + 0.060149*x39 - 0.014117*x40
     x42 = 0.103756774007336*x41
-    x43 = np.cos(q7)
-    x44 = np.sin(q7)
+    x43 = xp.cos(q7)
+    x44 = xp.sin(q7)
     x45 = -x21*x44 + x26*x43
     x46 = -x21*x43 - x26*x44
     x47 = 0.061597*x27 - 0.010517*x45 + 0.004252*x46
@@ -13309,6 +13395,8 @@ def com_jacobian_dot_qd(q, qd, p=None):
     x219 = x103*x185 - x107*x211 - x174*x183 + x181*x209 + x218
     x220 = -0.04027647139246521*x1*x193 + 0.103756774007336*x103*x140 + 0.04579230204309116*x104*x134 - 0.103756774007336*x107*x198 - 0.04579230204309116*x108*x195 - 0.04027647139246521*x119*x66 + 0.07632523503106561*x127*x86 + 0.22337601259907464*x136*x85 + 0.2010071888339605*x138*x84 + x142*x214 - x143*x189 - x152*x190 - x163*x191 - x174*x188 - x176*x192 - 0.07632523503106561*x194*x92 - 0.22337601259907464*x196*x91 - 0.2010071888339605*x197*x90 - x199*x215 + x200*x51 + x203*x55 + x206*x59 + x209*x42 + x210*x65 + 0.2010071888339605*x216 + 0.22337601259907464*x217 + 0.18008200903840163*x218 + 0.04579230204309116*x219
     return _assemble(
+        xp,
+        device,
         _lead,
         (3,),
         [
@@ -13324,8 +13412,9 @@ def link7_operational_space_inertia(q, p=None):
 
     Returns Lambda of shape (6, 6) for one state, (N, 6, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -13334,15 +13423,15 @@ def link7_operational_space_inertia(q, p=None):
     q5 = q[..., 4]
     q6 = q[..., 5]
     q7 = q[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.sin(q2)
-    x3 = np.sin(q1)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.sin(q2)
+    x3 = xp.sin(q1)
     x4 = x2*x3
-    x5 = np.cos(q3)
-    x6 = np.sin(q3)
-    x7 = np.cos(q1)
-    x8 = np.cos(q2)
+    x5 = xp.cos(q3)
+    x6 = xp.sin(q3)
+    x7 = xp.cos(q1)
+    x8 = xp.cos(q2)
     x9 = x3*x8
     x10 = x5*x9 + x6*x7
     x11 = x0*x10 + x1*x4
@@ -13350,10 +13439,10 @@ def link7_operational_space_inertia(q, p=None):
     x13 = 0.316*x4
     x14 = 0.0825*x10 + x13
     x15 = -0.0825*x11 + 0.384*x12 + x14
-    x16 = np.sin(q6)
-    x17 = np.cos(q6)
-    x18 = np.cos(q5)
-    x19 = np.sin(q5)
+    x16 = xp.sin(q6)
+    x17 = xp.cos(q6)
+    x18 = xp.cos(q5)
+    x19 = xp.sin(q5)
     x20 = x5*x7 - x6*x9
     x21 = x11*x18 + x19*x20
     x22 = x12*x16 + x17*x21
@@ -13382,8 +13471,8 @@ def link7_operational_space_inertia(q, p=None):
     x45 = x18*x26 - x19*x27
     x46 = -x11*x19 + x18*x20
     x47 = -x42*x46 + x43*x45
-    x48 = np.sin(q7)
-    x49 = np.cos(q7)
+    x48 = xp.sin(q7)
+    x49 = xp.cos(q7)
     x50 = 0.0031274395439999996*x48 + 0.007735484874*x49
     x51 = x50 + 0.16496755269500002
     x52 = 0.068832705569*x16 + x17*x51
@@ -13816,6 +13905,8 @@ def link7_operational_space_inertia(q, p=None):
     x479 = x434*x448
     x480 = x431 + x434*x479
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 6),
         [
@@ -13864,9 +13955,10 @@ def link7_operational_space_bias(q, qd, p=None):
 
     Returns mu of shape (6,) for one state, (N, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -13882,15 +13974,15 @@ def link7_operational_space_bias(q, qd, p=None):
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
     qd7 = qd[..., 6]
-    x0 = np.cos(q4)
-    x1 = np.sin(q4)
-    x2 = np.sin(q2)
-    x3 = np.sin(q1)
+    x0 = xp.cos(q4)
+    x1 = xp.sin(q4)
+    x2 = xp.sin(q2)
+    x3 = xp.sin(q1)
     x4 = x2*x3
-    x5 = np.cos(q3)
-    x6 = np.sin(q3)
-    x7 = np.cos(q1)
-    x8 = np.cos(q2)
+    x5 = xp.cos(q3)
+    x6 = xp.sin(q3)
+    x7 = xp.cos(q1)
+    x8 = xp.cos(q2)
     x9 = x3*x8
     x10 = x5*x9 + x6*x7
     x11 = x0*x10 + x1*x4
@@ -13898,10 +13990,10 @@ def link7_operational_space_bias(q, qd, p=None):
     x13 = 0.316*x4
     x14 = 0.0825*x10 + x13
     x15 = -0.0825*x11 + 0.384*x12 + x14
-    x16 = np.sin(q6)
-    x17 = np.cos(q6)
-    x18 = np.cos(q5)
-    x19 = np.sin(q5)
+    x16 = xp.sin(q6)
+    x17 = xp.cos(q6)
+    x18 = xp.cos(q5)
+    x19 = xp.sin(q5)
     x20 = x5*x7 - x6*x9
     x21 = x11*x18 + x19*x20
     x22 = x12*x16 + x17*x21
@@ -13930,8 +14022,8 @@ def link7_operational_space_bias(q, qd, p=None):
     x45 = x18*x26 - x19*x27
     x46 = -x11*x19 + x18*x20
     x47 = -x42*x46 + x43*x45
-    x48 = np.sin(q7)
-    x49 = np.cos(q7)
+    x48 = xp.sin(q7)
+    x49 = xp.cos(q7)
     x50 = 0.0031274395439999996*x48 + 0.007735484874*x49
     x51 = x50 + 0.16496755269500002
     x52 = 0.068832705569*x16 + x17*x51
@@ -14671,6 +14763,8 @@ def link7_operational_space_bias(q, qd, p=None):
     x786 = x460*x733 + x747*x770 + x752*x777 + x756*x782 + x758*x785 - x761*x784
     x787 = x444*x761 + x445*x733 + x747*x763 + x752*x772 + x756*x779 - x758*x784
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [

@@ -20,36 +20,56 @@ Every function takes one state (vectors of shape (NDOF,)) or a batch with a
 leading axis (shape (N, NDOF)); p, the free parameters in PARAM_NAMES order,
 is (NPARAM,) or (N, NPARAM) and may be None when NPARAM is 0. Outputs have
 shape (NDOF,) or (NDOF, NDOF) for one state, (N, NDOF) or (N, NDOF, NDOF) for
-a batch, all of dtype DTYPE. Needs only numpy.
+a batch, all of dtype float64 (DTYPE for NumPy).
+
+Written against the Python array API standard: the arrays given pick the
+namespace (array_api_compat.array_namespace), so the same file runs on NumPy,
+JAX, PyTorch or CuPy arrays and returns arrays of the same library, on the same
+device; NumPy arrays, lists, numbers and other array-likes are computed with NumPy. Needs numpy
+and array-api-compat.
 """
 
 import numpy as np
+from array_api_compat import array_namespace, is_array_api_obj
+from array_api_compat import device as _array_device
 
 NDOF = 6
 NPARAM = 0
 PARAM_NAMES = ()
 DTYPE = np.float64
+#: NumPy's own namespace follows the standard from NumPy 2 on; before, array-api-compat's wraps it
+_NUMPY = np if int(np.__version__.split(".")[0]) >= 2 else array_namespace(np.zeros(0))
+_NUMPY_INPUTS = (np.ndarray, np.generic, list, tuple, int, float)
 
 
-def _vector(x, size, name):
-    a = np.asarray(x, dtype=DTYPE)
+def _namespace(*args):
+    """The array namespace and device of the inputs' arrays; NumPy's for NumPy arrays, lists, numbers
+    and whatever else is no array of the standard (np.asarray reads it, as before)."""
+    arrays = [a for a in args if not isinstance(a, _NUMPY_INPUTS) and is_array_api_obj(a)]
+    if not arrays:
+        return _NUMPY, None
+    return array_namespace(*arrays), _array_device(arrays[0])
+
+
+def _vector(xp, device, x, size, name):
+    a = xp.asarray(x, dtype=xp.float64, device=device)
     if a.ndim == 0 or a.shape[-1] != size:
-        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {a.shape}")
+        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {tuple(a.shape)}")
     return a
 
 
-def _params(p):
+def _params(xp, device, p):
     if p is None:
         if NPARAM:
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
-        return np.zeros(0, dtype=DTYPE)
-    return _vector(p, NPARAM, "p")
+        return xp.zeros((0,), dtype=xp.float64, device=device)
+    return _vector(xp, device, p, NPARAM, "p")
 
 
-def _assemble(lead, shape, entries):
+def _assemble(xp, device, lead, shape, entries):
     """Broadcast every entry (a number or an array) to the leading shape and stack them."""
-    columns = [np.broadcast_to(np.asarray(e, dtype=DTYPE), lead) for e in entries]
-    return np.stack(columns, axis=-1).reshape(lead + shape)
+    columns = [xp.broadcast_to(xp.asarray(e, dtype=xp.float64, device=device), lead) for e in entries]
+    return xp.reshape(xp.stack(columns, axis=-1), lead + shape)
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -57,10 +77,11 @@ def inverse_dynamics(q, qd, qdd, p=None):
 
     Returns tau of shape (6,) for one state, (N, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -79,11 +100,11 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qdd4 = qdd[..., 3]
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
-    x0 = 5.8018217679508*qd1 + 24.7313845*np.sign(qd1)
-    x1 = np.sin(q2)
-    x2 = np.cos(q2)
-    x3 = np.cos(q3)
-    x4 = np.sin(q3)
+    x0 = 5.8018217679508*qd1 + 24.7313845*xp.sign(qd1)
+    x1 = xp.sin(q2)
+    x2 = xp.cos(q2)
+    x3 = xp.cos(q3)
+    x4 = xp.sin(q3)
     x5 = qd1*x2
     x6 = qd2*x5
     x7 = 0.015000000000000013*x6
@@ -107,8 +128,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x25 = x6 + x8
     x26 = x21 + 0.068*x24 + 0.006*x25
     x27 = -3.9585*x18 + 0.10439999999999999*x26 + x7 + 0.13*x8
-    x28 = np.cos(q4)
-    x29 = np.sin(q4)
+    x28 = xp.cos(q4)
+    x29 = xp.sin(q4)
     x30 = x3*x5
     x31 = x30 - x4*x9
     x32 = qd2 + qd3
@@ -140,8 +161,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x58 = x33 + x36
     x59 = x55 + x57 + 0.07*x58
     x60 = x34 + 0.066*x36 - 0.06767999999999999*x52 + 0.336*x59
-    x61 = np.sin(q5)
-    x62 = np.cos(q5)
+    x61 = xp.sin(q5)
+    x62 = xp.cos(q5)
     x63 = -x28*x32 - x29*x38
     x64 = qd4 + x31
     x65 = x63*x64
@@ -164,8 +185,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x82 = x65 - x69
     x83 = x81 + 0.019*x82
     x84 = -x66 + 0.0018*x69 - 0.015579999999999998*x83
-    x85 = np.cos(q6)
-    x86 = np.sin(q6)
+    x85 = xp.cos(q6)
+    x86 = xp.sin(q6)
     x87 = qd5 - x63
     x88 = 0.00010000000000000005*x87
     x89 = x28*x38 - x29*x32
@@ -264,18 +285,20 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x182 = x165*x3 - x173*x4
     x183 = x157*x4 + x163*x3 + x180 - 0.4318*x181 + 0.15005*x182
     x184 = 0.35*qdd1 + x1*x175 + x183*x2
-    x185 = 9.496868641825001*qd2 + 13.58469*np.sign(qd2)
+    x185 = 9.496868641825001*qd2 + 13.58469*xp.sign(qd2)
     x186 = 0.394*x15
     x187 = 0.539*qdd2 - 0.10439999999999999*x179 + 1.1832*x18 + x186
     x188 = 0.053500000000000006*x73
     x189 = -0.336*x160 - x188 + 0.086*x68
     x190 = -x132*x29 - x139*x28 - 0.4318*x164 + 0.0203*x172 + x189
     x191 = 0.4318*x174 + x187 + x190
-    x192 = 3.9804259903721997*qd3 + 7.0892316*np.sign(qd3)
-    x193 = 0.41164522969715195*qd4 + 0.85160768*np.sign(qd4)
-    x194 = 0.42728302093540005*qd5 + 0.6660069799999999*np.sign(qd5)
-    x195 = 0.2158232532732*qd6 + 0.30367656000000004*np.sign(qd6)
+    x192 = 3.9804259903721997*qd3 + 7.0892316*xp.sign(qd3)
+    x193 = 0.41164522969715195*qd4 + 0.85160768*xp.sign(qd4)
+    x194 = 0.42728302093540005*qd5 + 0.6660069799999999*xp.sign(qd5)
+    x195 = 0.2158232532732*qd6 + 0.30367656000000004*xp.sign(qd6)
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [
@@ -294,25 +317,26 @@ def mass_matrix(q, p=None):
 
     Returns M of shape (6, 6) for one state, (N, 6, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
     q5 = q[..., 4]
-    x0 = np.sin(q4)
-    x1 = np.sin(q5)
+    x0 = xp.sin(q4)
+    x1 = xp.sin(q5)
     x2 = 0.0028799999999999997*x1
     x3 = x0*x2
     x4 = x3 + 0.06767999999999999
     x5 = 0.3001*x4
-    x6 = np.cos(q3)
-    x7 = np.sin(q3)
-    x8 = np.cos(q4)
+    x6 = xp.cos(q3)
+    x7 = xp.sin(q3)
+    x8 = xp.cos(q4)
     x9 = x2*x8
     x10 = 0.025374999999999998 - x9
-    x11 = np.cos(q5)
+    x11 = xp.cos(q5)
     x12 = 0.0028799999999999997*x11
     x13 = x12 + 0.015579999999999998
     x14 = x13 + 0.87575
@@ -340,8 +364,8 @@ def mass_matrix(q, p=None):
     x36 = x7*x7
     x37 = x28*x36 + x30*x35
     x38 = x16 + x21 + x37 + x5 + 2.769262117125
-    x39 = np.sin(q2)
-    x40 = np.cos(q2)
+    x39 = xp.sin(q2)
+    x40 = xp.cos(q2)
     x41 = x39*x40
     x42 = 2*x41
     x43 = x27 - x37 + x5 + 1.1674009151249998
@@ -396,6 +420,8 @@ def mass_matrix(q, p=None):
     x92 = x84 + 0.576873331938
     x93 = x20 + 0.19079062612368
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 6),
         [
@@ -444,9 +470,10 @@ def coriolis_matrix(q, qd, p=None):
 
     Returns C of shape (6, 6) for one state, (N, 6, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -459,17 +486,17 @@ def coriolis_matrix(q, qd, p=None):
     qd4 = qd[..., 3]
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
-    x0 = np.cos(q2)
+    x0 = xp.cos(q2)
     x1 = qd1*x0
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
     x4 = x1*x3
-    x5 = np.sin(q2)
+    x5 = xp.sin(q2)
     x6 = qd1*x5
     x7 = x2*x6 + x4
     x8 = -1.03632*x1 + 0.168*x7
-    x9 = np.cos(q4)
-    x10 = np.sin(q4)
+    x9 = xp.cos(q4)
+    x10 = xp.sin(q4)
     x11 = qd2 + qd3
     x12 = -x10*x7 - x11*x9
     x13 = x1*x2
@@ -480,15 +507,15 @@ def coriolis_matrix(q, qd, p=None):
     x18 = -0.4318*x1 - 0.0203*x17 + 0.4318*x7
     x19 = -x10*x18 + x16*x9
     x20 = 0.007789999999999999*x12 + 0.41*x19
-    x21 = np.sin(q5)
-    x22 = np.cos(q5)
+    x21 = xp.sin(q5)
+    x22 = xp.cos(q5)
     x23 = x14*x2 - 0.15005*x4
     x24 = 0.0203*x11 + x23
     x25 = -x19*x21 + x22*x24
     x26 = 0.21500000000000002*x25
     x27 = x19*x22 + x21*x24
-    x28 = np.cos(q6)
-    x29 = np.sin(q6)
+    x28 = xp.cos(q6)
+    x29 = xp.sin(q6)
     x30 = -x10*x11 + x7*x9
     x31 = qd4 + x17
     x32 = x21*x31 + x22*x30
@@ -817,6 +844,8 @@ def coriolis_matrix(q, qd, p=None):
     x355 = -x12*x348 + x340
     x356 = -4e-05*x32 + x341
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 6),
         [
@@ -865,9 +894,10 @@ def coriolis(q, qd, p=None):
 
     Returns V of shape (6,) for one state, (N, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -880,10 +910,10 @@ def coriolis(q, qd, p=None):
     qd4 = qd[..., 3]
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
-    x0 = np.sin(q2)
-    x1 = np.cos(q2)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
+    x0 = xp.sin(q2)
+    x1 = xp.cos(q2)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
     x4 = qd1*x0
     x5 = qd1*x1
     x6 = x4*x5
@@ -901,8 +931,8 @@ def coriolis(q, qd, p=None):
     x18 = 0.012*x12 + 0.136*x14 + x17
     x19 = 0.13*x12 + x13 + 0.10439999999999999*x18
     x20 = -3.9585*x11 + x19
-    x21 = np.cos(q4)
-    x22 = np.sin(q4)
+    x21 = xp.cos(q4)
+    x22 = xp.sin(q4)
     x23 = x2*x5
     x24 = x23 - x3*x4
     x25 = qd2 + qd3
@@ -932,8 +962,8 @@ def coriolis(q, qd, p=None):
     x49 = x2*x46 + x3*x48
     x50 = x45 + x49
     x51 = x40 - 0.06767999999999999*x50
-    x52 = np.cos(q5)
-    x53 = np.sin(q5)
+    x52 = xp.cos(q5)
+    x53 = xp.sin(q5)
     x54 = x21*x31 - x22*x25
     x55 = qd4 + x24
     x56 = x52*x54 + x53*x55
@@ -969,8 +999,8 @@ def coriolis(q, qd, p=None):
     x86 = -x22*x81 - x85
     x87 = x75 + x86
     x88 = -x73 - 0.015579999999999998*x87
-    x89 = np.cos(q6)
-    x90 = np.sin(q6)
+    x89 = xp.cos(q6)
+    x90 = xp.sin(q6)
     x91 = x52*x55 - x53*x54
     x92 = x66*x91
     x93 = qd5*x91
@@ -1075,6 +1105,8 @@ def coriolis(q, qd, p=None):
     x192 = -x128*x22 - x138*x21 - 0.4318*x166 + 0.0203*x174 + x191
     x193 = 0.4318*x176 + x189 + x192
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [
@@ -1093,21 +1125,22 @@ def gravity(q, p=None):
 
     Returns G of shape (6,) for one state, (N, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
     q5 = q[..., 4]
-    x0 = np.cos(q3)
-    x1 = np.sin(q3)
-    x2 = np.cos(q4)
-    x3 = np.sin(q5)
+    x0 = xp.cos(q3)
+    x1 = xp.sin(q3)
+    x2 = xp.cos(q4)
+    x3 = xp.sin(q5)
     x4 = 0.0028799999999999997*x3
     x5 = x2*x4
     x6 = 0.025374999999999998 - x5
-    x7 = np.cos(q5)
+    x7 = xp.cos(q5)
     x8 = 0.0028799999999999997*x7
     x9 = x8 + 0.015579999999999998
     x10 = x9 + 0.87575
@@ -1115,17 +1148,19 @@ def gravity(q, p=None):
     x12 = x11 + 3.79559
     x13 = x0*x10 + x1*x6
     x14 = x13 + 0.10439999999999999
-    x15 = np.sin(q2)
+    x15 = xp.sin(q2)
     x16 = 9.81*x15
-    x17 = np.cos(q2)
+    x17 = xp.cos(q2)
     x18 = 9.81*x17
     x19 = -x0*x16 - x1*x18
     x20 = -x0*x18 + x1*x16
-    x21 = np.sin(q4)
+    x21 = xp.sin(q4)
     x22 = x19*x21
     x23 = x19*x2
     x24 = x20*x3 + x23*x7
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [
@@ -1144,8 +1179,9 @@ def friction(qd, p=None):
 
     Returns F of shape (6,) for one state, (N, 6) for a batch.
     """
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(qd, p)
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
     qd1 = qd[..., 0]
     qd2 = qd[..., 1]
@@ -1153,13 +1189,15 @@ def friction(qd, p=None):
     qd4 = qd[..., 3]
     qd5 = qd[..., 4]
     qd6 = qd[..., 5]
-    x0 = 5.8018217679508*qd1 + 24.7313845*np.sign(qd1)
-    x1 = 9.496868641825001*qd2 + 13.58469*np.sign(qd2)
-    x2 = 3.9804259903721997*qd3 + 7.0892316*np.sign(qd3)
-    x3 = 0.41164522969715195*qd4 + 0.85160768*np.sign(qd4)
-    x4 = 0.42728302093540005*qd5 + 0.6660069799999999*np.sign(qd5)
-    x5 = 0.2158232532732*qd6 + 0.30367656000000004*np.sign(qd6)
+    x0 = 5.8018217679508*qd1 + 24.7313845*xp.sign(qd1)
+    x1 = 9.496868641825001*qd2 + 13.58469*xp.sign(qd2)
+    x2 = 3.9804259903721997*qd3 + 7.0892316*xp.sign(qd3)
+    x3 = 0.41164522969715195*qd4 + 0.85160768*xp.sign(qd4)
+    x4 = 0.42728302093540005*qd5 + 0.6660069799999999*xp.sign(qd5)
+    x5 = 0.2158232532732*qd6 + 0.30367656000000004*xp.sign(qd6)
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [
@@ -1178,10 +1216,11 @@ def forward_dynamics(q, qd, tau, p=None):
 
     Returns qdd of shape (6,) for one state, (N, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1200,18 +1239,18 @@ def forward_dynamics(q, qd, tau, p=None):
     tau4 = tau[..., 3]
     tau5 = tau[..., 4]
     tau6 = tau[..., 5]
-    x0 = np.sin(q4)
-    x1 = np.sin(q5)
+    x0 = xp.sin(q4)
+    x1 = xp.sin(q5)
     x2 = 0.0028799999999999997*x1
     x3 = x0*x2
     x4 = x3 + 0.06767999999999999
     x5 = 0.3001*x4
-    x6 = np.cos(q3)
-    x7 = np.sin(q3)
-    x8 = np.cos(q4)
+    x6 = xp.cos(q3)
+    x7 = xp.sin(q3)
+    x8 = xp.cos(q4)
     x9 = x2*x8
     x10 = 0.025374999999999998 - x9
-    x11 = np.cos(q5)
+    x11 = xp.cos(q5)
     x12 = 0.0028799999999999997*x11
     x13 = x12 + 0.015579999999999998
     x14 = x13 + 0.87575
@@ -1239,8 +1278,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x36 = x7*x7
     x37 = x28*x36 + x30*x35
     x38 = x16 + x21 + x37 + x5 + 2.769262117125
-    x39 = np.sin(q2)
-    x40 = np.cos(q2)
+    x39 = xp.sin(q2)
+    x40 = xp.cos(q2)
     x41 = x39*x40
     x42 = 2*x41
     x43 = x27 - x37 + x5 + 1.1674009151249998
@@ -1252,7 +1291,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x49 = x38 + x48 + 0.35
     x50 = x49 + 0.784029968642
     x51 = 1/x50
-    x52 = 5.8018217679508*qd1 + 24.7313845*np.sign(qd1)
+    x52 = 5.8018217679508*qd1 + 24.7313845*xp.sign(qd1)
     x53 = qd1*x40
     x54 = qd2*x53
     x55 = 0.015000000000000013*x54
@@ -1339,8 +1378,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x136 = -x0*x135 - x129
     x137 = x125 + x136
     x138 = -x123 - 0.015579999999999998*x137
-    x139 = np.cos(q6)
-    x140 = np.sin(q6)
+    x139 = xp.cos(q6)
+    x140 = xp.sin(q6)
     x141 = -x1*x104 + x105*x11
     x142 = x116*x141
     x143 = qd5*x141
@@ -1513,9 +1552,9 @@ def forward_dynamics(q, qd, tau, p=None):
     x310 = 1/x309
     x311 = x310*(-x270*x277*x50 - x281*x285*x306 - x289*x293*x307 - x298*x303*x308)
     x312 = -(x277*x277)*x50 - x281*(x285*x285) - x289*(x293*x293) - x298*(x303*x303) - x309*(x311*x311) + 0.19410450566800005
-    x313 = 0.2158232532732*qd6 + 0.30367656000000004*np.sign(qd6)
+    x313 = 0.2158232532732*qd6 + 0.30367656000000004*xp.sign(qd6)
     x314 = tau6 - x114 - x313
-    x315 = 9.496868641825001*qd2 + 13.58469*np.sign(qd2)
+    x315 = 9.496868641825001*qd2 + 13.58469*xp.sign(qd2)
     x316 = 0.394*x64
     x317 = -0.10439999999999999*x232 + x316 + 1.1832*x70
     x318 = 0.053500000000000006*x130
@@ -1524,13 +1563,13 @@ def forward_dynamics(q, qd, tau, p=None):
     x321 = 0.4318*x226 + x317 + x320
     x322 = tau2 - x315 - x321
     x323 = -x239*x249 + x322
-    x324 = 3.9804259903721997*qd3 + 7.0892316*np.sign(qd3)
+    x324 = 3.9804259903721997*qd3 + 7.0892316*xp.sign(qd3)
     x325 = tau3 - x320 - x324
     x326 = -x239*x252 - x288*x323 + x325
-    x327 = 0.41164522969715195*qd4 + 0.85160768*np.sign(qd4)
+    x327 = 0.41164522969715195*qd4 + 0.85160768*xp.sign(qd4)
     x328 = tau4 - x214 - x327
     x329 = -x239*x259 - x296*x323 - x297*x326 + x328
-    x330 = 0.42728302093540005*qd5 + 0.6660069799999999*np.sign(qd5)
+    x330 = 0.42728302093540005*qd5 + 0.6660069799999999*xp.sign(qd5)
     x331 = tau5 - x187 - x330
     x332 = -x239*x270 - x306*x323 - x307*x326 - x308*x329 + x331
     x333 = -x239*x277 - x285*x323 - x293*x326 - x303*x329 - x311*x332 + x314
@@ -1541,6 +1580,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x338 = x282*x323 - x285*x334 - x288*x337 - x296*x336 - x306*x335
     x339 = x239*x51 - x249*x338 - x252*x337 - x259*x336 - x270*x335 - x277*x334
     return _assemble(
+        xp,
+        device,
         _lead,
         (6,),
         [
@@ -1559,10 +1600,11 @@ def regressor(q, qd, qdd, p=None):
 
     Returns Y of shape (6, 78) for one state, (N, 6, 78) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1581,9 +1623,9 @@ def regressor(q, qd, qdd, p=None):
     qdd4 = qdd[..., 3]
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
-    x0 = np.sign(qd1)
-    x1 = np.sin(q2)
-    x2 = np.cos(q2)
+    x0 = xp.sign(qd1)
+    x1 = xp.sin(q2)
+    x2 = xp.cos(q2)
     x3 = 9.81*x1
     x4 = 9.81*x2
     x5 = -x1*x4 + x2*x3
@@ -1602,8 +1644,8 @@ def regressor(q, qd, qdd, p=None):
     x18 = qdd2*x2 - x1*x15 + x16*x8
     x19 = qd2*x16
     x20 = 0.4318*x2
-    x21 = np.cos(q3)
-    x22 = np.sin(q3)
+    x21 = xp.cos(q3)
+    x22 = xp.sin(q3)
     x23 = x12 + x7
     x24 = x8*x8
     x25 = -x15 - x24
@@ -1659,8 +1701,8 @@ def regressor(q, qd, qdd, p=None):
     x75 = x44*x74 + x47*x65 + x54*x56
     x76 = x45*x74 + x47*x56 - x54*x65
     x77 = x49*x74
-    x78 = np.cos(q4)
-    x79 = np.sin(q4)
+    x78 = xp.cos(q4)
+    x79 = xp.sin(q4)
     x80 = x31 + 0.0203*x55 + 0.4318*x62
     x81 = x36 + 0.0203*x52 + x61
     x82 = -x78*x81 - x79*x80
@@ -1706,8 +1748,8 @@ def regressor(q, qd, qdd, p=None):
     x122 = x106*x56 + x110*x93 + x116*x95 + x121*x90
     x123 = -x102*x93 + x118*x95 + x121*x91 + x56*x97
     x124 = x121*x95 + x56*x93
-    x125 = np.cos(q5)
-    x126 = np.sin(q5)
+    x125 = xp.cos(q5)
+    x126 = xp.sin(q5)
     x127 = x125*x87 - x126*x86
     x128 = x125*x42 - x126*x88
     x129 = x127*x128
@@ -1749,8 +1791,8 @@ def regressor(q, qd, qdd, p=None):
     x165 = x102*x149 + x133*x164 + x136*x153 + x138*x159
     x166 = x102*x140 + x134*x164 + x136*x145 + x138*x161
     x167 = x102*x136 + x138*x164
-    x168 = np.cos(q6)
-    x169 = np.sin(q6)
+    x168 = xp.cos(q6)
+    x169 = xp.sin(q6)
     x170 = x130*x168 + x169*x82
     x171 = -x130*x169 + x168*x82
     x172 = x131*x168 + x169*x84
@@ -1794,7 +1836,7 @@ def regressor(q, qd, qdd, p=None):
     x210 = -x24 + x34
     x211 = x10 - x9
     x212 = x12 + x7
-    x213 = np.sign(qd2)
+    x213 = xp.sign(qd2)
     x214 = 0.4318*x22
     x215 = 0.4318*x21
     x216 = x214*x31 + x215*x32
@@ -1864,7 +1906,7 @@ def regressor(q, qd, qdd, p=None):
     x280 = x175*x279 + x178*x269 + x180*x274 + x191*x246
     x281 = x176*x279 + x178*x266 + x180*x276 + x182*x246
     x282 = x178*x246 + x180*x279
-    x283 = np.sign(qd3)
+    x283 = xp.sign(qd3)
     x284 = 0.4318*x79
     x285 = x284*x82
     x286 = 0.4318*x78
@@ -1888,7 +1930,7 @@ def regressor(q, qd, qdd, p=None):
     x304 = x108 - x99
     x305 = -x105 + x106
     x306 = x96 + x97
-    x307 = np.sign(qd4)
+    x307 = xp.sign(qd4)
     x308 = x125*x82
     x309 = x126*x82
     x310 = x125*x130 - x126*x127
@@ -1916,7 +1958,7 @@ def regressor(q, qd, qdd, p=None):
     x332 = -x142 + x151
     x333 = -x148 + x149
     x334 = x139 + x140
-    x335 = np.sign(qd5)
+    x335 = xp.sign(qd5)
     x336 = x127*x168
     x337 = x127*x169
     x338 = -x168*x170 + x169*x171
@@ -1930,8 +1972,10 @@ def regressor(q, qd, qdd, p=None):
     x346 = -x184 + x193
     x347 = -x190 + x191
     x348 = x181 + x182
-    x349 = np.sign(qd6)
+    x349 = xp.sign(qd6)
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 78),
         [
@@ -2412,10 +2456,11 @@ def base_regressor(q, qd, qdd, p=None):
 
     Returns Yb of shape (6, 52) for one state, (N, 6, 52) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -2434,9 +2479,9 @@ def base_regressor(q, qd, qdd, p=None):
     qdd4 = qdd[..., 3]
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
-    x0 = np.sign(qd1)
-    x1 = np.sin(q2)
-    x2 = np.cos(q2)
+    x0 = xp.sign(qd1)
+    x1 = xp.sin(q2)
+    x2 = xp.cos(q2)
     x3 = qd1*x1
     x4 = qd2*x3
     x5 = qd1*x2
@@ -2451,8 +2496,8 @@ def base_regressor(q, qd, qdd, p=None):
     x14 = qdd2*x2 - x1*x11 + x12*x5
     x15 = qd2*x12
     x16 = 0.4318*x2
-    x17 = np.cos(q3)
-    x18 = np.sin(q3)
+    x17 = xp.cos(q3)
+    x18 = xp.sin(q3)
     x19 = x17*x3 + x18*x5
     x20 = x17*x5 - x18*x3
     x21 = x19*x20
@@ -2493,8 +2538,8 @@ def base_regressor(q, qd, qdd, p=None):
     x56 = x19*x55 + x22*x51 + x34*x38
     x57 = x20*x55 + x22*x38 - x34*x51
     x58 = x24*x55
-    x59 = np.cos(q4)
-    x60 = np.sin(q4)
+    x59 = xp.cos(q4)
+    x60 = xp.sin(q4)
     x61 = x19*x59 - x24*x60
     x62 = -x19*x60 - x24*x59
     x63 = x61*x62
@@ -2544,8 +2589,8 @@ def base_regressor(q, qd, qdd, p=None):
     x107 = x100*x64 + x102*x66 + x106*x61 + x38*x95
     x108 = x104*x66 + x106*x62 + x38*x68 - x64*x88
     x109 = x106*x66 + x38*x64
-    x110 = np.cos(q5)
-    x111 = np.sin(q5)
+    x110 = xp.cos(q5)
+    x111 = xp.sin(q5)
     x112 = x110*x61 + x111*x66
     x113 = x110*x66 - x111*x61
     x114 = x112*x113
@@ -2580,8 +2625,8 @@ def base_regressor(q, qd, qdd, p=None):
     x143 = x112*x142 + x115*x136 + x117*x138 + x131*x88
     x144 = x113*x142 + x115*x125 + x117*x140 + x119*x88
     x145 = x115*x88 + x117*x142
-    x146 = np.cos(q6)
-    x147 = np.sin(q6)
+    x146 = xp.cos(q6)
+    x147 = xp.sin(q6)
     x148 = x112*x146 - x117*x147
     x149 = -x112*x147 - x117*x146
     x150 = x148*x149
@@ -2619,7 +2664,7 @@ def base_regressor(q, qd, qdd, p=None):
     x182 = x29 - x30
     x183 = -x6 + x7
     x184 = x4 + x9
-    x185 = np.sign(qd2)
+    x185 = xp.sign(qd2)
     x186 = 0.4318*x18
     x187 = 0.4318*x17
     x188 = x186*x35 + x187*x23 + x83
@@ -2673,7 +2718,7 @@ def base_regressor(q, qd, qdd, p=None):
     x236 = x148*x235 + x151*x228 + x153*x231 + x167*x207
     x237 = x149*x235 + x151*x223 + x153*x233 + x155*x207
     x238 = x151*x207 + x153*x235
-    x239 = np.sign(qd3)
+    x239 = xp.sign(qd3)
     x240 = 0.4318*x59
     x241 = 0.4318*x60
     x242 = x193 - x240*x87 + x241*x65 + 0.0203*x69
@@ -2689,7 +2734,7 @@ def base_regressor(q, qd, qdd, p=None):
     x252 = -x85 + x98
     x253 = -x94 + x95
     x254 = x67 + x68
-    x255 = np.sign(qd4)
+    x255 = xp.sign(qd4)
     x256 = x110*x82
     x257 = x111*x82
     x258 = x110*x118 + x111*x131
@@ -2713,7 +2758,7 @@ def base_regressor(q, qd, qdd, p=None):
     x276 = -x122 + x134
     x277 = -x130 + x131
     x278 = x118 + x119
-    x279 = np.sign(qd5)
+    x279 = xp.sign(qd5)
     x280 = x121*x146
     x281 = x121*x147
     x282 = -x146*x154 - x147*x167
@@ -2725,8 +2770,10 @@ def base_regressor(q, qd, qdd, p=None):
     x288 = -x158 + x170
     x289 = -x166 + x167
     x290 = x154 + x155
-    x291 = np.sign(qd6)
+    x291 = xp.sign(qd6)
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 52),
         [
@@ -3051,10 +3098,11 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
 
     Returns the tuple (dtau_dq, dtau_dqd) of shapes (6, 6), (6, 6) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -3073,14 +3121,14 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qdd4 = qdd[..., 3]
     qdd5 = qdd[..., 4]
     qdd6 = qdd[..., 5]
-    x0 = np.sin(q2)
-    x1 = np.cos(q2)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
-    x4 = np.cos(q4)
-    x5 = np.sin(q4)
-    x6 = np.sin(q5)
-    x7 = np.cos(q5)
+    x0 = xp.sin(q2)
+    x1 = xp.cos(q2)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
+    x4 = xp.cos(q4)
+    x5 = xp.sin(q4)
+    x6 = xp.sin(q5)
+    x7 = xp.cos(q5)
     x8 = qd1*x1
     x9 = x2*x8
     x10 = qd1*x0
@@ -3139,8 +3187,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x63 = x36 + x37
     x64 = x61 + x62 + 0.0203*x63
     x65 = x58*x7 + x6*x64
-    x66 = np.cos(q6)
-    x67 = np.sin(q6)
+    x66 = xp.cos(q6)
+    x67 = xp.sin(q6)
     x68 = -x39*x5 - x4*x56
     x69 = x65*x66 + x67*x68
     x70 = x35*x4
@@ -4055,6 +4103,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x979 = 2*x978
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (6, 6),
             [
@@ -4097,6 +4147,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (6, 6),
             [
@@ -4146,10 +4198,11 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
 
     Returns the tuple (dqdd_dq, dqdd_dqd, Minv) of shapes (6, 6), (6, 6), (6, 6) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -4168,17 +4221,17 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     tau4 = tau[..., 3]
     tau5 = tau[..., 4]
     tau6 = tau[..., 5]
-    x0 = np.sin(q5)
-    x1 = np.cos(q5)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
-    x4 = np.cos(q2)
+    x0 = xp.sin(q5)
+    x1 = xp.cos(q5)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
+    x4 = xp.cos(q2)
     x5 = qd1*x4
     x6 = x3*x5
-    x7 = np.sin(q2)
+    x7 = xp.sin(q2)
     x8 = qd1*x7
     x9 = x2*x8 + x6
-    x10 = np.cos(q4)
+    x10 = xp.cos(q4)
     x11 = x2*x5
     x12 = x11 - x3*x8
     x13 = x10*x12
@@ -4186,7 +4239,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x15 = qd5*x14
     x16 = qd2*x5
     x17 = 0.0028799999999999997*x0
-    x18 = np.sin(q4)
+    x18 = xp.sin(q4)
     x19 = x17*x18
     x20 = x19 + 0.06767999999999999
     x21 = 0.3001*x20
@@ -4394,8 +4447,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x223 = -x10*x222 - x18*x219
     x224 = 0.019*x214 + x223
     x225 = 0.0018*x204 - x213 - 0.015579999999999998*x224
-    x226 = np.cos(q6)
-    x227 = np.sin(q6)
+    x226 = xp.cos(q6)
+    x227 = xp.sin(q6)
     x228 = -x0*x196 + x1*x197
     x229 = x208*x228
     x230 = qd5*x228
@@ -4481,16 +4534,16 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x310 = x2*x294 - x3*x302
     x311 = x2*x292 + x286*x3 + x308 - 0.4318*x309 + 0.15005*x310
     x312 = x304*x7 + x311*x4
-    x313 = -5.8018217679508*qd1 + tau1 - x312 - 24.7313845*np.sign(qd1)
+    x313 = -5.8018217679508*qd1 + tau1 - x312 - 24.7313845*xp.sign(qd1)
     x314 = 0.394*x163 + 1.1832*x168 - 0.10439999999999999*x307
     x315 = -0.053500000000000006*x215 - 0.336*x289
     x316 = -x10*x268 - x18*x261 - 0.4318*x293 + 0.0203*x301 + x315
     x317 = 0.4318*x303 + x314 + x316
-    x318 = -9.496868641825001*qd2 + tau2 - x317 - 13.58469*np.sign(qd2)
-    x319 = -3.9804259903721997*qd3 + tau3 - x316 - 7.0892316*np.sign(qd3)
-    x320 = -0.41164522969715195*qd4 + tau4 - x291 - 0.85160768*np.sign(qd4)
-    x321 = -0.42728302093540005*qd5 + tau5 - x267 - 0.6660069799999999*np.sign(qd5)
-    x322 = -0.2158232532732*qd6 + tau6 - x206 - 0.30367656000000004*np.sign(qd6)
+    x318 = -9.496868641825001*qd2 + tau2 - x317 - 13.58469*xp.sign(qd2)
+    x319 = -3.9804259903721997*qd3 + tau3 - x316 - 7.0892316*xp.sign(qd3)
+    x320 = -0.41164522969715195*qd4 + tau4 - x291 - 0.85160768*xp.sign(qd4)
+    x321 = -0.42728302093540005*qd5 + tau5 - x267 - 0.6660069799999999*xp.sign(qd5)
+    x322 = -0.2158232532732*qd6 + tau6 - x206 - 0.30367656000000004*xp.sign(qd6)
     x323 = x140*x322 + x145*x313 + x149*x318 + x152*x319 + x154*x320 + x155*x321
     x324 = x16 + x323*x7
     x325 = -x157 + x323*x4
@@ -5404,6 +5457,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x1233 = 2*x1176*x511 - x1180*x504 - x1190*x476 - x1193*x463 - x1202*x140 - 0.2158232532732*x139
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (6, 6),
             [
@@ -5446,6 +5501,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (6, 6),
             [
@@ -5488,6 +5545,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (6, 6),
             [
@@ -5537,25 +5596,26 @@ def mass_matrix_inverse(q, p=None):
 
     Returns Minv of shape (6, 6) for one state, (N, 6, 6) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
     q5 = q[..., 4]
-    x0 = np.sin(q5)
+    x0 = xp.sin(q5)
     x1 = 0.0028799999999999997*x0
-    x2 = np.sin(q4)
+    x2 = xp.sin(q4)
     x3 = x1*x2
     x4 = x3 + 0.06767999999999999
     x5 = 0.3001*x4
-    x6 = np.cos(q3)
-    x7 = np.sin(q3)
-    x8 = np.cos(q4)
+    x6 = xp.cos(q3)
+    x7 = xp.sin(q3)
+    x8 = xp.cos(q4)
     x9 = x1*x8
     x10 = 0.025374999999999998 - x9
-    x11 = np.cos(q5)
+    x11 = xp.cos(q5)
     x12 = 0.0028799999999999997*x11
     x13 = x12 + 0.015579999999999998
     x14 = x13 + 0.87575
@@ -5583,8 +5643,8 @@ def mass_matrix_inverse(q, p=None):
     x36 = x7*x7
     x37 = x28*x36 + x30*x35
     x38 = x16 + x21 + x37 + x5 + 2.769262117125
-    x39 = np.sin(q2)
-    x40 = np.cos(q2)
+    x39 = xp.sin(q2)
+    x40 = xp.cos(q2)
     x41 = x39*x40
     x42 = 2*x41
     x43 = x27 - x37 + x5 + 1.1674009151249998
@@ -5711,6 +5771,8 @@ def mass_matrix_inverse(q, p=None):
     x164 = x126*x133
     x165 = x125 + x126*x164
     return _assemble(
+        xp,
+        device,
         _lead,
         (6, 6),
         [
@@ -5759,10 +5821,11 @@ def linearize(q, qd, tau, p=None):
 
     Returns the tuple (A, B) of shapes (12, 12), (12, 6) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -5781,17 +5844,17 @@ def linearize(q, qd, tau, p=None):
     tau4 = tau[..., 3]
     tau5 = tau[..., 4]
     tau6 = tau[..., 5]
-    x0 = np.sin(q5)
-    x1 = np.cos(q5)
-    x2 = np.cos(q3)
-    x3 = np.sin(q3)
-    x4 = np.cos(q2)
+    x0 = xp.sin(q5)
+    x1 = xp.cos(q5)
+    x2 = xp.cos(q3)
+    x3 = xp.sin(q3)
+    x4 = xp.cos(q2)
     x5 = qd1*x4
     x6 = x3*x5
-    x7 = np.sin(q2)
+    x7 = xp.sin(q2)
     x8 = qd1*x7
     x9 = x2*x8 + x6
-    x10 = np.cos(q4)
+    x10 = xp.cos(q4)
     x11 = x2*x5
     x12 = x11 - x3*x8
     x13 = x10*x12
@@ -5799,7 +5862,7 @@ def linearize(q, qd, tau, p=None):
     x15 = qd5*x14
     x16 = qd2*x5
     x17 = 0.0028799999999999997*x0
-    x18 = np.sin(q4)
+    x18 = xp.sin(q4)
     x19 = x17*x18
     x20 = x19 + 0.06767999999999999
     x21 = 0.3001*x20
@@ -6007,8 +6070,8 @@ def linearize(q, qd, tau, p=None):
     x223 = -x10*x222 - x18*x219
     x224 = 0.019*x214 + x223
     x225 = 0.0018*x204 - x213 - 0.015579999999999998*x224
-    x226 = np.cos(q6)
-    x227 = np.sin(q6)
+    x226 = xp.cos(q6)
+    x227 = xp.sin(q6)
     x228 = -x0*x196 + x1*x197
     x229 = x208*x228
     x230 = qd5*x228
@@ -6094,16 +6157,16 @@ def linearize(q, qd, tau, p=None):
     x310 = x2*x294 - x3*x302
     x311 = x2*x292 + x286*x3 + x308 - 0.4318*x309 + 0.15005*x310
     x312 = x304*x7 + x311*x4
-    x313 = -5.8018217679508*qd1 + tau1 - x312 - 24.7313845*np.sign(qd1)
+    x313 = -5.8018217679508*qd1 + tau1 - x312 - 24.7313845*xp.sign(qd1)
     x314 = 0.394*x163 + 1.1832*x168 - 0.10439999999999999*x307
     x315 = -0.053500000000000006*x215 - 0.336*x289
     x316 = -x10*x268 - x18*x261 - 0.4318*x293 + 0.0203*x301 + x315
     x317 = 0.4318*x303 + x314 + x316
-    x318 = -9.496868641825001*qd2 + tau2 - x317 - 13.58469*np.sign(qd2)
-    x319 = -3.9804259903721997*qd3 + tau3 - x316 - 7.0892316*np.sign(qd3)
-    x320 = -0.41164522969715195*qd4 + tau4 - x291 - 0.85160768*np.sign(qd4)
-    x321 = -0.42728302093540005*qd5 + tau5 - x267 - 0.6660069799999999*np.sign(qd5)
-    x322 = -0.2158232532732*qd6 + tau6 - x206 - 0.30367656000000004*np.sign(qd6)
+    x318 = -9.496868641825001*qd2 + tau2 - x317 - 13.58469*xp.sign(qd2)
+    x319 = -3.9804259903721997*qd3 + tau3 - x316 - 7.0892316*xp.sign(qd3)
+    x320 = -0.41164522969715195*qd4 + tau4 - x291 - 0.85160768*xp.sign(qd4)
+    x321 = -0.42728302093540005*qd5 + tau5 - x267 - 0.6660069799999999*xp.sign(qd5)
+    x322 = -0.2158232532732*qd6 + tau6 - x206 - 0.30367656000000004*xp.sign(qd6)
     x323 = x140*x322 + x145*x313 + x149*x318 + x152*x319 + x154*x320 + x155*x321
     x324 = x16 + x323*x7
     x325 = -x157 + x323*x4
@@ -7017,6 +7080,8 @@ def linearize(q, qd, tau, p=None):
     x1233 = 2*x1151*x511 - x1155*x504 - x1165*x476 - x1168*x463 - x1177*x140 - 0.2158232532732*x139
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 12),
             [
@@ -7167,6 +7232,8 @@ def linearize(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 6),
             [

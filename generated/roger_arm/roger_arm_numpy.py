@@ -20,36 +20,56 @@ Every function takes one state (vectors of shape (NDOF,)) or a batch with a
 leading axis (shape (N, NDOF)); p, the free parameters in PARAM_NAMES order,
 is (NPARAM,) or (N, NPARAM) and may be None when NPARAM is 0. Outputs have
 shape (NDOF,) or (NDOF, NDOF) for one state, (N, NDOF) or (N, NDOF, NDOF) for
-a batch, all of dtype DTYPE. Needs only numpy.
+a batch, all of dtype float64 (DTYPE for NumPy).
+
+Written against the Python array API standard: the arrays given pick the
+namespace (array_api_compat.array_namespace), so the same file runs on NumPy,
+JAX, PyTorch or CuPy arrays and returns arrays of the same library, on the same
+device; NumPy arrays, lists, numbers and other array-likes are computed with NumPy. Needs numpy
+and array-api-compat.
 """
 
 import numpy as np
+from array_api_compat import array_namespace, is_array_api_obj
+from array_api_compat import device as _array_device
 
 NDOF = 2
 NPARAM = 5
 PARAM_NAMES = ("g", "l1", "m1", "l2", "m2")
 DTYPE = np.float64
+#: NumPy's own namespace follows the standard from NumPy 2 on; before, array-api-compat's wraps it
+_NUMPY = np if int(np.__version__.split(".")[0]) >= 2 else array_namespace(np.zeros(0))
+_NUMPY_INPUTS = (np.ndarray, np.generic, list, tuple, int, float)
 
 
-def _vector(x, size, name):
-    a = np.asarray(x, dtype=DTYPE)
+def _namespace(*args):
+    """The array namespace and device of the inputs' arrays; NumPy's for NumPy arrays, lists, numbers
+    and whatever else is no array of the standard (np.asarray reads it, as before)."""
+    arrays = [a for a in args if not isinstance(a, _NUMPY_INPUTS) and is_array_api_obj(a)]
+    if not arrays:
+        return _NUMPY, None
+    return array_namespace(*arrays), _array_device(arrays[0])
+
+
+def _vector(xp, device, x, size, name):
+    a = xp.asarray(x, dtype=xp.float64, device=device)
     if a.ndim == 0 or a.shape[-1] != size:
-        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {a.shape}")
+        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {tuple(a.shape)}")
     return a
 
 
-def _params(p):
+def _params(xp, device, p):
     if p is None:
         if NPARAM:
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
-        return np.zeros(0, dtype=DTYPE)
-    return _vector(p, NPARAM, "p")
+        return xp.zeros((0,), dtype=xp.float64, device=device)
+    return _vector(xp, device, p, NPARAM, "p")
 
 
-def _assemble(lead, shape, entries):
+def _assemble(xp, device, lead, shape, entries):
     """Broadcast every entry (a number or an array) to the leading shape and stack them."""
-    columns = [np.broadcast_to(np.asarray(e, dtype=DTYPE), lead) for e in entries]
-    return np.stack(columns, axis=-1).reshape(lead + shape)
+    columns = [xp.broadcast_to(xp.asarray(e, dtype=xp.float64, device=device), lead) for e in entries]
+    return xp.reshape(xp.stack(columns, axis=-1), lead + shape)
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -57,10 +77,11 @@ def inverse_dynamics(q, qd, qdd, p=None):
 
     Returns tau of shape (2,) for one state, (N, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -73,16 +94,16 @@ def inverse_dynamics(q, qd, qdd, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = g*np.sin(q1)
+    x0 = g*xp.sin(q1)
     x1 = l1*qdd1 + x0
     x2 = m1*x1
     x3 = l1*x2
     x4 = qdd1 + qdd2
-    x5 = np.cos(q2)
-    x6 = np.sin(q2)
+    x5 = xp.cos(q2)
+    x6 = xp.sin(q2)
     x7 = qd1*qd1
     x8 = l1*x7
-    x9 = g*np.cos(q1)
+    x9 = g*xp.cos(q1)
     x10 = -x8 - x9
     x11 = -x10*x6
     x12 = x1*x5 + x11
@@ -99,6 +120,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x23 = x14*x5 + x22*x6
     x24 = l1*x23 + x15 + x3
     return _assemble(
+        xp,
+        device,
         _lead,
         (2,),
         [
@@ -113,8 +136,9 @@ def mass_matrix(q, p=None):
 
     Returns M of shape (2, 2) for one state, (N, 2, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     l1 = p[..., 1]
@@ -123,7 +147,7 @@ def mass_matrix(q, p=None):
     m2 = p[..., 4]
     x0 = l1*l1
     x1 = l2*m2
-    x2 = np.cos(q2)
+    x2 = xp.cos(q2)
     x3 = x1*x2
     x4 = l1*x3
     x5 = (l2*l2)*m2
@@ -131,6 +155,8 @@ def mass_matrix(q, p=None):
     x7 = m2*x0 + 2*x4 + x5 + x6
     x8 = x4 + x5
     return _assemble(
+        xp,
+        device,
         _lead,
         (2, 2),
         [
@@ -147,9 +173,10 @@ def coriolis_matrix(q, qd, p=None):
 
     Returns C of shape (2, 2) for one state, (N, 2, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -158,11 +185,11 @@ def coriolis_matrix(q, qd, p=None):
     l2 = p[..., 3]
     m2 = p[..., 4]
     x0 = l2*m2
-    x1 = np.sin(q2)
+    x1 = xp.sin(q2)
     x2 = l1*qd1
     x3 = x1*x2
     x4 = x0*x3
-    x5 = np.cos(q2)
+    x5 = xp.cos(q2)
     x6 = m2*x3
     x7 = 0.5*x6
     x8 = x2*x5
@@ -177,6 +204,8 @@ def coriolis_matrix(q, qd, p=None):
     x17 = x1*x15 + x16*x5
     x18 = l1*x17 + x14
     return _assemble(
+        xp,
+        device,
         _lead,
         (2, 2),
         [
@@ -193,9 +222,10 @@ def coriolis(q, qd, p=None):
 
     Returns V of shape (2,) for one state, (N, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -203,13 +233,13 @@ def coriolis(q, qd, p=None):
     l1 = p[..., 1]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = np.sin(q2)
+    x0 = xp.sin(q2)
     x1 = qd1*qd1
     x2 = l1*x1
     x3 = x0*x2
     x4 = m2*x3
     x5 = l2*x4
-    x6 = np.cos(q2)
+    x6 = xp.cos(q2)
     x7 = qd1 + qd2
     x8 = x7*x7
     x9 = l2*x8
@@ -219,6 +249,8 @@ def coriolis(q, qd, p=None):
     x13 = x0*x12 + x4*x6
     x14 = l1*x13 + x5
     return _assemble(
+        xp,
+        device,
         _lead,
         (2,),
         [
@@ -233,8 +265,9 @@ def gravity(q, p=None):
 
     Returns G of shape (2,) for one state, (N, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -244,17 +277,19 @@ def gravity(q, p=None):
     l2 = p[..., 3]
     m2 = p[..., 4]
     x0 = l2*m2
-    x1 = np.sin(q2)
+    x1 = xp.sin(q2)
     x2 = x0*x1
     x3 = l1*m1
-    x4 = np.cos(q2)
+    x4 = xp.cos(q2)
     x5 = x0*x4
     x6 = l1*m2 + x3 + x5
-    x7 = g*np.cos(q1)
-    x8 = g*np.sin(q1)
+    x7 = g*xp.cos(q1)
+    x8 = g*xp.sin(q1)
     x9 = x4*x8
     x10 = -x1*x7 - x9
     return _assemble(
+        xp,
+        device,
         _lead,
         (2,),
         [
@@ -269,10 +304,13 @@ def friction(qd, p=None):
 
     Returns F of shape (2,) for one state, (N, 2) for a batch.
     """
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(qd, p)
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
     return _assemble(
+        xp,
+        device,
         _lead,
         (2,),
         [
@@ -287,10 +325,11 @@ def forward_dynamics(q, qd, tau, p=None):
 
     Returns qdd of shape (2,) for one state, (N, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -305,21 +344,21 @@ def forward_dynamics(q, qd, tau, p=None):
     m2 = p[..., 4]
     x0 = l1*l1
     x1 = l2*m2
-    x2 = np.cos(q2)
+    x2 = xp.cos(q2)
     x3 = x1*x2
     x4 = l1*x3
     x5 = (l2*l2)*m2
     x6 = m1*x0
     x7 = m2*x0 + 2*x4 + x5 + x6
     x8 = 1/x7
-    x9 = g*np.sin(q1)
+    x9 = g*xp.sin(q1)
     x10 = m1*x9
     x11 = l1*x10
     x12 = x2*x9
-    x13 = np.sin(q2)
+    x13 = xp.sin(q2)
     x14 = qd1*qd1
     x15 = l1*x14
-    x16 = g*np.cos(q1)
+    x16 = g*xp.cos(q1)
     x17 = -x15 - x16
     x18 = -x13*x17
     x19 = x12 + x18
@@ -343,6 +382,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x37 = x36/x34
     x38 = x31*x8 - x33*x37
     return _assemble(
+        xp,
+        device,
         _lead,
         (2,),
         [
@@ -357,10 +398,11 @@ def regressor(q, qd, qdd, p=None):
 
     Returns Y of shape (2, 26) for one state, (N, 2, 26) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -370,14 +412,14 @@ def regressor(q, qd, qdd, p=None):
     qdd2 = qdd[..., 1]
     g = p[..., 0]
     l1 = p[..., 1]
-    x0 = g*np.sin(q1)
-    x1 = g*np.cos(q1)
-    x2 = np.sign(qd1)
+    x0 = g*xp.sin(q1)
+    x1 = g*xp.cos(q1)
+    x2 = xp.sign(qd1)
     x3 = l1*qdd1 + x0
-    x4 = np.sin(q2)
+    x4 = xp.sin(q2)
     x5 = qd1*qd1
     x6 = -l1*x5 - x1
-    x7 = np.cos(q2)
+    x7 = xp.cos(q2)
     x8 = x3*x4 + x6*x7
     x9 = x3*x7 - x4*x6
     x10 = l1*x4
@@ -388,8 +430,10 @@ def regressor(q, qd, qdd, p=None):
     x15 = qdd1 + qdd2
     x16 = -x10*x14 + x11*x15 + x9
     x17 = -x10*x15 - x11*x14 - x8
-    x18 = np.sign(qd2)
+    x18 = xp.sign(qd2)
     return _assemble(
+        xp,
+        device,
         _lead,
         (2, 26),
         [
@@ -454,10 +498,11 @@ def base_regressor(q, qd, qdd, p=None):
 
     Returns Yb of shape (2, 11) for one state, (N, 2, 11) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -467,25 +512,27 @@ def base_regressor(q, qd, qdd, p=None):
     qdd2 = qdd[..., 1]
     g = p[..., 0]
     l1 = p[..., 1]
-    x0 = g*np.sin(q1)
-    x1 = g*np.cos(q1)
-    x2 = np.sign(qd1)
+    x0 = g*xp.sin(q1)
+    x1 = g*xp.cos(q1)
+    x2 = xp.sign(qd1)
     x3 = qd1 + qd2
     x4 = x3*x3
     x5 = qdd1 + qdd2
     x6 = l1*qdd1 + x0
-    x7 = np.sin(q2)
+    x7 = xp.sin(q2)
     x8 = qd1*qd1
     x9 = -l1*x8 - x1
-    x10 = np.cos(q2)
+    x10 = xp.cos(q2)
     x11 = x10*x6 - x7*x9
     x12 = l1*x7
     x13 = l1*x10
     x14 = x11 - x12*x4 + x13*x5
     x15 = x10*x9 + x6*x7
     x16 = -x12*x5 - x13*x4 - x15
-    x17 = np.sign(qd2)
+    x17 = xp.sign(qd2)
     return _assemble(
+        xp,
+        device,
         _lead,
         (2, 11),
         [
@@ -520,10 +567,11 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
 
     Returns the tuple (dtau_dq, dtau_dqd) of shapes (2, 2), (2, 2) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -536,12 +584,12 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = g*np.cos(q1)
+    x0 = g*xp.cos(q1)
     x1 = m1*x0
     x2 = l1*x1
-    x3 = np.cos(q2)
-    x4 = np.sin(q2)
-    x5 = g*np.sin(q1)
+    x3 = xp.cos(q2)
+    x4 = xp.sin(q2)
+    x5 = g*xp.sin(q1)
     x6 = x4*x5
     x7 = x0*x3 - x6
     x8 = m2*x7
@@ -593,6 +641,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x54 = 2*x47
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (2, 2),
             [
@@ -603,6 +653,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (2, 2),
             [
@@ -620,10 +672,11 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
 
     Returns the tuple (dqdd_dq, dqdd_dqd, Minv) of shapes (2, 2), (2, 2), (2, 2) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -636,11 +689,11 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = np.cos(q2)
-    x1 = np.sin(q2)
-    x2 = g*np.sin(q1)
+    x0 = xp.cos(q2)
+    x1 = xp.sin(q2)
+    x2 = g*xp.sin(q1)
     x3 = x1*x2
-    x4 = g*np.cos(q1)
+    x4 = g*xp.cos(q1)
     x5 = x0*x4 - x3
     x6 = m2*x5
     x7 = l2*x6
@@ -728,6 +781,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x89 = -x26*x86 + x27*x85
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (2, 2),
             [
@@ -738,6 +793,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (2, 2),
             [
@@ -748,6 +805,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (2, 2),
             [
@@ -765,8 +824,9 @@ def mass_matrix_inverse(q, p=None):
 
     Returns Minv of shape (2, 2) for one state, (N, 2, 2) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     l1 = p[..., 1]
@@ -775,7 +835,7 @@ def mass_matrix_inverse(q, p=None):
     m2 = p[..., 4]
     x0 = l1*l1
     x1 = l2*m2
-    x2 = np.cos(q2)
+    x2 = xp.cos(q2)
     x3 = x1*x2
     x4 = l1*x3
     x5 = (l2*l2)*m2
@@ -789,6 +849,8 @@ def mass_matrix_inverse(q, p=None):
     x13 = x10*x12
     x14 = x10*x13 + x8
     return _assemble(
+        xp,
+        device,
         _lead,
         (2, 2),
         [
@@ -805,10 +867,11 @@ def linearize(q, qd, tau, p=None):
 
     Returns the tuple (A, B) of shapes (4, 4), (4, 2) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -821,11 +884,11 @@ def linearize(q, qd, tau, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = np.cos(q2)
-    x1 = np.sin(q2)
-    x2 = g*np.sin(q1)
+    x0 = xp.cos(q2)
+    x1 = xp.sin(q2)
+    x2 = g*xp.sin(q1)
     x3 = x1*x2
-    x4 = g*np.cos(q1)
+    x4 = g*xp.cos(q1)
     x5 = x0*x4 - x3
     x6 = m2*x5
     x7 = l2*x6
@@ -913,6 +976,8 @@ def linearize(q, qd, tau, p=None):
     x89 = -x26*x84 + x27*x83
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (4, 4),
             [
@@ -935,6 +1000,8 @@ def linearize(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (4, 2),
             [

@@ -20,36 +20,56 @@ Every function takes one state (vectors of shape (NDOF,)) or a batch with a
 leading axis (shape (N, NDOF)); p, the free parameters in PARAM_NAMES order,
 is (NPARAM,) or (N, NPARAM) and may be None when NPARAM is 0. Outputs have
 shape (NDOF,) or (NDOF, NDOF) for one state, (N, NDOF) or (N, NDOF, NDOF) for
-a batch, all of dtype DTYPE. Needs only numpy.
+a batch, all of dtype float64 (DTYPE for NumPy).
+
+Written against the Python array API standard: the arrays given pick the
+namespace (array_api_compat.array_namespace), so the same file runs on NumPy,
+JAX, PyTorch or CuPy arrays and returns arrays of the same library, on the same
+device; NumPy arrays, lists, numbers and other array-likes are computed with NumPy. Needs numpy
+and array-api-compat.
 """
 
 import numpy as np
+from array_api_compat import array_namespace, is_array_api_obj
+from array_api_compat import device as _array_device
 
 NDOF = 12
 NPARAM = 0
 PARAM_NAMES = ()
 DTYPE = np.float64
+#: NumPy's own namespace follows the standard from NumPy 2 on; before, array-api-compat's wraps it
+_NUMPY = np if int(np.__version__.split(".")[0]) >= 2 else array_namespace(np.zeros(0))
+_NUMPY_INPUTS = (np.ndarray, np.generic, list, tuple, int, float)
 
 
-def _vector(x, size, name):
-    a = np.asarray(x, dtype=DTYPE)
+def _namespace(*args):
+    """The array namespace and device of the inputs' arrays; NumPy's for NumPy arrays, lists, numbers
+    and whatever else is no array of the standard (np.asarray reads it, as before)."""
+    arrays = [a for a in args if not isinstance(a, _NUMPY_INPUTS) and is_array_api_obj(a)]
+    if not arrays:
+        return _NUMPY, None
+    return array_namespace(*arrays), _array_device(arrays[0])
+
+
+def _vector(xp, device, x, size, name):
+    a = xp.asarray(x, dtype=xp.float64, device=device)
     if a.ndim == 0 or a.shape[-1] != size:
-        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {a.shape}")
+        raise ValueError(f"{name} must have shape ({size},) or (N, {size}); got {tuple(a.shape)}")
     return a
 
 
-def _params(p):
+def _params(xp, device, p):
     if p is None:
         if NPARAM:
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
-        return np.zeros(0, dtype=DTYPE)
-    return _vector(p, NPARAM, "p")
+        return xp.zeros((0,), dtype=xp.float64, device=device)
+    return _vector(xp, device, p, NPARAM, "p")
 
 
-def _assemble(lead, shape, entries):
+def _assemble(xp, device, lead, shape, entries):
     """Broadcast every entry (a number or an array) to the leading shape and stack them."""
-    columns = [np.broadcast_to(np.asarray(e, dtype=DTYPE), lead) for e in entries]
-    return np.stack(columns, axis=-1).reshape(lead + shape)
+    columns = [xp.broadcast_to(xp.asarray(e, dtype=xp.float64, device=device), lead) for e in entries]
+    return xp.reshape(xp.stack(columns, axis=-1), lead + shape)
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -57,10 +77,11 @@ def inverse_dynamics(q, qd, qdd, p=None):
 
     Returns tau of shape (12,) for one state, (N, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -98,13 +119,13 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qdd10 = qdd[..., 9]
     qdd11 = qdd[..., 10]
     qdd12 = qdd[..., 11]
-    x0 = np.cos(q2)
-    x1 = np.sin(q2)
-    x2 = 9.81*np.cos(q1)
+    x0 = xp.cos(q2)
+    x1 = xp.sin(q2)
+    x2 = 9.81*xp.cos(q1)
     x3 = 0.0014853845*x2
     x4 = 4.5093845000000035e-05*qdd1 + x3
-    x5 = np.sin(q3)
-    x6 = np.cos(q3)
+    x5 = xp.sin(q3)
+    x6 = xp.cos(q3)
     x7 = qd1*x1
     x8 = qd1*x0
     x9 = 0.0013320948074879001*qd2 + 0.0002730308797879413*x7 - 3.959544277738894e-08*x8
@@ -112,7 +133,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x11 = 0.0002730308797879413*qd2 + 8.590521094399056e-05*x7 + 1.609852873477455e-07*x8
     x12 = qd1*qd1
     x13 = 0.014*x12
-    x14 = 9.81*np.sin(q1)
+    x14 = 9.81*xp.sin(q1)
     x15 = -x13 + x14
     x16 = qd2*x11 - x10 + 0.01169101578415*x15
     x17 = qd2*x7
@@ -195,13 +216,13 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x94 = -x24*x43 + x24*x93
     x95 = 0.0005426192213171668*x59 + 3.3497340042275575e-05*x61 - 0.0038482516772413004*x62 + x94
     x96 = -0.16*x79 + x92 + x95
-    x97 = np.cos(q5)
-    x98 = np.sin(q5)
-    x99 = 9.81*np.cos(q4)
+    x97 = xp.cos(q5)
+    x98 = xp.sin(q5)
+    x99 = 9.81*xp.cos(q4)
     x100 = -0.0014853845*x99
     x101 = 4.5093845000000035e-05*qdd4 + x100
-    x102 = np.sin(q6)
-    x103 = np.cos(q6)
+    x102 = xp.sin(q6)
+    x103 = xp.cos(q6)
     x104 = qd4*x98
     x105 = qd4*x97
     x106 = 0.0013320948074879001*qd5 - 0.0002730308797879413*x104 - 3.959544277738894e-08*x105
@@ -209,7 +230,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x108 = -qd5*x107 + x104*x106
     x109 = qd4*qd4
     x110 = 0.014*x109
-    x111 = 9.81*np.sin(q4)
+    x111 = 9.81*xp.sin(q4)
     x112 = x110 + x111
     x113 = -0.01169101578415*x112
     x114 = qd5*x104
@@ -291,13 +312,13 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x190 = -0.0005446477058047094*x121*x123 + x121*x140
     x191 = 0.0005426192213171668*x156 - 3.3497340042275575e-05*x158 - 0.0038482516772413004*x159 - x190
     x192 = -0.16*x176 + x189 + x191
-    x193 = np.cos(q8)
-    x194 = np.sin(q8)
-    x195 = 9.81*np.cos(q7)
+    x193 = xp.cos(q8)
+    x194 = xp.sin(q8)
+    x195 = 9.81*xp.cos(q7)
     x196 = 0.0014853845*x195
     x197 = 4.5093845000000035e-05*qdd7 + x196
-    x198 = np.sin(q9)
-    x199 = np.cos(q9)
+    x198 = xp.sin(q9)
+    x199 = xp.cos(q9)
     x200 = qd7*x194
     x201 = qd7*x193
     x202 = 0.0013320948074879001*qd8 + 0.0002730308797879413*x200 - 3.959544277738894e-08*x201
@@ -305,7 +326,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x204 = 0.0002730308797879413*qd8 + 8.590521094399056e-05*x200 + 1.609852873477455e-07*x201
     x205 = qd7*qd7
     x206 = 0.014*x205
-    x207 = 9.81*np.sin(q7)
+    x207 = 9.81*xp.sin(q7)
     x208 = -x206 + x207
     x209 = qd8*x204 - x203 + 0.01169101578415*x208
     x210 = qd8*x200
@@ -388,13 +409,13 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x287 = -x217*x236 + x217*x286
     x288 = 0.0005426192213171668*x252 + 3.3497340042275575e-05*x254 - 0.0038482516772413004*x255 + x287
     x289 = -0.16*x272 + x285 + x288
-    x290 = np.cos(q11)
-    x291 = np.sin(q11)
-    x292 = 9.81*np.cos(q10)
+    x290 = xp.cos(q11)
+    x291 = xp.sin(q11)
+    x292 = 9.81*xp.cos(q10)
     x293 = -0.0014853845*x292
     x294 = 4.5093845000000035e-05*qdd10 + x293
-    x295 = np.sin(q12)
-    x296 = np.cos(q12)
+    x295 = xp.sin(q12)
+    x296 = xp.cos(q12)
     x297 = qd10*x291
     x298 = qd10*x290
     x299 = 0.0013320948074879001*qd11 - 0.0002730308797879413*x297 - 3.959544277738894e-08*x298
@@ -402,7 +423,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x301 = -qd11*x300 + x297*x299
     x302 = qd10*qd10
     x303 = 0.014*x302
-    x304 = 9.81*np.sin(q10)
+    x304 = 9.81*xp.sin(q10)
     x305 = x303 + x304
     x306 = -0.01169101578415*x305
     x307 = qd11*x297
@@ -485,6 +506,8 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x384 = 0.0005426192213171668*x349 - 3.3497340042275575e-05*x351 - 0.0038482516772413004*x352 - x383
     x385 = -0.16*x369 + x382 + x384
     return _assemble(
+        xp,
+        device,
         _lead,
         (12,),
         [
@@ -509,8 +532,9 @@ def mass_matrix(q, p=None):
 
     Returns M of shape (12, 12) for one state, (N, 12, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -520,15 +544,15 @@ def mass_matrix(q, p=None):
     q9 = q[..., 8]
     q11 = q[..., 10]
     q12 = q[..., 11]
-    x0 = np.cos(q3)
+    x0 = xp.cos(q3)
     x1 = 0.0038482516772413004*x0
     x2 = 0.32*x1
-    x3 = np.sin(q3)
+    x3 = xp.sin(q3)
     x4 = x3*x3
     x5 = 0.0005396092213171668*x4
     x6 = x2 - x5 + 0.0029700831576528162
-    x7 = np.cos(q2)
-    x8 = np.sin(q2)
+    x7 = xp.cos(q2)
+    x8 = xp.sin(q2)
     x9 = x7*x8
     x10 = 2*x9
     x11 = 0.0038482516772413004*x3
@@ -550,15 +574,15 @@ def mass_matrix(q, p=None):
     x27 = x18*x7 + x20*x8 + 0.014*x26
     x28 = x2 + 0.0028381974208050668
     x29 = 0.16*x1 + 0.0005426192213171668
-    x30 = np.cos(q6)
+    x30 = xp.cos(q6)
     x31 = 0.0038482516772413004*x30
     x32 = 0.32*x31
-    x33 = np.sin(q6)
+    x33 = xp.sin(q6)
     x34 = x33*x33
     x35 = 0.0005396092213171668*x34
     x36 = x32 - x35 + 0.0029700831576528162
-    x37 = np.cos(q5)
-    x38 = np.sin(q5)
+    x37 = xp.cos(q5)
+    x38 = xp.sin(q5)
     x39 = x37*x38
     x40 = 2*x39
     x41 = 0.0038482516772413004*x33
@@ -580,15 +604,15 @@ def mass_matrix(q, p=None):
     x57 = -x37*x48 - x38*x50 - 0.014*x56
     x58 = x32 + 0.0028381974208050668
     x59 = 0.16*x31 + 0.0005426192213171668
-    x60 = np.cos(q9)
+    x60 = xp.cos(q9)
     x61 = 0.0038482516772413004*x60
     x62 = 0.32*x61
-    x63 = np.sin(q9)
+    x63 = xp.sin(q9)
     x64 = x63*x63
     x65 = 0.0005396092213171668*x64
     x66 = x62 - x65 + 0.0029700831576528162
-    x67 = np.cos(q8)
-    x68 = np.sin(q8)
+    x67 = xp.cos(q8)
+    x68 = xp.sin(q8)
     x69 = x67*x68
     x70 = 2*x69
     x71 = 0.0038482516772413004*x63
@@ -610,15 +634,15 @@ def mass_matrix(q, p=None):
     x87 = x67*x78 + x68*x80 + 0.014*x86
     x88 = x62 + 0.0028381974208050668
     x89 = 0.16*x61 + 0.0005426192213171668
-    x90 = np.cos(q12)
+    x90 = xp.cos(q12)
     x91 = 0.0038482516772413004*x90
     x92 = 0.32*x91
-    x93 = np.sin(q12)
+    x93 = xp.sin(q12)
     x94 = x93*x93
     x95 = 0.0005396092213171668*x94
     x96 = x92 - x95 + 0.0029700831576528162
-    x97 = np.cos(q11)
-    x98 = np.sin(q11)
+    x97 = xp.cos(q11)
+    x98 = xp.sin(q11)
     x99 = x97*x98
     x100 = 2*x99
     x101 = 0.0038482516772413004*x93
@@ -641,6 +665,8 @@ def mass_matrix(q, p=None):
     x118 = x92 + 0.0028381974208050668
     x119 = 0.16*x91 + 0.0005426192213171668
     return _assemble(
+        xp,
+        device,
         _lead,
         (12, 12),
         [
@@ -797,9 +823,10 @@ def coriolis_matrix(q, qd, p=None):
 
     Returns C of shape (12, 12) for one state, (N, 12, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -821,11 +848,11 @@ def coriolis_matrix(q, qd, p=None):
     qd10 = qd[..., 9]
     qd11 = qd[..., 10]
     qd12 = qd[..., 11]
-    x0 = np.cos(q2)
+    x0 = xp.cos(q2)
     x1 = qd1*x0
-    x2 = np.sin(q3)
-    x3 = np.cos(q3)
-    x4 = np.sin(q2)
+    x2 = xp.sin(q3)
+    x3 = xp.cos(q3)
+    x4 = xp.sin(q2)
     x5 = qd1*x4
     x6 = x1*x3 - x2*x5
     x7 = 0.0030108856000000002*x1 + 0.0019241258386206502*x6
@@ -947,11 +974,11 @@ def coriolis_matrix(q, qd, p=None):
     x123 = -x120*x2 + x121*x3
     x124 = x0*x122 + x123*x4
     x125 = x1*x112 - x110*x5 - x114 - x13*x55 + x15*x51
-    x126 = np.cos(q5)
+    x126 = xp.cos(q5)
     x127 = qd4*x126
-    x128 = np.sin(q6)
-    x129 = np.cos(q6)
-    x130 = np.sin(q5)
+    x128 = xp.sin(q6)
+    x129 = xp.cos(q6)
+    x130 = xp.sin(q5)
     x131 = qd4*x130
     x132 = x127*x129 - x128*x131
     x133 = 0.0030108856000000002*x127 + 0.0019241258386206502*x132
@@ -1074,11 +1101,11 @@ def coriolis_matrix(q, qd, p=None):
     x250 = -x128*x247 + x129*x248
     x251 = x126*x249 + x130*x250
     x252 = -x127*x239 + x131*x237 + x139*x181 - x141*x177 + x241
-    x253 = np.cos(q8)
+    x253 = xp.cos(q8)
     x254 = qd7*x253
-    x255 = np.sin(q9)
-    x256 = np.cos(q9)
-    x257 = np.sin(q8)
+    x255 = xp.sin(q9)
+    x256 = xp.cos(q9)
+    x257 = xp.sin(q8)
     x258 = qd7*x257
     x259 = x254*x256 - x255*x258
     x260 = 0.0030108856000000002*x254 + 0.0019241258386206502*x259
@@ -1200,11 +1227,11 @@ def coriolis_matrix(q, qd, p=None):
     x376 = -x255*x373 + x256*x374
     x377 = x253*x375 + x257*x376
     x378 = x254*x365 - x258*x363 - x266*x308 + x268*x304 - x367
-    x379 = np.cos(q11)
+    x379 = xp.cos(q11)
     x380 = qd10*x379
-    x381 = np.sin(q12)
-    x382 = np.cos(q12)
-    x383 = np.sin(q11)
+    x381 = xp.sin(q12)
+    x382 = xp.cos(q12)
+    x383 = xp.sin(q11)
     x384 = qd10*x383
     x385 = x380*x382 - x381*x384
     x386 = 0.0030108856000000002*x380 + 0.0019241258386206502*x385
@@ -1328,6 +1355,8 @@ def coriolis_matrix(q, qd, p=None):
     x504 = x379*x502 + x383*x503
     x505 = -x380*x492 + x384*x490 + x392*x434 - x394*x430 + x494
     return _assemble(
+        xp,
+        device,
         _lead,
         (12, 12),
         [
@@ -1484,9 +1513,10 @@ def coriolis(q, qd, p=None):
 
     Returns V of shape (12,) for one state, (N, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -1508,10 +1538,10 @@ def coriolis(q, qd, p=None):
     qd10 = qd[..., 9]
     qd11 = qd[..., 10]
     qd12 = qd[..., 11]
-    x0 = np.cos(q2)
-    x1 = np.sin(q2)
-    x2 = np.sin(q3)
-    x3 = np.cos(q3)
+    x0 = xp.cos(q2)
+    x1 = xp.sin(q2)
+    x2 = xp.sin(q3)
+    x3 = xp.cos(q3)
     x4 = qd1*x0
     x5 = qd2*x4
     x6 = qd1*x1
@@ -1594,10 +1624,10 @@ def coriolis(q, qd, p=None):
     x83 = 3.3497340042275575e-05*x48 + x82
     x84 = -0.0038482516772413004*x50 + x83
     x85 = -0.16*x68 + x80 + x84
-    x86 = np.cos(q5)
-    x87 = np.sin(q5)
-    x88 = np.sin(q6)
-    x89 = np.cos(q6)
+    x86 = xp.cos(q5)
+    x87 = xp.sin(q5)
+    x88 = xp.sin(q6)
+    x89 = xp.cos(q6)
     x90 = qd4*x87
     x91 = qd5*x90
     x92 = qd4*x86
@@ -1679,10 +1709,10 @@ def coriolis(q, qd, p=None):
     x168 = 3.3497340042275575e-05*x134 + x167
     x169 = -0.0038482516772413004*x136 - x168
     x170 = -0.16*x154 + x166 + x169
-    x171 = np.cos(q8)
-    x172 = np.sin(q8)
-    x173 = np.sin(q9)
-    x174 = np.cos(q9)
+    x171 = xp.cos(q8)
+    x172 = xp.sin(q8)
+    x173 = xp.sin(q9)
+    x174 = xp.cos(q9)
     x175 = qd7*x171
     x176 = qd8*x175
     x177 = qd7*x172
@@ -1765,10 +1795,10 @@ def coriolis(q, qd, p=None):
     x254 = 3.3497340042275575e-05*x219 + x253
     x255 = -0.0038482516772413004*x221 + x254
     x256 = -0.16*x239 + x251 + x255
-    x257 = np.cos(q11)
-    x258 = np.sin(q11)
-    x259 = np.sin(q12)
-    x260 = np.cos(q12)
+    x257 = xp.cos(q11)
+    x258 = xp.sin(q11)
+    x259 = xp.sin(q12)
+    x260 = xp.cos(q12)
     x261 = qd10*x258
     x262 = qd11*x261
     x263 = qd10*x257
@@ -1851,6 +1881,8 @@ def coriolis(q, qd, p=None):
     x340 = -0.0038482516772413004*x307 - x339
     x341 = -0.16*x325 + x337 + x340
     return _assemble(
+        xp,
+        device,
         _lead,
         (12,),
         [
@@ -1875,8 +1907,9 @@ def gravity(q, p=None):
 
     Returns G of shape (12,) for one state, (N, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -1890,63 +1923,65 @@ def gravity(q, p=None):
     q10 = q[..., 9]
     q11 = q[..., 10]
     q12 = q[..., 11]
-    x0 = np.cos(q2)
-    x1 = np.sin(q2)
-    x2 = np.sin(q3)
+    x0 = xp.cos(q2)
+    x1 = xp.sin(q2)
+    x2 = xp.sin(q3)
     x3 = 0.0038482516772413004*x2
     x4 = 2.0453744564999998e-06 - x3
-    x5 = np.cos(q3)
+    x5 = xp.cos(q3)
     x6 = 0.0038482516772413004*x5
     x7 = -x6 - 0.01771278698415
     x8 = x0*x7 - x1*x4
-    x9 = 9.81*np.sin(q1)
-    x10 = 9.81*np.cos(q1)
+    x9 = 9.81*xp.sin(q1)
+    x10 = 9.81*xp.cos(q1)
     x11 = x1*x10
     x12 = x0*x10
     x13 = x11*x5 + x12*x2
-    x14 = np.cos(q5)
-    x15 = np.sin(q5)
-    x16 = np.sin(q6)
+    x14 = xp.cos(q5)
+    x15 = xp.sin(q5)
+    x16 = xp.sin(q6)
     x17 = 0.0038482516772413004*x16
     x18 = -x17 - 2.0453744564999998e-06
-    x19 = np.cos(q6)
+    x19 = xp.cos(q6)
     x20 = 0.0038482516772413004*x19
     x21 = -x20 - 0.01771278698415
     x22 = x14*x21 - x15*x18
-    x23 = 9.81*np.sin(q4)
-    x24 = 9.81*np.cos(q4)
+    x23 = 9.81*xp.sin(q4)
+    x24 = 9.81*xp.cos(q4)
     x25 = x15*x24
     x26 = x14*x24
     x27 = x16*x26 + x19*x25
-    x28 = np.cos(q8)
-    x29 = np.sin(q8)
-    x30 = np.sin(q9)
+    x28 = xp.cos(q8)
+    x29 = xp.sin(q8)
+    x30 = xp.sin(q9)
     x31 = 0.0038482516772413004*x30
     x32 = 2.0453744564999998e-06 - x31
-    x33 = np.cos(q9)
+    x33 = xp.cos(q9)
     x34 = 0.0038482516772413004*x33
     x35 = -x34 - 0.01771278698415
     x36 = x28*x35 - x29*x32
-    x37 = 9.81*np.sin(q7)
-    x38 = 9.81*np.cos(q7)
+    x37 = 9.81*xp.sin(q7)
+    x38 = 9.81*xp.cos(q7)
     x39 = x29*x38
     x40 = x28*x38
     x41 = x30*x40 + x33*x39
-    x42 = np.cos(q11)
-    x43 = np.sin(q11)
-    x44 = np.sin(q12)
+    x42 = xp.cos(q11)
+    x43 = xp.sin(q11)
+    x44 = xp.sin(q12)
     x45 = 0.0038482516772413004*x44
     x46 = -x45 - 2.0453744564999998e-06
-    x47 = np.cos(q12)
+    x47 = xp.cos(q12)
     x48 = 0.0038482516772413004*x47
     x49 = -x48 - 0.01771278698415
     x50 = x42*x49 - x43*x46
-    x51 = 9.81*np.sin(q10)
-    x52 = 9.81*np.cos(q10)
+    x51 = 9.81*xp.sin(q10)
+    x52 = 9.81*xp.cos(q10)
     x53 = x43*x52
     x54 = x42*x52
     x55 = x44*x54 + x47*x53
     return _assemble(
+        xp,
+        device,
         _lead,
         (12,),
         [
@@ -1971,10 +2006,13 @@ def friction(qd, p=None):
 
     Returns F of shape (12,) for one state, (N, 12) for a batch.
     """
-    qd = _vector(qd, NDOF, "qd")
-    p = _params(p)
+    xp, device = _namespace(qd, p)
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
     return _assemble(
+        xp,
+        device,
         _lead,
         (12,),
         [
@@ -1999,10 +2037,11 @@ def forward_dynamics(q, qd, tau, p=None):
 
     Returns qdd of shape (12,) for one state, (N, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -2040,15 +2079,15 @@ def forward_dynamics(q, qd, tau, p=None):
     tau10 = tau[..., 9]
     tau11 = tau[..., 10]
     tau12 = tau[..., 11]
-    x0 = np.cos(q3)
+    x0 = xp.cos(q3)
     x1 = 0.0038482516772413004*x0
     x2 = 0.32*x1
-    x3 = np.sin(q3)
+    x3 = xp.sin(q3)
     x4 = x3*x3
     x5 = 0.0005396092213171668*x4
     x6 = x2 - x5 + 0.0029700831576528162
-    x7 = np.cos(q2)
-    x8 = np.sin(q2)
+    x7 = xp.cos(q2)
+    x8 = xp.sin(q2)
     x9 = x7*x8
     x10 = 2*x9
     x11 = 0.0038482516772413004*x3
@@ -2090,7 +2129,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x47 = x42 + 3.3497340042275575e-05*x46
     x48 = x35*x36
     x49 = 0.16*x48
-    x50 = 9.81*np.cos(q1)
+    x50 = 9.81*xp.cos(q1)
     x51 = x50*x8
     x52 = -x49 - x51
     x53 = x35*x35
@@ -2110,7 +2149,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x67 = 0.0002730308797879413*qd2 + 1.609852873477455e-07*x35 + 8.590521094399056e-05*x36
     x68 = qd1*qd1
     x69 = 0.014*x68
-    x70 = 9.81*np.sin(q1)
+    x70 = 9.81*xp.sin(q1)
     x71 = -x69 + x70
     x72 = qd2*x67 - x66 + 0.01169101578415*x71
     x73 = 1.609852873477455e-07*x44 + 0.0028754860404784995*x57 - x64 + x72
@@ -2179,15 +2218,15 @@ def forward_dynamics(q, qd, tau, p=None):
     x136 = x135/x34
     x137 = x134*x25 - x136*x33
     x138 = -1842.9129686423128*x136*x21 - x137*x26 + 1842.9129686423128*x61
-    x139 = np.cos(q6)
+    x139 = xp.cos(q6)
     x140 = 0.0038482516772413004*x139
     x141 = 0.32*x140
-    x142 = np.sin(q6)
+    x142 = xp.sin(q6)
     x143 = x142*x142
     x144 = 0.0005396092213171668*x143
     x145 = x141 - x144 + 0.0029700831576528162
-    x146 = np.cos(q5)
-    x147 = np.sin(q5)
+    x146 = xp.cos(q5)
+    x147 = xp.sin(q5)
     x148 = x146*x147
     x149 = 2*x148
     x150 = 0.0038482516772413004*x142
@@ -2228,7 +2267,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x185 = x180 + 3.3497340042275575e-05*x184
     x186 = x174*x175
     x187 = 0.16*x186
-    x188 = 9.81*np.cos(q4)
+    x188 = 9.81*xp.cos(q4)
     x189 = x147*x188
     x190 = -x187 - x189
     x191 = x174*x174
@@ -2248,7 +2287,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x205 = 0.001386899962102278*x181 + 1.609852873477455e-07*x182 + x204
     x206 = qd4*qd4
     x207 = 0.014*x206
-    x208 = 9.81*np.sin(q4)
+    x208 = 9.81*xp.sin(q4)
     x209 = x207 + x208
     x210 = -0.01169101578415*x209
     x211 = -0.0028754860404784995*x195 - x205 - x210
@@ -2317,15 +2356,15 @@ def forward_dynamics(q, qd, tau, p=None):
     x274 = x273/x173
     x275 = x164*x272 - x172*x274
     x276 = -1842.9129686423128*x160*x274 - x165*x275 + 1842.9129686423128*x199
-    x277 = np.cos(q9)
+    x277 = xp.cos(q9)
     x278 = 0.0038482516772413004*x277
     x279 = 0.32*x278
-    x280 = np.sin(q9)
+    x280 = xp.sin(q9)
     x281 = x280*x280
     x282 = 0.0005396092213171668*x281
     x283 = x279 - x282 + 0.0029700831576528162
-    x284 = np.cos(q8)
-    x285 = np.sin(q8)
+    x284 = xp.cos(q8)
+    x285 = xp.sin(q8)
     x286 = x284*x285
     x287 = 2*x286
     x288 = 0.0038482516772413004*x280
@@ -2367,7 +2406,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x324 = x319 + 3.3497340042275575e-05*x323
     x325 = x312*x313
     x326 = 0.16*x325
-    x327 = 9.81*np.cos(q7)
+    x327 = 9.81*xp.cos(q7)
     x328 = x285*x327
     x329 = -x326 - x328
     x330 = x312*x312
@@ -2387,7 +2426,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x344 = 0.0002730308797879413*qd8 + 1.609852873477455e-07*x312 + 8.590521094399056e-05*x313
     x345 = qd7*qd7
     x346 = 0.014*x345
-    x347 = 9.81*np.sin(q7)
+    x347 = 9.81*xp.sin(q7)
     x348 = -x346 + x347
     x349 = qd8*x344 - x343 + 0.01169101578415*x348
     x350 = 1.609852873477455e-07*x321 + 0.0028754860404784995*x334 - x341 + x349
@@ -2456,15 +2495,15 @@ def forward_dynamics(q, qd, tau, p=None):
     x413 = x412/x311
     x414 = x302*x411 - x310*x413
     x415 = -1842.9129686423128*x298*x413 - x303*x414 + 1842.9129686423128*x338
-    x416 = np.cos(q12)
+    x416 = xp.cos(q12)
     x417 = 0.0038482516772413004*x416
     x418 = 0.32*x417
-    x419 = np.sin(q12)
+    x419 = xp.sin(q12)
     x420 = x419*x419
     x421 = 0.0005396092213171668*x420
     x422 = x418 - x421 + 0.0029700831576528162
-    x423 = np.cos(q11)
-    x424 = np.sin(q11)
+    x423 = xp.cos(q11)
+    x424 = xp.sin(q11)
     x425 = x423*x424
     x426 = 2*x425
     x427 = 0.0038482516772413004*x419
@@ -2505,7 +2544,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x462 = x457 + 3.3497340042275575e-05*x461
     x463 = x451*x452
     x464 = 0.16*x463
-    x465 = 9.81*np.cos(q10)
+    x465 = 9.81*xp.cos(q10)
     x466 = x424*x465
     x467 = -x464 - x466
     x468 = x451*x451
@@ -2525,7 +2564,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x482 = 0.001386899962102278*x458 + 1.609852873477455e-07*x459 + x481
     x483 = qd10*qd10
     x484 = 0.014*x483
-    x485 = 9.81*np.sin(q10)
+    x485 = 9.81*xp.sin(q10)
     x486 = x484 + x485
     x487 = -0.01169101578415*x486
     x488 = -0.0028754860404784995*x472 - x482 - x487
@@ -2595,6 +2634,8 @@ def forward_dynamics(q, qd, tau, p=None):
     x552 = x441*x549 - x449*x551
     x553 = -1842.9129686423128*x437*x551 - x442*x552 + 1842.9129686423128*x476
     return _assemble(
+        xp,
+        device,
         _lead,
         (12,),
         [
@@ -2619,10 +2660,11 @@ def regressor(q, qd, qdd, p=None):
 
     Returns Y of shape (12, 156) for one state, (N, 12, 156) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -2660,13 +2702,13 @@ def regressor(q, qd, qdd, p=None):
     qdd10 = qdd[..., 9]
     qdd11 = qdd[..., 10]
     qdd12 = qdd[..., 11]
-    x0 = 9.81*np.cos(q1)
-    x1 = 9.81*np.sin(q1)
-    x2 = np.sign(qd1)
-    x3 = np.sin(q2)
+    x0 = 9.81*xp.cos(q1)
+    x1 = 9.81*xp.sin(q1)
+    x2 = xp.sign(qd1)
+    x3 = xp.sin(q2)
     x4 = 0.014*qdd1 + x0
     x5 = x3*x4
-    x6 = np.cos(q2)
+    x6 = xp.cos(q2)
     x7 = x4*x6
     x8 = 0.014*x3
     x9 = 0.014*x6
@@ -2700,8 +2742,8 @@ def regressor(q, qd, qdd, p=None):
     x37 = qdd2*x3 + x14*x33 + x17*x6
     x38 = x22*x3 + x24*x6
     x39 = 0.16*x6
-    x40 = np.cos(q3)
-    x41 = np.sin(q3)
+    x40 = xp.cos(q3)
+    x41 = xp.sin(q3)
     x42 = 0.03745*x23 - 0.16*x28 - x5
     x43 = 0.03745*x26 - 0.16*x30 + x7
     x44 = x40*x42 - x41*x43
@@ -2750,7 +2792,7 @@ def regressor(q, qd, qdd, p=None):
     x87 = x24 + x25
     x88 = x18 - x29
     x89 = -x21 + x22
-    x90 = np.sign(qd2)
+    x90 = xp.sign(qd2)
     x91 = 0.16*x40
     x92 = 0.16*x41
     x93 = -x44*x91 - x48*x92
@@ -2760,14 +2802,14 @@ def regressor(q, qd, qdd, p=None):
     x97 = x69 + x70
     x98 = x64 - x72
     x99 = -x56 + x57
-    x100 = np.sign(qd3)
-    x101 = 9.81*np.cos(q4)
-    x102 = 9.81*np.sin(q4)
-    x103 = np.sign(qd4)
-    x104 = np.sin(q5)
+    x100 = xp.sign(qd3)
+    x101 = 9.81*xp.cos(q4)
+    x102 = 9.81*xp.sin(q4)
+    x103 = xp.sign(qd4)
+    x104 = xp.sin(q5)
     x105 = -0.014*qdd4 + x101
     x106 = x104*x105
-    x107 = np.cos(q5)
+    x107 = xp.cos(q5)
     x108 = x105*x107
     x109 = 0.014*x104
     x110 = 0.014*x107
@@ -2801,8 +2843,8 @@ def regressor(q, qd, qdd, p=None):
     x138 = qdd5*x104 + x107*x118 + x115*x134
     x139 = x104*x123 + x107*x125
     x140 = 0.16*x107
-    x141 = np.cos(q6)
-    x142 = np.sin(q6)
+    x141 = xp.cos(q6)
+    x142 = xp.sin(q6)
     x143 = -x106 - 0.03745*x124 - 0.16*x129
     x144 = x108 - 0.03745*x127 - 0.16*x131
     x145 = x141*x143 - x142*x144
@@ -2851,7 +2893,7 @@ def regressor(q, qd, qdd, p=None):
     x188 = x125 + x126
     x189 = x119 - x130
     x190 = -x122 + x123
-    x191 = np.sign(qd5)
+    x191 = xp.sign(qd5)
     x192 = 0.16*x141
     x193 = 0.16*x142
     x194 = -x145*x192 - x149*x193
@@ -2861,14 +2903,14 @@ def regressor(q, qd, qdd, p=None):
     x198 = x170 + x171
     x199 = x165 - x173
     x200 = -x157 + x158
-    x201 = np.sign(qd6)
-    x202 = 9.81*np.cos(q7)
-    x203 = 9.81*np.sin(q7)
-    x204 = np.sign(qd7)
-    x205 = np.sin(q8)
+    x201 = xp.sign(qd6)
+    x202 = 9.81*xp.cos(q7)
+    x203 = 9.81*xp.sin(q7)
+    x204 = xp.sign(qd7)
+    x205 = xp.sin(q8)
     x206 = 0.014*qdd7 + x202
     x207 = x205*x206
-    x208 = np.cos(q8)
+    x208 = xp.cos(q8)
     x209 = x206*x208
     x210 = 0.014*x205
     x211 = 0.014*x208
@@ -2902,8 +2944,8 @@ def regressor(q, qd, qdd, p=None):
     x239 = qdd8*x205 + x208*x219 + x216*x235
     x240 = x205*x224 + x208*x226
     x241 = 0.16*x208
-    x242 = np.cos(q9)
-    x243 = np.sin(q9)
+    x242 = xp.cos(q9)
+    x243 = xp.sin(q9)
     x244 = -x207 + 0.03745*x225 - 0.16*x230
     x245 = x209 + 0.03745*x228 - 0.16*x232
     x246 = x242*x244 - x243*x245
@@ -2952,7 +2994,7 @@ def regressor(q, qd, qdd, p=None):
     x289 = x226 + x227
     x290 = x220 - x231
     x291 = -x223 + x224
-    x292 = np.sign(qd8)
+    x292 = xp.sign(qd8)
     x293 = 0.16*x242
     x294 = 0.16*x243
     x295 = -x246*x293 - x250*x294
@@ -2962,14 +3004,14 @@ def regressor(q, qd, qdd, p=None):
     x299 = x271 + x272
     x300 = x266 - x274
     x301 = -x258 + x259
-    x302 = np.sign(qd9)
-    x303 = 9.81*np.cos(q10)
-    x304 = 9.81*np.sin(q10)
-    x305 = np.sign(qd10)
-    x306 = np.sin(q11)
+    x302 = xp.sign(qd9)
+    x303 = 9.81*xp.cos(q10)
+    x304 = 9.81*xp.sin(q10)
+    x305 = xp.sign(qd10)
+    x306 = xp.sin(q11)
     x307 = -0.014*qdd10 + x303
     x308 = x306*x307
-    x309 = np.cos(q11)
+    x309 = xp.cos(q11)
     x310 = x307*x309
     x311 = 0.014*x306
     x312 = 0.014*x309
@@ -3003,8 +3045,8 @@ def regressor(q, qd, qdd, p=None):
     x340 = qdd11*x306 + x309*x320 + x317*x336
     x341 = x306*x325 + x309*x327
     x342 = 0.16*x309
-    x343 = np.cos(q12)
-    x344 = np.sin(q12)
+    x343 = xp.cos(q12)
+    x344 = xp.sin(q12)
     x345 = -x308 - 0.03745*x326 - 0.16*x331
     x346 = x310 - 0.03745*x329 - 0.16*x333
     x347 = x343*x345 - x344*x346
@@ -3053,7 +3095,7 @@ def regressor(q, qd, qdd, p=None):
     x390 = x327 + x328
     x391 = x321 - x332
     x392 = -x324 + x325
-    x393 = np.sign(qd11)
+    x393 = xp.sign(qd11)
     x394 = 0.16*x343
     x395 = 0.16*x344
     x396 = -x347*x394 - x351*x395
@@ -3063,8 +3105,10 @@ def regressor(q, qd, qdd, p=None):
     x400 = x372 + x373
     x401 = x367 - x375
     x402 = -x359 + x360
-    x403 = np.sign(qd12)
+    x403 = xp.sign(qd12)
     return _assemble(
+        xp,
+        device,
         _lead,
         (12, 156),
         [
@@ -4949,10 +4993,11 @@ def base_regressor(q, qd, qdd, p=None):
 
     Returns Yb of shape (12, 96) for one state, (N, 12, 96) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -4990,13 +5035,13 @@ def base_regressor(q, qd, qdd, p=None):
     qdd10 = qdd[..., 9]
     qdd11 = qdd[..., 10]
     qdd12 = qdd[..., 11]
-    x0 = 9.81*np.cos(q1)
-    x1 = 9.81*np.sin(q1)
-    x2 = np.sign(qd1)
-    x3 = np.sin(q2)
+    x0 = 9.81*xp.cos(q1)
+    x1 = 9.81*xp.sin(q1)
+    x2 = xp.sign(qd1)
+    x3 = xp.sin(q2)
     x4 = qd1*qd1
     x5 = x1 - 0.014*x4
-    x6 = np.cos(q2)
+    x6 = xp.cos(q2)
     x7 = qd1*x6
     x8 = qd1*x3
     x9 = x7*x8
@@ -5022,8 +5067,8 @@ def base_regressor(q, qd, qdd, p=None):
     x29 = x21*x6 - x22*x3 + x23*x3 + x28*x6
     x30 = qdd2*x3 + x11*x6 + x25*x8
     x31 = 0.16*x6
-    x32 = np.cos(q3)
-    x33 = np.sin(q3)
+    x32 = xp.cos(q3)
+    x33 = xp.sin(q3)
     x34 = x32*x7 - x33*x8
     x35 = qd2 + qd3
     x36 = x34*x35
@@ -5065,7 +5110,7 @@ def base_regressor(q, qd, qdd, p=None):
     x72 = x22 + x23
     x73 = x12 - x18
     x74 = -x21 + x28
-    x75 = np.sign(qd2)
+    x75 = xp.sign(qd2)
     x76 = x21 - x28
     x77 = -0.16*x17 - x71 + 0.03745*x76
     x78 = x22 + x23
@@ -5079,14 +5124,14 @@ def base_regressor(q, qd, qdd, p=None):
     x86 = x56 + x57
     x87 = x47 - x59
     x88 = -x36 + x37
-    x89 = np.sign(qd3)
-    x90 = 9.81*np.cos(q4)
-    x91 = 9.81*np.sin(q4)
-    x92 = np.sign(qd4)
-    x93 = np.sin(q5)
+    x89 = xp.sign(qd3)
+    x90 = 9.81*xp.cos(q4)
+    x91 = 9.81*xp.sin(q4)
+    x92 = xp.sign(qd4)
+    x93 = xp.sin(q5)
     x94 = qd4*qd4
     x95 = x91 + 0.014*x94
-    x96 = np.cos(q5)
+    x96 = xp.cos(q5)
     x97 = qd4*x96
     x98 = qd4*x93
     x99 = x97*x98
@@ -5112,8 +5157,8 @@ def base_regressor(q, qd, qdd, p=None):
     x119 = x111*x96 - x112*x93 + x113*x93 + x118*x96
     x120 = qdd5*x93 + x101*x96 + x115*x98
     x121 = 0.16*x96
-    x122 = np.cos(q6)
-    x123 = np.sin(q6)
+    x122 = xp.cos(q6)
+    x123 = xp.sin(q6)
     x124 = x122*x97 - x123*x98
     x125 = qd5 + qd6
     x126 = x124*x125
@@ -5155,7 +5200,7 @@ def base_regressor(q, qd, qdd, p=None):
     x162 = x112 + x113
     x163 = x102 - x108
     x164 = -x111 + x118
-    x165 = np.sign(qd5)
+    x165 = xp.sign(qd5)
     x166 = x111 - x118
     x167 = -0.16*x107 - x161 - 0.03745*x166
     x168 = x112 + x113
@@ -5169,14 +5214,14 @@ def base_regressor(q, qd, qdd, p=None):
     x176 = x146 + x147
     x177 = x137 - x149
     x178 = -x126 + x127
-    x179 = np.sign(qd6)
-    x180 = 9.81*np.cos(q7)
-    x181 = 9.81*np.sin(q7)
-    x182 = np.sign(qd7)
-    x183 = np.sin(q8)
+    x179 = xp.sign(qd6)
+    x180 = 9.81*xp.cos(q7)
+    x181 = 9.81*xp.sin(q7)
+    x182 = xp.sign(qd7)
+    x183 = xp.sin(q8)
     x184 = qd7*qd7
     x185 = x181 - 0.014*x184
-    x186 = np.cos(q8)
+    x186 = xp.cos(q8)
     x187 = qd7*x186
     x188 = qd7*x183
     x189 = x187*x188
@@ -5202,8 +5247,8 @@ def base_regressor(q, qd, qdd, p=None):
     x209 = -x183*x202 + x183*x203 + x186*x201 + x186*x208
     x210 = qdd8*x183 + x186*x191 + x188*x205
     x211 = 0.16*x186
-    x212 = np.cos(q9)
-    x213 = np.sin(q9)
+    x212 = xp.cos(q9)
+    x213 = xp.sin(q9)
     x214 = x187*x212 - x188*x213
     x215 = qd8 + qd9
     x216 = x214*x215
@@ -5245,7 +5290,7 @@ def base_regressor(q, qd, qdd, p=None):
     x252 = x202 + x203
     x253 = x192 - x198
     x254 = -x201 + x208
-    x255 = np.sign(qd8)
+    x255 = xp.sign(qd8)
     x256 = x201 - x208
     x257 = -0.16*x197 - x251 + 0.03745*x256
     x258 = x202 + x203
@@ -5259,14 +5304,14 @@ def base_regressor(q, qd, qdd, p=None):
     x266 = x236 + x237
     x267 = x227 - x239
     x268 = -x216 + x217
-    x269 = np.sign(qd9)
-    x270 = 9.81*np.cos(q10)
-    x271 = 9.81*np.sin(q10)
-    x272 = np.sign(qd10)
-    x273 = np.sin(q11)
+    x269 = xp.sign(qd9)
+    x270 = 9.81*xp.cos(q10)
+    x271 = 9.81*xp.sin(q10)
+    x272 = xp.sign(qd10)
+    x273 = xp.sin(q11)
     x274 = qd10*qd10
     x275 = x271 + 0.014*x274
-    x276 = np.cos(q11)
+    x276 = xp.cos(q11)
     x277 = qd10*x276
     x278 = qd10*x273
     x279 = x277*x278
@@ -5292,8 +5337,8 @@ def base_regressor(q, qd, qdd, p=None):
     x299 = -x273*x292 + x273*x293 + x276*x291 + x276*x298
     x300 = qdd11*x273 + x276*x281 + x278*x295
     x301 = 0.16*x276
-    x302 = np.cos(q12)
-    x303 = np.sin(q12)
+    x302 = xp.cos(q12)
+    x303 = xp.sin(q12)
     x304 = x277*x302 - x278*x303
     x305 = qd11 + qd12
     x306 = x304*x305
@@ -5335,7 +5380,7 @@ def base_regressor(q, qd, qdd, p=None):
     x342 = x292 + x293
     x343 = x282 - x288
     x344 = -x291 + x298
-    x345 = np.sign(qd11)
+    x345 = xp.sign(qd11)
     x346 = x291 - x298
     x347 = -0.16*x287 - x341 - 0.03745*x346
     x348 = x292 + x293
@@ -5349,8 +5394,10 @@ def base_regressor(q, qd, qdd, p=None):
     x356 = x326 + x327
     x357 = x317 - x329
     x358 = -x306 + x307
-    x359 = np.sign(qd12)
+    x359 = xp.sign(qd12)
     return _assemble(
+        xp,
+        device,
         _lead,
         (12, 96),
         [
@@ -6515,10 +6562,11 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
 
     Returns the tuple (dtau_dq, dtau_dqd) of shapes (12, 12), (12, 12) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    qdd = _vector(qdd, NDOF, "qdd")
-    p = _params(p)
+    xp, device = _namespace(q, qd, qdd, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    qdd = _vector(xp, device, qdd, NDOF, "qdd")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -6556,16 +6604,16 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qdd10 = qdd[..., 9]
     qdd11 = qdd[..., 10]
     qdd12 = qdd[..., 11]
-    x0 = np.sin(q2)
-    x1 = np.cos(q2)
-    x2 = 9.81*np.sin(q1)
-    x3 = np.sin(q3)
-    x4 = np.cos(q3)
+    x0 = xp.sin(q2)
+    x1 = xp.cos(q2)
+    x2 = 9.81*xp.sin(q1)
+    x3 = xp.sin(q3)
+    x4 = xp.cos(q3)
     x5 = x0*x2
     x6 = x1*x2
     x7 = x3*x6 + x4*x5
     x8 = 0.0002972952667644*x7
-    x9 = 9.81*np.cos(q1)
+    x9 = 9.81*xp.cos(q1)
     x10 = -0.0028754860404784995*x6 + 0.01169101578415*x9
     x11 = x3*x5 - x4*x6
     x12 = 0.0002972952667644*x11 + 0.0038482516772413004*x9
@@ -6755,16 +6803,16 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x196 = -0.16*x153 + x192 + x195
     x197 = 3.3497340042275575e-05*x176 + x194 + 0.0038482516772413004*x61
     x198 = -0.16*x184 + x197
-    x199 = np.sin(q5)
-    x200 = np.cos(q5)
-    x201 = 9.81*np.sin(q4)
-    x202 = np.sin(q6)
-    x203 = np.cos(q6)
+    x199 = xp.sin(q5)
+    x200 = xp.cos(q5)
+    x201 = 9.81*xp.sin(q4)
+    x202 = xp.sin(q6)
+    x203 = xp.cos(q6)
     x204 = x199*x201
     x205 = x200*x201
     x206 = x202*x205 + x203*x204
     x207 = 0.0002972952667644*x206
-    x208 = 9.81*np.cos(q4)
+    x208 = 9.81*xp.cos(q4)
     x209 = 0.0028754860404784995*x205 + 0.01169101578415*x208
     x210 = x202*x204 - x203*x205
     x211 = 0.0038482516772413004*x208 - 0.0002972952667644*x210
@@ -6955,16 +7003,16 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x396 = -0.16*x353 + x393 + x395
     x397 = 0.0038482516772413004*x259 - 3.3497340042275575e-05*x377 - x394
     x398 = -0.16*x385 + x397
-    x399 = np.sin(q8)
-    x400 = np.cos(q8)
-    x401 = 9.81*np.sin(q7)
-    x402 = np.sin(q9)
-    x403 = np.cos(q9)
+    x399 = xp.sin(q8)
+    x400 = xp.cos(q8)
+    x401 = 9.81*xp.sin(q7)
+    x402 = xp.sin(q9)
+    x403 = xp.cos(q9)
     x404 = x399*x401
     x405 = x400*x401
     x406 = x402*x405 + x403*x404
     x407 = 0.0002972952667644*x406
-    x408 = 9.81*np.cos(q7)
+    x408 = 9.81*xp.cos(q7)
     x409 = -0.0028754860404784995*x405 + 0.01169101578415*x408
     x410 = x402*x404 - x403*x405
     x411 = 0.0038482516772413004*x408 + 0.0002972952667644*x410
@@ -7154,16 +7202,16 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x595 = -0.16*x552 + x591 + x594
     x596 = 0.0038482516772413004*x460 + 3.3497340042275575e-05*x575 + x593
     x597 = -0.16*x583 + x596
-    x598 = np.sin(q11)
-    x599 = np.cos(q11)
-    x600 = 9.81*np.sin(q10)
-    x601 = np.sin(q12)
-    x602 = np.cos(q12)
+    x598 = xp.sin(q11)
+    x599 = xp.cos(q11)
+    x600 = 9.81*xp.sin(q10)
+    x601 = xp.sin(q12)
+    x602 = xp.cos(q12)
     x603 = x598*x600
     x604 = x599*x600
     x605 = x601*x604 + x602*x603
     x606 = 0.0002972952667644*x605
-    x607 = 9.81*np.cos(q10)
+    x607 = 9.81*xp.cos(q10)
     x608 = 0.0028754860404784995*x604 + 0.01169101578415*x607
     x609 = x601*x603 - x602*x604
     x610 = 0.0038482516772413004*x607 - 0.0002972952667644*x609
@@ -7848,6 +7896,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x1289 = 2*x1278
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 12),
             [
@@ -7998,6 +8048,8 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 12),
             [
@@ -8155,10 +8207,11 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
 
     Returns the tuple (dqdd_dq, dqdd_dqd, Minv) of shapes (12, 12), (12, 12), (12, 12) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -8196,12 +8249,12 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     tau10 = tau[..., 9]
     tau11 = tau[..., 10]
     tau12 = tau[..., 11]
-    x0 = np.sin(q3)
-    x1 = np.cos(q3)
-    x2 = np.sin(q2)
-    x3 = 9.81*np.sin(q1)
+    x0 = xp.sin(q3)
+    x1 = xp.cos(q3)
+    x2 = xp.sin(q2)
+    x3 = 9.81*xp.sin(q1)
     x4 = x2*x3
-    x5 = np.cos(q2)
+    x5 = xp.cos(q2)
     x6 = x3*x5
     x7 = x0*x6 + x1*x4
     x8 = 0.0038482516772413004*x7
@@ -8212,7 +8265,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x13 = x10*x7 + x11*x12
     x14 = -0.16*x13 - x8 + x9
     x15 = 0.0002972952667644*x7
-    x16 = 9.81*np.cos(q1)
+    x16 = 9.81*xp.cos(q1)
     x17 = 0.01169101578415*x16 - 0.0028754860404784995*x6
     x18 = 0.0002972952667644*x12 + 0.0038482516772413004*x16
     x19 = x10*x12 - x11*x7
@@ -8482,12 +8535,12 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x283 = -x14*x186 + 0.0038482516772413004*x196*x7 - x26*x61
     x284 = -x165*x196 - x183*x186 - x260*x61
     x285 = -x186*x269 - x196*x263 - x278*x61
-    x286 = np.sin(q6)
-    x287 = np.cos(q6)
-    x288 = np.sin(q5)
-    x289 = 9.81*np.sin(q4)
+    x286 = xp.sin(q6)
+    x287 = xp.cos(q6)
+    x288 = xp.sin(q5)
+    x289 = 9.81*xp.sin(q4)
     x290 = x288*x289
-    x291 = np.cos(q5)
+    x291 = xp.cos(q5)
     x292 = x289*x291
     x293 = x286*x292 + x287*x290
     x294 = 0.0038482516772413004*x293
@@ -8498,7 +8551,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x299 = x293*x296 + x297*x298
     x300 = -x294 + x295 - 0.16*x299
     x301 = 0.0002972952667644*x293
-    x302 = 9.81*np.cos(q4)
+    x302 = 9.81*xp.cos(q4)
     x303 = 0.0028754860404784995*x292 + 0.01169101578415*x302
     x304 = -0.0002972952667644*x298 + 0.0038482516772413004*x302
     x305 = -x293*x297 + x296*x298
@@ -8769,12 +8822,12 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x570 = 0.0038482516772413004*x293*x481 - x300*x472 - x312*x347
     x571 = -x347*x546 - x451*x481 - x469*x472
     x572 = -x347*x565 - x472*x555 - x481*x549
-    x573 = np.sin(q9)
-    x574 = np.cos(q9)
-    x575 = np.sin(q8)
-    x576 = 9.81*np.sin(q7)
+    x573 = xp.sin(q9)
+    x574 = xp.cos(q9)
+    x575 = xp.sin(q8)
+    x576 = 9.81*xp.sin(q7)
     x577 = x575*x576
-    x578 = np.cos(q8)
+    x578 = xp.cos(q8)
     x579 = x576*x578
     x580 = x573*x579 + x574*x577
     x581 = 0.0038482516772413004*x580
@@ -8785,7 +8838,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x586 = x580*x583 + x584*x585
     x587 = -x581 + x582 - 0.16*x586
     x588 = 0.0002972952667644*x580
-    x589 = 9.81*np.cos(q7)
+    x589 = 9.81*xp.cos(q7)
     x590 = -0.0028754860404784995*x579 + 0.01169101578415*x589
     x591 = 0.0002972952667644*x585 + 0.0038482516772413004*x589
     x592 = -x580*x584 + x583*x585
@@ -9055,12 +9108,12 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x856 = 0.0038482516772413004*x580*x769 - x587*x759 - x599*x634
     x857 = -x634*x833 - x738*x769 - x756*x759
     x858 = -x634*x851 - x759*x842 - x769*x836
-    x859 = np.sin(q12)
-    x860 = np.cos(q12)
-    x861 = np.sin(q11)
-    x862 = 9.81*np.sin(q10)
+    x859 = xp.sin(q12)
+    x860 = xp.cos(q12)
+    x861 = xp.sin(q11)
+    x862 = 9.81*xp.sin(q10)
     x863 = x861*x862
-    x864 = np.cos(q11)
+    x864 = xp.cos(q11)
     x865 = x862*x864
     x866 = x859*x865 + x860*x863
     x867 = 0.0038482516772413004*x866
@@ -9071,7 +9124,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x872 = x866*x869 + x870*x871
     x873 = -x867 + x868 - 0.16*x872
     x874 = 0.0002972952667644*x866
-    x875 = 9.81*np.cos(q10)
+    x875 = 9.81*xp.cos(q10)
     x876 = 0.0028754860404784995*x865 + 0.01169101578415*x875
     x877 = -0.0002972952667644*x871 + 0.0038482516772413004*x875
     x878 = -x866*x870 + x869*x871
@@ -9800,6 +9853,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x1601 = -x1045*x1597 - x1054*x1579 - x1590*x920
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 12),
             [
@@ -9950,6 +10005,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 12),
             [
@@ -10100,6 +10157,8 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (12, 12),
             [
@@ -10257,8 +10316,9 @@ def mass_matrix_inverse(q, p=None):
 
     Returns Minv of shape (12, 12) for one state, (N, 12, 12) for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    p = _params(p)
+    xp, device = _namespace(q, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -10268,15 +10328,15 @@ def mass_matrix_inverse(q, p=None):
     q9 = q[..., 8]
     q11 = q[..., 10]
     q12 = q[..., 11]
-    x0 = np.cos(q3)
+    x0 = xp.cos(q3)
     x1 = 0.0038482516772413004*x0
     x2 = 0.32*x1
-    x3 = np.sin(q3)
+    x3 = xp.sin(q3)
     x4 = x3*x3
     x5 = 0.0005396092213171668*x4
     x6 = x2 - x5 + 0.0029700831576528162
-    x7 = np.sin(q2)
-    x8 = np.cos(q2)
+    x7 = xp.sin(q2)
+    x8 = xp.cos(q2)
     x9 = x7*x8
     x10 = 2*x9
     x11 = 0.0038482516772413004*x3
@@ -10312,15 +10372,15 @@ def mass_matrix_inverse(q, p=None):
     x41 = x25*x37
     x42 = -x33*x39 - x41
     x43 = x37*x41 + x38*x39 + 1842.9129686423128
-    x44 = np.cos(q6)
+    x44 = xp.cos(q6)
     x45 = 0.0038482516772413004*x44
     x46 = 0.32*x45
-    x47 = np.sin(q6)
+    x47 = xp.sin(q6)
     x48 = x47*x47
     x49 = 0.0005396092213171668*x48
     x50 = x46 - x49 + 0.0029700831576528162
-    x51 = np.sin(q5)
-    x52 = np.cos(q5)
+    x51 = xp.sin(q5)
+    x52 = xp.cos(q5)
     x53 = x51*x52
     x54 = 2*x53
     x55 = 0.0038482516772413004*x47
@@ -10356,15 +10416,15 @@ def mass_matrix_inverse(q, p=None):
     x85 = x69*x81
     x86 = -x77*x83 - x85
     x87 = x81*x85 + x82*x83 + 1842.9129686423128
-    x88 = np.cos(q9)
+    x88 = xp.cos(q9)
     x89 = 0.0038482516772413004*x88
     x90 = 0.32*x89
-    x91 = np.sin(q9)
+    x91 = xp.sin(q9)
     x92 = x91*x91
     x93 = 0.0005396092213171668*x92
     x94 = x90 - x93 + 0.0029700831576528162
-    x95 = np.sin(q8)
-    x96 = np.cos(q8)
+    x95 = xp.sin(q8)
+    x96 = xp.cos(q8)
     x97 = x95*x96
     x98 = 2*x97
     x99 = 0.0038482516772413004*x91
@@ -10400,15 +10460,15 @@ def mass_matrix_inverse(q, p=None):
     x129 = x113*x125
     x130 = -x121*x127 - x129
     x131 = x125*x129 + x126*x127 + 1842.9129686423128
-    x132 = np.cos(q12)
+    x132 = xp.cos(q12)
     x133 = 0.0038482516772413004*x132
     x134 = 0.32*x133
-    x135 = np.sin(q12)
+    x135 = xp.sin(q12)
     x136 = x135*x135
     x137 = 0.0005396092213171668*x136
     x138 = x134 - x137 + 0.0029700831576528162
-    x139 = np.sin(q11)
-    x140 = np.cos(q11)
+    x139 = xp.sin(q11)
+    x140 = xp.cos(q11)
     x141 = x139*x140
     x142 = 2*x141
     x143 = 0.0038482516772413004*x135
@@ -10445,6 +10505,8 @@ def mass_matrix_inverse(q, p=None):
     x174 = -x165*x171 - x173
     x175 = x169*x173 + x170*x171 + 1842.9129686423128
     return _assemble(
+        xp,
+        device,
         _lead,
         (12, 12),
         [
@@ -10601,10 +10663,11 @@ def linearize(q, qd, tau, p=None):
 
     Returns the tuple (A, B) of shapes (24, 24), (24, 12) for one state, with a leading N for a batch.
     """
-    q = _vector(q, NDOF, "q")
-    qd = _vector(qd, NDOF, "qd")
-    tau = _vector(tau, NDOF, "tau")
-    p = _params(p)
+    xp, device = _namespace(q, qd, tau, p)
+    q = _vector(xp, device, q, NDOF, "q")
+    qd = _vector(xp, device, qd, NDOF, "qd")
+    tau = _vector(xp, device, tau, NDOF, "tau")
+    p = _params(xp, device, p)
     _lead = np.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
@@ -10642,12 +10705,12 @@ def linearize(q, qd, tau, p=None):
     tau10 = tau[..., 9]
     tau11 = tau[..., 10]
     tau12 = tau[..., 11]
-    x0 = np.sin(q3)
-    x1 = np.cos(q3)
-    x2 = np.sin(q2)
-    x3 = 9.81*np.sin(q1)
+    x0 = xp.sin(q3)
+    x1 = xp.cos(q3)
+    x2 = xp.sin(q2)
+    x3 = 9.81*xp.sin(q1)
     x4 = x2*x3
-    x5 = np.cos(q2)
+    x5 = xp.cos(q2)
     x6 = x3*x5
     x7 = x0*x6 + x1*x4
     x8 = 0.0038482516772413004*x7
@@ -10658,7 +10721,7 @@ def linearize(q, qd, tau, p=None):
     x13 = x10*x7 + x11*x12
     x14 = -0.16*x13 - x8 + x9
     x15 = 0.0002972952667644*x7
-    x16 = 9.81*np.cos(q1)
+    x16 = 9.81*xp.cos(q1)
     x17 = 0.01169101578415*x16 - 0.0028754860404784995*x6
     x18 = 0.0002972952667644*x12 + 0.0038482516772413004*x16
     x19 = x10*x12 - x11*x7
@@ -11041,12 +11104,12 @@ def linearize(q, qd, tau, p=None):
     x396 = -x186*x387 - x196*x298 - x327*x61
     x397 = -x186*x389 - x196*x357 - x364*x61
     x398 = -x186*x391 - x196*x370 - x381*x61
-    x399 = np.sin(q6)
-    x400 = np.cos(q6)
-    x401 = np.sin(q5)
-    x402 = 9.81*np.sin(q4)
+    x399 = xp.sin(q6)
+    x400 = xp.cos(q6)
+    x401 = xp.sin(q5)
+    x402 = 9.81*xp.sin(q4)
     x403 = x401*x402
-    x404 = np.cos(q5)
+    x404 = xp.cos(q5)
     x405 = x402*x404
     x406 = x399*x405 + x400*x403
     x407 = 0.0038482516772413004*x406
@@ -11057,7 +11120,7 @@ def linearize(q, qd, tau, p=None):
     x412 = x406*x409 + x410*x411
     x413 = -x407 + x408 - 0.16*x412
     x414 = 0.0002972952667644*x406
-    x415 = 9.81*np.cos(q4)
+    x415 = 9.81*xp.cos(q4)
     x416 = 0.0028754860404784995*x405 + 0.01169101578415*x415
     x417 = -0.0002972952667644*x411 + 0.0038482516772413004*x415
     x418 = -x406*x410 + x409*x411
@@ -11443,12 +11506,12 @@ def linearize(q, qd, tau, p=None):
     x798 = -x460*x727 - x585*x789 - x594*x698
     x799 = -x460*x766 - x585*x791 - x594*x759
     x800 = -x460*x783 - x585*x793 - x594*x772
-    x801 = np.sin(q9)
-    x802 = np.cos(q9)
-    x803 = np.sin(q8)
-    x804 = 9.81*np.sin(q7)
+    x801 = xp.sin(q9)
+    x802 = xp.cos(q9)
+    x803 = xp.sin(q8)
+    x804 = 9.81*xp.sin(q7)
     x805 = x803*x804
-    x806 = np.cos(q8)
+    x806 = xp.cos(q8)
     x807 = x804*x806
     x808 = x801*x807 + x802*x805
     x809 = 0.0038482516772413004*x808
@@ -11459,7 +11522,7 @@ def linearize(q, qd, tau, p=None):
     x814 = x808*x811 + x812*x813
     x815 = -x809 + x810 - 0.16*x814
     x816 = 0.0002972952667644*x808
-    x817 = 9.81*np.cos(q7)
+    x817 = 9.81*xp.cos(q7)
     x818 = -0.0028754860404784995*x807 + 0.01169101578415*x817
     x819 = 0.0002972952667644*x813 + 0.0038482516772413004*x817
     x820 = -x808*x812 + x811*x813
@@ -11842,12 +11905,12 @@ def linearize(q, qd, tau, p=None):
     x1197 = -x1099*x997 - x1128*x862 - x1188*x987
     x1198 = -x1158*x997 - x1165*x862 - x1190*x987
     x1199 = -x1171*x997 - x1182*x862 - x1192*x987
-    x1200 = np.sin(q12)
-    x1201 = np.cos(q12)
-    x1202 = np.sin(q11)
-    x1203 = 9.81*np.sin(q10)
+    x1200 = xp.sin(q12)
+    x1201 = xp.cos(q12)
+    x1202 = xp.sin(q11)
+    x1203 = 9.81*xp.sin(q10)
     x1204 = x1202*x1203
-    x1205 = np.cos(q11)
+    x1205 = xp.cos(q11)
     x1206 = x1203*x1205
     x1207 = x1200*x1206 + x1201*x1204
     x1208 = 0.0038482516772413004*x1207
@@ -11858,7 +11921,7 @@ def linearize(q, qd, tau, p=None):
     x1213 = x1207*x1210 + x1211*x1212
     x1214 = -x1208 + x1209 - 0.16*x1213
     x1215 = 0.0002972952667644*x1207
-    x1216 = 9.81*np.cos(q10)
+    x1216 = 9.81*xp.cos(q10)
     x1217 = 0.0028754860404784995*x1206 + 0.01169101578415*x1216
     x1218 = -0.0002972952667644*x1212 + 0.0038482516772413004*x1216
     x1219 = -x1207*x1211 + x1210*x1212
@@ -12246,6 +12309,8 @@ def linearize(q, qd, tau, p=None):
     x1601 = -x1261*x1584 - x1386*x1594 - x1395*x1573
     return (
         _assemble(
+            xp,
+            device,
             _lead,
             (24, 24),
             [
@@ -12828,6 +12893,8 @@ def linearize(q, qd, tau, p=None):
             ],
         ),
         _assemble(
+            xp,
+            device,
             _lead,
             (24, 12),
             [

@@ -214,7 +214,7 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--target",
         action="append",
-        choices=("c", "casadi", "python", "latex", "matlab"),
+        choices=("c", "casadi", "python", "jax", "latex", "matlab"),
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")
@@ -262,7 +262,7 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
 #: Every subcommand, in the order `symdyn --help` lists them: name -> (help, adds its arguments).
 COMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
     "derive": ("print M, C, V, G, F of a robot", _derive_arguments),
-    "generate": ("generate code (C, CasADi, NumPy, LaTeX)", _generate_arguments),
+    "generate": ("generate code (C, CasADi, NumPy, JAX, LaTeX, MATLAB)", _generate_arguments),
     **APPLICATIONS,  # simulate, analyze, check, cache (the lecture's applications)
     **IDENTIFICATION,  # identify, excite
 }

@@ -1,4 +1,4 @@
-"""Code generation: the seven functions of docs/generated-code.md rendered for C, CasADi, NumPy and LaTeX.
+"""Code generation: the functions of docs/generated-code.md rendered for C, CasADi, NumPy, JAX, LaTeX, MATLAB.
 
 Each target is a backend package `symdyn.codegen.<backend>` (TARGETS maps target
 names to them) shaped like a SymForce backend: a config of names and a printer
@@ -30,7 +30,14 @@ from .render import PRECISIONS, RenderContext
 
 __all__ = ["generate", "render", "file_tools", "TARGETS", "FUNCTION_NAMES"]
 
-TARGETS = {"c": "c", "casadi": "casadi", "python": "python", "latex": "latex", "matlab": "matlab"}
+TARGETS = {
+    "c": "c",
+    "casadi": "casadi",
+    "python": "python",
+    "jax": "jax",
+    "latex": "latex",
+    "matlab": "matlab",
+}
 
 
 def _target_module(name: str):

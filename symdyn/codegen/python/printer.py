@@ -1,11 +1,14 @@
-"""SymPy expression -> NumPy text, and the Python names of the NumPy backend.
+"""SymPy expression -> array-API text, and the Python names of the NumPy and JAX backends.
 
-`NumpyPrinter` is SymPy's NumPyPrinter with `np.` functions, small integer
-powers as products (as the operation counts assume), floats and rationals in
-full precision (repr), sign as np.sign and Heaviside(x, 0) as
-np.heaviside(x, 0.0) (0 at 0). `local_names` gives every free
-parameter a Python name that shadows nothing the generated module defines.
-The statements around the expressions are spelled in templates/python/module.py.j2.
+`NumpyPrinter` is SymPy's NumPyPrinter with the functions of the Python array API standard
+taken from a namespace variable (`xp.sin`: the NumPy module's namespace, picked from its
+inputs by array-api-compat; `jnp.sin` in the JAX module), small integer powers as products
+(as the operation counts assume), floats and rationals in full precision (repr), every
+constant number (pi, sqrt(2), sin(pi/7)) as its double literal, sign as xp.sign and
+Heaviside(x, 0) as (xp.sign(x) + abs(xp.sign(x)))*0.5 (0 at 0; the standard has no
+heaviside). `local_names` gives every free parameter a Python name that shadows nothing the
+generated module defines. The statements around the expressions are spelled in
+templates/python/module.py.j2 and templates/jax/module.py.j2.
 """
 
 from __future__ import annotations
@@ -24,8 +27,10 @@ __all__ = ["NumpyPrinter", "local_names", "dtype"]
 
 #: Names the generated function bodies use besides their locals.
 _RESERVED = frozenset(
-    {"np", "q", "qd", "qdd", "tau", "p", "NDOF", "NQ", "NV", "NPARAM", "PARAM_NAMES"}
-    | {"_vector", "_params", "_assemble", "_lead"}
+    {"np", "xp", "jnp", "jax", "q", "qd", "qdd", "tau", "p", "NDOF", "NQ", "NV", "NPARAM", "PARAM_NAMES", "DTYPE"}
+    | {"array_namespace", "is_array_api_obj", "device", "_array_device", "_NUMPY", "_NUMPY_INPUTS"}
+    | {"_namespace", "_batch", "functools"}
+    | {"_vector", "_params", "_assemble", "_lead", "_check_x64"}
 )
 _GENERATED_NAME = re.compile(r"(x|q|qd|qdd|tau)[0-9]+\Z")
 
@@ -36,17 +41,28 @@ def _small_power(expr: sp.Expr) -> bool:
 
 
 class NumpyPrinter(NumPyPrinter):
-    """NumPy code with `np.` functions, small integer powers as products, floats in full precision.
+    """Array-API code with `xp.` functions (`module`), small integer powers as products, numbers
+    in full precision.
 
-    `names` maps symbols to the Python names they have in the generated code.
+    `names` maps symbols to the Python names they have in the generated code; `module` is the
+    name of the array namespace there ("xp" in the NumPy module, "jnp" in the JAX module).
     """
 
-    def __init__(self, names: dict[sp.Symbol, str] | None = None) -> None:
+    def __init__(self, names: dict[sp.Symbol, str] | None = None, module: str = "xp") -> None:
         super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False})
         self._names = names or {}
+        self._xp = module
 
     def _module_format(self, fqn: str, register: bool = True) -> str:
-        return "np." + fqn[len("numpy.") :] if fqn.startswith("numpy.") else fqn
+        return f"{self._xp}." + fqn[len("numpy.") :] if fqn.startswith("numpy.") else fqn
+
+    def _print(self, expr, **kwargs) -> str:
+        # a constant that is not a literal (pi, sqrt(2), sin(pi/7)) is its double: an array
+        # function of a Python number is outside the standard, and a literal keeps its dtype weak
+        if isinstance(expr, sp.Expr) and expr.is_number and not expr.is_Rational and not expr.is_Float:
+            value = float(expr)
+            return repr(value) if value >= 0 else f"({value!r})"
+        return super()._print(expr, **kwargs)
 
     def _print_Symbol(self, expr: sp.Symbol) -> str:
         return self._names.get(expr, expr.name)
@@ -61,11 +77,12 @@ class NumpyPrinter(NumPyPrinter):
         return repr(float(expr))
 
     def _print_sign(self, expr) -> str:
-        return f"np.sign({self._print(expr.args[0])})"
+        return f"{self._xp}.sign({self._print(expr.args[0])})"
 
     def _print_Heaviside(self, expr) -> str:
         assert expr.args[1:] == (sp.S.Zero,), expr
-        return f"np.heaviside({self._print(expr.args[0])}, 0.0)"
+        sign = f"{self._xp}.sign({self._print(expr.args[0])})"
+        return f"(({sign} + abs({sign}))*0.5)"
 
     def _print_Pow(self, expr: sp.Pow, rational: bool = False) -> str:
         base, exp = expr.base, expr.exp
@@ -76,7 +93,7 @@ class NumpyPrinter(NumPyPrinter):
             inverse = sp.Pow(base, -exp, evaluate=False) if exp != -1 else base
             return f"1/{self.parenthesize(inverse, PRECEDENCE['Mul'], strict=False)}"
         if exp == sp.S.Half:
-            return f"np.sqrt({self._print(base)})"
+            return f"{self._xp}.sqrt({self._print(base)})"
         return f"{self.parenthesize(base, PRECEDENCE['Pow'])}**{self.parenthesize(exp, PRECEDENCE['Pow'])}"
 
     def parenthesize(self, item, level, strict=False) -> str:

@@ -1,4 +1,4 @@
-"""The NumPy target: `NAME_numpy.py`, a standalone module (imports only numpy).
+"""The NumPy target: `NAME_numpy.py`, a standalone module (imports numpy and array-api-compat).
 
 It holds the seven functions of docs/generated-code.md with the C target's names and
 arguments (p optional when the robot has no free parameters), plus NDOF,
@@ -8,7 +8,10 @@ state (vectors of shape (n,)) or a batch with leading axes ((N, n); p either
 (k,) or (N, k)). The outputs are assembled by broadcasting every entry to the
 common leading shape, so constant entries (0) get the batch shape too.
 Inputs and outputs are float64 (DTYPE), float32 with precision "float".
-forward_dynamics is the unrolled LDL^T solve of the spec, elementwise as well.
+forward_dynamics is the unrolled LDL^T solve of the spec, elementwise as well. The module is
+written against the Python array API standard: each call takes its namespace from its
+inputs (array-api-compat), so that NumPy, JAX, PyTorch and CuPy arrays all work; NumPy
+arrays, lists and numbers take NumPy's own namespace at once (no wrapper: NumPy's speed).
 
 This module builds the render context as plain data (names, shapes, printed
 expressions); every Python statement is spelled in templates/python/module.py.j2.
@@ -21,7 +24,7 @@ from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
 from .printer import NumpyPrinter, dtype, local_names
 
-__all__ = ["render", "file_name", "TOOLS"]
+__all__ = ["render", "render_module", "file_name", "function_view", "TOOLS"]
 
 #: The inputs with one value per joint (NDOF); any other input has a fixed size (F: 6).
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
@@ -41,7 +44,7 @@ def _size(inp, floating: bool) -> str:
     return "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols))
 
 
-def _function(spec: FunctionSpec, printer: NumpyPrinter, floating: bool = False) -> dict:
+def function_view(spec: FunctionSpec, printer: NumpyPrinter, floating: bool = False) -> dict:
     """One function as data: arguments (and their sizes: NDOF or a number), the input elements
     it reads, temporaries, output entries."""
     free = spec.free_symbols
@@ -70,12 +73,13 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter, floating: bool = False)
     }
 
 
-def render(ctx: RenderContext) -> dict[str, str]:
-    """{NAME_numpy.py: module text} for the robot of `ctx`."""
-    printer = NumpyPrinter(local_names(ctx))
-    text = (
+def render_module(ctx: RenderContext, template: str, namespace: str) -> str:
+    """The text of a Python module of the robot of `ctx` from `template` (a path under templates/),
+    its expressions printed with the array namespace `namespace` ("xp", "jnp")."""
+    printer = NumpyPrinter(local_names(ctx), module=namespace)
+    return (
         environment()
-        .get_template("python/module.py.j2")
+        .get_template(template)
         .render(
             header=header_lines(ctx),
             name=ctx.name,
@@ -83,8 +87,12 @@ def render(ctx: RenderContext) -> dict[str, str]:
             nq=ctx.robot.nq if ctx.robot.floating else None,
             param_names=[s.name for s in ctx.dynamics.params],
             dtype=dtype(ctx.precision),
-            functions=[_function(spec, printer, ctx.robot.floating) for spec in ctx.functions],
+            functions=[function_view(spec, printer, ctx.robot.floating) for spec in ctx.functions],
             loops=loop_solve_context(ctx),
         )
     )
-    return {file_name(ctx.name): text}
+
+
+def render(ctx: RenderContext) -> dict[str, str]:
+    """{NAME_numpy.py: module text} for the robot of `ctx`."""
+    return {file_name(ctx.name): render_module(ctx, "python/module.py.j2", "xp")}

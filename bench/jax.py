@@ -1,0 +1,325 @@
+"""The JAX target on the CPU against the NumPy module and ADAM (issue 26), in one run.
+
+    python bench/jax.py [--batch N] [--reps R] [--adam-python PATH] [--out bench/results/jax.txt]
+
+The Panda of example-robot-data (its URDF cut at panda_hand: 7 joints, the hand and fingers
+merged into link 7) is generated in double precision for the targets python and jax
+(--functions dynamics), and each of inverse dynamics, M and forward dynamics is timed per state:
+* NumPy, one state per call (the generated NumPy module, from Python);
+* NumPy, one call on the whole batch of N states (default 100,000), divided by N;
+* JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit) on the batch, the
+  arrays already on the device, after a first call that compiles (its time is listed);
+* ADAM (adam-robotics, its JAX backend) on the same URDF and the same batch, jax.jit(jax.vmap(..)):
+  M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + h, h its
+  bias_force plus the URDF's joint damping b qd (ADAM's RNEA takes no accelerations, and it
+  ignores damping, which symdyn reads as viscous friction), and forward dynamics
+  jnp.linalg.solve(M, tau - h) (its aba is floating-base), the base fixed at the identity, at rest.
+ADAM 0.5 requires jax <= 0.6 while symdyn pins a newer jax, so ADAM runs in another Python
+given by --adam-python (a virtual environment with `pip install "adam-robotics[jax]==0.5.0"`),
+which times the symdyn JAX module there as well, for a ratio under one jax version. Without it
+the ADAM columns are left empty. Every route is checked against the numeric oracle
+(symdyn.rnea) on 8 states before timing; the medians of --reps runs are reported. The machine
+is shared: compare within one run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+# bench/ must come after site-packages: this file is named jax.py and `import jax` is the library
+_BENCH = str(Path(__file__).resolve().parent)
+sys.path[:] = [p for p in sys.path if p != _BENCH] + [_BENCH]
+
+import numpy as np  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+URDF_INSIDE = "panda_description/urdf/panda.urdf"
+TIP = "panda_hand"
+JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
+FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
+NCHECK = 8
+#: XLA's CPU fusion emitters (the default in recent jax) can make a large fused function far slower
+NO_EMITTERS = "--xla_cpu_use_fusion_emitters=false"
+
+
+def _module(path: str, name: str):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _states(n: int, count: int, seed: int = 26) -> dict[str, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    return {
+        "q": rng.uniform(-np.pi, np.pi, (count, n)),
+        "qd": rng.uniform(-2.0, 2.0, (count, n)),
+        "qdd": rng.uniform(-4.0, 4.0, (count, n)),
+        "tau": rng.uniform(-20.0, 20.0, (count, n)),
+    }
+
+
+def _arguments(states, function: str):
+    names = {
+        "inverse_dynamics": ("q", "qd", "qdd"),
+        "mass_matrix": ("q",),
+        "forward_dynamics": ("q", "qd", "tau"),
+    }
+    return tuple(states[n] for n in names[function])
+
+
+def _jax_timing(fn, args, count: int, reps: int) -> tuple[float, float]:
+    """(seconds of the first call, which compiles; median seconds per state of the next calls)."""
+    import jax
+
+    t = time.perf_counter()
+    jax.block_until_ready(fn(*args))
+    compile_s = time.perf_counter() - t
+    times = []
+    for _ in range(reps):
+        t = time.perf_counter()
+        jax.block_until_ready(fn(*args))
+        times.append(time.perf_counter() - t)
+    return compile_s, statistics.median(times) / count
+
+
+def _fixed_fingers(urdf: str, folder: str) -> tuple[str, list[float]]:
+    """A copy of the URDF whose joints other than JOINTS are fixed: ADAM 0.5.0 fails on a prismatic
+    joint anywhere in the file (its prismatic motion subspace stacks arrays of unequal shapes),
+    and it holds every joint outside its list at 0 anyway, as symdyn's cut at panda_hand does.
+    Also the viscous damping of JOINTS, which symdyn reads as friction and ADAM ignores."""
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(urdf)
+    damping = {}
+    for joint in tree.getroot().iter("joint"):
+        if joint.get("name") not in JOINTS:
+            joint.set("type", "fixed")
+        else:
+            dynamics = joint.find("dynamics")
+            damping[joint.get("name")] = float(dynamics.get("damping", 0.0)) if dynamics is not None else 0.0
+    path = str(Path(folder) / "panda_fixed_fingers.urdf")
+    tree.write(path)
+    return path, [damping[j] for j in JOINTS]
+
+
+def adam_functions(urdf: str, gravity: list[float]):
+    """ADAM's joint-space M, inverse and forward dynamics of one state (the base fixed, at rest),
+    with symdyn's gravity (ADAM's default is 9.80665 m/s^2, the URDF loader's 9.81) and the URDF's
+    viscous damping added as symdyn adds it (F = b qd)."""
+    import jax.numpy as jnp
+    from adam.jax import KinDynComputations
+
+    with tempfile.TemporaryDirectory() as folder:
+        fixed, damping = _fixed_fingers(urdf, folder)
+        kd = KinDynComputations(fixed, list(JOINTS), gravity=jnp.array([*gravity, 0, 0, 0]))
+    b = jnp.array(damping)
+    base, rest = jnp.eye(4), jnp.zeros(6)
+
+    def mass_matrix(q):
+        return kd.mass_matrix(base, q)[6:, 6:]
+
+    def bias(q, qd):
+        return kd.bias_force(base, q, rest, qd)[6:] + b * qd
+
+    def inverse_dynamics(q, qd, qdd):
+        return mass_matrix(q) @ qdd + bias(q, qd)
+
+    def forward_dynamics(q, qd, tau):
+        return jnp.linalg.solve(mass_matrix(q), tau - bias(q, qd))
+
+    return {
+        "inverse_dynamics": inverse_dynamics,
+        "mass_matrix": mass_matrix,
+        "forward_dynamics": forward_dynamics,
+    }
+
+
+def worker(module_path: str, urdf: str | None, count: int, reps: int, reference: dict, gravity=None) -> dict:
+    """Time the generated JAX module (and ADAM when `urdf` is given) in this interpreter; check both
+    against `reference` (the oracle's values on the first NCHECK states)."""
+    import jax
+
+    jax.config.update("jax_enable_x64", True)
+    import jax.numpy as jnp
+
+    arm = _module(module_path, "panda_urdf_jax")
+    states = _states(arm.NDOF, count)
+    device = {k: jnp.asarray(v) for k, v in states.items()}
+    check = _states(arm.NDOF, NCHECK)  # the states of `reference`
+    out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
+    routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in FUNCTIONS}}
+    if urdf is not None:
+        from importlib.metadata import version
+
+        out["adam_version"] = version("adam-robotics")
+        routes["adam"] = {f: jax.jit(jax.vmap(g)) for f, g in adam_functions(urdf, gravity).items()}
+    for route, fns in routes.items():
+        for f in FUNCTIONS:
+            got = np.asarray(fns[f](*_arguments(check, f)))
+            want = np.asarray(reference[f])
+            out["error"][f"{route} {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
+            out[route][f] = _jax_timing(fns[f], _arguments(device, f), count, reps)
+    return out
+
+
+def _external(python: str, payload: dict, tmp: str, **env) -> dict:
+    """worker(**payload) run by another Python (or this one with other XLA flags)."""
+    path = Path(tmp) / "worker.json"
+    path.write_text(json.dumps(payload))
+    done = subprocess.run(
+        [python, __file__, "--worker", path], capture_output=True, text=True, env={**os.environ, **env}
+    )
+    if done.returncode != 0:
+        raise SystemExit(f"the run of {python} failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _numpy_timing(arm, states, function: str, reps: int) -> tuple[float, float]:
+    """(median seconds of one call on one state, median seconds per state of one batch call)."""
+    from python_timing import time_python
+
+    fn = getattr(arm, function)
+    args = _arguments(states, function)
+    singles = [tuple(a[i] for a in args) for i in range(64)]
+    one = time_python(fn, singles, reps, 1.0)
+    batch = time_python(fn, [args], reps, 2.0 * reps) / len(states["q"])
+    return one, batch
+
+
+def _generate(urdf: Path, folder: Path):
+    import warnings
+
+    from symdyn import generate
+    from symdyn.parsers import load
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = load(urdf, tip=TIP)
+    assert tuple(lk.joint_name for lk in robot.links) == JOINTS, [lk.joint_name for lk in robot.links]
+    generate(robot, targets=("python", "jax"), out_dir=folder, functions=("dynamics",))
+    return robot, folder / f"{robot.name}_numpy.py", folder / f"{robot.name}_jax.py"
+
+
+def _row(cells, widths) -> str:
+    return "  ".join(
+        f"{c:>{w}}" if i else f"{c:<{w}}" for i, (c, w) in enumerate(zip(cells, widths, strict=True))
+    )
+
+
+def table(results: dict, opts) -> list[str]:
+    here, plain, there = results["here"], results["plain"], results.get("there")
+    ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
+    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX (jax {here['jax']})", "same, emitters off"]
+    if there:
+        head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
+    head += ["JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
+    rows = [head]
+    for f in FUNCTIONS:
+        one, batch = results["numpy"][f]
+        jx = min(here["symdyn"][f][1], plain["symdyn"][f][1])
+        row = [f, ns(one), ns(batch), ns(here["symdyn"][f][1]), ns(plain["symdyn"][f][1])]
+        if there:
+            row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
+        row += [f"{jx / batch:.2f}x"]
+        if there:
+            row += [f"{there['symdyn'][f][1] / there['adam'][f][1]:.2f}x"]
+        rows.append(row)
+    widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
+    lines = [
+        f"The Panda (example-robot-data URDF cut at {TIP}, 7 joints), double precision, on the CPU: "
+        f"ns per state, batch of {opts.batch:,} states (medians of {opts.reps} runs)",
+        _row(head, widths),
+        _row(["-" * w for w in widths], widths),
+        *(_row(r, widths) for r in rows[1:]),
+        "",
+        f"JAX/NumPy batch: the faster JAX column; emitters off: XLA_FLAGS={NO_EMITTERS}; "
+        "JAX/ADAM: both under ADAM's jax",
+        "compile time of the first batch call (s): "
+        + ", ".join(f"{f} {here['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
+        + "; emitters off "
+        + ", ".join(f"{f} {plain['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
+        + ("; ADAM " + ", ".join(f"{f} {there['adam'][f][0]:.1f}" for f in FUNCTIONS) if there else ""),
+        "largest relative error against symdyn.rnea on 8 states: "
+        + ", ".join(f"{k} {v:.1e}" for k, v in {**here["error"], **(there or {}).get("error", {})}.items()),
+    ]
+    if not there:
+        lines.append("ADAM: not run (give --adam-python, a Python with adam-robotics[jax] installed)")
+    lines += [
+        f"machine: {results['machine']}; load average {results['load']}",
+        f"whole run {results['wall']:.0f} s",
+    ]
+    return lines
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python bench/jax.py", description=__doc__.split("\n")[0])
+    parser.add_argument("--batch", type=int, default=100_000, help="states per batch call")
+    parser.add_argument("--reps", type=int, default=5, help="timed repetitions (medians)")
+    parser.add_argument("--adam-python", help="a Python with adam-robotics[jax] (and its jax) installed")
+    parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "jax.txt"))
+    parser.add_argument("--worker", help=argparse.SUPPRESS)  # a JSON file of worker()'s arguments
+    opts = parser.parse_args(argv)
+    if opts.worker:
+        print(json.dumps(worker(**json.loads(Path(opts.worker).read_text()))))
+        return 0
+    sys.path.insert(0, str(ROOT))
+    from machine import load_averages, log, machine
+    from robots import example_robot_file
+
+    from symdyn.rnea import forward_dynamics, mass_matrix, rnea
+
+    urdf = example_robot_file(URDF_INSIDE)
+    if urdf is None:
+        raise SystemExit("bench/jax.py needs example-robot-data (the test extra) for the Panda URDF")
+    start, load_before = time.perf_counter(), load_averages()
+    with tempfile.TemporaryDirectory(prefix="symdyn-bench-jax-") as tmp:
+        log("generating the Panda's NumPy and JAX modules")
+        robot, numpy_path, jax_path = _generate(urdf, Path(tmp))
+        check = _states(robot.n, NCHECK)
+        reference = {
+            "inverse_dynamics": rnea(robot, check["q"], check["qd"], check["qdd"]).tolist(),
+            "mass_matrix": mass_matrix(robot, check["q"]).tolist(),
+            "forward_dynamics": forward_dynamics(robot, check["q"], check["qd"], check["tau"]).tolist(),
+        }
+        arm = _module(str(numpy_path), "panda_urdf_numpy")
+        states = _states(robot.n, opts.batch)
+        results: dict = {"numpy": {}}
+        for f in FUNCTIONS:
+            log(f"NumPy {f}")
+            results["numpy"][f] = _numpy_timing(arm, states, f, opts.reps)
+            got = getattr(arm, f)(*_arguments(check, f))
+            err = float(np.max(np.abs(got - reference[f])) / np.max(np.abs(reference[f])))
+            assert err < 1e-9, (f, err)
+        log("JAX (this Python)")
+        args = {"module_path": str(jax_path), "urdf": None, "count": opts.batch, "reps": opts.reps}
+        results["here"] = worker(**args, reference=reference)
+        log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
+        flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()
+        results["plain"] = _external(sys.executable, {**args, "reference": reference}, tmp, XLA_FLAGS=flags)
+        if opts.adam_python:
+            log(f"JAX and ADAM ({opts.adam_python})")
+            gravity = [float(g) for g in robot.gravity]
+            payload = {**args, "urdf": str(urdf), "reference": reference, "gravity": gravity}
+            results["there"] = _external(opts.adam_python, payload, tmp)
+    for route in ("here", "plain", "there"):
+        for key, err in results.get(route, {}).get("error", {}).items():
+            assert err < 1e-9, (route, key, err)
+    results.update(machine=machine(), load=(load_before, load_averages()), wall=time.perf_counter() - start)
+    text = "\n".join(table(results, opts)) + "\n"
+    Path(opts.out).write_text(text)
+    print(text, end="")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

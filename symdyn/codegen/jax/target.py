@@ -1,0 +1,34 @@
+"""The JAX target: `NAME_jax.py`, a module of jax.numpy functions of one state (imports only jax).
+
+It holds every function of the context (docs/generated-code.md) with the NumPy target's
+names and arguments, written for ONE state: vectors of shape (n,), p of shape (k,). The
+bodies are the eliminated straight-line code, one statement per temporary, with no branch
+on a value, no in-place update and no NumPy call, so that jax.jit, jax.vmap, jax.grad and
+jax.jacfwd, and jax.lax.scan apply to them unchanged; p is an argument, so parameters can
+be fitted by gradient. Each function has a batched twin NAME_batch (vmapped over the
+leading axis of the arguments that have one, jitted). Inputs and outputs are float64
+(--precision double, which needs JAX's x64 mode: the module refuses to import without it
+rather than compute in float32) or float32.
+
+The names, shapes and printed expressions are the NumPy target's (symdyn.codegen.python,
+printed with the namespace `jnp`); every Python statement is spelled in templates/jax/module.py.j2.
+"""
+
+from __future__ import annotations
+
+from ..python.target import render_module
+from ..render import RenderContext
+
+__all__ = ["render", "file_name", "TOOLS"]
+
+#: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
+TOOLS = {"_jax.py": ("sympy",)}
+
+
+def file_name(name: str) -> str:
+    return f"{name}_jax.py"
+
+
+def render(ctx: RenderContext) -> dict[str, str]:
+    """{NAME_jax.py: module text} for the robot of `ctx`."""
+    return {file_name(ctx.name): render_module(ctx, "jax/module.py.j2", "jnp")}

@@ -1,0 +1,271 @@
+"""The JAX target (NAME_jax.py) against the NumPy target and the numeric oracle symdyn.rnea.
+
+generated/ holds NAME_jax.py beside NAME_numpy.py for roger_arm, puma560, panda (with its frame
+functions) and the legs of solo12 (a kinematic tree), kept up to date by tests/test_generated.py,
+so no robot is derived here. At a random state every function of each JAX module must equal the
+NumPy module's (itself checked against the oracle by tests/test_numpy_target.py) to 1e-12, and
+the dynamics the oracle's; jax.jacfwd of the JAX inverse and forward dynamics must equal the
+generated derivative functions, jax.jacfwd in p central differences; jit and vmap (the f_batch
+twins) and jax.lax.scan (a simulation) give the NumPy module's values; a float32 module is
+checked with a float32 tolerance, and a double one refuses to import without JAX's x64 mode.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from robots import example
+
+from symdyn.cli import main
+from symdyn.codegen import render
+from symdyn.errors import SymdynWarning
+from symdyn.loading import load_module
+from symdyn.regenerate import example_robot
+
+jax = pytest.importorskip("jax")
+jnp = pytest.importorskip("jax.numpy")
+
+rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
+ROOT = Path(__file__).resolve().parents[1]
+GENERATED = ROOT / "generated"
+ROBOTS = ("roger_arm", "puma560", "panda", "solo12")
+#: sizes of the inputs that are not one value per joint (the tip wrench of tip_wrench_torque)
+SIZES = {"F": 6}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def x64():
+    """The generated double modules need JAX's 64-bit mode (restored afterwards)."""
+    before = jax.config.jax_enable_x64
+    jax.config.update("jax_enable_x64", True)
+    yield
+    jax.config.update("jax_enable_x64", before)
+
+
+@pytest.fixture(scope="module")
+def modules(x64):
+    """robot -> (its JAX module, its NumPy module, its Robot), from generated/."""
+    with warnings.catch_warnings():
+        return _modules()
+
+
+def _modules():
+    out = {}
+    warnings.simplefilter("ignore", SymdynWarning)  # the published data of puma560.yaml
+    for name in ROBOTS:
+        jax_mod = load_module(GENERATED / name / f"{name}_jax.py", f"_symdyn_test_{name}_jax")
+        numpy_mod = load_module(GENERATED / name / f"{name}_numpy.py", f"_symdyn_test_{name}_numpy")
+        out[name] = (jax_mod, numpy_mod, example_robot(ROOT, name))
+    return out
+
+
+def _functions(mod) -> list[str]:
+    return [
+        n
+        for n, f in vars(mod).items()
+        if inspect.isfunction(f) and f.__module__ == mod.__name__ and not n.startswith("_")
+    ]
+
+
+def _inputs(mod, name: str, rng, batch=()) -> list[np.ndarray]:
+    names = [a for a in inspect.signature(getattr(mod, name)).parameters if a != "p"]
+    return [rng.uniform(-2.0, 2.0, (*batch, SIZES.get(a, mod.NDOF))) for a in names]
+
+
+def _params(mod, rng, batch=()):
+    return rng.uniform(0.5, 2.0, (*batch, mod.NPARAM)) if mod.NPARAM else None
+
+
+def _tuple(x):
+    return x if isinstance(x, tuple) else (x,)
+
+
+def _close(actual, expected, rtol=1e-12):
+    """Relative agreement, measured against the size of the expected array."""
+    actual, expected = np.asarray(actual), np.asarray(expected)
+    assert actual.shape == expected.shape
+    scale = max(1.0, float(np.max(np.abs(expected), initial=0.0)))
+    np.testing.assert_allclose(actual, expected, rtol=rtol, atol=rtol * scale)
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_every_function_matches_numpy_and_the_oracle(robot, modules):
+    jax_mod, numpy_mod, model = modules[robot]
+    assert (jax_mod.NDOF, jax_mod.NPARAM, jax_mod.PARAM_NAMES) == (
+        numpy_mod.NDOF,
+        numpy_mod.NPARAM,
+        numpy_mod.PARAM_NAMES,
+    )
+    names = _functions(jax_mod)
+    assert names == _functions(numpy_mod)
+    assert all(callable(getattr(jax_mod, f"{n}_batch")) for n in names)
+    rng = np.random.default_rng(len(robot))
+    p = _params(jax_mod, rng)
+    for name in names:
+        args = _inputs(jax_mod, name, rng)
+        got, want = _tuple(getattr(jax_mod, name)(*args, p)), _tuple(getattr(numpy_mod, name)(*args, p))
+        assert len(got) == len(want), name
+        for g, w in zip(got, want, strict=True):
+            assert isinstance(g, jax.Array) and g.dtype == jnp.float64, name
+            _close(g, w)
+    q, qd, qdd = rng.uniform(-2.0, 2.0, (3, model.n))
+    params = dict(zip(jax_mod.PARAM_NAMES, p, strict=True)) if p is not None else None
+    tau = rn.rnea(model, q, qd, qdd, params)
+    _close(jax_mod.inverse_dynamics(q, qd, qdd, p), tau, rtol=1e-9)
+    _close(jax_mod.mass_matrix(q, p), rn.mass_matrix(model, q, params), rtol=1e-9)
+    _close(jax_mod.coriolis(q, qd, p), rn.bias_torque(model, q, qd, params), rtol=1e-9)
+    _close(jax_mod.gravity(q, p), rn.gravity_torque(model, q, params), rtol=1e-9)
+    _close(jax_mod.forward_dynamics(q, qd, tau, p), qdd, rtol=1e-9)
+
+
+def test_jacfwd_equals_the_generated_derivatives(modules):
+    """jax.jit of jax.jacfwd through the JAX inverse and forward dynamics = the derivative
+    functions symdyn derived symbolically (and M^-1 = d qdd / d tau), for Roger's arm."""
+    jax_mod, _, _ = modules["roger_arm"]
+    rng = np.random.default_rng(3)
+    q, qd, qdd, tau = rng.uniform(-2.0, 2.0, (4, jax_mod.NDOF))
+    p = _params(jax_mod, rng)
+    dq, dqd = jax.jit(jax.jacfwd(jax_mod.inverse_dynamics, argnums=(0, 1)))(q, qd, qdd, p)
+    want_dq, want_dqd = jax_mod.inverse_dynamics_derivatives(q, qd, qdd, p)
+    _close(dq, want_dq, rtol=1e-10)
+    _close(dqd, want_dqd, rtol=1e-10)
+    dq, dqd, dtau = jax.jit(jax.jacfwd(jax_mod.forward_dynamics, argnums=(0, 1, 2)))(q, qd, tau, p)
+    want_dq, want_dqd, minv = jax_mod.forward_dynamics_derivatives(q, qd, tau, p)
+    _close(dq, want_dq, rtol=1e-10)
+    _close(dqd, want_dqd, rtol=1e-10)
+    _close(dtau, minv, rtol=1e-10)
+
+
+def test_jacfwd_of_inverse_dynamics_on_a_tree(modules):
+    """jax.jacfwd (op by op: compiling would cost more) of the inverse dynamics of the Solo-12
+    legs, a kinematic tree of 12 joints = the generated inverse_dynamics_derivatives."""
+    jax_mod, _, _ = modules["solo12"]
+    rng = np.random.default_rng(4)
+    q, qd, qdd = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
+    dq, dqd = jax.jacfwd(jax_mod.inverse_dynamics, argnums=(0, 1))(q, qd, qdd, None)
+    want_dq, want_dqd = jax_mod.inverse_dynamics_derivatives(q, qd, qdd, None)
+    _close(dq, want_dq, rtol=1e-10)
+    _close(dqd, want_dqd, rtol=1e-10)
+
+
+def test_gradient_in_the_parameters(modules):
+    """jax.jacfwd of tau in p = central differences of the NumPy module in p."""
+    jax_mod, numpy_mod, _ = modules["roger_arm"]
+    rng = np.random.default_rng(5)
+    q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 2))
+    p = _params(jax_mod, rng)
+    got = jax.jacfwd(jax_mod.inverse_dynamics, argnums=3)(q, qd, qdd, p)
+    h = 1e-6
+    want = np.stack(
+        [
+            (
+                numpy_mod.inverse_dynamics(q, qd, qdd, p + h * e)
+                - numpy_mod.inverse_dynamics(q, qd, qdd, p - h * e)
+            )
+            / (2 * h)
+            for e in np.eye(len(p))
+        ],
+        axis=-1,
+    )
+    _close(got, want, rtol=1e-7)
+
+
+def test_jit_vmap_and_batches(modules):
+    """f_batch (vmap + jit) and jax.jit(jax.vmap(f)) equal the NumPy module over a batch, with
+    one parameter set for all states or one per state."""
+    jax_mod, numpy_mod, _ = modules["roger_arm"]
+    rng = np.random.default_rng(7)
+    q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 64, 2))
+    p, P = _params(jax_mod, rng), _params(jax_mod, rng, (64,))
+    _close(jax_mod.inverse_dynamics_batch(q, qd, qdd, p), numpy_mod.inverse_dynamics(q, qd, qdd, p))
+    _close(jax_mod.inverse_dynamics_batch(q, qd, qdd, P), numpy_mod.inverse_dynamics(q, qd, qdd, P))
+    _close(jax_mod.mass_matrix_batch(q, p), numpy_mod.mass_matrix(q, p))
+    forward = jax.jit(jax.vmap(jax_mod.forward_dynamics, in_axes=(0, 0, 0, None)))
+    tau = numpy_mod.inverse_dynamics(q, qd, qdd, p)
+    _close(forward(q, qd, tau, p), qdd, rtol=1e-10)
+    # one state through the batch twin is the function itself
+    _close(jax_mod.gravity_batch(q[0], p), numpy_mod.gravity(q[0], p))
+
+
+def test_lax_scan_simulation(modules):
+    """A semi-implicit Euler simulation under jax.lax.scan (jitted) follows the same loop
+    written with the NumPy module."""
+    jax_mod, numpy_mod, _ = modules["roger_arm"]
+    p = np.array([9.81, 1.0, 1.2, 0.8, 0.7])  # g, l1, m1, l2, m2
+    dt, steps = 1e-3, 300
+    x0 = (np.array([0.4, -0.3]), np.array([0.0, 0.5]))
+    tau = np.array([0.3, -0.1])
+
+    def step(state, _):
+        q, qd = state
+        qd = qd + dt * jax_mod.forward_dynamics(q, qd, tau, p)
+        return (q + dt * qd, qd), q
+
+    (q_end, qd_end), path = jax.jit(lambda x: jax.lax.scan(step, x, None, length=steps))(x0)
+    q, qd = x0
+    for _ in range(steps):
+        qd = qd + dt * numpy_mod.forward_dynamics(q, qd, tau, p)
+        q = q + dt * qd
+    assert path.shape == (steps, 2)
+    _close(q_end, q, rtol=1e-10)
+    _close(qd_end, qd, rtol=1e-10)
+
+
+def test_float32_module(tmp_path):
+    """--precision float: float32 in and out (also with x64 on), jittable, equal to the oracle
+    within float32's precision."""
+    robot = example("roger_arm")
+    files = render(robot, targets=("jax",), precision="float")
+    assert list(files) == ["roger_arm_jax.py"]
+    (tmp_path / "roger_arm_jax.py").write_text(files["roger_arm_jax.py"])
+    mod = load_module(tmp_path / "roger_arm_jax.py", "_symdyn_test_roger_arm_jax32")
+    assert mod.DTYPE is jnp.float32
+    rng = np.random.default_rng(9)
+    q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 16, 2))
+    p = rng.uniform(0.5, 2.0, 5)
+    tau = mod.inverse_dynamics_batch(q, qd, qdd, p)
+    assert tau.dtype == jnp.float32
+    params = dict(zip(mod.PARAM_NAMES, p, strict=True))
+    _close(tau, rn.rnea(robot, q, qd, qdd, params), rtol=2e-5)
+    _close(mod.forward_dynamics_batch(q, qd, tau, p), qdd, rtol=1e-3)
+
+
+def test_double_needs_x64_and_bad_input_is_a_clear_error(modules):
+    jax_mod, _, _ = modules["roger_arm"]
+    jax.config.update("jax_enable_x64", False)
+    try:
+        with pytest.raises(ImportError, match="jax_enable_x64"):
+            load_module(GENERATED / "roger_arm" / "roger_arm_jax.py", "_symdyn_test_no_x64")
+    finally:
+        jax.config.update("jax_enable_x64", True)
+    with pytest.raises(ValueError, match="p is required"):
+        jax_mod.mass_matrix(np.zeros(2))
+    with pytest.raises(ValueError, match=r"q must have shape \(2,\)"):
+        jax_mod.mass_matrix(np.zeros((4, 2)), np.ones(5))
+
+
+def test_cli_writes_the_jax_module(tmp_path):
+    robot = str(ROOT / "examples" / "roger_eye.yaml")
+    assert main(["generate", robot, "--target", "jax", "--out", str(tmp_path)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["roger_eye_jax.py"]
+    text = (tmp_path / "roger_eye_jax.py").read_text()
+    again = render(example("roger_eye"), targets=("jax",), functions=("dynamics",))
+    assert text == again["roger_eye_jax.py"]  # deterministic
+    assert "numpy" not in text.replace("jax.numpy", "") and " np." not in text
+
+
+def test_identification_example(tmp_path):
+    """examples/jax_identification: gradient descent through jax.grad recovers Roger's arm."""
+    script = load_module(ROOT / "examples" / "jax_identification" / "identify.py", "_symdyn_jax_identify")
+    arm = script.generated_module(tmp_path)
+    found = script.identify(arm, *script.samples(200, seed=1))
+    for name, value in script.TRUE.items():
+        assert found[name] == pytest.approx(value, rel=1e-6), name
+    np.testing.assert_allclose(
+        script.base_parameters(**found), script.base_parameters(**script.TRUE), rtol=1e-6
+    )
