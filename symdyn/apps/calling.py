@@ -41,15 +41,16 @@ def _declarations(functions: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def load_library(path: Path, functions: list[dict], width: str):
+def load_library(path: Path, functions: list[dict], width: str, real: str = "double"):
     """(ffi, lib, W) for the library at `path` (opened once per process); `width` names its
-    NAME_batch_width function (the states NAME_batch evaluates per instruction)."""
+    NAME_batch_width function (the states NAME_batch evaluates per instruction); `real` is the
+    floating type of its functions (symdyn.compile's are double)."""
     key = str(path)
     if key not in _LIBRARIES:
         import cffi
 
         ffi = cffi.FFI()
-        ffi.cdef(_declarations(functions).replace("symdyn_batch_width", width))
+        ffi.cdef(_declarations(functions).replace("symdyn_batch_width", width).replace("double", real))
         lib = ffi.dlopen(key)
         _LIBRARIES[key] = (ffi, lib, int(getattr(lib, width)()))
     return _LIBRARIES[key]
