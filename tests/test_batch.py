@@ -216,14 +216,17 @@ def test_the_vector_path_under_sanitizers(tree, tmp_path):
 
 @pytest.fixture(scope="module")
 def compiled():
-    """planar_3r through symdyn.compile (-O2 -march=native; tests/test_compile_c.py builds the same
-    entry in the session's cache)."""
+    """planar_3r through symdyn.compile with its default flags (-O2 -march=native; the suite's
+    conftest.py builds without -march otherwise)."""
     robot = example("planar_3r")
-    return robot, symdyn.compile(robot)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv(build.ARCH_ENV, raising=False)
+        return robot, symdyn.compile(robot)
 
 
-def test_compiled_batches_without_copies_and_with_threads(compiled):
+def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch):
     robot, fast = compiled
+    monkeypatch.delenv(build.ARCH_ENV, raising=False)  # symdyn.compile's default flags, as `compiled`
     n = robot.n
     rng = np.random.default_rng(3)
     q, qd, qdd = (rng.uniform(-2, 2, (1001, n)) for _ in range(3))
