@@ -20,6 +20,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ...errors import SymdynError
+from ...symbolic.simplify import MAX_UNROLLED_POWER
 from ..functions import FunctionSpec
 from ..printing import step_comparison
 from ..render import RenderContext
@@ -83,8 +84,8 @@ class VectorPrinter(CPrinter):
         raise SymdynError(f"no vector form of '{type(e).__name__}'")
 
     def _pow(self, e: sp.Pow) -> tuple[str, int]:
-        if not self.varying(e) or (e.exp.is_Integer and e.exp != 0):
-            return super()._pow(e)  # integer powers are products and quotients: lane by lane
+        if not self.varying(e) or (e.exp.is_Integer and 0 < abs(e.exp) <= MAX_UNROLLED_POWER):
+            return super()._pow(e)  # small integer powers are products and quotients: lane by lane
         sqrt = self.prefix + self.config.math("sqrt")
         if e.exp == sp.Rational(1, 2):
             return f"{sqrt}({self._print(e.base)[0]})", ATOM
