@@ -194,7 +194,15 @@ def identify_part(samples: int, command_samples: int, folder: Path) -> dict[str,
     Yb = base_regressor_samples(robot, data.q, data.qd, data.qdd)
     times[f"base regressor, one batch call ({samples:,})"] = time.perf_counter() - t0
     times["nbase"] = Yb.shape[2]
-    del Yb, data
+    shape = Yb.shape
+    del Yb
+    t0 = time.perf_counter()
+    np.ones(shape)
+    times["for scale: np.ones of the regressor's size"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    base_regressor_samples(robot, data.q[:100_000], data.qd[:100_000], data.qdd[:100_000])
+    times["base regressor, one batch call (100,000)"] = time.perf_counter() - t0
+    del data
     t0 = time.perf_counter()
     cmd = [sys.executable, "-m", "symdyn.cli", "identify", str(path), str(small)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
