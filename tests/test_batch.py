@@ -74,7 +74,7 @@ def _build_all(ctx, folder: Path, names) -> dict:
     for name, job in jobs.items():
         assert job.wait() == 0, job.stderr.read()
         libs[name] = load_library(folder / f"{name}.so", table, f"{ctx.name}_batch_width", ctx.precision)
-    return {"table": {f["name"]: f for f in table}, "libs": libs}
+    return {"table": {f["name"]: f for f in table}, "libs": libs, "batch": files[f"{ctx.name}_batch.c"]}
 
 
 @pytest.fixture(scope="module")
@@ -138,6 +138,7 @@ def test_panda_batches_equal_the_scalar_functions_bit_for_bit(panda, name):
     width = panda["libs"][name][2]
     assert width == BUILDS[name][1]
     for function in ("inverse_dynamics", "mass_matrix", "forward_dynamics"):
+        assert f"static void panda_simd_{function}(" in panda["batch"]  # a vector body, not the loop
         for count in _sizes(width):
             _check(panda, name, function, count, rng)
 

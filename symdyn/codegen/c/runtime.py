@@ -4,7 +4,8 @@
 its inputs and outputs with their sizes), so the Python binding (symdyn.apps.compile)
 needs no knowledge of which functions exist: whatever `build_functions` generates,
 with any number of outputs of any shape, becomes a method. `render_runtime(ctx)` gives
-NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C),
+NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C, W states
+per instruction through the function's body over vectors: symdyn.codegen.c.vector),
 symdyn_step.c (the fixed-step integrators of symdyn.apps.simulate) and symdyn_csv.c (the
 CSV writer of symdyn.apps.csv_format), the last two robot-independent. Every C statement
 is spelled in templates/c/batch.c.j2, templates/c/step.c.j2 and templates/c/csv.c.j2.
@@ -52,7 +53,6 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
             {
                 "c_name": f["c_name"],
                 "inputs": inputs,
-                "sizes": dict(inputs),
                 "outputs": [(name, rows * cols) for name, rows, cols, _ in f["outputs"]],
                 "vector": vector_view(ctx, names, spec),
             }

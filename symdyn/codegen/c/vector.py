@@ -12,7 +12,11 @@ cosines of double precision go through the same helper as NAME_f (NAME_sincos,
 symdyn.codegen.c.sincos) on the angles of all W lanes at once.
 
 A function whose code holds anything else gets no vector form (`vector_view` returns None): its
-batch wrapper then calls NAME_f once per state.
+batch wrapper then calls NAME_f once per state. So does a function with fewer than
+MIN_OPS_PER_OUTPUT operations per output value (the regressors: the Panda's base regressor has
+434 outputs for 1429 operations): copying its outputs from the W lanes back into the batch's
+layout costs more than the vector arithmetic saves (measured on the Panda: 1.6 times the scalar
+loop's time), while M (8 operations per output) gains.
 """
 
 from __future__ import annotations
@@ -29,7 +33,10 @@ from .printer import ATOM, MUL, CPrinter
 from .sincos import gather
 from .target import function_inputs, symbol_names
 
-__all__ = ["VectorPrinter", "vector_view", "simd_prefix", "LANE_CALLS"]
+__all__ = ["VectorPrinter", "vector_view", "simd_prefix", "LANE_CALLS", "MIN_OPS_PER_OUTPUT"]
+
+#: Fewer operations per output value than this: the batch keeps the scalar loop (module docstring).
+MIN_OPS_PER_OUTPUT = 5
 
 #: The <math.h> functions (double names) the lane helpers wrap: one argument, and pow with two.
 LANE_CALLS = (*sorted(set(MATH_CALLS.values())), "sqrt")
@@ -101,6 +108,8 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
     (name, size, stores: (index, vector text)), unused, reads ((local, input, index, vector?)),
     angles (their vector texts, double precision only) and temporaries ((vector?, name, text)).
     """
+    if spec.ops.total < MIN_OPS_PER_OUTPUT * len(spec.outputs):
+        return None
     known = symbol_names(ctx, names, spec)
     _, unused, reads = function_inputs(names, spec)
     varying = {s for inp in spec.inputs if inp.name != "p" for s in inp.symbols}
