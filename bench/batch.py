@@ -6,7 +6,7 @@
 Part 1: the Panda's inverse dynamics, M and forward dynamics. A C harness links NAME_dynamics.c
 and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.build: COMPILE_FLAGS and
 -march=native unless $SYMDYN_MARCH says otherwise) and times, over the same states, the scalar
-function called once per state in a C loop and one call of NAME_batch (the best of 7 rounds,
+function called once per state in a C loop and one call of NAME_batch (the best of 15 rounds,
 interleaved); it also checks that both give the same bits. Then the batch through Python
 (symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2.
 Part 2: `symdyn identify` on a log of the Panda (t, q, qd, qdd, tau; tau from the compiled inverse
@@ -38,7 +38,7 @@ from symdyn.codegen.c.runtime import render_runtime  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
-ROUNDS = 7
+ROUNDS = 15
 
 HARNESS = r"""
 #define _POSIX_C_SOURCE 199309L
