@@ -1,6 +1,12 @@
 """Shared pytest set-up.
 
 - The helper modules of tests/ (`robots`, `cbuild`) are importable from every test file.
+- symdyn.compile builds its libraries without -march (SYMDYN_MARCH=none, symdyn.apps.build), the
+  compiler's default target: the SIMD bodies of the batch wrappers are then left out by the
+  preprocessor, so the many libraries the suite compiles cost what they cost before them (the
+  vector bodies double a library's compile time). tests/test_batch.py compiles and checks the
+  vector path, and symdyn.compile's default -march=native, itself. A SYMDYN_MARCH set by the
+  caller is kept.
 - Under CI (the environment variable CI set to true, as .ci/run is run), a skipped test is a
   failure: CI installs every tool the tests use (a C compiler, pdflatex, the test extra), so a
   skip there would only hide a missing install step. Locally, tests of absent tools still skip.
@@ -40,6 +46,7 @@ def _temporary_symdyn_cache(tmp_path_factory):
     it is safe under concurrent builds (tests of the cache itself use folders of their own).
     """
     old = os.environ.get("SYMDYN_CACHE_DIR")
+    os.environ.setdefault("SYMDYN_MARCH", "none")
     if os.environ.get("PYTEST_XDIST_WORKER"):
         folder = tmp_path_factory.getbasetemp().parent / "symdyn-cache"
         folder.mkdir(exist_ok=True)

@@ -2,7 +2,7 @@
 
 The robot is derived and its code generated once (symdyn.codegen: the C target, the
 NumPy target and the batch wrappers of symdyn.codegen.c.runtime); the C is compiled
-with the system's compiler (symdyn.codegen.c.build) into a shared library, and all of
+with the system's compiler for this machine (symdyn.apps.build) into a shared library, and all of
 it is stored in the cache (symdyn.apps.cache) under a hash of the robot's content,
 symdyn's version and the options. The next call for the same robot loads the library
 without deriving anything.
@@ -11,8 +11,10 @@ Every generated function becomes a method of `CompiledDynamics` with the generat
 function's name and inputs (without p, which is bound): whatever the code generator
 emits, including functions with several outputs (returned as a tuple) or outputs that
 are not square. One state (vectors of their size) runs one C call; a batch (leading
-axes, e.g. (B, n)) runs one call of NAME_batch, whose loop is in C. Joint quantities are
-in joint space (rad or m), the base frame fixes gravity, as in docs/generated-code.md.
+axes, e.g. (B, n)) runs one call of NAME_batch, W states per instruction, optionally in
+threads (symdyn.apps.calling: the layout, when arrays are passed without a copy). Joint
+quantities are in joint space (rad or m), the base frame fixes gravity, as in
+docs/generated-code.md. The robot's cache key is symdyn.apps.robot_key's.
 
 The methods bind through cffi's ABI mode: measured on this machine, a 7-joint function called with
 NumPy arrays costs about 2.7 us through cffi (ffi.from_buffer) against 5.8-6.3 us through
@@ -36,7 +38,9 @@ from ..errors import SymdynError, SymdynWarning
 from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
 from . import cache
+from .calling import c_method, check_threads, load_library
 from .compiled_frames import FrameMethods
+from .robot_key import robot_digest
 from .singular import INVERTING, NotGeneratedError, guarded
 
 __all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
@@ -59,40 +63,20 @@ class RobotInfo:
     params: tuple[str, ...] = ()
 
 
-def _canonical(value):
-    """A deterministic, content-only description of a robot (dataclasses, tuples, SymPy objects)."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return [type(value).__name__] + [
-            [f.name, _canonical(getattr(value, f.name))]
-            for f in dataclasses.fields(value)
-            if f.name != "source"
-        ]
-    if isinstance(value, (tuple, list)):
-        return [_canonical(v) for v in value]
-    if isinstance(value, (str, int, float, bool)) or value is None:
-        return value
-    import sympy as sp
-
-    return sp.srepr(value)
-
-
-def robot_digest(robot) -> str:
-    """SHA-256 of the robot's content (every field but the file it came from)."""
-    import hashlib
-    import json
-
-    return hashlib.sha256(json.dumps(_canonical(robot)).encode()).hexdigest()
-
-
 def _options(method: str, precision: str = "double") -> dict:
-    from .build import COMPILE_FLAGS, find_compiler
+    """What a library depends on besides the robot: the method, the compiler, its flags, and with
+    -march=native the machine (symdyn.apps.build)."""
+    from .build import COMPILE_FLAGS, arch_flags, find_compiler, machine_fingerprint
 
     compiler = find_compiler()
+    arch = list(arch_flags()) if compiler else []
     return {
         "method": method,
         "precision": precision,
         "compiler": compiler,
-        "flags": list(COMPILE_FLAGS) if compiler else None,
+        "flags": [*COMPILE_FLAGS, *arch] if compiler else None,
+        "arch": arch,
+        "machine": machine_fingerprint() if "-march=native" in arch else None,
     }
 
 
@@ -121,6 +105,7 @@ def _build(robot, method: str, options: dict, frames: dict | None = None) -> Cal
                 options["compiler"],
                 {k: v for k, v in files.items() if k.endswith((".c", ".h"))},
                 folder / library,
+                options["arch"],
             )
         return {
             "robot": {
@@ -142,13 +127,16 @@ def _loaded_files(meta: dict) -> list[str]:
     return [meta["library"] or meta["numpy"]]
 
 
-def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: str = "newton-euler"):
+def cached_dynamics(
+    key_parts: dict, make_robot: Callable, params=None, method: str = "newton-euler", threads: int = 1
+):
     """A CompiledDynamics from the cache entry of `key_parts` (plus the options), built when missing.
 
     make_robot() is called only to build the entry (a cache hit never derives nor loads it);
     the result then carries a RobotInfo instead of the Robot. A hit verifies the digest of the
     file it loads (the library); the others are verified when first read (cache.Entry.file).
     """
+    check_threads(threads)
     options = _options(method)
     key = cache.entry_key(**key_parts, **options)
     entry = cache.lookup(key, _loaded_files)
@@ -157,6 +145,7 @@ def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: 
         robot = make_robot()
         entry = cache.get_or_build(key, _build(robot, method, options))
     self = CompiledDynamics._from_entry(entry, robot, params)
+    self.threads = threads
     self._source = ({**key_parts, "method": method}, make_robot)
     self._build_frames = lambda robot, folder, frames: _build(robot, method, options, frames)(folder)
     self._options = options
@@ -168,12 +157,14 @@ def cached_dynamics(key_parts: dict, make_robot: Callable, params=None, method: 
     return self
 
 
-def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamics:
+def compile(robot, params=None, method: str = "newton-euler", threads: int = 1) -> CompiledDynamics:
     """The robot's generated functions compiled to C, with its free parameters bound to `params`.
 
     params: None (no free parameters), a map name -> value, or one value per free parameter
-    in the robot's order. The library is cached (docs/speed.md: the cache); the second
-    compile of an unchanged robot loads it in milliseconds.
+    in the robot's order. threads: how many threads a batch call uses by default (each method
+    also takes threads=; symdyn.apps.calling). The library is built for the machine it runs on
+    (symdyn.apps.build: -march=native unless $SYMDYN_MARCH says otherwise) and cached
+    (docs/speed.md: the cache); the second compile of an unchanged robot loads it in milliseconds.
     """
     from ..model.robot import Robot
 
@@ -187,7 +178,7 @@ def compile(robot, params=None, method: str = "newton-euler") -> CompiledDynamic
 
     families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
     return cached_dynamics(
-        {"robot": robot_digest(robot), "families": families}, lambda: robot, params, method
+        {"robot": robot_digest(robot), "families": families}, lambda: robot, params, method, threads
     )
 
 
@@ -226,8 +217,8 @@ class CompiledDynamics(FrameMethods):
     NumPy module; `robot` the Robot (or a RobotInfo when it came from the cache alone).
     """
 
-    def __init__(self, robot, params=None, method: str = "newton-euler") -> None:
-        other = compile(robot, params, method)
+    def __init__(self, robot, params=None, method: str = "newton-euler", threads: int = 1) -> None:
+        other = compile(robot, params, method, threads)
         self.__dict__.update(other.__dict__)
 
     @classmethod
@@ -241,6 +232,7 @@ class CompiledDynamics(FrameMethods):
         self._entry = entry
         self._params = params
         self._frame_libraries: dict = {}
+        self.threads = 1
         self.frame_names = tuple(info.get("frames", ()))
         self._module = None
         self.functions = tuple(f["name"] for f in meta["functions"])
@@ -259,11 +251,23 @@ class CompiledDynamics(FrameMethods):
             raise NotGeneratedError(self.robot.name, name)
         if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
             raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
-        ffi, lib = _load_library(self._library, entry.meta["functions"])
+        ffi, lib, _ = load_library(self._library, entry.meta["functions"], self._width_name)
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
-            setattr(self, f["name"], guarded(self, f["name"], _c_method(ffi, lib, f, p_ptr)))
+            setattr(self, f["name"], guarded(self, f["name"], c_method(ffi, lib, f, p_ptr, self)))
         return self.__dict__[name]
+
+    @property
+    def _width_name(self) -> str:
+        return f"{self._entry.meta['robot']['name']}_batch_width"
+
+    @property
+    def batch_width(self) -> int:
+        """W, the states a batch call evaluates per instruction (8 with AVX-512, 4 with AVX, else 1;
+        1 on the NumPy backend)."""
+        if self._library is None:
+            return 1
+        return load_library(self._library, self._entry.meta["functions"], self._width_name)[2]
 
     @property
     def cdll(self):
@@ -340,7 +344,9 @@ class CompiledDynamics(FrameMethods):
                 json.dumps({"frame": frame, "group": group, "axes": task, **self._options}, sort_keys=True),
                 lambda robot, folder: self._build_frames(robot, folder, options),
             )
-            self._frame_libraries[key] = CompiledDynamics._from_entry(entry, self.robot, self._params)
+            frames = CompiledDynamics._from_entry(entry, self.robot, self._params)
+            frames.threads = self.threads
+            self._frame_libraries[key] = frames
         return self._frame_libraries[key]
 
     def __repr__(self) -> str:
@@ -360,87 +366,11 @@ def _warn_fallback() -> None:
 
 
 def _numpy_method(owner: CompiledDynamics, name: str) -> Callable:
-    def call(*args):
+    def call(*args, threads: int | None = None):  # the NumPy module vectorises itself: no threads
         return getattr(owner.module, name)(*args, owner.p)
 
     call.__name__ = name
     return call
 
 
-def _declarations(functions: list[dict]) -> str:
-    """The cdef of every generated function and its batch wrapper."""
-    lines = []
-    for f in functions:
-        ins = ", ".join(f"const double {name}[]" for name, _ in f["inputs"])
-        outs = ", ".join(f"double {name}[]" for name, *_ in f["outputs"])
-        lines.append(f"void {f['c_name']}({ins}, {outs});")
-        lines.append(f"void {f['c_name']}_batch(long count, {ins}, {outs});")
-    return "\n".join(lines)
-
-
-_LIBRARIES: dict[str, tuple] = {}
 _CDLLS: dict = {}
-
-
-def _load_library(path: Path, functions: list[dict]):
-    """(ffi, lib) for the library at `path` (opened once per process)."""
-    key = str(path)
-    if key not in _LIBRARIES:
-        import cffi
-
-        ffi = cffi.FFI()
-        ffi.cdef(_declarations(functions))
-        _LIBRARIES[key] = (ffi, ffi.dlopen(key))
-    return _LIBRARIES[key]
-
-
-def _c_method(ffi, lib, f: dict, p_ptr) -> Callable:
-    """One generated function as a Python callable: one state per C call, a batch through NAME_batch."""
-    single = getattr(lib, f["c_name"])
-    batch = getattr(lib, f["c_name"] + "_batch")
-    sizes = [size for name, size in f["inputs"] if name != "p"]
-    names = [name for name, _ in f["inputs"] if name != "p"]
-    with_p = len(sizes) != len(f["inputs"])
-    shapes = [(rows, cols) if matrix else (rows,) for _, rows, cols, matrix in f["outputs"]]
-    one = len(shapes) == 1
-    buf = ffi.from_buffer
-    p_args = (p_ptr,) if with_p else ()
-    f64, ndarray = np.dtype(np.float64), np.ndarray
-    one_state = [(size,) for size in sizes]
-
-    def call(*args):
-        if len(args) != len(sizes):
-            raise TypeError(f"{f['name']}({', '.join(names)}) takes {len(sizes)} arguments, got {len(args)}")
-        pointers = []
-        for a, shape in zip(args, one_state, strict=True):  # the fast path: one state, float64 arrays
-            if a.__class__ is not ndarray or a.dtype != f64 or a.shape != shape or not a.flags.c_contiguous:
-                break
-            pointers.append(buf("double[]", a))
-        else:
-            outs = [np.empty(shape) for shape in shapes]
-            single(*pointers, *p_args, *[buf("double[]", o) for o in outs])
-            return outs[0] if one else tuple(outs)
-        arrays = [np.ascontiguousarray(a, dtype=f64) for a in args]
-        if all(a.shape == shape for a, shape in zip(arrays, one_state, strict=True)):
-            return call(*arrays)
-        return _batch_call(batch, buf, arrays, sizes, names, p_args, shapes, one, f["name"])
-
-    call.__name__ = f["name"]
-    call.__doc__ = f"{f['doc']} (generated C; inputs {', '.join(names)})."
-    return call
-
-
-def _batch_call(batch, buf, arrays, sizes, names, p_args, shapes, one, name):
-    for a, s, n in zip(arrays, sizes, names, strict=True):
-        if a.ndim == 0 or a.shape[-1] != s:
-            raise ValueError(f"{name}: {n} must have shape ({s},) or (..., {s}); got {a.shape}")
-    lead = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
-    count = int(np.prod(lead, dtype=np.int64))
-    flat = [
-        np.ascontiguousarray(np.broadcast_to(a, (*lead, s))).reshape(count, s)
-        for a, s in zip(arrays, sizes, strict=True)
-    ]
-    outs = [np.empty((*lead, *shape)) for shape in shapes]
-    if count:
-        batch(count, *[buf("double[]", a) for a in flat], *p_args, *[buf("double[]", o) for o in outs])
-    return outs[0] if one else tuple(outs)

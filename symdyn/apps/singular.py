@@ -52,8 +52,8 @@ def guarded(owner, name: str, method: Callable) -> Callable:
     if name not in INVERTING:
         return method
 
-    def call(*args):
-        out = method(*args)
+    def call(*args, **options):
+        out = method(*args, **options)
         if all(_finite(o) for o in (out if isinstance(out, tuple) else (out,))):
             return out
         inputs = [np.asarray(a, dtype=float) for a in args]

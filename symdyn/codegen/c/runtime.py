@@ -4,7 +4,8 @@
 its inputs and outputs with their sizes), so the Python binding (symdyn.apps.compile)
 needs no knowledge of which functions exist: whatever `build_functions` generates,
 with any number of outputs of any shape, becomes a method. `render_runtime(ctx)` gives
-NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C),
+NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C, W states
+per instruction through the function's body over vectors: symdyn.codegen.c.vector),
 symdyn_step.c (the fixed-step integrators of symdyn.apps.simulate) and symdyn_csv.c (the
 CSV writer of symdyn.apps.csv_format), the last two robot-independent. Every C statement
 is spelled in templates/c/batch.c.j2, templates/c/step.c.j2 and templates/c/csv.c.j2.
@@ -14,6 +15,8 @@ from __future__ import annotations
 
 from ..render import RenderContext, environment, header_lines
 from .config import CConfig, c_names
+from .sincos import BLOCK
+from .vector import LANE_CALLS, simd_prefix, vector_view
 
 __all__ = ["function_table", "render_runtime", "STEP_SOURCE", "CSV_SOURCE"]
 
@@ -41,21 +44,40 @@ def function_table(ctx: RenderContext) -> list[dict]:
 def render_runtime(ctx: RenderContext) -> dict[str, str]:
     """NAME_batch.c, symdyn_step.c and symdyn_csv.c for the robot of `ctx` (compiled with NAME_dynamics.c)."""
     names = c_names(ctx)
-    real = CConfig(ctx.precision).real
-    functions = [
-        {
-            "c_name": f["c_name"],
-            "inputs": [(name, size) for name, size in f["inputs"]],
-            "outputs": [(name, rows * cols) for name, rows, cols, _ in f["outputs"]],
-        }
-        for f in function_table(ctx)
-    ]
+    config = CConfig(ctx.precision)
+    prefix = simd_prefix(ctx)
+    functions = []
+    for f, spec in zip(function_table(ctx), ctx.functions, strict=True):
+        inputs = [(name, size) for name, size in f["inputs"]]
+        functions.append(
+            {
+                "c_name": f["c_name"],
+                "inputs": inputs,
+                "outputs": [(name, rows * cols) for name, rows, cols, _ in f["outputs"]],
+                "vector": vector_view(ctx, names, spec),
+            }
+        )
+    added = {prefix + f.name for f in ctx.functions} | {f"{ctx.name}_batch_width"}
+    taken = set(names.functions.values()) | {c + "_batch" for c in names.functions.values()}
+    assert not added & taken, f"a generated function has the name of a batch helper: {added & taken}"
     env = environment()
     lines = header_lines(ctx)
+    angles = any(f["vector"] and f["vector"]["angles"] for f in functions)
     return {
         f"{ctx.name}_batch.c": env.get_template("c/batch.c.j2").render(
-            header_lines=lines, header_file=names.header_file, real=real, functions=functions
+            header_lines=lines,
+            header_file=names.header_file,
+            real=config.real,
+            functions=functions,
+            W=f"{ctx.name}_SIMD_W",
+            width=f"{ctx.name}_batch_width",
+            vd=f"{ctx.name}_vd",
+            vi=f"{ctx.name}_vi",
+            P=prefix,
+            lane_calls=[config.math(c) for c in LANE_CALLS],
+            pow=config.math("pow"),
+            sincos={**names.sincos, "block": BLOCK} if angles else None,
         ),
-        STEP_SOURCE: env.get_template("c/step.c.j2").render(header_lines=lines, real=real),
+        STEP_SOURCE: env.get_template("c/step.c.j2").render(header_lines=lines, real=config.real),
         CSV_SOURCE: env.get_template("c/csv.c.j2").render(header_lines=lines),
     }

@@ -25,7 +25,7 @@ from .config import TEMPORARY, CConfig, CNames, c_names
 from .printer import CPrinter
 from .sincos import BLOCK, gather
 
-__all__ = ["render", "render_context", "TOOLS"]
+__all__ = ["render", "render_context", "symbol_names", "function_inputs", "TOOLS"]
 
 #: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6) or one
 #: value per actuated joint (NAME_NACT, ACTUATED_INPUTS: robots with loops).
@@ -62,17 +62,22 @@ def _sincos_view(
     return printer, temporaries, {"count": len(angles), "size": trig.size, "angles": angles + padding}
 
 
-def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
-    """One function as data: its inputs, the locals it reads, temporaries and output stores."""
-    symbol_names = dict(names.locals)
+def symbol_names(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
+    """The C name of every symbol a function's code reads: its input locals and temporaries."""
+    known = dict(names.locals)
     for sym, _ in spec.temporaries:
-        if sym in symbol_names or not TEMPORARY.match(sym.name):
+        if sym in known or not TEMPORARY.match(sym.name):
             raise SymdynError(
                 f"robot '{ctx.name}': temporary '{sym}' of {spec.name} has the name of an input "
                 "(or no C name); rename the parameter"
             )
-        symbol_names[sym] = sym.name
-    printer, temporaries, sincos = _sincos_view(ctx, names, spec, symbol_names)
+        known[sym] = sym.name
+    return known
+
+
+def function_inputs(names: CNames, spec: FunctionSpec) -> tuple[list, list, list]:
+    """(inputs, unused, reads) of a function: each input's name, whether it is read and its size;
+    the inputs it never reads; (local, input, index) of every input value it copies into a local."""
     used_symbols = spec.free_symbols
     inputs, unused, reads = [], [], []
     for inp in spec.inputs:
@@ -87,6 +92,13 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         for s in used:
             index = names.param_macro[s] if inp.name == "p" else str(inp.symbols.index(s))
             reads.append((names.locals[s], inp.name, index))
+    return inputs, unused, reads
+
+
+def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
+    """One function as data: its inputs, the locals it reads, temporaries and output stores."""
+    printer, temporaries, sincos = _sincos_view(ctx, names, spec, symbol_names(ctx, names, spec))
+    inputs, unused, reads = function_inputs(names, spec)
     outputs = []
     for result in spec.results:
         rows, cols = (names.dims[d] for d in result.dims)

@@ -1,0 +1,260 @@
+"""Speed of the SIMD batch wrappers (issue 26): NAME_batch against the scalar function in a C loop.
+
+    python bench/batch.py            # 100,000 states; identify on a one-million-sample log
+    python bench/batch.py --quick    # 10,000 states; 100,000 samples
+
+Part 1: the Panda's inverse dynamics, M and forward dynamics. A C harness links NAME_dynamics.c
+and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.build: COMPILE_FLAGS and
+-march=native unless $SYMDYN_MARCH says otherwise) and times, over the same states, the scalar
+function called once per state in a C loop and one call of NAME_batch (the best of 15 rounds,
+interleaved); it also checks that both give the same bits. Then the batch through Python
+(symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2.
+Part 2: `symdyn identify` on a log of the Panda (t, q, qd, qdd, tau; tau from the compiled inverse
+dynamics plus noise), end to end as a command, and its stages in this process: reading the CSV,
+the base regressor at every sample (one batch call), the least squares.
+The table goes to stdout and to bench/results/batch.txt.
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from machine import RESULTS, load_averages, log, machine, project_path  # noqa: E402
+
+import symdyn  # noqa: E402
+from symdyn.apps.build import COMPILE_FLAGS, arch_flags, find_compiler  # noqa: E402
+from symdyn.codegen import c as c_target  # noqa: E402
+from symdyn.codegen import context  # noqa: E402
+from symdyn.codegen.c.runtime import render_runtime  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
+ROUNDS = 15
+
+HARNESS = r"""
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "panda_dynamics.h"
+typedef const double *in;
+void panda_inverse_dynamics_batch(long, in, in, in, in, double *);
+void panda_mass_matrix_batch(long, in, in, double *);
+void panda_forward_dynamics_batch(long, in, in, in, in, double *);
+int panda_batch_width(void);
+#define N panda_NDOF
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+int main(int argc, char **argv)
+{
+    const long count = atol(argv[1]);
+    double *q = malloc(sizeof(double) * count * N), *qd = malloc(sizeof(double) * count * N);
+    double *u = malloc(sizeof(double) * count * N);
+    double *a = malloc(sizeof(double) * count * N * N), *b = malloc(sizeof(double) * count * N * N);
+    double best[3][2] = {{1e30, 1e30}, {1e30, 1e30}, {1e30, 1e30}};
+    unsigned long long s = 2026;
+    long i;
+    int r, f, same[3] = {1, 1, 1};
+    (void)argc;
+    for (i = 0; i < count * N; ++i) { /* uniform in [-2, 2) from a 64-bit LCG */
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        q[i] = 4.0 * (double)(s >> 11) / 9007199254740992.0 - 2.0;
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        qd[i] = 4.0 * (double)(s >> 11) / 9007199254740992.0 - 2.0;
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        u[i] = 4.0 * (double)(s >> 11) / 9007199254740992.0 - 2.0;
+    }
+    for (r = 0; r < ROUNDS; ++r) {
+        for (f = 0; f < 3; ++f) {
+            const long size = f == 1 ? N * N : N;
+            double t0, t1, t2;
+            t0 = now();
+            for (i = 0; i < count; ++i) {
+                if (f == 0) panda_inverse_dynamics(q + i * N, qd + i * N, u + i * N, NULL, a + i * size);
+                else if (f == 1) panda_mass_matrix(q + i * N, NULL, a + i * size);
+                else panda_forward_dynamics(q + i * N, qd + i * N, u + i * N, NULL, a + i * size);
+            }
+            t1 = now();
+            if (f == 0) panda_inverse_dynamics_batch(count, q, qd, u, NULL, b);
+            else if (f == 1) panda_mass_matrix_batch(count, q, NULL, b);
+            else panda_forward_dynamics_batch(count, q, qd, u, NULL, b);
+            t2 = now();
+            if (t1 - t0 < best[f][0]) best[f][0] = t1 - t0;
+            if (t2 - t1 < best[f][1]) best[f][1] = t2 - t1;
+            same[f] = same[f] && memcmp(a, b, sizeof(double) * count * size) == 0;
+        }
+    }
+    printf("%d\n", panda_batch_width());
+    for (f = 0; f < 3; ++f) {
+        printf("%.3f %.3f %d\n", 1e9 * best[f][0] / count, 1e9 * best[f][1] / count, same[f]);
+    }
+    return 0;
+}
+"""
+
+
+def c_part(count: int, folder: Path) -> tuple[int, list[tuple[str, float, float, bool]], list[str]]:
+    """(W, [(function, scalar ns/state, batch ns/state, same bits)], flags) from the C harness."""
+    robot = symdyn.load_robot(ROOT / "examples" / "panda.yaml")
+    ctx = context(robot, functions=("dynamics",))
+    files = {**c_target.render(ctx), **render_runtime(ctx), "main.c": HARNESS}
+    for name, text in files.items():
+        (folder / name).write_text(text, encoding="utf-8")
+    compiler = find_compiler()
+    flags = [f for f in COMPILE_FLAGS if f not in ("-shared", "-fPIC")] + list(arch_flags())
+    objects = []
+    jobs = []
+    for name in ("panda_dynamics.c", "panda_batch.c"):
+        objects.append(name[:-2] + ".o")
+        jobs.append(subprocess.Popen([*compiler, *flags, "-c", name, "-o", objects[-1]], cwd=folder))
+    assert all(job.wait() == 0 for job in jobs)
+    harness = [*compiler, *flags, f"-DROUNDS={ROUNDS}", "main.c", *objects, "-o", "harness", "-lm"]
+    subprocess.run(harness, cwd=folder, check=True)
+    out = subprocess.run([str(folder / "harness"), str(count)], capture_output=True, text=True, check=True)
+    lines = out.stdout.split("\n")
+    rows = []
+    for name, line in zip(FUNCTIONS, lines[1:4], strict=True):
+        scalar, batch, same = line.split()
+        rows.append((name, float(scalar), float(batch), same == "1"))
+    return int(lines[0]), rows, flags
+
+
+def python_part(count: int) -> dict[str, tuple[float, float]]:
+    """ns per state of symdyn.compile's batch methods (threads=1, threads=2; best of 5)."""
+    robot = symdyn.load_robot(ROOT / "examples" / "panda.yaml")
+    fast = symdyn.compile(robot)
+    rng = np.random.default_rng(7)
+    q, qd, u = (rng.uniform(-2, 2, (count, robot.n)) for _ in range(3))
+    calls = {
+        "inverse_dynamics": lambda t: fast.inverse_dynamics(q, qd, u, threads=t),
+        "mass_matrix": lambda t: fast.mass_matrix(q, threads=t),
+        "forward_dynamics": lambda t: fast.forward_dynamics(q, qd, u, threads=t),
+    }
+    result = {}
+    for name, call in calls.items():
+        best = {}
+        for threads in (1, 2):
+            times = []
+            for _ in range(5):
+                t0 = time.perf_counter()
+                call(threads)
+                times.append(time.perf_counter() - t0)
+            best[threads] = 1e9 * min(times) / count
+        result[name] = (best[1], best[2])
+    return result
+
+
+def _log(robot, fast, samples: int, path: Path) -> None:
+    """A Panda log of `samples` samples at 1 kHz (sines), tau from the compiled inverse dynamics + noise."""
+    from symdyn.apps.csv_format import csv_text
+
+    n = robot.n
+    t = np.arange(samples) * 1e-3
+    k = np.arange(1, n + 1)
+    phase = np.outer(t, 0.5 * k) + k
+    q, qd, qdd = 0.8 * np.sin(phase), 0.4 * k * np.cos(phase), -0.2 * k**2 * np.sin(phase)
+    tau = fast.inverse_dynamics(q, qd, qdd) + np.random.default_rng(1).normal(0, 0.01, (samples, n))
+    header = ["t", *(f"{s}{i}" for s in ("q", "qd", "qdd", "tau") for i in k)]
+    path.write_text(csv_text(header, np.column_stack([t, q, qd, qdd, tau])), encoding="utf-8")
+
+
+def identify_part(samples: int, command_samples: int, folder: Path) -> dict[str, float]:
+    """Seconds of the stages of identification on a log of `samples` samples (reading the CSV, the
+    base regressor at every sample: one batch call), and of `symdyn identify` end to end on
+    `command_samples` samples (its least squares holds the stacked regressor, N n x nbase doubles,
+    several times: 3.5 GB a copy at a million Panda samples, more than a shared machine spares)."""
+    from symdyn.apps.identify import base_regressor_samples, read_measurements
+
+    path = ROOT / "examples" / "panda.yaml"
+    robot = symdyn.load_robot(path)
+    fast = symdyn.compile(robot)
+    times = {}
+    big, small = folder / "log.csv", folder / "small.csv"
+    _log(robot, fast, samples, big)
+    _log(robot, fast, command_samples, small)
+    t0 = time.perf_counter()
+    data = read_measurements(big, robot.n)
+    times[f"read the CSV ({samples:,} samples)"] = time.perf_counter() - t0
+    base_regressor_samples(robot, data.q[:10], data.qd[:10], data.qdd[:10])  # warm: cffi's parse
+    t0 = time.perf_counter()
+    Yb = base_regressor_samples(robot, data.q, data.qd, data.qdd)
+    times[f"base regressor, one batch call ({samples:,})"] = time.perf_counter() - t0
+    times["nbase"] = Yb.shape[2]
+    shape = Yb.shape
+    del Yb
+    t0 = time.perf_counter()
+    np.ones(shape)
+    times["for scale: np.ones of the regressor's size"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    base_regressor_samples(robot, data.q[:100_000], data.qd[:100_000], data.qdd[:100_000])
+    times["base regressor, one batch call (100,000)"] = time.perf_counter() - t0
+    del data
+    t0 = time.perf_counter()
+    cmd = [sys.executable, "-m", "symdyn.cli", "identify", str(path), str(small)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    times[f"symdyn identify, whole command ({command_samples:,})"] = time.perf_counter() - t0
+    assert proc.returncode == 0, proc.stderr
+    return times
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    count, samples, command = (10_000, 100_000, 20_000) if args.quick else (100_000, 1_000_000, 100_000)
+    lines = [f"# bench/batch.py: {machine()}; load averages {load_averages()}", ""]
+    with tempfile.TemporaryDirectory(prefix="symdyn-batch-") as tmp:
+        log("C harness")
+        width, rows, flags = c_part(count, Path(tmp))
+        log("Python methods")
+        py = python_part(count)
+        log("identify")
+        ident = identify_part(samples, command, Path(tmp))
+    lines += [
+        f"Panda, {count:,} states, flags {' '.join(flags)}; W = {width} doubles per instruction",
+        "",
+        f"{'function':<18}  {'scalar C loop ns':>16}  {'batch ns':>8}  {'batch/scalar':>12}"
+        f"  {'same bits':>9}  {'Python batch ns':>15}  {'threads=2 ns':>12}",
+        "-" * 104,
+    ]
+    for name, scalar, batch, same in rows:
+        one, two = py[name]
+        lines.append(
+            f"{name:<18}  {scalar:>16.1f}  {batch:>8.1f}  {batch / scalar:>11.2f}x"
+            f"  {'yes' if same else 'NO':>9}  {one:>15.1f}  {two:>12.1f}"
+        )
+    target = all(batch / scalar <= 0.4 for _, scalar, batch, _ in rows)
+    lines += [
+        "",
+        f"target batch <= 0.4x scalar per state: {'PASS' if target else 'FAIL'} "
+        f"({', '.join(f'{n} {b / s:.2f}x' for n, s, b, _ in rows)})",
+        "",
+        f"identification of the Panda ({ident['nbase']} base parameters), seconds:",
+    ]
+    for key, value in ident.items():
+        if key != "nbase":
+            lines.append(f"  {key:<50} {value:8.2f} s")
+    text = "\n".join(lines) + "\n"
+    print(text, end="")
+    out = RESULTS / "batch.txt"
+    out.write_text(text, encoding="utf-8")
+    log(f"wrote {project_path(out)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,153 @@
+"""Calling a compiled library's functions from Python: one state, or a batch through NAME_batch.
+
+The methods of `CompiledDynamics` (symdyn.apps.compile) are built here from the library's
+function table (symdyn.codegen.c.runtime.function_table) through cffi's ABI mode. One state
+(vectors of their size) is one C call. A batch (leading axes, e.g. (B, n)) is one call of
+NAME_batch, which evaluates W states per instruction (templates/c/batch.c.j2): the arrays are
+passed to C without a copy when they are C-contiguous float64 of the batch's full shape (a state's
+values contiguous, the states one after the other); any other array (another dtype, a strided
+view, an input broadcast against the others) is copied once into that layout. With threads > 1 a
+batch is cut into that many chunks (a multiple of 16 states each, so every chunk keeps whole
+vectors of any W), evaluated at once by Python threads (cffi releases the GIL during the call):
+each state's result is computed by the same instructions whatever the chunk, so it equals the
+one-thread result bit for bit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SymdynError
+
+__all__ = ["load_library", "c_method", "check_threads", "batch_layout", "CHUNK"]
+
+#: The states of a thread's chunk are a multiple of this (every vector width W divides it).
+CHUNK = 16
+
+_LIBRARIES: dict[str, tuple] = {}
+
+
+def _declarations(functions: list[dict]) -> str:
+    """The cdef of every generated function, its batch wrapper and the batch's vector width."""
+    lines = ["int symdyn_batch_width(void);"]
+    for f in functions:
+        ins = ", ".join(f"const double {name}[]" for name, _ in f["inputs"])
+        outs = ", ".join(f"double {name}[]" for name, *_ in f["outputs"])
+        lines.append(f"void {f['c_name']}({ins}, {outs});")
+        lines.append(f"void {f['c_name']}_batch(long count, {ins}, {outs});")
+    return "\n".join(lines)
+
+
+def load_library(path: Path, functions: list[dict], width: str, real: str = "double"):
+    """(ffi, lib, W) for the library at `path` (opened once per process); `width` names its
+    NAME_batch_width function (the states NAME_batch evaluates per instruction); `real` is the
+    floating type of its functions (symdyn.compile's are double)."""
+    key = str(path)
+    if key not in _LIBRARIES:
+        import cffi
+
+        ffi = cffi.FFI()
+        ffi.cdef(_declarations(functions).replace("symdyn_batch_width", width).replace("double", real))
+        lib = ffi.dlopen(key)
+        _LIBRARIES[key] = (ffi, lib, int(getattr(lib, width)()))
+    return _LIBRARIES[key]
+
+
+def batch_layout(a: np.ndarray, lead: tuple, size: int, count: int) -> np.ndarray:
+    """`a` as a C-contiguous float64 (count, size) array: a view of it when it already is one
+    (no copy), else a copy (its broadcast to the batch's leading axes `lead`)."""
+    if a.shape == (*lead, size):
+        return np.ascontiguousarray(a, dtype=np.float64).reshape(count, size)
+    return np.ascontiguousarray(np.broadcast_to(a, (*lead, size)), dtype=np.float64).reshape(count, size)
+
+
+def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
+    """One generated function as a Python callable: one state per C call, a batch through NAME_batch.
+
+    `owner.threads` is the default number of threads of a batch; a call may give its own (threads=).
+    """
+    single = getattr(lib, f["c_name"])
+    batch = getattr(lib, f["c_name"] + "_batch")
+    sizes = [size for name, size in f["inputs"] if name != "p"]
+    names = [name for name, _ in f["inputs"] if name != "p"]
+    with_p = len(sizes) != len(f["inputs"])
+    shapes = [(rows, cols) if matrix else (rows,) for _, rows, cols, matrix in f["outputs"]]
+    one = len(shapes) == 1
+    buf = ffi.from_buffer
+    p_args = (p_ptr,) if with_p else ()
+    f64, ndarray = np.dtype(np.float64), np.ndarray
+    one_state = [(size,) for size in sizes]
+
+    def call(*args, threads: int | None = None):
+        if len(args) != len(sizes):
+            raise TypeError(f"{f['name']}({', '.join(names)}) takes {len(sizes)} arguments, got {len(args)}")
+        pointers = []
+        for a, shape in zip(args, one_state, strict=True):  # the fast path: one state, float64 arrays
+            if a.__class__ is not ndarray or a.dtype != f64 or a.shape != shape or not a.flags.c_contiguous:
+                break
+            pointers.append(buf("double[]", a))
+        else:
+            outs = [np.empty(shape) for shape in shapes]
+            single(*pointers, *p_args, *[buf("double[]", o) for o in outs])
+            return outs[0] if one else tuple(outs)
+        arrays = [a if isinstance(a, ndarray) else np.asarray(a, dtype=f64) for a in args]
+        if all(a.shape == shape for a, shape in zip(arrays, one_state, strict=True)):
+            return call(*[np.ascontiguousarray(a, dtype=f64) for a in arrays])
+        for a, s, n in zip(arrays, sizes, names, strict=True):
+            if a.ndim == 0 or a.shape[-1] != s:
+                raise ValueError(f"{f['name']}: {n} must have shape ({s},) or (..., {s}); got {a.shape}")
+        lead = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
+        count = int(np.prod(lead, dtype=np.int64))
+        flat = [batch_layout(a, lead, s, count) for a, s in zip(arrays, sizes, strict=True)]
+        outs = [np.empty((*lead, *shape)) for shape in shapes]
+        flat_outs = [o.reshape(count, int(np.prod(shape))) for o, shape in zip(outs, shapes, strict=True)]
+        chunks = _chunks(count, owner.threads if threads is None else threads)
+        if count:
+            _run(batch, buf, chunks, flat, p_args, flat_outs)
+        return outs[0] if one else tuple(outs)
+
+    call.__name__ = f["name"]
+    call.__doc__ = f"{f['doc']} (generated C; inputs {', '.join(names)}; a batch may give threads=)."
+    return call
+
+
+def check_threads(threads) -> int:
+    """`threads` when it is a whole number >= 1; else SymdynError."""
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise SymdynError(f"threads must be a whole number >= 1, got {threads!r}")
+    return int(threads)
+
+
+def _chunks(count: int, threads) -> list[tuple[int, int]]:
+    """(start, stop) of each thread's states: `threads` chunks of a multiple of CHUNK states."""
+    check_threads(threads)
+    per = -(-count // int(threads))
+    per = -(-per // CHUNK) * CHUNK
+    if per >= count:
+        return [(0, count)]
+    return [(start, min(start + per, count)) for start in range(0, count, per)]
+
+
+def _run(batch, buf, chunks, flat, p_args, outs) -> None:
+    """NAME_batch on each chunk, each in its own thread when there are several (the C call runs
+    without the GIL)."""
+
+    def run(chunk: tuple[int, int]) -> None:
+        start, stop = chunk
+        batch(
+            stop - start,
+            *[buf("double[]", a[start:stop]) for a in flat],
+            *p_args,
+            *[buf("double[]", o[start:stop]) for o in outs],
+        )
+
+    if len(chunks) == 1:
+        run(chunks[0])
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=len(chunks)) as pool:
+        list(pool.map(run, chunks))

@@ -1,0 +1,154 @@
+"""A generated C function's code on W states at once, for the SIMD batch wrappers (NAME_batch.c).
+
+The body of NAME_f is printed a second time over GCC/Clang vector types (`NAME_vd`, W lanes
+of double or float, templates/c/batch.c.j2 picks W from the compiler's target macros): every
+local that depends on the state (q, qd, qdd, tau and what is computed from them) is a vector,
+the parameters p and what depends on them alone stay scalars (C broadcasts them in a mixed
+operation). +, -, * and / act lane by lane with the rounding of the scalar operation, so a lane
+computes exactly what NAME_f computes for its state; every call that has no vector form
+(sqrt, pow, fabs, tan, sign, the step of Coulomb friction) goes through a lane-by-lane helper
+calling the same <math.h> function or comparison as the scalar code, branch-free. The sines and
+cosines of double precision go through the same helper as NAME_f (NAME_sincos,
+symdyn.codegen.c.sincos) on the angles of all W lanes at once.
+
+A function whose code holds anything else gets no vector form (`vector_view` returns None): its
+batch wrapper then calls NAME_f once per state. So does a function with fewer than
+MIN_OPS_PER_OUTPUT operations per output value (the regressors: the Panda's base regressor has
+434 outputs for 1429 operations): copying its outputs from the W lanes back into the batch's
+layout costs more than the vector arithmetic saves (measured on the Panda: 1.6 times the scalar
+loop's time), while M (8 operations per output) gains.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ...errors import SymdynError
+from ...symbolic.simplify import MAX_UNROLLED_POWER
+from ..functions import FunctionSpec
+from ..printing import step_comparison
+from ..render import RenderContext
+from .config import MATH_CALLS, CNames
+from .printer import ATOM, MUL, CPrinter
+from .sincos import gather
+from .target import function_inputs, symbol_names
+
+__all__ = ["VectorPrinter", "vector_view", "simd_prefix", "LANE_CALLS", "MIN_OPS_PER_OUTPUT"]
+
+#: Fewer operations per output value than this: the batch keeps the scalar loop (module docstring).
+MIN_OPS_PER_OUTPUT = 5
+
+#: The <math.h> functions (double names) the lane helpers wrap: one argument, and pow with two.
+LANE_CALLS = (*sorted(set(MATH_CALLS.values())), "sqrt")
+
+
+def simd_prefix(ctx: RenderContext) -> str:
+    """The prefix of every name NAME_batch.c adds: NAME_simd_ (helpers, blocks of W states)."""
+    return f"{ctx.name}_simd_"
+
+
+class VectorPrinter(CPrinter):
+    """SymPy expression -> C text over W states: a vector where it depends on `varying` symbols.
+
+    `varying`: the symbols held as vectors (the state's inputs, then the temporaries computed from
+    them, added by the caller in order); `calls` (sin(a), cos(a) read from the arrays of angles)
+    are vectors. `prefix` names the lane helpers (NAME_simd_sqrt, ...).
+    """
+
+    def __init__(self, names: dict, precision: str, calls: dict, varying: set, prefix: str):
+        super().__init__(names, precision, calls)
+        self.vary = set(varying)
+        self.prefix = prefix
+        self._memo: dict[sp.Expr, bool] = {}
+
+    def varying(self, e: sp.Expr) -> bool:
+        """Whether the text of `e` is a vector (it reads a varying symbol or an array of sines)."""
+        if e in self.calls:
+            return True
+        if e.is_Symbol:
+            return e in self.vary
+        if e not in self._memo:
+            self._memo[e] = any(self.varying(a) for a in e.args)
+        return self._memo[e]
+
+    def vector(self, e: sp.Expr) -> str:
+        """The text of `e` as a vector: a scalar is broadcast to every lane (NAME_simd_splat)."""
+        text = self.doprint(e)
+        return text if self.varying(sp.sympify(e)) else f"{self.prefix}splat({text})"
+
+    def _call(self, e: sp.Expr) -> tuple[str, int]:
+        if e in self.calls or not self.varying(e):
+            return super()._call(e)
+        if isinstance(e, sp.sign):
+            return f"{self.prefix}sign({self._print(e.args[0])[0]})", ATOM
+        if isinstance(e, sp.Heaviside):
+            x, op = step_comparison(e)
+            side = "positive" if op == ">" else "negative"
+            return f"{self.prefix}{side}({self._print(x)[0]})", ATOM
+        call = MATH_CALLS.get(type(e))
+        if call is not None and len(e.args) == 1:
+            return f"{self.prefix}{self.config.math(call)}({self._print(e.args[0])[0]})", ATOM
+        raise SymdynError(f"no vector form of '{type(e).__name__}'")
+
+    def _pow(self, e: sp.Pow) -> tuple[str, int]:
+        if not self.varying(e) or (e.exp.is_Integer and 0 < abs(e.exp) <= MAX_UNROLLED_POWER):
+            return super()._pow(e)  # small integer powers are products and quotients: lane by lane
+        sqrt = self.prefix + self.config.math("sqrt")
+        if e.exp == sp.Rational(1, 2):
+            return f"{sqrt}({self._print(e.base)[0]})", ATOM
+        if e.exp == sp.Rational(-1, 2):
+            return f"{self.literal(1.0)}/{sqrt}({self._print(e.base)[0]})", MUL
+        return f"{self.prefix}{self.config.math('pow')}({self.vector(e.base)}, {self.vector(e.exp)})", ATOM
+
+
+def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict | None:
+    """One function's body on W states as data for templates/c/batch.c.j2, or None without a vector form.
+
+    Keys: block (the static function's name), inputs (name, size: a state's values), outputs
+    (name, size, stores: (index, vector text)), unused, reads ((local, input, index, vector?)),
+    angles (their vector texts, double precision only) and temporaries ((vector?, name, text)).
+    """
+    if spec.ops.total < MIN_OPS_PER_OUTPUT * len(spec.outputs):
+        return None
+    known = symbol_names(ctx, names, spec)
+    _, unused, reads = function_inputs(names, spec)
+    varying = {s for inp in spec.inputs if inp.name != "p" for s in inp.symbols}
+    prefix = simd_prefix(ctx)
+    temporaries = list(spec.temporaries)
+    angles: list[str] = []
+    calls: dict = {}
+    try:
+        if ctx.precision == "double":
+            trig = gather(spec.temporaries, spec.outputs)
+            temporaries = [(s, e) for s, e in spec.temporaries if s in trig.live]
+            plain = VectorPrinter(known, ctx.precision, {}, varying, prefix)
+            angles = [plain.vector(a) for a in trig.angles]
+            arrays = (names.sincos["sine"], names.sincos["cosine"])
+            calls = {call: f"{arrays[which]}[{k}]" for call, (which, k) in trig.calls.items()}
+        printer = VectorPrinter(known, ctx.precision, calls, varying, prefix)
+        body = []
+        for s, e in temporaries:
+            vector = printer.varying(e)
+            if vector:
+                printer.vary.add(s)
+            body.append((vector, s.name, printer.doprint(e)))
+        outputs = [
+            {
+                "name": r.name,
+                "size": r.rows * r.cols,
+                "stores": [(k, printer.vector(e)) for k, e in enumerate(spec.entries(r))],
+            }
+            for r in spec.results
+        ]
+    except SymdynError:
+        return None
+    sizes = {inp.name: len(inp.symbols) for inp in spec.inputs}
+    return {
+        "block": prefix + spec.name,
+        "inputs": [(inp.name, sizes[inp.name]) for inp in spec.inputs],
+        "outputs": outputs,
+        "unused": unused,
+        "reads": [(local, array, index, array != "p") for local, array, index in reads],
+        "angles": angles,
+        "temporaries": body,
+    }

@@ -1,0 +1,278 @@
+"""The SIMD batch wrappers (templates/c/batch.c.j2, symdyn.codegen.c.vector) and their calling.
+
+NAME_batch evaluates W states per instruction: the function's body over vectors of W lanes, each
+lane performing the scalar function's operations in its order, the sines and cosines by the vector
+twin of NAME_sincos. So a batch must equal the scalar function state by state, bit for bit (both
+compiled with -ffp-contract=off, as symdyn.compile does), for every batch size, a multiple of W or
+not: on the Panda (inverse dynamics, M, forward dynamics, under -march=native and with AVX2 alone)
+and a tree robot with friction (whose sign and step go through the lane helpers), in double and
+float, and with the scalar fallback (no AVX). States include angles the vector sine sends to the
+C library (|q| >= 2^19 pi/2), tiny ones and -0. Every build uses the C contract's -Werror flags;
+one runs the batch path under -fsanitize=address,undefined. Through symdyn.compile: no copy of
+C-contiguous float64 arrays, and threads= giving the one-thread result bit for bit.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import platform
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cbuild import SANITIZE_FLAGS, STRICT_FLAGS, TEST_OPT, compile_program, compilers, write_files
+from robots import example, y_robot
+
+import symdyn
+from symdyn.apps import build
+from symdyn.apps.calling import batch_layout, load_library
+from symdyn.codegen import c as c_target
+from symdyn.codegen import context
+from symdyn.codegen.c.runtime import function_table, render_runtime
+from symdyn.errors import SymdynError
+
+pytestmark = pytest.mark.skipif("gcc" not in compilers(), reason="needs gcc")
+
+#: unoptimised, as tests/cbuild.py's builds (the values do not depend on the level without
+#: -ffast-math; symdyn.compile's -O2 -march=native library is checked by the last tests)
+BASE = (TEST_OPT, "-ffp-contract=off", "-shared", "-fPIC")
+X86 = platform.machine().lower() in ("x86_64", "amd64")
+
+
+def _cpu_flags() -> set[str]:
+    try:
+        text = Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return set()
+    flags = [line.split(":")[1].split() for line in text.splitlines() if line.startswith("flags")]
+    return set(flags[0]) if flags else set()
+
+
+CPU = _cpu_flags()
+#: name -> (flags, W expected); the vector builds only where this CPU can run them
+BUILDS = {"scalar": (("-mno-avx",), 1)} if X86 else {}
+if {"avx2", "fma"} <= CPU:
+    BUILDS["avx2"] = (("-mavx2", "-mfma"), 4)
+if {"avx2", "avx512f"} <= CPU:
+    BUILDS["native"] = (("-march=native",), 8)
+
+
+def _build_all(ctx, folder: Path, names) -> dict:
+    """Compile the robot's C and batch wrappers once per build of `names`, all at once; load each."""
+    files = {**c_target.render(ctx), **render_runtime(ctx)}
+    paths = write_files(files, folder)
+    sources = [str(p) for p in paths if p.name.endswith(("_dynamics.c", "_batch.c"))]
+    jobs = {}
+    for name in names:
+        flags, _ = BUILDS[name]
+        cmd = ["gcc", *STRICT_FLAGS, *BASE, *flags, "-o", str(folder / f"{name}.so"), *sources, "-lm"]
+        jobs[name] = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
+    table = function_table(ctx)
+    libs = {}
+    for name, job in jobs.items():
+        assert job.wait() == 0, job.stderr.read()
+        libs[name] = load_library(folder / f"{name}.so", table, f"{ctx.name}_batch_width", ctx.precision)
+    return {"table": {f["name"]: f for f in table}, "libs": libs, "batch": files[f"{ctx.name}_batch.c"]}
+
+
+@pytest.fixture(scope="module")
+def panda(tmp_path_factory):
+    ctx = context(example("panda"), functions=("dynamics",))
+    return _build_all(ctx, tmp_path_factory.mktemp("panda"), [b for b in BUILDS if b != "scalar"])
+
+
+@pytest.fixture(scope="module")
+def tree(tmp_path_factory):
+    """The tree robot's context (derived once: float only prints it otherwise) and its builds."""
+    ctx = context(y_robot(), functions=("dynamics",))
+    builds = {}
+    for precision in ("double", "float"):
+        ctx_p = dataclasses.replace(ctx, precision=precision)
+        builds[precision] = _build_all(ctx_p, tmp_path_factory.mktemp(f"tree-{precision}"), list(BUILDS))
+    return ctx, builds
+
+
+def _states(n: int, count: int, rng) -> np.ndarray:
+    """`count` random states of n values, with awkward angles in some lanes: beyond 2^19 pi/2
+    (the C library's range), below 2^-27 (sin x = x), -0, exact multiples of pi/2."""
+    x = rng.uniform(-4.0, 4.0, (count, n))
+    awkward = [1e6, -3e7, 1e-30, -0.0, 0.0, np.pi / 2, -np.pi, 823549.7, 2.0**-28]
+    for k, value in enumerate(awkward):
+        x[(3 * k + 1) % count, k % n] = value
+    return x
+
+
+def _check(build: dict, name: str, function: str, count: int, rng, dtype=np.float64) -> int:
+    """NAME_batch over `count` states against NAME state by state: the same bits. Returns W."""
+    ffi, lib, width = build["libs"][name]
+    f = build["table"][function]
+    inputs = [(n, s) for n, s in f["inputs"] if n != "p"]
+    with_p = len(inputs) != len(f["inputs"])
+    real = "float" if dtype == np.float32 else "double"
+    arrays = [_states(s, count, rng).astype(dtype) for _, s in inputs]
+    sizes = [rows * cols for _, rows, cols, _ in f["outputs"]]
+    batch = [np.full((count, s), np.nan, dtype) for s in sizes]
+    buf = ffi.from_buffer
+    p = [ffi.NULL] if with_p else []
+    getattr(lib, f["c_name"] + "_batch")(
+        count, *[buf(f"{real}[]", a) for a in arrays], *p, *[buf(f"{real}[]", o) for o in batch]
+    )
+    one = [np.full((count, s), np.nan, dtype) for s in sizes]
+    single = getattr(lib, f["c_name"])
+    for i in range(count):
+        single(*[buf(f"{real}[]", a[i]) for a in arrays], *p, *[buf(f"{real}[]", o[i]) for o in one])
+    for got, want in zip(batch, one, strict=True):
+        assert got.tobytes() == want.tobytes(), f"{name} {function} count={count}"
+    return width
+
+
+def _sizes(width: int) -> list[int]:
+    return sorted({1, max(width - 1, 1), width, width + 1, 2 * width + 3, 1000})
+
+
+@pytest.mark.parametrize("name", [b for b in BUILDS if b != "scalar"])
+def test_panda_batches_equal_the_scalar_functions_bit_for_bit(panda, name):
+    rng = np.random.default_rng(26)
+    width = panda["libs"][name][2]
+    assert width == BUILDS[name][1]
+    for function in ("inverse_dynamics", "mass_matrix", "forward_dynamics"):
+        assert f"static void panda_simd_{function}(" in panda["batch"]  # a vector body, not the loop
+        for count in _sizes(width):
+            _check(panda, name, function, count, rng)
+
+
+@pytest.mark.parametrize("name", list(BUILDS))
+def test_tree_batches_equal_the_scalar_functions_bit_for_bit(tree, name):
+    """Every function of the dynamics group, friction's sign and step included; float too
+    (W doubled), and the scalar fallback (W = 1) without AVX."""
+    _, builds = tree
+    rng = np.random.default_rng(5)
+    for precision, dtype in (("double", np.float64), ("float", np.float32)):
+        build_ = builds[precision]
+        width = build_["libs"][name][2]
+        assert width == BUILDS[name][1] * (2 if precision == "float" and width > 1 else 1)
+        for function in build_["table"]:
+            for count in _sizes(width):
+                _check(build_, name, function, count, rng, dtype)
+
+
+DRIVER = r"""
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "ytree_dynamics.h"
+typedef const double *in;
+void ytree_inverse_dynamics_batch(long, in, in, in, in, double *);
+void ytree_mass_matrix_batch(long, in, in, double *);
+void ytree_forward_dynamics_batch(long, in, in, in, in, double *);
+int ytree_batch_width(void);
+#define N ytree_NDOF
+int main(void)
+{
+    const long count = 2 * ytree_batch_width() + 3;
+    double *q = malloc(sizeof(double) * count * N), *qd = malloc(sizeof(double) * count * N);
+    double *u = malloc(sizeof(double) * count * N), *out = malloc(sizeof(double) * count * N * N);
+    double one[N * N];
+    long i, bad = 0;
+    for (i = 0; i < count * N; ++i) {
+        q[i] = 0.37 * (double)(i % 11) - 1.5; qd[i] = 0.11 * (double)(i % 7); u[i] = 0.5 - 0.05 * (double)i;
+    }
+    q[3] = 1e7;
+    ytree_inverse_dynamics_batch(count, q, qd, u, NULL, out);
+    for (i = 0; i < count; ++i) {
+        ytree_inverse_dynamics(q + i * N, qd + i * N, u + i * N, NULL, one);
+        bad += memcmp(one, out + i * N, sizeof(double) * N) != 0;
+    }
+    ytree_forward_dynamics_batch(count, q, qd, u, NULL, out);
+    for (i = 0; i < count; ++i) {
+        ytree_forward_dynamics(q + i * N, qd + i * N, u + i * N, NULL, one);
+        bad += memcmp(one, out + i * N, sizeof(double) * N) != 0;
+    }
+    ytree_mass_matrix_batch(count, q, NULL, out);
+    for (i = 0; i < count; ++i) {
+        ytree_mass_matrix(q + i * N, NULL, one);
+        bad += memcmp(one, out + i * N * N, sizeof(double) * N * N) != 0;
+    }
+    printf("%d %ld\n", ytree_batch_width(), bad);
+    free(q); free(qd); free(u); free(out);
+    return 0;
+}
+"""
+
+
+@pytest.mark.skipif("avx2" not in CPU, reason="needs a CPU with AVX2")
+def test_the_vector_path_under_sanitizers(tree, tmp_path):
+    """count = 2W + 3 states in buffers of exactly that size: no read or write outside them."""
+    ctx, _ = tree
+    files = {**c_target.render(ctx), **render_runtime(ctx), "main.c": DRIVER}
+    paths = [p for p in write_files(files, tmp_path) if p.suffix == ".c" and "symdyn_" not in p.name]
+    exe = compile_program(paths, tmp_path / "driver", extra=(*SANITIZE_FLAGS, "-mavx2", "-mfma"))
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=1", UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+    proc = subprocess.run([str(exe)], capture_output=True, text=True, env=env, timeout=60)
+    assert proc.returncode == 0 and "runtime error" not in proc.stderr, proc.stderr
+    assert proc.stdout.split() == ["4", "0"]
+
+
+@pytest.fixture(scope="module")
+def compiled():
+    """planar_3r through symdyn.compile with its default flags (-O2 -march=native; the suite's
+    conftest.py builds without -march otherwise)."""
+    robot = example("planar_3r")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv(build.ARCH_ENV, raising=False)
+        return robot, symdyn.compile(robot)
+
+
+def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch):
+    robot, fast = compiled
+    monkeypatch.delenv(build.ARCH_ENV, raising=False)  # symdyn.compile's default flags, as `compiled`
+    n = robot.n
+    rng = np.random.default_rng(3)
+    q, qd, qdd = (rng.uniform(-2, 2, (1001, n)) for _ in range(3))
+    # the batch's own layout is passed as it is; other arrays are copied into it
+    assert np.shares_memory(batch_layout(q, (1001,), n, 1001), q)
+    assert np.shares_memory(batch_layout(q.reshape(7, 143, n), (7, 143), n, 1001), q)
+    for other in (np.asfortranarray(q), q.astype(np.float32), q[::2], q[0]):
+        lead = other.shape[:-1] if other.ndim > 1 else (1001,)
+        count = int(np.prod(lead))
+        flat = batch_layout(other, lead, n, count)
+        assert not np.shares_memory(flat, other) and flat.flags.c_contiguous and flat.shape == (count, n)
+    one = fast.inverse_dynamics(q, qd, qdd)
+    assert np.array_equal(one, np.array([fast.inverse_dynamics(*s) for s in zip(q, qd, qdd, strict=True)]))
+    oracle = symdyn.rnea(robot, q[:5], qd[:5], qdd[:5])
+    np.testing.assert_allclose(one[:5], oracle, rtol=1e-10, atol=1e-10)
+    for threads in (2, 3, 64):
+        assert fast.inverse_dynamics(q, qd, qdd, threads=threads).tobytes() == one.tobytes()
+        M = fast.mass_matrix(q, threads=threads)
+        assert M.tobytes() == fast.mass_matrix(q).tobytes()
+    threaded = symdyn.compile(robot, threads=2)
+    assert threaded.threads == 2 and threaded.forward_dynamics(q, qd, qdd).tobytes() == (
+        fast.forward_dynamics(q, qd, qdd).tobytes()
+    )
+    assert fast.batch_width == (8 if "avx512f" in CPU else 4 if "avx" in CPU else 1)
+    for bad in (0, -1, 1.5, True, "2"):
+        with pytest.raises(SymdynError, match="threads must be a whole number"):
+            fast.inverse_dynamics(q, qd, qdd, threads=bad)
+    with pytest.raises(SymdynError, match="threads must be a whole number"):
+        symdyn.compile(robot, threads=0)
+
+
+def test_the_cache_key_holds_the_flags_and_the_machine(monkeypatch):
+    """-march=native by default, with the CPU's fingerprint in the key; $SYMDYN_MARCH another target
+    (no fingerprint then: the library runs on any machine of that target), or none."""
+    from symdyn.apps.compile import _options
+
+    monkeypatch.delenv(build.ARCH_ENV, raising=False)
+    native = _options("newton-euler")
+    assert "-march=native" in native["flags"] and native["machine"] == build.machine_fingerprint()
+    assert "-ffp-contract=off" in native["flags"]
+    monkeypatch.setenv(build.ARCH_ENV, "x86-64-v3")
+    portable = _options("newton-euler")
+    assert "-march=x86-64-v3" in portable["flags"] and portable["machine"] is None
+    monkeypatch.setenv(build.ARCH_ENV, "none")
+    assert not any(f.startswith("-march") for f in _options("newton-euler")["flags"])
+    monkeypatch.setenv(build.ARCH_ENV, "native; rm -rf /")
+    with pytest.raises(SymdynError, match="SYMDYN_MARCH"):
+        _options("newton-euler")
