@@ -37,10 +37,11 @@ class Input:
 
 #: Size names of the outputs (Output.dims): "1" for a vector's columns, "n" for the joints, "2n"
 #: for the state x = (q, qd), "3", "4", "6" fixed sizes, "k" the task axes of the
-#: operational-space functions (symdyn.codegen.frame_functions); a target spells each as its own
+#: operational-space functions (symdyn.codegen.frame_functions), "nq" and "nv" a floating robot's
+#: configuration and velocity sizes (symdyn.codegen.configuration_functions); a target spells each as its own
 #: expression (C: a macro), and a family of functions that needs another size adds the name and
 #: every target's spelling.
-DIMS = ("1", "n", "2n", "nstd", "nbase", "3", "4", "6", "k")
+DIMS = ("1", "n", "2n", "nstd", "nbase", "3", "4", "6", "k", "nq", "nv")
 
 
 @dataclass(frozen=True)

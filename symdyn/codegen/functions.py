@@ -37,6 +37,7 @@ from ..dynamics import QUANTITIES, Dynamics, singular_message
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
+from .configuration_functions import configuration_rows
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
 from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
 from .function_rows import (
@@ -182,6 +183,7 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     derivative_rows,
     kinematics_rows,
     operational_space_rows,
+    configuration_rows,
 )
 
 
@@ -215,6 +217,7 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
     "derivatives": (derivative_rows,),
     "kinematics": (kinematics_rows,),
     "operational_space": (operational_space_rows,),
+    "configuration": (configuration_rows,),
 }
 
 #: The groups built per frame (symdyn.codegen.frame_functions): only when named, never by default.

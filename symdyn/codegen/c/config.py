@@ -203,6 +203,8 @@ def c_names(ctx: RenderContext) -> CNames:
             "nbase": f"{name}_NBASE",
             **{d: d for d in ("3", "4", "6")},
             "k": str(_task_size(ctx)),
+            "nq": str(ctx.robot.nq),
+            "nv": str(ctx.robot.nv),
         },
         sincos=sincos,
     )

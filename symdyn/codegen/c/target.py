@@ -26,7 +26,8 @@ from .sincos import BLOCK, gather
 
 __all__ = ["render", "render_context", "TOOLS"]
 
-#: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6).
+#: The inputs with one value per joint (NAME_NDOF); any other input (or one of these with another
+#: length: q of a floating robot's integrate) has a fixed size (F: 6).
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
@@ -74,7 +75,8 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     inputs, unused, reads = [], [], []
     for inp in spec.inputs:
         used = [s for s in inp.symbols if s in used_symbols]
-        size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+        joint = inp.name in JOINT_INPUTS and len(inp.symbols) == ctx.robot.n
+        size = names.ndof if joint else str(len(inp.symbols))
         inputs.append({"name": inp.name, "read": bool(used), "size": size})
         if not used:
             unused.append(inp.name)

@@ -22,7 +22,8 @@ from .printer import NumpyPrinter, dtype, local_names
 
 __all__ = ["render", "file_name", "TOOLS"]
 
-#: The inputs with one value per joint (NDOF); any other input has a fixed size (F: 6).
+#: The inputs with one value per joint (NDOF); any other input (or one of these with another
+#: length: q of a floating robot's integrate) has a fixed size (F: 6).
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
@@ -33,7 +34,7 @@ def file_name(name: str) -> str:
     return f"{name}_numpy.py"
 
 
-def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
+def _function(spec: FunctionSpec, printer: NumpyPrinter, n: int) -> dict:
     """One function as data: arguments (and their sizes: NDOF or a number), the input elements
     it reads, temporaries, output entries."""
     free = spec.free_symbols
@@ -42,7 +43,8 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter) -> dict:
         "doc": spec.doc,
         "inputs": [inp.name for inp in spec.inputs if inp.name != "p"],
         "sizes": {
-            inp.name: "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols)) for inp in spec.inputs
+            inp.name: "NDOF" if inp.name in JOINT_INPUTS and len(inp.symbols) == n else str(len(inp.symbols))
+            for inp in spec.inputs
         },
         "has_p": any(inp.name == "p" for inp in spec.inputs),
         "lead": [inp.name for inp in spec.inputs],
@@ -76,7 +78,7 @@ def render(ctx: RenderContext) -> dict[str, str]:
             ndof=ctx.robot.n,
             param_names=[s.name for s in ctx.dynamics.params],
             dtype=dtype(ctx.precision),
-            functions=[_function(spec, printer) for spec in ctx.functions],
+            functions=[_function(spec, printer, ctx.robot.n) for spec in ctx.functions],
         )
     )
     return {file_name(ctx.name): text}
