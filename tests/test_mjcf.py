@@ -174,7 +174,10 @@ def test_sites_agree_with_mujoco():
     ("name", "message"),
     [
         ("bad_ball", "field 'joint(shoulder).type': body 'l1', joint 'shoulder' is a ball joint"),
-        ("bad_free", "field 'joint(root).type': body 'base', joint 'root' is a free joint (a floating base)"),
+        (
+            "bad_free",
+            "field 'joint(other).type': free joints 'root', 'other': symdyn models one floating base",
+        ),
         (
             "bad_include",
             "MuJoCo's compiler refused it: XML Error: Error opening file 'no_such_file.xml'; "

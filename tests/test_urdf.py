@@ -697,7 +697,8 @@ BAD = [
         "body",
         "joint(free).type",
         "is a floating joint: symdyn handles revolute, continuous, prismatic and fixed joints only; "
-        "floating bases are out of scope: load the robot below it with --base body",
+        "load it as a floating base with --floating (floating=True), or the robot below it on a fixed "
+        "base with --base body",
     ),
     ("bad_planar.urdf", 3, "puck", "joint(slide).type", "is a planar joint"),
     ("bad_number.urdf", 2, "l1", "inertial.mass.value", "expected a number, got '1,5'"),
@@ -800,7 +801,8 @@ def test_cli_errors(tmp_path, capsys):
     assert "Traceback" not in err
     assert main(["derive", str(DATA / "bad_floating.urdf")]) == 1
     assert (
-        "floating bases are out of scope: load the robot below it with --base body" in capsys.readouterr().err
+        "load it as a floating base with --floating (floating=True), or the robot below it on a fixed "
+        "base with --base body" in capsys.readouterr().err
     )
     out_dir = tmp_path / "out"
     assert main(["generate", str(DATA / "branch.urdf"), "--tip", "nope", "--out", str(out_dir)]) == 1

@@ -18,7 +18,8 @@ def load_robot_argument(args: argparse.Namespace):
     its name."""
     from ..parsers import load
 
-    return load(args.robot, base=args.base, tip=args.tip, **xacro_arguments(args))
+    floating = getattr(args, "floating", False)
+    return load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
 
 
 def xacro_arguments(args: argparse.Namespace) -> dict:
@@ -49,6 +50,12 @@ def add_robot_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--tip",
         help="URDF: load only the chain from the base to this link (default: the whole tree)",
+    )
+    parser.add_argument(
+        "--floating",
+        action="store_true",
+        help="the robot's base floats, joined to the world by a free flyer (q = [x y z qx qy qz qw, "
+        "joints], v = [base twist in the base frame, joint rates]; docs/floating-base.md)",
     )
     parser.add_argument(
         "--xacro-arg",

@@ -23,13 +23,18 @@ Pinocchio's JointModelFreeFlyer (its configuration and tangent vectors).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
 import sympy as sp
 
 __all__ = [
+    "BaseBody",
     "BASE_POSITION_NAMES",
     "BASE_VELOCITY_NAMES",
     "BASE_ACCELERATION_NAMES",
     "BASE_WRENCH_NAMES",
+    "BASE_NAMES",
     "NQ_BASE",
     "NV_BASE",
     "base_symbols",
@@ -44,6 +49,8 @@ BASE_VELOCITY_NAMES = ("vx_b", "vy_b", "vz_b", "wx_b", "wy_b", "wz_b")
 BASE_ACCELERATION_NAMES = ("ax_b", "ay_b", "az_b", "dwx_b", "dwy_b", "dwz_b")
 #: the wrench on the base in the base frame: force then moment
 BASE_WRENCH_NAMES = ("fx_b", "fy_b", "fz_b", "mx_b", "my_b", "mz_b")
+#: every name of the free flyer's symbols: no parameter may take one
+BASE_NAMES = BASE_POSITION_NAMES + BASE_VELOCITY_NAMES + BASE_ACCELERATION_NAMES + BASE_WRENCH_NAMES
 NQ_BASE = len(BASE_POSITION_NAMES)
 NV_BASE = len(BASE_VELOCITY_NAMES)
 
@@ -56,16 +63,48 @@ def base_symbols() -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
     )
 
 
-def quaternion_rotation(qx, qy, qz, qw) -> sp.Matrix:
-    """world_R_base of a unit quaternion (qx, qy, qz, qw), scalar last (Hamilton's convention).
+def _zero3() -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(sp.zeros(3, 1))
 
-    The polynomial form, exact for a unit quaternion: what it returns for a quaternion of
-    another norm is not a rotation (the generated functions document how they treat one).
+
+def _zero33() -> sp.ImmutableMatrix:
+    return sp.ImmutableMatrix(sp.zeros(3, 3))
+
+
+@dataclass(frozen=True)
+class BaseBody:
+    """The rigid body that the free flyer moves: the base link (and what is fixed to it).
+
+    `mass`, `com` (3x1, base frame) and `inertia` (3x3 about the centre of mass, base-frame axes)
+    enter the dynamics of a floating robot only (on a fixed base the base is the ground). `name`
+    is the base link's name (the frame of the base).
     """
+
+    name: str = "base"
+    mass: sp.Expr = sp.S.Zero
+    com: sp.ImmutableMatrix = field(default_factory=_zero3)
+    inertia: sp.ImmutableMatrix = field(default_factory=_zero33)
+
+    def subs(self, mapping: Mapping) -> BaseBody:
+        x = dict(mapping)
+        return BaseBody(
+            self.name, sp.sympify(self.mass).xreplace(x), self.com.xreplace(x), self.inertia.xreplace(x)
+        )
+
+
+def quaternion_rotation(qx, qy, qz, qw) -> sp.Matrix:
+    """world_R_base of the quaternion (qx, qy, qz, qw), scalar last (Hamilton's convention).
+
+    R = 1 + s (qw [u]x + [u]x^2) with u = (qx, qy, qz) and s = 2 / |q|^2: the rotation of the
+    normalised quaternion q / |q|, whatever the norm of q (for a unit quaternion s = 2, the usual
+    polynomial form). Every floating-base function therefore reads the orientation of q / |q|;
+    the zero quaternion has no orientation (s divides by zero: the results are not finite).
+    """
+    s = 2 / (qx**2 + qy**2 + qz**2 + qw**2)
     return sp.Matrix(
         [
-            [1 - 2 * (qy**2 + qz**2), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
-            [2 * (qx * qy + qz * qw), 1 - 2 * (qx**2 + qz**2), 2 * (qy * qz - qx * qw)],
-            [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx**2 + qy**2)],
+            [1 - s * (qy**2 + qz**2), s * (qx * qy - qz * qw), s * (qx * qz + qy * qw)],
+            [s * (qx * qy + qz * qw), 1 - s * (qx**2 + qz**2), s * (qy * qz - qx * qw)],
+            [s * (qx * qz - qy * qw), s * (qy * qz + qx * qw), 1 - s * (qx**2 + qy**2)],
         ]
     )

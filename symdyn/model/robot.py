@@ -36,14 +36,24 @@ import sympy as sp
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
 from .frames import Frame, check_frame_names, unknown_frame
-from .free_flyer import NQ_BASE, NV_BASE
+from .free_flyer import NQ_BASE, NV_BASE, BaseBody
 from .friction import Friction
 from .limits import check_limits
 from .parameter_names import parameter_names_problem, parameter_number
 from .table import robot_table
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
-__all__ = ["Friction", "Motor", "Link", "Robot", "Mimic", "Frame", "JOINT_TYPES", "DEFAULT_GRAVITY"]
+__all__ = [
+    "Friction",
+    "Motor",
+    "Link",
+    "Robot",
+    "Mimic",
+    "Frame",
+    "BaseBody",
+    "JOINT_TYPES",
+    "DEFAULT_GRAVITY",
+]
 
 JOINT_TYPES = ("revolute", "prismatic")
 #: Gravity (base frame) when the robot description gives none: 9.81 m/s^2 along -z.
@@ -160,6 +170,8 @@ class Robot:
     base: Transform = field(default_factory=Transform.identity)
     #: the base is joined to the world by a free flyer (symdyn.model.free_flyer) instead of fixed
     floating: bool = False
+    #: the body the free flyer moves (its mass and inertia): used only when `floating`
+    base_body: BaseBody = field(default_factory=BaseBody)
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
@@ -414,5 +426,6 @@ class Robot:
             gravity=self.gravity.xreplace(mapping),
             frames=tuple(f.subs(mapping) for f in self.frames),
             base=self.base.subs(mapping),
+            base_body=self.base_body.subs(mapping),
             **changes,
         )

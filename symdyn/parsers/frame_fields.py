@@ -1,6 +1,8 @@
 """A robot file's `frames:` and `base:` (every convention; docs/frames.md).
 
     base: {xyz: [x, y, z], rpy: [r, p, y]}          # world_T_base; gravity is then in the world
+    base: floating                                  # a floating base (docs/floating-base.md)
+    base: {floating: true, mass: m, com: [..], inertia: {ixx: ..}}   # ... with its body's inertia
     frames:
       - {name: tool, link: link6, xyz: [0, 0, 0.1], rpy: [0, 0, 0]}   # link6_T_tool
 
@@ -22,10 +24,20 @@ from ..model.robot import Link
 from ..spatial.transform import Transform, rpy_matrix
 from .source import did_you_mean
 
-__all__ = ["FRAME_FIELDS", "BASE_FIELDS", "FrameData", "read_frames", "read_base", "model_frames"]
+__all__ = [
+    "FRAME_FIELDS",
+    "BASE_FIELDS",
+    "FLOATING_FIELDS",
+    "FrameData",
+    "read_frames",
+    "read_base",
+    "model_frames",
+]
 
 FRAME_FIELDS = ("name", "link", "xyz", "rpy")
 BASE_FIELDS = ("xyz", "rpy")
+#: the fields of a floating base: the flag, then its body's mass, centre of mass and inertia
+FLOATING_FIELDS = ("floating", "mass", "com", "inertia")
 
 
 @dataclass(frozen=True)
@@ -54,9 +66,42 @@ def _placement(reader, entries: dict, field: str) -> Transform:
     return Transform(rpy_matrix(*snapped), sp.ImmutableMatrix(3, 1, list(p)))
 
 
-def read_base(reader, value: object) -> Transform:
-    """`base: {xyz, rpy}`: the base frame in the world (null: the identity)."""
-    return _placement(reader, reader.mapping(value, BASE_FIELDS, "base"), "base")
+def read_base(reader, value: object) -> tuple[Transform, dict | None]:
+    """`base:` the base frame in the world and, for a floating base, the fields of its body.
+
+    `{xyz, rpy}` (null: the identity) places a fixed base: (placement, None). `floating`, or
+    `{floating: true, mass, com, inertia}`, makes the base float: (identity, the body's fields as
+    written, maybe empty); a placement beside it is refused (the base's pose is coordinates).
+    """
+    if value == "floating":
+        return Transform.identity(), {}
+    if isinstance(value, str):
+        raise reader.error(
+            f"expected 'floating' or a mapping {{xyz, rpy}} (or {{floating: true, mass, com, inertia}}), "
+            f"got {value!r}",
+            field="base",
+        )
+    entries = reader.mapping(value, BASE_FIELDS + FLOATING_FIELDS, "base")
+    floating = entries.get("floating", False)
+    if not isinstance(floating, bool):
+        raise reader.error(f"expected true or false, got {floating!r}", field="base.floating")
+    if not floating:
+        body = next((k for k in FLOATING_FIELDS[1:] if k in entries), None)
+        if body is not None:
+            raise reader.error(
+                "a fixed base is the ground: its body's mass, com and inertia apply to a floating base "
+                "(floating: true)",
+                field=f"base.{body}",
+            )
+        return _placement(reader, entries, "base"), None
+    placed = next((k for k in BASE_FIELDS if k in entries), None)
+    if placed is not None:
+        raise reader.error(
+            "a floating base has no placement in the world (its position and orientation are "
+            "coordinates): remove it, or make the base fixed",
+            field=f"base.{placed}",
+        )
+    return Transform.identity(), {k: v for k, v in entries.items() if k != "floating"}
 
 
 def read_frames(reader, value: object, pattern) -> list[FrameData]:

@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from dataclasses import replace
 
 from ..errors import SymdynError
 from ..model.robot import Robot
+from ..spatial.transform import Transform
 from .mjcf import mjcf_from_bytes
 from .robot_file import robot_from_bytes
 from .safe_xml import looks_like_xml, parse_xml
@@ -22,6 +24,7 @@ def load_robot(
     path: str | os.PathLike,
     base: str | None = None,
     tip: str | None = None,
+    floating: bool = False,
     **xacro: Mapping[str, str] | None,
 ) -> Robot:
     """Read a robot file (YAML or JSON), a URDF (or xacro) or an MJCF file, recognised by its content.
@@ -32,7 +35,10 @@ def load_robot(
     other XML is refused with a SymdynError naming the file). Anything else is a robot file. Only
     a URDF takes `base` and `tip`, only xacro xacro_args and package_dirs. Raises SymdynError
     (naming file, link and field) for any bad input; warns with SymdynWarning for implausible
-    inertial data.
+    inertial data. floating=True: the robot's base floats, joined to the world by a free flyer
+    (docs/floating-base.md): a URDF's base link (`load_urdf`), an MJCF's root body (a free joint
+    there makes it floating anyway: `load_mjcf`), a robot file's base frame with a massless base
+    body (write `base: floating` in the file to give the base a mass).
     """
     unknown = sorted(set(xacro) - {"xacro_args", "package_dirs"})
     if unknown:
@@ -42,10 +48,24 @@ def load_robot(
         root = parse_xml(raw, file)
         if root.tag == "mujoco":
             _urdf_only(base, tip, xacro, file, "an MJCF file")
-            return mjcf_from_bytes(raw, file, digest)
-        return urdf_from_root(root, file, digest, base, tip, **xacro)
+            return mjcf_from_bytes(raw, file, digest, floating=floating)
+        return urdf_from_root(root, file, digest, base, tip, floating=floating, **xacro)
     _urdf_only(base, tip, xacro, file, "a robot file")
-    return robot_from_bytes(raw, file, digest)
+    robot = robot_from_bytes(raw, file, digest)
+    return _floated(robot, file) if floating and not robot.floating else robot
+
+
+def _floated(robot: Robot, file: str) -> Robot:
+    """A fixed-base robot made floating: its base frame joined to the world by a free flyer, the base
+    body massless (a robot file's `base: floating` gives it a mass)."""
+    if robot.base != Transform.identity():
+        raise SymdynError(
+            "a floating base has no placement in the world (its pose is the coordinates): remove "
+            "'base:' or do not ask for a floating base",
+            file=file,
+            field="base",
+        )
+    return replace(robot, floating=True)
 
 
 def _urdf_only(base: str | None, tip: str | None, xacro: dict, file: str, what: str) -> None:

@@ -23,8 +23,16 @@ walked, body by body (MuJoCo numbers a parent before its children):
   frictionloss flags drops those terms too); a joint's range is the link's limits when the
   joint is limited.
 
-Refused, naming the file, body and joint: ball joints; a free joint (a floating base, not
-supported yet). Warned about and ignored: joint stiffness (springs), gravity compensation and
+A free joint on a root body (a body whose parent is the world) makes the robot floating, always
+(MuJoCo simulates it so; floating=True asks for it and refuses a file without one): that body is
+the floating base (its inertial is `Robot.base_body`, its frame the base frame) joined to the world
+by symdyn's free flyer, whose coordinates are Pinocchio's (symdyn.model.free_flyer), not MuJoCo's
+(qpos [x y z qw qx qy qz], qvel with the linear velocity in the world frame); the other bodies
+welded to the world are the scenery and are left out.
+
+Refused, naming the file, body and joint: ball joints; a free joint below the root, or more than
+one; a floating model with joints outside the floating body's tree.
+Warned about and ignored: joint stiffness (springs), gravity compensation and
 equality constraints, which symdyn does not model. Every number is a compiled double
 (symdyn.parsers.mjcf_values: rotations snapped to exact multiples of pi/2 within 1e-9 rad).
 """
@@ -41,7 +49,7 @@ import sympy as sp
 from ..errors import SymdynError, SymdynWarning
 from ..model.frames import Frame
 from ..model.inertia import check_inertia
-from ..model.robot import Friction, Link, Motor, Robot
+from ..model.robot import BaseBody, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform, rot_axis
 from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
 from .mjcf_values import number, pose, vector
@@ -52,6 +60,7 @@ from .urdf_merge import merge_inertials
 __all__ = ["load_mjcf", "mjcf_from_bytes"]
 
 _FREE, _BALL, _SLIDE, _HINGE = 0, 1, 2, 3
+_OUTSIDE = -2
 
 
 @dataclass
@@ -63,24 +72,53 @@ class _Walk:
     links: list[dict] = field(default_factory=list)
     parts: list[list[tuple[UrdfInertial, Transform]]] = field(default_factory=list)
     frames: list[Frame] = field(default_factory=list)
-    #: per body: (link index or -1, the MuJoCo body frame in that link's body frame)
+    #: per body: (link index or -1, the MuJoCo body frame in that link's body frame); _OUTSIDE:
+    #: a body outside a floating robot (the scenery)
     owner: list[tuple[int, Transform]] = field(default_factory=list)
+    #: the body of the free joint (the floating base), or None
+    free_body: int | None = None
+    #: the inertials of the floating base's body, in its frame
+    base_parts: list[tuple[UrdfInertial, Transform]] = field(default_factory=list)
 
 
-def load_mjcf(path: str | os.PathLike) -> Robot:
+def load_mjcf(path: str | os.PathLike, floating: bool = False) -> Robot:
     """Read an MJCF (MuJoCo XML) file and return its robot on a fixed base.
 
     The file is compiled by MuJoCo (the `mujoco` package: pip install 'symdyn[mjcf]') and read
     from the compiled model (see the module documentation and docs/mjcf.md). Raises SymdynError
     naming the file (and the body and joint) for bad input, with MuJoCo's message for a file its
     compiler rejects; warns with SymdynWarning for what is ignored and for implausible inertias.
-    `symdyn.load_robot` reads MJCF too (it recognises the top element <mujoco>).
+    `symdyn.load_robot` reads MJCF too (it recognises the top element <mujoco>). A free joint on
+    the root body makes a floating robot (floating=True: the file must have one).
     """
     file, raw, digest = read_source(path, "MJCF file")
-    return mjcf_from_bytes(raw, file, digest)
+    return mjcf_from_bytes(raw, file, digest, floating=floating)
 
 
-def mjcf_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
+def _free_body(model: Any, file: str, body_names: list[str], joint_names: list[str]) -> int | None:
+    """The body of the model's free joint (a root body), None without one."""
+    free = [j for j in range(model.njnt) if int(model.jnt_type[j]) == _FREE]
+    if not free:
+        return None
+    if len(free) > 1:
+        listed = ", ".join(f"'{joint_names[j]}'" for j in free)
+        raise SymdynError(
+            f"free joints {listed}: symdyn models one floating base (one free joint, on the root body)",
+            file=file,
+            field=f"joint({joint_names[free[1]]}).type",
+        )
+    b = int(model.jnt_bodyid[free[0]])
+    if int(model.body_parentid[b]) != 0:
+        raise SymdynError(
+            f"body '{body_names[b]}', joint '{joint_names[free[0]]}' is a free joint below the root: a "
+            "floating base is a body whose parent is the world",
+            file=file,
+            field=f"joint({joint_names[free[0]]}).type",
+        )
+    return b
+
+
+def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) -> Robot:
     """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
     model = compile_mjcf(raw, file)
     check_numbers(model, file)
@@ -90,11 +128,18 @@ def mjcf_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
     site_names = names(model, "site", model.nsite, "site")
     _refuse_clashes(file, body_names[1:], site_names)
     _warn_ignored(file, model, flags, body_names, joint_names)
-    walk = _Walk(file, model, owner=[(-1, Transform.identity())])
+    free = _free_body(model, file, body_names, joint_names)
+    if floating and free is None:
+        raise SymdynError(
+            "no free joint: a floating MJCF robot has a free joint on its root body (<freejoint/>)", file=file
+        )
+    walk = _Walk(file, model, owner=[(-1, Transform.identity())], free_body=free)
     for b in range(1, model.nbody):
         _body(walk, b, body_names, joint_names, flags)
     for s in range(model.nsite):
         k, T = walk.owner[int(model.site_bodyid[s])]
+        if k == _OUTSIDE:
+            continue
         where = {"file": file, "field": f"site({site_names[s]}).quat"}
         walk.frames.append(Frame(site_names[s], k, T @ pose(model.site_pos[s], model.site_quat[s], **where)))
     if not walk.links:
@@ -108,7 +153,17 @@ def mjcf_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
         source_sha256=digest,
         convention="mjcf",
         frames=tuple(walk.frames),
+        floating=free is not None,
+        base_body=BaseBody() if free is None else _base_body(walk, body_names[free]),
     )
+
+
+def _base_body(walk: _Walk, name: str) -> BaseBody:
+    """The floating base's body: the free joint's body and the bodies welded to it."""
+    mass, com, inertia = merge_inertials(walk.base_parts)
+    mass, com, inertia = numeric(mass), com.applyfunc(numeric), inertia.applyfunc(numeric)
+    check_inertia(mass, inertia, file=walk.file, link_name=name)
+    return BaseBody(name, mass, com, inertia)
 
 
 def _disabled(model: Any) -> set[str]:
@@ -157,9 +212,27 @@ def _warn_ignored(file: str, model: Any, flags: set[str], bodies: list[str], joi
 def _body(walk: _Walk, b: int, body_names: list[str], joint_names: list[str], flags: set[str]) -> None:
     """Body b: merged into its parent's link (no joint), or one link per joint."""
     model, name = walk.model, body_names[b]
-    k, T_parent = walk.owner[int(model.body_parentid[b])]
-    T = T_parent @ pose(model.body_pos[b], model.body_quat[b], file=walk.file, field=f"body({name}).quat")
+    parent = int(model.body_parentid[b])
+    k, T_parent = walk.owner[parent]
     first, count = int(model.body_jntadr[b]), int(model.body_jntnum[b])
+    if b == walk.free_body:
+        if count > 1:
+            raise SymdynError(
+                f"body '{name}' has a free joint and other joints: a floating base has the free joint alone",
+                file=walk.file,
+            )
+        k, T, first, count = -1, Transform.identity(), first + 1, 0
+    elif k == _OUTSIDE or (walk.free_body is not None and parent == 0):
+        if count:
+            raise SymdynError(
+                f"body '{name}', joint '{joint_names[first]}' moves outside the floating body's tree: a "
+                "floating robot is one tree on its free joint",
+                file=walk.file,
+            )
+        walk.owner.append((_OUTSIDE, Transform.identity()))
+        return
+    else:
+        T = T_parent @ pose(model.body_pos[b], model.body_quat[b], file=walk.file, field=f"body({name}).quat")
     for n, j in enumerate(range(first, first + count)):
         _refuse_joint(walk, int(model.jnt_type[j]), name, joint_names[j])
         T = _joint(walk, j, k, T, name if n == count - 1 else joint_names[j], flags, joint_names[j])
@@ -168,22 +241,19 @@ def _body(walk: _Walk, b: int, body_names: list[str], joint_names: list[str], fl
     if not count:
         walk.frames.append(Frame(name, k, T))
     massive = float(model.body_mass[b]) != 0 or any(float(x) != 0 for x in model.body_inertia[b])
-    if k >= 0 and massive:
+    if massive and (k >= 0 or walk.free_body is not None):
         inertial = UrdfInertial(
             number(model.body_mass[b]),
             pose(model.body_ipos[b], model.body_iquat[b], file=walk.file, field=f"body({name}).iquat"),
             sp.ImmutableMatrix(sp.diag(*[number(x) for x in model.body_inertia[b]])),
         )
-        walk.parts[k].append((inertial, T))
+        (walk.parts[k] if k >= 0 else walk.base_parts).append((inertial, T))
 
 
 def _refuse_joint(walk: _Walk, kind: int, body: str, joint: str) -> None:
     """A free or ball joint is refused, naming the body and the joint."""
     if kind == _FREE:
-        why = (
-            "a free joint (a floating base): symdyn does not support floating bases yet; weld the "
-            "robot's root body to the world (remove the free joint)"
-        )
+        why = "a free joint below the root: a floating base is a body whose parent is the world"
     elif kind == _BALL:
         why = "a ball joint: symdyn handles hinge and slide joints only (write it as three hinge joints)"
     else:

@@ -108,6 +108,8 @@ class RobotFileReader:
         self.gravity: tuple[sp.Expr, ...] | None = None
         self.links: list[LinkData] = []
         self.base = Transform.identity()
+        #: a floating base's body as read: (mass, com, inertia components), None for a fixed base
+        self.base_body: tuple[sp.Expr, tuple[sp.Expr, ...], dict[str, sp.Expr]] | None = None
         self.frames: list[FrameData] = []
 
     # -- helpers
@@ -214,7 +216,13 @@ class RobotFileReader:
         self.gravity = self.vector(value, "gravity")
 
     def _read_base(self, value: object) -> None:
-        self.base = read_base(self, value)
+        self.base, body = read_base(self, value)
+        if body is None:
+            return
+        mass = self.expr(body["mass"], "base.mass") if "mass" in body else sp.S.Zero
+        com = self.vector(body["com"], "base.com") if "com" in body else (sp.S.Zero,) * 3
+        entries = self.mapping(body.get("inertia"), INERTIA_KEYS, "base.inertia")
+        self.base_body = (mass, com, {k: self.expr(v, f"base.inertia.{k}") for k, v in entries.items()})
 
     def _read_frames(self, value: object) -> None:
         self.frames = read_frames(self, value, _LINK_NAME)

@@ -31,10 +31,11 @@ from ..errors import SymdynError, link_fields
 from ..model.angles import constant_angle
 from ..model.bounded import bounded_subs
 from ..model.frames import Frame
+from ..model.free_flyer import BASE_NAMES
 from ..model.friction import coulomb_fields
 from ..model.inertia import tensor_from_components
 from ..model.physical import check_link_numbers
-from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Motor, Robot
+from ..model.robot import DEFAULT_GRAVITY, BaseBody, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform
 from .dh import dh_link, to_body
 from .frame_fields import model_frames
@@ -214,7 +215,28 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
         convention=reader.convention,
         frames=frames,
         base=reader.base,
+        floating=reader.base_body is not None,
+        base_body=_base_body(reader, subs),
     )
+
+
+def _base_body(reader: RobotFileReader, subs: dict) -> BaseBody:
+    """A floating base's body (base frame, inertia about its centre of mass), its numbers checked
+    once parameters have values; massless for a fixed base (unused there)."""
+    if reader.base_body is None:
+        return BaseBody()
+    clash = sorted({str(n) for n in reader.order} & set(BASE_NAMES))
+    if clash:
+        raise reader.error(
+            f"parameter '{clash[0]}' is the name of a floating base coordinate (rename the parameter)",
+            field=f"parameters.{clash[0]}",
+        )
+    mass, com, components = reader.base_body
+    tensor = tensor_from_components(components)
+    check_link_numbers(
+        mass.xreplace(subs), tensor.xreplace(subs), {}, sp.S.One, file=reader.file, link_name="base"
+    )
+    return BaseBody("base", mass, sp.ImmutableMatrix(3, 1, list(com)), sp.ImmutableMatrix(tensor))
 
 
 def _dh_links(reader: RobotFileReader, subs: dict) -> list[Link]:

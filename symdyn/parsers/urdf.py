@@ -45,9 +45,14 @@ that hangs off the chain (side branches, whatever lies below the tip) is merged
 into the chain link it hangs from, its joints locked at zero (a mimic joint at
 its offset, when its master is locked too).
 
+A floating robot (floating=True, --floating): the base link floats, joined to the world by a free
+flyer (symdyn.model.free_flyer); a floating joint that joins the root to it through fixed joints
+(world -> base_link) is that free flyer, and the base link with the links fixed to it is the
+floating base's body (`Robot.base_body`), whose mass enters the dynamics.
+
 Refused, naming the joint: floating and planar joints in the loaded part (a
-floating root joint, such as world -> base_link, with the hint to load the part
-below it with --base: floating bases are out of scope); a mimic of an unknown,
+floating root joint, such as world -> base_link, without floating=True, with the hint to load
+it with --floating or the part below it with --base); a mimic of an unknown,
 fixed or unloaded joint, and mimic cycles; a locked joint that mimics a joint of
 the chain. Numbers are read as doubles (finite, at most 1e150 in absolute
 value): integer values as Integer, others as the Float of the double; an rpy
@@ -82,7 +87,7 @@ import sympy as sp
 from ..errors import SymdynError, SymdynWarning, location
 from ..model.frames import Frame
 from ..model.inertia import check_inertia
-from ..model.robot import DEFAULT_GRAVITY, Friction, Link, Mimic, Robot
+from ..model.robot import DEFAULT_GRAVITY, BaseBody, Friction, Link, Mimic, Robot
 from ..spatial.transform import Transform
 from .safe_xml import Element, looks_like_xml, parse_xml
 from .source import MAX_BYTES, read_source
@@ -146,7 +151,12 @@ def _refuse_unmodelled(
         if j.type not in ("floating", "planar"):
             continue
         if all(k.type == "fixed" for k in tree.path(base, j.parent)):  # the robot's own floating base
-            hint = f"{j.type} bases are out of scope: load the robot below it with --base {j.child}"
+            hint = (
+                f"load it as a floating base with --floating (floating=True), or the robot below it on a "
+                f"fixed base with --base {j.child}"
+                if j.type == "floating"
+                else f"planar bases are out of scope: load the robot below it with --base {j.child}"
+            )
         else:
             hint = "choose a base below it (--base), or a tip (--tip) whose chain does not carry it"
         raise reader.error(
@@ -199,9 +209,42 @@ def _mimic(reader: UrdfReader, joint: UrdfJoint, index: dict[str, int], where: s
     return Mimic(index[master.name], multiplier, offset)
 
 
-def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -> Robot:
+def _floating_root(reader: UrdfReader, tree: UrdfTree, base: str) -> str:
+    """The floating base's link: `base`, or the child of the floating joint that joins it (through
+    fixed joints only) to the world, such as world -> base_link: that joint is the free flyer."""
+    stack = [base]
+    while stack:
+        name = stack.pop()
+        for j in tree.children[name]:
+            if j.type == "floating":
+                return j.child
+            if j.type == "fixed":
+                stack.append(j.child)
+    return base
+
+
+def _base_body(reader: UrdfReader, tree: UrdfTree, base: str) -> BaseBody:
+    """The floating base's body: the base link and the links fixed to it, merged."""
+    parts = _fixed_parts(tree, base)
+    _check_inertials(reader, [name for name, _ in parts])
+    mass, com, inertia = merge_inertials(
+        [(reader.links[n].inertial, T) for n, T in parts if reader.links[n].inertial is not None]
+    )
+    return BaseBody(base, numeric(mass), com.applyfunc(numeric), inertia.applyfunc(numeric))
+
+
+def _build(
+    reader: UrdfReader, digest: str, base: str | None, tip: str | None, floating: bool = False
+) -> Robot:
     tree = UrdfTree(reader)
     base = tree.root if base is None else link_name(reader, base, "base")
+    if floating:
+        if tip is not None:
+            raise SymdynError(
+                "a floating robot is the whole tree below its base: give no tip (--tip) with --floating",
+                file=reader.file,
+            )
+        base = _floating_root(reader, tree, base)
     loaded, where = _loaded(reader, tree, base, tip)
     index = {j.name: i for i, j in enumerate(loaded)}
 
@@ -241,6 +284,8 @@ def _build(reader: UrdfReader, digest: str, base: str | None, tip: str | None) -
         source_sha256=digest,
         convention="urdf",
         frames=tuple(frames),
+        floating=floating,
+        base_body=_base_body(reader, tree, base) if floating else BaseBody(base),
     )
 
 
@@ -261,8 +306,14 @@ def load_urdf(
     tip: str | None = None,
     xacro_args: Mapping[str, str] | None = None,
     package_dirs: Mapping[str, str] | None = None,
+    floating: bool = False,
 ) -> Robot:
     """Read a URDF file and return the tree below `base`, or the chain from `base` to `tip`, as a `Robot`.
+
+    floating=True: the base link (default the root link; the child of a floating joint that joins
+    the root to the world, such as world -> base_link) is a floating base joined to the world by a
+    free flyer (symdyn.model.free_flyer), its mass and inertia (and those of the links fixed to it)
+    part of the dynamics; no tip then.
 
     base: a link name (default: the root link); tip: a link below it (default: none,
     the whole tree; see the module documentation). A xacro file (named *.xacro, or declaring
@@ -275,11 +326,19 @@ def load_urdf(
     `symdyn.load_robot` reads a URDF too (it recognises one by its content).
     """
     file, raw, digest = read_source(path, "URDF file")
-    return urdf_from_bytes(raw, file, digest, base, tip, xacro_args=xacro_args, package_dirs=package_dirs)
+    return urdf_from_bytes(
+        raw, file, digest, base, tip, xacro_args=xacro_args, package_dirs=package_dirs, floating=floating
+    )
 
 
 def urdf_from_bytes(
-    raw: bytes, file: str, digest: str, base: str | None, tip: str | None, **xacro: Mapping[str, str] | None
+    raw: bytes,
+    file: str,
+    digest: str,
+    base: str | None,
+    tip: str | None,
+    floating: bool = False,
+    **xacro: Mapping[str, str] | None,
 ) -> Robot:
     """The `Robot` of a URDF file's bytes (`file` names it in messages, `digest` is their sha256);
     `xacro`: xacro_args and package_dirs of a xacro file (see load_urdf)."""
@@ -289,7 +348,7 @@ def urdf_from_bytes(
             "a robot file (YAML or JSON) is read by symdyn.load_robot",
             file=file,
         )
-    return urdf_from_root(parse_xml(raw, file), file, digest, base, tip, **xacro)
+    return urdf_from_root(parse_xml(raw, file), file, digest, base, tip, floating=floating, **xacro)
 
 
 def urdf_from_root(
@@ -300,6 +359,7 @@ def urdf_from_root(
     tip: str | None,
     xacro_args: Mapping[str, str] | None = None,
     package_dirs: Mapping[str, str] | None = None,
+    floating: bool = False,
 ) -> Robot:
     """The `Robot` of a URDF file's parsed top element (`file` names it, `digest` is its sha256);
     a xacro file is expanded first (its digest is then the expanded URDF's)."""
@@ -313,4 +373,4 @@ def urdf_from_root(
         raise SymdynError("xacro arguments and package folders apply to xacro files only", file=file)
     reader = UrdfReader(file)
     reader.read(root)
-    return _build(reader, digest, base, tip)
+    return _build(reader, digest, base, tip, floating)
