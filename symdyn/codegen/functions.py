@@ -37,6 +37,7 @@ from ..dynamics import QUANTITIES, Dynamics, singular_message
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
+from .centroidal_functions import centroidal_rows
 from .configuration_functions import configuration_rows
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
 from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
@@ -184,6 +185,7 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     kinematics_rows,
     operational_space_rows,
     configuration_rows,
+    centroidal_rows,
 )
 
 
@@ -218,10 +220,19 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
     "kinematics": (kinematics_rows,),
     "operational_space": (operational_space_rows,),
     "configuration": (configuration_rows,),
+    "centroidal": (centroidal_rows,),
 }
 
 #: The groups built per frame (symdyn.codegen.frame_functions): only when named, never by default.
 FRAME_GROUPS = ("kinematics", "operational_space")
+#: The groups built only when named (the frame groups and the centroidal functions).
+NAMED_ONLY = (*FRAME_GROUPS, "centroidal")
+#: Functions two groups both have (com: kinematics and centroidal): built once, by the first.
+SHARED_FUNCTIONS = ("com",)
+
+
+def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
+    return next(row for row in rows if row.name == name)
 
 
 def build_functions(
@@ -239,19 +250,22 @@ def build_functions(
     frames, symdyn.codegen.frame_functions.choose_frames).
     The regressor and the derivatives add intermediates to `dyn.program`; each family has a pass
     of its own so that it cannot change the other functions' temporaries. `groups` (names of
-    GROUPS; all but FRAME_GROUPS by default) keeps only those families: their code is the same
-    as in a full build.
+    GROUPS; all but NAMED_ONLY, the frame groups and centroidal, by default) keeps only those
+    families: their code is the same as in a full build.
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
     per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
-    chosen = set(FAMILIES) - per_frame if groups is None else {b for g in groups for b in GROUPS[g]}
+    named_only = {b for g in NAMED_ONLY for b in GROUPS[g]}
+    chosen = set(FAMILIES) - named_only if groups is None else {b for g in groups for b in GROUPS[g]}
     if frames is None and chosen & per_frame:
         frames = choose_frames(dyn.robot)
     x = Inputs.of(dyn, frames)
     families = [family for family in FAMILIES if family in chosen]
     _warn_singular(dyn, families)
     rows = [row for family in families for row in family(dyn, x)]
+    shared = [row for row in rows if row.name in SHARED_FUNCTIONS]
+    rows = [row for row in rows if row.name not in SHARED_FUNCTIONS or row is _first(shared, row.name)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
     code = {}
