@@ -49,6 +49,7 @@ from .algorithms.configuration_space import ConfigurationSpace, configuration_sp
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
+from .algorithms.floating import floating_newton_euler_terms
 from .algorithms.frame_kinematics import FrameKinematics
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
@@ -59,6 +60,7 @@ from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.singular import SingularJoint, describe_singular, singular_joints
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
+from .model.free_flyer import base_symbols
 from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
@@ -146,7 +148,9 @@ class Dynamics:
 
     @property
     def n(self) -> int:
-        return self.robot.n
+        """The size of qd, qdd, tau and of M: the number of joints, or NV = 6 + joints on a
+        floating base (whose q has NQ = 7 + joints entries)."""
+        return self.robot.nv
 
     def closed_form(self, name: str) -> sp.Matrix:
         """Quantity `name` with the intermediates substituted back (and simplified if requested).
@@ -172,6 +176,7 @@ class Dynamics:
         if name not in self._closed:
             if (
                 not self.simplified
+                and not self.robot.floating
                 and name in ALL_QUANTITIES
                 and name != "F"
                 and self.configuration_space.readable
@@ -195,7 +200,10 @@ class Dynamics:
     def singular_joints(self) -> tuple[SingularJoint, ...]:
         """The joints that make M(q) singular for every q, with the cause: the exactly zero
         pivots of M = L D L^T and the joints that move no mass (symdyn.algorithms.singular).
-        Empty when M can be inverted as far as its numbers tell."""
+        Empty when M can be inverted as far as its numbers tell (and for a floating robot, whose M
+        is checked numerically by the oracle instead)."""
+        if self.robot.floating:
+            return ()
         return singular_joints(self.robot, self.compact["M"])
 
     @property
@@ -347,7 +355,11 @@ class Dynamics:
         """
         where = "Dynamics.evaluate"
         _check_quantity(name, where)
-        vec = [self.robot.joint_values(v, label, where) for v, label in ((q, "q"), (qd, "qd"), (qdd, "qdd"))]
+        named = ((q, self.q, "q"), (qd, self.qd, "qd"), (qdd, self.qdd, "qdd"))
+        if self.robot.floating:
+            vec = [_state_vector(v, len(s), label, where) for v, s, label in named]
+        else:
+            vec = [self.robot.joint_values(v, label, where) for v, _, label in named]
         values = self.robot.param_values(params, where)
         p = [values[s] for s in self.params]
         shape = self.compact[name].shape
@@ -548,6 +560,29 @@ def singular_message(dyn: Dynamics) -> str:
     return f"robot '{dyn.robot.name}': {SINGULAR_M}: {describe_singular(dyn.robot, joints)}"
 
 
+def state_symbols(robot: Robot) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    """(q, qd, qdd) symbols: the joints' (symdyn.model.symbols), after the free flyer's on a
+    floating base (symdyn.model.free_flyer: q of NQ = 7 + n, qd and qdd of NV = 6 + n)."""
+    q, qd, qdd = joint_symbols(robot.n)
+    if not robot.floating:
+        return q, qd, qdd
+    bq, bv, ba = base_symbols()
+    return sp.Matrix.vstack(bq, q), sp.Matrix.vstack(bv, qd), sp.Matrix.vstack(ba, qdd)
+
+
+def _state_vector(values, size: int, name: str, where: str) -> np.ndarray:
+    """`size` numbers (None: zeros) as a float array, else a SymdynError naming the vector."""
+    if values is None:
+        return np.zeros(size)
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise SymdynError(f"{where}: {name} must hold numbers, got {values!r}") from None
+    if a.shape != (size,):
+        raise SymdynError(f"{where}: {name} has shape {a.shape}, expected ({size},)")
+    return a
+
+
 def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = None) -> Dynamics:
     """Derive M, C, V, G, F, tau and the bias V + G + F of `robot` (slide 16).
 
@@ -583,15 +618,24 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
     if simplify is not None and not isinstance(simplify, bool):
         raise SymdynError(f"derive: simplify must be True, False or None, got {simplify!r}")
     r = robot.resolved()
-    q, qd, qdd = joint_symbols(r.n)
+    q, qd, qdd = state_symbols(r)
     program = Program()
+    if r.floating and method != "newton-euler":
+        raise SymdynError(
+            f"derive: robot '{r.name}' has a floating base: derive it by the newton-euler method "
+            "(the Lagrange route does not handle a floating base yet)"
+        )
     with distribute(False):
-        if method == "newton-euler":
+        if r.floating:
+            terms = floating_newton_euler_terms(r, q, qd, qdd, program)
+        elif method == "newton-euler":
             terms = _newton_euler_terms(r, q, qd, qdd, program)
         else:
             terms = lagrange(r, q, qd, program)
             terms["V"] = sp.Matrix([program.let(v, "V") for v in terms["C"] * qd])
-        F = friction_vector(r, qd)
+        F = friction_vector(r, qd[6:, :] if r.floating else qd)
+        if r.floating:
+            F = sp.Matrix.vstack(sp.zeros(6, 1), F)
         terms["F"] = F
         if method == "lagrange":
             terms["tau"] = terms["M"] * qdd + terms["V"] + terms["G"] + F
@@ -609,7 +653,7 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         qdd=qdd,
         params=r.params,
         program=program,
-        compact={k: sp.Matrix(terms[k]) for k in ALL_QUANTITIES},
+        compact={k: sp.Matrix(terms[k]) for k in ALL_QUANTITIES if k in terms},
         simplified=bool(simplify),
     )
     if dyn.singular_joints:

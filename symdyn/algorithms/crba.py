@@ -120,7 +120,11 @@ def composite_inertias(robot: Robot, frames: list[JointFrame], program: Program)
 
 
 def mass_matrix_crba(
-    robot: Robot, frames: list[JointFrame], composites: list[SpatialInertia], program: Program
+    robot: Robot,
+    frames: list[JointFrame],
+    composites: list[SpatialInertia],
+    program: Program,
+    base_columns: list[Force] | None = None,
 ) -> sp.Matrix:
     """M(q) by the composite-rigid-body algorithm (Featherstone 2008, sec. 6.2), plus the
     reflected motor inertia gear_ratio^2 J_m on the diagonal (Grupen (2015), slide 16).
@@ -130,6 +134,8 @@ def mass_matrix_crba(
         frames: `joint_frames(robot, q)`.
         composites: `composite_inertias(robot, frames, program)` (body frames).
         program: receives the named intermediates.
+        base_columns: receives, per joint j, the force of its unit acceleration carried down to
+            the base frame (n, f about the base origin): the base rows of a floating M.
 
     Returns:
         The symmetric nb x nb inertia matrix of the bodies' joints over the program's
@@ -148,6 +154,8 @@ def mass_matrix_crba(
                 entry = entry + robot.links[j].motor.reflected_inertia
             M[i, j] = M[j, i] = program.let(entry, "M")
             if parents[i] < 0:
+                if base_columns is not None:
+                    base_columns.append(frames[i].force_to_parent(force, program, "Ff"))
                 break
             force = frames[i].force_to_parent(force, program, "Ff")
             force = force._replace(angular=program.let_vector(force.angular, "Fn"))
@@ -156,7 +164,11 @@ def mass_matrix_crba(
 
 
 def gravity_composite(
-    robot: Robot, frames: list[JointFrame], composites: list[SpatialInertia], program: Program
+    robot: Robot,
+    frames: list[JointFrame],
+    composites: list[SpatialInertia],
+    program: Program,
+    g_base: v3.Vec | None = None,
 ) -> list[sp.Expr]:
     """G(q) from the composite bodies (Grupen (2015), slide 16: the G of tau = M qdd + V + G + F).
 
@@ -176,11 +188,13 @@ def gravity_composite(
         frames: `joint_frames(robot, q)`.
         composites: `composite_inertias(robot, frames, program)` (body frames).
         program: receives the named intermediates (the g_k).
+        g_base: gravity in the base frame when it is not the robot's `base_gravity` (a floating
+            base: R^T g with R its orientation).
 
     Returns:
         nb expressions (the bodies' joints) over the program's intermediates.
     """
-    g_base = v3.vec(robot.base_gravity)
+    g_base = v3.vec(robot.base_gravity) if g_base is None else g_base
     g: list[v3.Vec] = []  # g_k, frame k
     G: list[sp.Expr] = []
     for k, link in enumerate(robot.links):

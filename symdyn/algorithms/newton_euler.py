@@ -52,7 +52,7 @@ from ..spatial.motion import Force
 from ..symbolic.program import Program
 from .frames import JointFrame, joint_frames
 
-__all__ = ["newton_euler", "outward", "tilde", "LinkAcceleration"]
+__all__ = ["newton_euler", "outward", "tilde", "body_wrench", "LinkAcceleration"]
 
 
 class LinkAcceleration(NamedTuple):
@@ -72,7 +72,7 @@ def _about_origin(link: Link) -> bool:
     return any(Ic[r, s] != 0 for r in range(3) for s in range(3) if r != s)
 
 
-def _body_wrench(link: Link, W: v3.Mat, motion: LinkAcceleration, program: Program, k: str) -> Force:
+def body_wrench(link: Link, W: v3.Mat, motion: LinkAcceleration, program: Program, k: str) -> Force:
     """The net wrench (N, F) about the body origin that accelerates the link (slide 15), body frame.
 
     Either about the centre of mass, F = m (W c + vd), N = I_c wd + w x I_c w + c x F,
@@ -145,6 +145,8 @@ def newton_euler(
     gravity: bool = True,
     tag: str = "",
     rotations: list[JointFrame] | None = None,
+    base: LinkAcceleration | None = None,
+    base_wrench: list[Force] | None = None,
 ) -> list[sp.Expr]:
     """Rigid-body joint efforts (no friction, no motor inertia) by recursive Newton-Euler.
 
@@ -159,6 +161,10 @@ def newton_euler(
         gravity: enter the robot's gravity (base frame) as the base acceleration vd_0 = -g.
         tag: prefix of the intermediates' names, to tell passes apart.
         rotations: `symdyn.algorithms.frames.joint_frames(robot, q)`, to share them.
+        base: the base's motion (w, wd, vd of its origin, base frame; gravity included) when it
+            moves (a floating base, symdyn.algorithms.floating); None: at rest, vd_0 = -g.
+        base_wrench: receives the wrench (n, f) the links on the base exert on it, about its
+            origin, base frame: sum_j (R_j n_j + p_j x R_j f_j, R_j f_j) over its children.
 
     Returns:
         nb joint efforts tau_i = a_i . n_i (revolute) or a_i . f_i (prismatic), with n_i, f_i
@@ -170,20 +176,22 @@ def newton_euler(
     parents = robot.parents
     frames = rotations if rotations is not None else joint_frames(robot, q)
     zero = v3.ZERO3
-    vd_0 = program.let_vector(v3.neg(v3.vec(robot.base_gravity)), f"{tag}g") if gravity else zero
-    base = LinkAcceleration(zero, zero, vd_0)
+    if base is None:
+        vd_0 = program.let_vector(v3.neg(v3.vec(robot.base_gravity)), f"{tag}g") if gravity else zero
+        base = LinkAcceleration(zero, zero, vd_0)
+    W_base = v3.ZERO33 if base.w == zero and base.wd == zero else tilde(program, base.w, base.wd, f"{tag}0")
     motions: list[LinkAcceleration] = []  # of link i, in frame i
     Ws: list[v3.Mat] = []
     wrenches: list[Force] = []  # net wrench of link i about its origin, frame i
     for i, link in enumerate(robot.links):
         k = f"{tag}{i + 1}"
         p = parents[i]
-        parent, W_parent = (base, v3.ZERO33) if p < 0 else (motions[p], Ws[p])
+        parent, W_parent = (base, W_base) if p < 0 else (motions[p], Ws[p])
         motion = outward(link, frames[i], parent, W_parent, qd[i], qdd[i], program, k)
         W = tilde(program, motion.w, motion.wd, k)
         motions.append(motion)
         Ws.append(W)
-        wrenches.append(_body_wrench(link, W, motion, program, k))
+        wrenches.append(body_wrench(link, W, motion, program, k))
     tau: list[sp.Expr] = [sp.S.Zero] * nb
     transmitted: list[Force] = [Force(zero, zero)] * nb  # the wrench on link i from its parent, frame i
     for i in reversed(range(nb)):
@@ -198,4 +206,9 @@ def newton_euler(
         transmitted[i] = Force(program.let_vector(n_i, f"n{k}_"), f)
         a = v3.vec(link.axis)
         tau[i] = v3.dot(a, transmitted[i].angular if link.joint == "revolute" else f)
+    if base_wrench is not None:
+        carried = [
+            frames[j].force_to_parent(transmitted[j], program, f"Rf{tag}0_") for j in children(parents, -1)
+        ]
+        base_wrench.append(Force(v3.add(*(c.angular for c in carried)), v3.add(*(c.linear for c in carried))))
     return tau

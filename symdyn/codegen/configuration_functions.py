@@ -29,9 +29,11 @@ CONFIGURATION_FUNCTIONS = ("integrate", "difference")
 def configuration_inputs(dyn: Dynamics) -> tuple[Input, Input, Input, Input]:
     """The inputs q (NQ), v (NV), dt (1) and q_next (NQ) of the two functions (q0 reads q's symbols)."""
     qb, vb, _ = base_symbols()
-    joints = [sp.Symbol(f"{s}_1_b") for s in dyn.q]
-    q = Input("q", (*qb, *dyn.q))
-    v = Input("v", (*vb, *dyn.qd))
+    n = dyn.robot.n
+    q_joints, v_joints = list(dyn.q)[len(dyn.q) - n :], list(dyn.qd)[len(dyn.qd) - n :]
+    joints = [sp.Symbol(f"{s}_1_b") for s in q_joints]
+    q = Input("q", (*qb, *q_joints))
+    v = Input("v", (*vb, *v_joints))
     dt = Input("dt", (sp.Symbol("dt_b"),))
     q1 = Input("q_next", (*(sp.Symbol(f"{str(s)[:-2]}_1_b") for s in qb), *joints))
     return q, v, dt, q1
@@ -42,7 +44,7 @@ def configuration_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     robot = dyn.robot
     if not robot.floating:
         return []
-    n = len(dyn.q)
+    n = robot.n
     q, v, dt, q1 = configuration_inputs(dyn)
     rows = []
     prog = Program()

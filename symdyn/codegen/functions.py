@@ -34,7 +34,7 @@ from collections.abc import Callable, Sequence
 import sympy as sp
 
 from ..dynamics import QUANTITIES, Dynamics, singular_message
-from ..errors import SymdynWarning
+from ..errors import SymdynError, SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .centroidal_functions import centroidal_rows
@@ -121,6 +121,8 @@ def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     ]
     rows = []
     for name, doc, inputs, out in table:
+        if out not in c:  # C of a floating robot (not derived)
+            continue
         shape = joint_matrix_output if out in ("M", "C") else vector_output
         rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), tuple(c[out])))
     return rows
@@ -135,7 +137,10 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     c = dyn.compact
     fd = Program()
     b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
-    order = list(range(n)) if dyn.robot.is_chain else list(reversed(range(n)))
+    # a floating base is the root of the tree, its six coordinates first: eliminating the last
+    # coordinate first leaves its 6 x 6 block, dense, for the end and fills nothing else in
+    chain = dyn.robot.is_chain and not dyn.robot.floating
+    order = list(range(n)) if chain else list(reversed(range(n)))
     solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
     qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
@@ -235,6 +240,26 @@ def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
     return next(row for row in rows if row.name == name)
 
 
+#: the groups generated for a floating robot (docs/floating-base.md, docs/centroidal.md)
+FLOATING_GROUPS = ("dynamics", "configuration", "kinematics", "centroidal")
+#: those built by default (the others only when named)
+FLOATING_DEFAULT = ("dynamics", "configuration")
+
+
+def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
+    """The groups of a floating robot: FLOATING_DEFAULT by default; any group outside
+    FLOATING_GROUPS is a SymdynError."""
+    if groups is None:
+        return FLOATING_DEFAULT
+    other = [g for g in groups if g not in FLOATING_GROUPS]
+    if other:
+        raise SymdynError(
+            f"robot '{dyn.robot.name}' has a floating base: the {other[0]} functions are not generated "
+            f"for a floating robot (available: {', '.join(FLOATING_GROUPS)})"
+        )
+    return groups
+
+
 def build_functions(
     dyn: Dynamics, groups: Sequence[str] | None = None, frames: FrameChoice | None = None
 ) -> list[FunctionSpec]:
@@ -255,6 +280,8 @@ def build_functions(
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
+    if dyn.robot.floating:
+        groups = _floating_groups(dyn, groups)
     per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
     named_only = {b for g in NAMED_ONLY for b in GROUPS[g]}
     chosen = set(FAMILIES) - named_only if groups is None else {b for g in groups for b in GROUPS[g]}
@@ -273,7 +300,8 @@ def build_functions(
         members = [row for row in rows if row.cse == group]
         needs = [e for row in members for e in row.exprs] + [e for row in members for _, e in row.steps]
         if not group:
-            needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
+            needs += [e for name in QUANTITIES if name in dyn.compact for e in dyn.compact[name]]
+            needs += list(dyn.compact["bias"])
         steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
         code |= eliminate_many(steps, {row.name: list(row.exprs) for row in members}, reserved=x.symbols)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

@@ -48,7 +48,9 @@ class NumericModel:
     independent coordinate each body's joint follows, with `multiplier` and `offset` (nb,)
     (q_i = multiplier_i q[coordinate_i] + offset_i); `selection` (nb, n) the matrix S of
     qd_b = S qd; `own` (n,) int, per coordinate the link whose joint it is (not a mimic);
-    `names` the links' names and `name` the robot's, for messages.
+    `names` the links' names and `name` the robot's, for messages. `floating`: the base floats
+    (Robot.floating), `base_inertia` (6,6) the spatial inertia of its body about the base origin
+    (zero on a fixed base).
     """
 
     revolute: np.ndarray
@@ -79,6 +81,8 @@ class NumericModel:
     own: np.ndarray
     names: tuple[str, ...]
     name: str
+    floating: bool
+    base_inertia: np.ndarray
 
     def __post_init__(self) -> None:
         for value in vars(self).values():  # cached and shared: make every array read-only
@@ -148,14 +152,13 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
     n = len(links)
     R0, inertia = R0.reshape(n, 3, 3), inertia.reshape(n, 3, 3)
     p0, axis, com, mass = p0.reshape(n, 3), axis.reshape(n, 3), com.reshape(n, 3), mass.reshape(n)
-    # Spatial inertia about the body origin: [[Ic + m cx cx^T, m cx], [m cx^T, m 1]].
-    cx = skew(com)
-    m = mass[:, None, None]
-    spatial = np.zeros((n, 6, 6))
-    spatial[:, :3, :3] = inertia + m * cx @ np.swapaxes(cx, -1, -2)
-    spatial[:, :3, 3:] = m * cx
-    spatial[:, 3:, :3] = m * np.swapaxes(cx, -1, -2)
-    spatial[:, 3:, 3:] = m * np.eye(3)
+    spatial = _spatial_inertias(mass, com, inertia)
+    body = r.base_body
+    base_inertia = _spatial_inertias(
+        _floats(body.mass, (1,), "base mass"),
+        _floats(body.com, (1, 3), "base com"),
+        _floats(body.inertia, (1, 3, 3), "base inertia"),
+    )[0]
     fr = [
         (lk.friction.viscous, lk.friction.coulomb, lk.motor.reflected_inertia, lk.friction.coulomb_minus)
         for lk in links
@@ -192,32 +195,48 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
         coordinate=coordinate, multiplier=multiplier.reshape(n), offset=offset.reshape(n),
         selection=selection, own=np.array([i for i, lk in enumerate(links) if lk.mimic is None], dtype=int),
         names=tuple(lk.name for lk in links), name=r.name,
+        floating=bool(r.floating), base_inertia=base_inertia,
     )  # fmt: skip
 
 
-def _states(where: str, n: int, *named: tuple[str, object]) -> tuple[list[np.ndarray], bool]:
-    """Joint vectors (name, value), each (n,) or (N, n) and all of one shape, as (N, n) arrays;
-    and whether they were single states."""
+def _spatial_inertias(mass: np.ndarray, com: np.ndarray, inertia: np.ndarray) -> np.ndarray:
+    """Spatial inertias (k,6,6) about the body origins: [[Ic + m cx cx^T, m cx], [m cx^T, m 1]]."""
+    cx = skew(com)
+    m = mass[:, None, None]
+    spatial = np.zeros((len(mass), 6, 6))
+    spatial[:, :3, :3] = inertia + m * cx @ np.swapaxes(cx, -1, -2)
+    spatial[:, :3, 3:] = m * cx
+    spatial[:, 3:, :3] = m * np.swapaxes(cx, -1, -2)
+    spatial[:, 3:, 3:] = m * np.eye(3)
+    return spatial
+
+
+def _states(where: str, n: int, *named: tuple) -> tuple[list[np.ndarray], bool]:
+    """Joint vectors (name, value), each (n,) or (N, n), or (name, value, size, what) with their
+    own size (a floating robot's q of NQ entries, v of NV: `what` says so), all with one number of
+    states N, as (N, size) arrays; and whether they were single states."""
     arrays = []
-    for name, x in named:
+    for name, x, *sized in named:
+        size, what = sized if sized else (n, "one per joint")
         try:
             a = np.asarray(x, dtype=float)
         except (TypeError, ValueError):
             raise SymdynError(f"{where}: {name} must hold numbers, got {x!r}") from None
-        if a.ndim == 1 and a.shape != (n,):
+        if a.ndim == 1 and a.shape != (size,):
             count = f"{a.size} entry" if a.size == 1 else f"{a.size} entries"
-            raise SymdynError(f"{where}: {name} has {count}, expected {n} (one per joint)")
-        if a.ndim not in (1, 2) or a.shape[-1] != n:
+            raise SymdynError(f"{where}: {name} has {count}, expected {size} ({what})")
+        if a.ndim not in (1, 2) or a.shape[-1] != size:
+            rows = f"{what}: one row per state" if sized else "one column per joint"
             raise SymdynError(
-                f"{where}: {name} has shape {a.shape}, expected ({n},) or (N, {n}) (one column per joint)"
+                f"{where}: {name} has shape {a.shape}, expected ({size},) or (N, {size}) ({rows})"
             )
         arrays.append(a)
-    if len({a.shape for a in arrays}) > 1:
-        shapes = ", ".join(f"{name} {a.shape}" for (name, _), a in zip(named, arrays, strict=True))
+    if len({a.shape[:-1] for a in arrays}) > 1 or len({a.ndim for a in arrays}) > 1:
+        shapes = ", ".join(f"{t[0]} {a.shape}" for t, a in zip(named, arrays, strict=True))
         raise SymdynError(
             f"{where}: the joint vectors differ in shape ({shapes}); give each one state or N states"
         )
-    return [a.reshape(-1, n) for a in arrays], arrays[0].ndim == 1
+    return [a.reshape(-1, a.shape[-1]) for a in arrays], not arrays or arrays[0].ndim == 1
 
 
 def checked_inputs(where: str, robot, params, *named: tuple[str, object]):

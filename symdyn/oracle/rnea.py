@@ -23,12 +23,18 @@ the n independent joint coordinates, as a single state (vectors of length n) or 
 (arrays of shape (N, n)). A mimic joint follows another, q_j = multiplier q_i + offset:
 the algorithms run on the nb bodies at q_b, qd_b = S qd, qdd_b = S qdd and the efforts come
 back as S^T tau_b (M = S^T M_b S), by virtual work (Featherstone 2008, ch. 8: qd_b = S qd as a constraint).
+
+On a floating robot (Robot.floating) rnea, mass_matrix, gravity_torque, bias_torque,
+friction_torque, forward_dynamics and kinetic_energy take Pinocchio's vectors, q of NQ = 7 + n
+entries and velocities, accelerations and efforts of NV = 6 + n (symdyn.oracle.floating).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SymdynError
+from .floating import floating_inputs, floating_mass_matrix, floating_rnea, solve
 from .inputs import (
     NumericModel,
     body_positions,
@@ -37,8 +43,9 @@ from .inputs import (
     numeric_model,
     project,
 )
+from .recursions import body_crba, body_rnea, joint_friction
 from .singular import check_invertible
-from .spatial import crm, joint_poses, motion_transforms, mv, subspaces
+from .spatial import joint_poses, motion_transforms, mv, subspaces
 
 __all__ = [
     "NumericModel",
@@ -56,56 +63,31 @@ __all__ = [
 ]
 
 
+def _floating(robot) -> bool:
+    """Whether the robot's base floats (symdyn.oracle.floating then evaluates its dynamics)."""
+    return getattr(robot, "floating", False) is True
+
+
+def _fixed_only(robot, where: str) -> None:
+    """A SymdynError for a floating robot in a function that handles a fixed base only."""
+    if _floating(robot):
+        raise SymdynError(f"{where}: robot '{robot.name}' has a floating base: {where} is for a fixed base")
+
+
 def _out(a: np.ndarray, single: bool) -> np.ndarray:
     return a[0] if single else a
-
-
-def _body_rnea(mdl: NumericModel, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, g_on: bool) -> np.ndarray:
-    """Rigid-body efforts of the bodies' joints (N, nb) by the spatial RNEA on the tree, for the
-    bodies' joint positions, velocities and accelerations (N, nb) each; see `rnea`."""
-    N = len(q)
-    X = motion_transforms(joint_poses(mdl, q))
-    S = subspaces(mdl)
-    base_v = np.zeros((N, 6))
-    base_a = np.zeros((N, 6))
-    if g_on:
-        base_a[:, 3:] = -mdl.gravity  # fictitious base acceleration a_0 = [0; -g]
-    vs: list[np.ndarray] = []
-    accs: list[np.ndarray] = []
-    forces = []
-    for i in range(mdl.nb):
-        p = mdl.parent[i]
-        v_p, a_p = (base_v, base_a) if p < 0 else (vs[p], accs[p])
-        v = mv(X[i], v_p) + S[i] * qd[:, i, None]
-        vx = crm(v)
-        a = mv(X[i], a_p) + S[i] * qdd[:, i, None] + mv(vx, S[i]) * qd[:, i, None]
-        vs.append(v)
-        accs.append(a)
-        Iv = mv(mdl.spatial_inertia[i], v)
-        # f = I a + v x* (I v), with v x* = -(v x)^T the force cross product.
-        forces.append(mv(mdl.spatial_inertia[i], a) - mv(np.swapaxes(vx, -1, -2), Iv))
-    tau = np.zeros((N, mdl.nb))
-    for i in reversed(range(mdl.nb)):  # every child's force is in by now: children come later
-        tau[:, i] = forces[i] @ S[i]
-        p = mdl.parent[i]
-        if p >= 0:
-            forces[p] = forces[p] + mv(np.swapaxes(X[i], -1, -2), forces[i])
-    return tau
-
-
-def _friction(mdl, qd_b: np.ndarray) -> np.ndarray:
-    """The bodies' friction efforts at their rates qd_b (N, nb): viscous qd + coulomb [qd > 0]
-    - coulomb_minus [qd < 0] (= coulomb sign(qd) when the two magnitudes are the same)."""
-    return mdl.viscous * qd_b + mdl.coulomb * (qd_b > 0) - mdl.coulomb_minus * (qd_b < 0)
 
 
 def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
     """tau (N, n) for independent q, qd, qdd (N, n): the bodies' efforts, with rotor inertia and
     friction at the bodies' rates, projected by S^T; see `rnea`."""
     q_b, qd_b, qdd_b = body_positions(mdl, q), body_rates(mdl, qd), body_rates(mdl, qdd)
-    tau = _body_rnea(mdl, q_b, qd_b, qdd_b, g_on) + mdl.reflected * qdd_b
+    base_a = np.zeros((len(q), 6))
+    if g_on:
+        base_a[:, 3:] = -mdl.gravity  # fictitious base acceleration a_0 = [0; -g]
+    tau = body_rnea(mdl, q_b, qd_b, qdd_b, np.zeros((len(q), 6)), base_a)[0] + mdl.reflected * qdd_b
     if f_on:
-        tau += _friction(mdl, qd_b)
+        tau += joint_friction(mdl, qd_b)
     return project(mdl, tau)
 
 
@@ -134,27 +116,18 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
     Raises:
         SymdynError: a vector of the wrong shape or not numeric, or bad parameter values.
     """
+    if _floating(robot):
+        mdl, (q, v, a), single = floating_inputs(
+            "rnea", robot, params, ("q", q, "q"), ("v", qd, "v"), ("a", qdd, "v")
+        )
+        return _out(floating_rnea(mdl, q, v, a, gravity, friction), single)
     mdl, (q, qd, qdd), single = checked_inputs("rnea", robot, params, ("q", q), ("qd", qd), ("qdd", qdd))
     return _out(_rnea(mdl, q, qd, qdd, gravity, friction), single)
 
 
 def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
     """M for a batch of independent q (N, n) -> (N, n, n); see `mass_matrix`."""
-    N = len(q)
-    X = motion_transforms(joint_poses(mdl, body_positions(mdl, q)))
-    S = subspaces(mdl)
-    Ic = [np.broadcast_to(mdl.spatial_inertia[i], (N, 6, 6)).copy() for i in range(mdl.nb)]
-    M = np.zeros((N, mdl.nb, mdl.nb))
-    for i in reversed(range(mdl.nb)):  # Ic[i] is complete: its children come after it
-        if mdl.parent[i] >= 0:
-            Ic[mdl.parent[i]] += np.swapaxes(X[i], -1, -2) @ Ic[i] @ X[i]
-        F = Ic[i] @ S[i]
-        M[:, i, i] = F @ S[i] + mdl.reflected[i]
-        j = i
-        while mdl.parent[j] >= 0:
-            F = mv(np.swapaxes(X[j], -1, -2), F)
-            j = mdl.parent[j]
-            M[:, i, j] = M[:, j, i] = F @ S[j]
+    M = body_crba(mdl, body_positions(mdl, q))[0] + np.diag(mdl.reflected)
     return mdl.selection.T @ M @ mdl.selection
 
 
@@ -175,6 +148,9 @@ def mass_matrix(robot, q, params=None) -> np.ndarray:
     Returns:
         M, (n, n) or (N, n, n).
     """
+    if _floating(robot):
+        mdl, (q,), single = floating_inputs("mass_matrix", robot, params, ("q", q, "q"))
+        return _out(floating_mass_matrix(mdl, q), single)
     mdl, (q,), single = checked_inputs("mass_matrix", robot, params, ("q", q))
     return _out(_mass_matrix(mdl, q), single)
 
@@ -190,6 +166,10 @@ def gravity_torque(robot, q, params=None) -> np.ndarray:
     Returns:
         G, (n,) or (N, n).
     """
+    if _floating(robot):
+        mdl, (q,), single = floating_inputs("gravity_torque", robot, params, ("q", q, "q"))
+        z = np.zeros((len(q), mdl.n + 6))
+        return _out(floating_rnea(mdl, q, z, z, True, False), single)
     mdl, (q,), single = checked_inputs("gravity_torque", robot, params, ("q", q))
     z = np.zeros_like(q)
     return _out(_rnea(mdl, q, z, z, True, False), single)
@@ -208,6 +188,9 @@ def bias_torque(robot, q, qd, params=None) -> np.ndarray:
     Returns:
         V, (n,) or (N, n).
     """
+    if _floating(robot):
+        mdl, (q, v), single = floating_inputs("bias_torque", robot, params, ("q", q, "q"), ("v", qd, "v"))
+        return _out(floating_rnea(mdl, q, v, np.zeros_like(v), False, False), single)
     mdl, (q, qd), single = checked_inputs("bias_torque", robot, params, ("q", q), ("qd", qd))
     return _out(_rnea(mdl, q, qd, np.zeros_like(q), False, False), single)
 
@@ -225,9 +208,13 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
     Returns:
         F, (n,) or (N, n).
     """
+    if _floating(robot):  # none on the free flyer
+        mdl, (v,), single = floating_inputs("friction_torque", robot, params, ("v", qd, "v"))
+        F = project(mdl, joint_friction(mdl, body_rates(mdl, v[:, 6:])))
+        return _out(np.concatenate([np.zeros((len(v), 6)), F], 1), single)
     mdl, (qd,), single = checked_inputs("friction_torque", robot, params, ("qd", qd))
     qd_b = body_rates(mdl, qd)
-    return _out(project(mdl, _friction(mdl, qd_b)), single)
+    return _out(project(mdl, joint_friction(mdl, qd_b)), single)
 
 
 def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
@@ -248,6 +235,12 @@ def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
             pivot of M = L D L^T vanishes), naming the joint and why: it moves no mass or
             inertia, or only mass on its own axis, or only as the joints before it do.
     """
+    if _floating(robot):
+        mdl, (q, v, tau), single = floating_inputs(
+            "forward_dynamics", robot, params, ("q", q, "q"), ("v", qd, "v"), ("tau", tau, "v")
+        )
+        h = floating_rnea(mdl, q, v, np.zeros_like(v), True, True)
+        return _out(solve(floating_mass_matrix(mdl, q), tau - h, "forward_dynamics"), single)
     mdl, (q, qd, tau), single = checked_inputs(
         "forward_dynamics", robot, params, ("q", q), ("qd", qd), ("tau", tau)
     )
@@ -271,6 +264,10 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
     Returns:
         T, a float or (N,).
     """
+    if _floating(robot):
+        mdl, (q, v), single = floating_inputs("kinetic_energy", robot, params, ("q", q, "q"), ("v", qd, "v"))
+        T = 0.5 * np.einsum("ni,nij,nj->n", v, floating_mass_matrix(mdl, q), v)
+        return float(T[0]) if single else T
     mdl, (q, qd), single = checked_inputs("kinetic_energy", robot, params, ("q", q), ("qd", qd))
     X = motion_transforms(joint_poses(mdl, body_positions(mdl, q)))
     S = subspaces(mdl)
@@ -309,6 +306,7 @@ def forward_kinematics(robot, q, params=None) -> list[np.ndarray]:
     Returns:
         A list of nb arrays (4, 4), or (N, 4, 4) for a batch, one per link.
     """
+    _fixed_only(robot, "forward_kinematics")
     mdl, (q,), single = checked_inputs("forward_kinematics", robot, params, ("q", q))
     return [_out(T, single) for T in _poses(mdl, q)]
 
@@ -330,6 +328,7 @@ def link_com_positions(robot, q, params=None) -> np.ndarray:
     Returns:
         (nb, 3), or (N, nb, 3) for a batch, one row per link.
     """
+    _fixed_only(robot, "link_com_positions")
     mdl, (q,), single = checked_inputs("link_com_positions", robot, params, ("q", q))
     return _out(_com_positions(mdl, q), single)
 
@@ -345,6 +344,7 @@ def potential_energy(robot, q, params=None) -> float | np.ndarray:
     Returns:
         U, a float or (N,).
     """
+    _fixed_only(robot, "potential_energy")
     mdl, (q,), single = checked_inputs("potential_energy", robot, params, ("q", q))
     U = -np.einsum("i,nij,j->n", mdl.mass, _com_positions(mdl, q), mdl.gravity)
     return float(U[0]) if single else U

@@ -92,6 +92,9 @@ class CNames:
     guard: str
     ndof: str
     nparam: str
+    #: NAME_NQ and NAME_NV of a floating robot (the sizes of q and of qd, qdd, tau), else None
+    nq: str | None
+    nv: str | None
     param_pattern: str  # how the index macros are spelled, for the documentation: NAME_P_<name>
     param_macros: tuple[tuple[str, int], ...]  # (NAME_P_<param>, index) in dyn.params order
     aliases: tuple[tuple[str, str], ...]  # (UPPER_CASE alias, macro it stands for)
@@ -142,6 +145,8 @@ def c_names(ctx: RenderContext) -> CNames:
     name = ctx.name
     params = tuple(ctx.dynamics.params)
     ndof, nparam = f"{name}_NDOF", f"{name}_NPARAM"
+    floating = ctx.robot.floating
+    nq, nv = (f"{name}_NQ", f"{name}_NV") if floating else (None, None)
     param_macros = tuple((f"{name}_P_{p}", k) for k, p in enumerate(params))
     functions = {f.name: f"{name}_{f.name}" for f in ctx.functions}
     sincos = {
@@ -155,6 +160,7 @@ def c_names(ctx: RenderContext) -> CNames:
     column_dims = {r.dims[1] for f in ctx.functions for r in f.results} & {"nstd", "nbase"}
     written = (
         [ndof, nparam]
+        + ([nq, nv] if floating else [])
         + [m for m, _ in param_macros]
         + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
         + ([f"{name}_NFRAMES"] if ctx.frames else [])
@@ -189,6 +195,8 @@ def c_names(ctx: RenderContext) -> CNames:
         guard=guard,
         ndof=ndof,
         nparam=nparam,
+        nq=nq,
+        nv=nv,
         param_pattern=f"{name}_P_<name>",
         param_macros=param_macros,
         aliases=aliases,
@@ -203,8 +211,8 @@ def c_names(ctx: RenderContext) -> CNames:
             "nbase": f"{name}_NBASE",
             **{d: d for d in ("3", "4", "6")},
             "k": str(_task_size(ctx)),
-            "nq": str(ctx.robot.nq),
-            "nv": str(ctx.robot.nv),
+            "nq": nq or str(ctx.robot.nq),
+            "nv": nv or str(ctx.robot.nv),
         },
         sincos=sincos,
     )

@@ -26,8 +26,7 @@ from .sincos import BLOCK, gather
 
 __all__ = ["render", "render_context", "TOOLS"]
 
-#: The inputs with one value per joint (NAME_NDOF); any other input (or one of these with another
-#: length: q of a floating robot's integrate) has a fixed size (F: 6).
+#: The inputs with one value per joint (NAME_NDOF); any other input has a fixed size (F: 6).
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
@@ -75,8 +74,9 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     inputs, unused, reads = [], [], []
     for inp in spec.inputs:
         used = [s for s in inp.symbols if s in used_symbols]
-        joint = inp.name in JOINT_INPUTS and len(inp.symbols) == ctx.robot.n
-        size = names.ndof if joint else str(len(inp.symbols))
+        size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+        if inp.name == "q" and names.nq is not None:
+            size = names.nq
         inputs.append({"name": inp.name, "read": bool(used), "size": size})
         if not used:
             unused.append(inp.name)
@@ -126,7 +126,12 @@ def render_context(ctx: RenderContext) -> dict:
         "source_file": names.source_file,
         "guard": names.guard,
         "ndof": names.ndof,
-        "n": ctx.robot.n,
+        "n": ctx.robot.nv,
+        "floating": ctx.robot.floating,
+        "joints": ctx.robot.n,
+        "nq_macro": names.nq,
+        "nv_macro": names.nv,
+        "nq": ctx.robot.nq,
         "nparam": names.nparam,
         "k": len(ctx.dynamics.params),
         "param_pattern": names.param_pattern,

@@ -24,7 +24,7 @@ __all__ = ["NumpyPrinter", "local_names", "dtype"]
 
 #: Names the generated function bodies use besides their locals.
 _RESERVED = frozenset(
-    {"np", "q", "qd", "qdd", "tau", "p", "NDOF", "NPARAM", "PARAM_NAMES"}
+    {"np", "q", "qd", "qdd", "tau", "p", "NDOF", "NQ", "NV", "NPARAM", "PARAM_NAMES"}
     | {"_vector", "_params", "_assemble", "_lead"}
 )
 _GENERATED_NAME = re.compile(r"(x|q|qd|qdd|tau)[0-9]+\Z")

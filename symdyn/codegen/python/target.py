@@ -22,8 +22,7 @@ from .printer import NumpyPrinter, dtype, local_names
 
 __all__ = ["render", "file_name", "TOOLS"]
 
-#: The inputs with one value per joint (NDOF); any other input (or one of these with another
-#: length: q of a floating robot's integrate) has a fixed size (F: 6).
+#: The inputs with one value per joint (NDOF); any other input has a fixed size (F: 6).
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
@@ -34,7 +33,14 @@ def file_name(name: str) -> str:
     return f"{name}_numpy.py"
 
 
-def _function(spec: FunctionSpec, printer: NumpyPrinter, n: int) -> dict:
+def _size(inp, floating: bool) -> str:
+    """An input's size: NDOF for the joint vectors (NQ for a floating robot's q), else a number."""
+    if inp.name == "q" and floating:
+        return "NQ"
+    return "NDOF" if inp.name in JOINT_INPUTS else str(len(inp.symbols))
+
+
+def _function(spec: FunctionSpec, printer: NumpyPrinter, floating: bool = False) -> dict:
     """One function as data: arguments (and their sizes: NDOF or a number), the input elements
     it reads, temporaries, output entries."""
     free = spec.free_symbols
@@ -42,10 +48,7 @@ def _function(spec: FunctionSpec, printer: NumpyPrinter, n: int) -> dict:
         "name": spec.name,
         "doc": spec.doc,
         "inputs": [inp.name for inp in spec.inputs if inp.name != "p"],
-        "sizes": {
-            inp.name: "NDOF" if inp.name in JOINT_INPUTS and len(inp.symbols) == n else str(len(inp.symbols))
-            for inp in spec.inputs
-        },
+        "sizes": {inp.name: _size(inp, floating) for inp in spec.inputs},
         "has_p": any(inp.name == "p" for inp in spec.inputs),
         "lead": [inp.name for inp in spec.inputs],
         "unpack": [
@@ -75,10 +78,11 @@ def render(ctx: RenderContext) -> dict[str, str]:
         .render(
             header=header_lines(ctx),
             name=ctx.name,
-            ndof=ctx.robot.n,
+            ndof=ctx.robot.nv,
+            nq=ctx.robot.nq if ctx.robot.floating else None,
             param_names=[s.name for s in ctx.dynamics.params],
             dtype=dtype(ctx.precision),
-            functions=[_function(spec, printer, ctx.robot.n) for spec in ctx.functions],
+            functions=[_function(spec, printer, ctx.robot.floating) for spec in ctx.functions],
         )
     )
     return {file_name(ctx.name): text}
