@@ -22,15 +22,24 @@ the bodies are the links and, on a floating base, the base body (Robot.base_body
 
 from __future__ import annotations
 
+import dataclasses
 from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import SymdynError
-from .inputs import body_positions, body_rates, numeric_model
+from .frames import frame_state
+from .inputs import body_positions, body_rates, numeric_model, skew
+from .rnea import mass_matrix
 from .spatial import joint_poses
 
-__all__ = ["CentroidalState", "centroidal", "quaternion_matrix"]
+__all__ = [
+    "CentroidalState",
+    "centroidal",
+    "quaternion_matrix",
+    "floating_frame_jacobian",
+    "generalized_jacobian",
+]
 
 
 class CentroidalState(NamedTuple):
@@ -166,3 +175,33 @@ def centroidal(robot, q, v=None, params=None) -> CentroidalState:
     Ag = bodies.momentum(robot, np.eye(robot.nv))[0]
     drift = bodies.momentum(robot, v[:, None])[1][:, 0]
     return CentroidalState(bodies.total, bodies.com, Ag[:3] / bodies.total, Ag, drift)
+
+
+def floating_frame_jacobian(robot, q, frame: str, params=None) -> tuple[np.ndarray, np.ndarray]:
+    """(world_T_F (4 x 4), J (6 x NV)) of a floating robot's frame: J world-aligned at F's origin,
+    rows v then w, the base's columns [R, -R [r]x; 0, R] (r = base_p_F) then blockdiag(R, R) times
+    the fixed-base Jacobian of the joints (symdyn.oracle.frames on the robot with its base fixed)."""
+    q = _vector(robot, q, robot.nq, "q")
+    fixed = dataclasses.replace(robot, floating=False)
+    base_T_F = frame_state(fixed, frame, q[7:], None, params)
+    R = quaternion_matrix(q[3:7])
+    r = base_T_F.pose[:3, 3]
+    world_T_base = np.eye(4)
+    world_T_base[:3, :3], world_T_base[:3, 3] = R, q[:3]
+    J = np.zeros((6, robot.nv))
+    J[:3, :3], J[:3, 3:6], J[3:, 3:6] = R, -R @ skew(r), R
+    J[:3, 6:], J[3:, 6:] = R @ base_T_F.jacobian[:3], R @ base_T_F.jacobian[3:]
+    return world_T_base @ base_T_F.pose, J
+
+
+def generalized_jacobian(robot, q, frame: str, params=None) -> np.ndarray:
+    """J* = J_m - J_b H_b^-1 H_bm (6 x n) of a floating robot's frame (Umetani and Yoshida, 1989):
+    the frame's world-aligned velocity from the joint rates alone when the robot's momentum is zero.
+
+    H_b, H_bm are the base rows of M (the momentum of the whole robot in the base frame is
+    H_b v_base + H_bm qd, zero: v_base = -H_b^-1 H_bm qd), J_b, J_m the base's and the joints'
+    columns of floating_frame_jacobian.
+    """
+    M = mass_matrix(robot, q, params)
+    J = floating_frame_jacobian(robot, q, frame, params)[1]
+    return J[:, 6:] - J[:, :6] @ np.linalg.solve(M[:6, :6], M[:6, 6:])
