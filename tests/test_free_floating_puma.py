@@ -1,4 +1,4 @@
-"""The free-floating PUMA on a satellite (examples/free_floating_puma.yaml) and the generalized
+"""The free-floating PUMA on a satellite (examples/free_floating/free_floating_puma.yaml) and the generalized
 Jacobian of Umetani and Yoshida (1989), J* = J_m - J_b H_b^-1 H_bm (symdyn.oracle.centroidal):
 checked against the end effector's velocity along a simulated motion with zero momentum (the
 oracle's forward dynamics, integrated on the Lie group), which never uses J*; the physics checks
@@ -31,7 +31,7 @@ pin = pytest.importorskip("pinocchio")
 def puma():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the published PUMA tensors (examples/puma560.yaml)
-        return symdyn.load_robot(EXAMPLES_DIR / "free_floating_puma.yaml")
+        return symdyn.load_robot(EXAMPLES_DIR / "free_floating" / "free_floating_puma.yaml")
 
 
 class _OraclePlant:
