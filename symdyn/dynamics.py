@@ -77,9 +77,14 @@ ALL_QUANTITIES = (*QUANTITIES, "bias")
 AUTO_SIMPLIFY_MAX_JOINTS = 3
 
 
-def _check_quantity(name, where: str) -> str:
+def _check_quantity(name, where: str, dyn: Dynamics | None = None) -> str:
     if name not in ALL_QUANTITIES:
         raise SymdynError(f"{where}: unknown quantity {name!r} (one of {', '.join(ALL_QUANTITIES)})")
+    if dyn is not None and name not in dyn.compact:
+        raise SymdynError(
+            f"{where}: {name} is not derived for robot '{dyn.robot.name}', which has a floating base "
+            "(docs/floating-base.md)"
+        )
     return name
 
 
@@ -165,7 +170,7 @@ class Dynamics:
         Raises:
             SymdynError: an unknown name.
         """
-        _check_quantity(name, "Dynamics.closed_form")
+        _check_quantity(name, "Dynamics.closed_form", self)
         return self._expanded(name, self.compact[name])
 
     def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
@@ -192,7 +197,7 @@ class Dynamics:
     def expanded(self, name: str) -> list[sp.Expr]:
         """Quantity `name` by substituting the program's intermediates back (simplified if
         requested): the full expansion of the recursion, entries in row-major order."""
-        _check_quantity(name, "Dynamics.expanded")
+        _check_quantity(name, "Dynamics.expanded", self)
         entries = self.program.expand(list(self.compact[name]))
         return [simplify_entry(e) for e in entries] if self.simplified else entries
 
@@ -322,7 +327,7 @@ class Dynamics:
         if isinstance(names, str):
             raise SymdynError(f"Dynamics.assignments: names must be a sequence of names, got {names!r}")
         for name in names:
-            _check_quantity(name, "Dynamics.assignments")
+            _check_quantity(name, "Dynamics.assignments", self)
         outs = [e for name in names for e in self.compact[name]]
         return self.program.needed(outs)
 
@@ -354,7 +359,7 @@ class Dynamics:
                 unknown parameters.
         """
         where = "Dynamics.evaluate"
-        _check_quantity(name, where)
+        _check_quantity(name, where, self)
         named = ((q, self.q, "q"), (qd, self.qd, "qd"), (qdd, self.qdd, "qdd"))
         if self.robot.floating:
             vec = [_state_vector(v, len(s), label, where) for v, s, label in named]
@@ -499,7 +504,7 @@ class Dynamics:
     def latex(self, name: str) -> str:
         """Closed form of quantity `name` (ALL_QUANTITIES) in LaTeX, joint space, with q_{i},
         \\dot{q}_{i}, \\ddot{q}_{i} for the joint symbols (as in docs/generated-code.md)."""
-        _check_quantity(name, "Dynamics.latex")
+        _check_quantity(name, "Dynamics.latex", self)
         names = {}
         for head, v in (("q", self.q), ("\\dot{q}", self.qd), ("\\ddot{q}", self.qdd)):
             names.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})

@@ -16,6 +16,7 @@ from cbuild import compile_shared, header_macros, write_files
 
 import symdyn
 from symdyn import SymdynError
+from symdyn.cli.main import main
 from symdyn.codegen import render
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import bias_torque, friction_torque, gravity_torque, mass_matrix
@@ -204,3 +205,24 @@ def test_other_function_groups_are_refused_on_a_floating_robot(arm):
     robot, _ = arm
     with pytest.raises(SymdynError, match=r"floating base: the regressor functions are not generated"):
         render(robot, targets=("python",), functions=["dynamics", "regressor"])
+
+
+def test_command_line(tmp_path, capsys):
+    """derive and generate take --floating; the other commands refuse a floating robot in one line."""
+    assert main(["derive", str(ARM)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("# floating_arm: 3 joints and a floating base (NV = 9), method newton-euler\n")
+    assert "C[" not in out and "M[9,9] = " in out
+    urdf = Path(__file__).parent / "data" / "urdf" / "bad_floating.urdf"
+    assert main(["generate", str(urdf), "--floating", "--target", "python", "--out", str(tmp_path)]) == 0
+    text = (tmp_path / "bad_numpy.py").read_text()
+    assert "NQ = 8\n" in text and "NDOF = 7\n" in text
+    for argv, message in (
+        (["derive", str(ARM), "--form", "configuration"], "derive: a floating robot prints --form compact"),
+        (["derive", str(ARM), "--steps"], "derive --steps: robot 'floating_arm' has a floating base"),
+        (["simulate", str(ARM), "--duration", "1", "--dt", "0.1", "--out", str(tmp_path / "s.csv")],
+         "symdyn simulate: robot 'floating_arm' has a floating base, which this command does not handle"),
+    ):  # fmt: skip
+        assert main(argv) == 1
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and message in err, err

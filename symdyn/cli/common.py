@@ -5,21 +5,31 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METHODS"]
+__all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METHODS", "FLOATING_COMMANDS"]
 
 #: symdyn.dynamics.METHODS, spelled here so that building the parser imports no SymPy
 #: (tests/test_cli.py checks that the two agree).
 METHODS = ("newton-euler", "lagrange")
+#: the commands that handle a floating robot (docs/floating-base.md)
+FLOATING_COMMANDS = ("derive", "generate", "simulate")
 
 
 def load_robot_argument(args: argparse.Namespace):
     """A robot from a robot file, an MJCF file, or a URDF file with --base/--tip (a xacro file with
     --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.loading), whatever
     its name."""
+    from ..errors import SymdynError
     from ..parsers import load
 
     floating = getattr(args, "floating", False)
-    return load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
+    robot = load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
+    command = getattr(args, "command", None)
+    if robot.floating and command not in FLOATING_COMMANDS:
+        raise SymdynError(
+            f"symdyn {command}: robot '{robot.name}' has a floating base, which this command does not "
+            f"handle yet ({', '.join(FLOATING_COMMANDS)} do: docs/floating-base.md)"
+        )
+    return robot
 
 
 def xacro_arguments(args: argparse.Namespace) -> dict:

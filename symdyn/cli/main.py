@@ -35,13 +35,15 @@ def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
 def _derive_text(dyn) -> str:
     import sympy as sp
 
+    from .derive_output import floating_note as _floating_note
+
     lines = [
-        f"# {dyn.robot.name}: {dyn.n} joints, method {dyn.method}",
+        f"# {dyn.robot.name}: {dyn.robot.n} joints{_floating_note(dyn)}, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
         + (", ".join(map(str, dyn.params)) or "none"),
         "# tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd",
     ]
-    for name in PRINTED:
+    for name in (k for k in PRINTED if k in dyn.compact):
         m = dyn.closed_form(name)
         lines.append("")
         for k, e in enumerate(m):
@@ -61,7 +63,7 @@ def _derive_json(dyn) -> str:
         "qdd": [str(s) for s in dyn.qdd],
         "params": [str(s) for s in dyn.params],
     }
-    for name in PRINTED:
+    for name in (k for k in PRINTED if k in dyn.compact):
         m = dyn.closed_form(name)
         if name not in ("M", "C"):
             doc[name] = [sp.sstr(e) for e in m]
@@ -96,6 +98,13 @@ def cmd_derive(args: argparse.Namespace) -> int:
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
     frames = out.frame_names(dyn, args.frames)
+    if robot.floating:  # trigonometric polynomials in the joint angles: not with a quaternion
+        if args.form not in (None, "compact") or args.lumped or args.prune is not None:
+            raise SymdynError(
+                "derive: a floating robot prints --form compact (no configuration or product form, "
+                "--lumped or --prune)"
+            )
+        args.form = "compact"
     if args.form is None:
         args.form = "configuration"
         if not dyn.configuration_space.readable:
@@ -221,12 +230,16 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
             "derivatives",
             "kinematics",
             "operational_space",
+            "configuration",
+            "centroidal",
             "all",
         ),
         default=["dynamics"],
         help="the groups of functions to build (default: dynamics, the seven of tau = M qdd + V + G + F "
         "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives, "
-        "kinematics and operational_space (per frame, see --frames); all: every group",
+        "kinematics and operational_space (per frame, see --frames); configuration (a floating robot's "
+        "integrate and difference), centroidal (momentum matrix, its drift, com, total mass); all: "
+        "every group",
     )
     g.add_argument(
         "--frames",

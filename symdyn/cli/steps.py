@@ -40,6 +40,10 @@ def cmd_derive_steps(args: argparse.Namespace) -> int:
     if not args.steps:
         raise SymdynError("--at gives the state of --steps; add --steps")
     robot = load_robot_argument(args)
+    if robot.floating:
+        raise SymdynError(
+            f"derive --steps: robot '{robot.name}' has a floating base; --steps shows a fixed base"
+        )
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     at = parse_at(args.at) if args.at else None
     steps = derivation_steps(robot, args.method, at=at, simplify=simplify)

@@ -247,10 +247,12 @@ FLOATING_DEFAULT = ("dynamics", "configuration")
 
 
 def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
-    """The groups of a floating robot: FLOATING_DEFAULT by default; any group outside
-    FLOATING_GROUPS is a SymdynError."""
+    """The groups of a floating robot: FLOATING_DEFAULT by default, FLOATING_GROUPS for every
+    group (--functions all); any group outside FLOATING_GROUPS is a SymdynError."""
     if groups is None:
         return FLOATING_DEFAULT
+    if set(groups) == set(GROUPS):
+        return FLOATING_GROUPS
     other = [g for g in groups if g not in FLOATING_GROUPS]
     if other:
         raise SymdynError(
