@@ -65,6 +65,7 @@ __all__ = [
     "FAMILIES",
     "GROUPS",
     "FRAME_GROUPS",
+    "NAMED_ONLY",
     "build_functions",
     "vector_output",
     "joint_matrix_output",
