@@ -71,6 +71,24 @@ static Model build_model(std::istream & in, int & n)
   for (int j = 0; j < 3; ++j)
     g[j] = read<double>(in, "gravity");
   std::vector<double> armature(n);
+  // optional: `floating mass cx cy cz Ixx Ixy Ixz Iyy Iyz Izz`, a free flyer (Pinocchio's joint 1)
+  // carrying the base body, ahead of the joints (bench/floating.py)
+  int first = 1;
+  in >> std::ws;
+  if (in.peek() == 'f')
+  {
+    expect(in, "floating");
+    const double mass = read<double>(in, "base mass");
+    Eigen::Vector3d com;
+    for (int j = 0; j < 3; ++j)
+      com[j] = read<double>(in, "base com");
+    double I[6];
+    for (int j = 0; j < 6; ++j)
+      I[j] = read<double>(in, "base inertia");
+    const auto id = model.addJoint(0, pinocchio::JointModelFreeFlyer(), pinocchio::SE3::Identity(), "root");
+    model.appendBodyToJoint(id, pinocchio::Inertia(mass, com, pinocchio::Symmetric3(I[0], I[1], I[3], I[2], I[4], I[5])));
+    first = 2;
+  }
   for (int i = 0; i < n; ++i)
   {
     expect(in, "joint");
@@ -78,7 +96,7 @@ static Model build_model(std::istream & in, int & n)
     const int parent_line = read<int>(in, "parent");
     if (parent_line < -1 || parent_line >= i)
       fail("joint " + std::to_string(i + 1) + ": the parent must be -1 (base) or an earlier joint");
-    const pinocchio::JointIndex parent = pinocchio::JointIndex(parent_line + 1);
+    const pinocchio::JointIndex parent = pinocchio::JointIndex(parent_line + first);
     Eigen::Vector3d axis, p, com;
     Eigen::Matrix3d R;
     for (int j = 0; j < 3; ++j)
@@ -124,14 +142,15 @@ static Model build_model(std::istream & in, int & n)
     else
       fail("joint type must be R or P, not " + type);
     const pinocchio::Symmetric3 Ic(I[0], I[1], I[3], I[2], I[4], I[5]);  // xx xy yy xz yz zz
-    if (id != pinocchio::JointIndex(i + 1))
+    if (id != pinocchio::JointIndex(i + first))
       fail("joint " + std::to_string(i + 1) + " got Pinocchio index " + std::to_string(id));
     model.appendBodyToJoint(id, pinocchio::Inertia(mass, com, Ic), pinocchio::SE3::Identity());
   }
-  if (model.nv != n)
-    fail("model has nv != n");
+  const int base = first == 2 ? 6 : 0;
+  if (model.nv != n + base)
+    fail("model has nv != n (+ 6 on a floating base)");
   for (int i = 0; i < n; ++i)
-    model.armature[i] = armature[i];
+    model.armature[base + i] = armature[i];
   model.gravity.linear(g);
   return model;
 }

@@ -49,7 +49,7 @@ from .algorithms.configuration_space import ConfigurationSpace, configuration_sp
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
-from .algorithms.floating import floating_newton_euler_terms
+from .algorithms.floating import floating_lagrange_terms, floating_newton_euler_terms
 from .algorithms.frame_kinematics import FrameKinematics
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
@@ -77,14 +77,9 @@ ALL_QUANTITIES = (*QUANTITIES, "bias")
 AUTO_SIMPLIFY_MAX_JOINTS = 3
 
 
-def _check_quantity(name, where: str, dyn: Dynamics | None = None) -> str:
+def _check_quantity(name, where: str) -> str:
     if name not in ALL_QUANTITIES:
         raise SymdynError(f"{where}: unknown quantity {name!r} (one of {', '.join(ALL_QUANTITIES)})")
-    if dyn is not None and name not in dyn.compact:
-        raise SymdynError(
-            f"{where}: {name} is not derived for robot '{dyn.robot.name}', which has a floating base "
-            "(docs/floating-base.md)"
-        )
     return name
 
 
@@ -170,7 +165,7 @@ class Dynamics:
         Raises:
             SymdynError: an unknown name.
         """
-        _check_quantity(name, "Dynamics.closed_form", self)
+        _check_quantity(name, "Dynamics.closed_form")
         return self._expanded(name, self.compact[name])
 
     def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
@@ -197,7 +192,7 @@ class Dynamics:
     def expanded(self, name: str) -> list[sp.Expr]:
         """Quantity `name` by substituting the program's intermediates back (simplified if
         requested): the full expansion of the recursion, entries in row-major order."""
-        _check_quantity(name, "Dynamics.expanded", self)
+        _check_quantity(name, "Dynamics.expanded")
         entries = self.program.expand(list(self.compact[name]))
         return [simplify_entry(e) for e in entries] if self.simplified else entries
 
@@ -327,7 +322,7 @@ class Dynamics:
         if isinstance(names, str):
             raise SymdynError(f"Dynamics.assignments: names must be a sequence of names, got {names!r}")
         for name in names:
-            _check_quantity(name, "Dynamics.assignments", self)
+            _check_quantity(name, "Dynamics.assignments")
         outs = [e for name in names for e in self.compact[name]]
         return self.program.needed(outs)
 
@@ -359,7 +354,7 @@ class Dynamics:
                 unknown parameters.
         """
         where = "Dynamics.evaluate"
-        _check_quantity(name, where, self)
+        _check_quantity(name, where)
         named = ((q, self.q, "q"), (qd, self.qd, "qd"), (qdd, self.qdd, "qdd"))
         if self.robot.floating:
             vec = [_state_vector(v, len(s), label, where) for v, s, label in named]
@@ -504,7 +499,7 @@ class Dynamics:
     def latex(self, name: str) -> str:
         """Closed form of quantity `name` (ALL_QUANTITIES) in LaTeX, joint space, with q_{i},
         \\dot{q}_{i}, \\ddot{q}_{i} for the joint symbols (as in docs/generated-code.md)."""
-        _check_quantity(name, "Dynamics.latex", self)
+        _check_quantity(name, "Dynamics.latex")
         names = {}
         for head, v in (("q", self.q), ("\\dot{q}", self.qd), ("\\ddot{q}", self.qdd)):
             names.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})
@@ -625,14 +620,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
     r = robot.resolved()
     q, qd, qdd = state_symbols(r)
     program = Program()
-    if r.floating and method != "newton-euler":
-        raise SymdynError(
-            f"derive: robot '{r.name}' has a floating base: derive it by the newton-euler method "
-            "(the Lagrange route does not handle a floating base yet)"
-        )
     with distribute(False):
         if r.floating:
-            terms = floating_newton_euler_terms(r, q, qd, qdd, program)
+            route = floating_newton_euler_terms if method == "newton-euler" else floating_lagrange_terms
+            terms = route(r, q, qd, qdd, program)
         elif method == "newton-euler":
             terms = _newton_euler_terms(r, q, qd, qdd, program)
         else:
@@ -642,10 +633,10 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         if r.floating:
             F = sp.Matrix.vstack(sp.zeros(6, 1), F)
         terms["F"] = F
-        if method == "lagrange":
+        if method == "lagrange" and not r.floating:
             terms["tau"] = terms["M"] * qdd + terms["V"] + terms["G"] + F
             terms["bias"] = terms["V"] + terms["G"] + F
-        else:
+        else:  # the Newton-Euler route, or the floating Lagrange route (tau and bias without F)
             terms["tau"] = terms["tau"] + F
             terms["bias"] = terms["bias"] + F
     if simplify is None:
@@ -658,7 +649,7 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         qdd=qdd,
         params=r.params,
         program=program,
-        compact={k: sp.Matrix(terms[k]) for k in ALL_QUANTITIES if k in terms},
+        compact={k: sp.Matrix(terms[k]) for k in ALL_QUANTITIES},
         simplified=bool(simplify),
     )
     if dyn.singular_joints:

@@ -18,6 +18,7 @@ import symdyn
 from symdyn import SymdynError
 from symdyn.cli.main import main
 from symdyn.codegen import render
+from symdyn.codegen.functions import build_functions
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import bias_torque, friction_torque, gravity_torque, mass_matrix
 
@@ -49,9 +50,10 @@ def _state(robot, rng, scale=1.0):
     return q, rng.normal(size=robot.nv), rng.normal(size=robot.nv)
 
 
-@pytest.mark.parametrize("which", ["arm", "solo"])
-def test_derivation_equals_the_oracle(which, request):
-    robot, dyn = request.getfixturevalue(which)
+def test_derivation_equals_the_oracle(arm):
+    """Solo-12's derivation is compared with Pinocchio below (the oracle equals Pinocchio on it:
+    tests/test_oracle_floating.py)."""
+    robot, dyn = arm
     assert dyn.q.shape == (robot.n + 7, 1) and dyn.qd.shape == (robot.n + 6, 1)
     assert [str(s) for s in dyn.q[:7]] == ["x_b", "y_b", "z_b", "qx_b", "qy_b", "qz_b", "qw_b"]
     rng = np.random.default_rng(11)
@@ -67,6 +69,14 @@ def test_derivation_equals_the_oracle(which, request):
         }
         for name, value in expected.items():
             np.testing.assert_allclose(dyn.evaluate(name, q, v, a), value, atol=1e-11, err_msg=name)
+        # C qd = V, and dM/dt = C + C^T with dM/dt through the tangent space (M depends on the
+        # joints only: a central difference along the joint rates)
+        C = dyn.evaluate("C", q, v)
+        np.testing.assert_allclose(C @ v, expected["V"], atol=1e-11)
+        h = 1e-6
+        step = np.concatenate([np.zeros(7), h * v[6:]])
+        dM = (mass_matrix(robot, q + step) - mass_matrix(robot, q - step)) / (2 * h)
+        np.testing.assert_allclose(dM, C + C.T, atol=1e-8)
 
 
 def test_solo_against_pinocchio(solo):
@@ -112,10 +122,24 @@ def test_mass_matrix_depends_on_the_joints_only(arm):
     assert not G_free & set(dyn.q[:3]) and G_free & set(dyn.q[3:7])
 
 
+def test_lagrange_route_in_the_tangent_space_equals_newton_euler(arm):
+    """Boltzmann-Hamel / Euler-Poincare (symdyn.algorithms.floating_lagrange) against the recursion."""
+    robot, newton_euler = arm
+    lagrange = symdyn.derive(robot, method="lagrange", simplify=False)
+    rng = np.random.default_rng(21)
+    for _ in range(2):
+        q, v, a = _state(robot, rng)
+        for name in ("M", "tau", "G", "V", "bias"):
+            np.testing.assert_allclose(
+                lagrange.evaluate(name, q, v, a),
+                newton_euler.evaluate(name, q, v, a),
+                atol=1e-11,
+                err_msg=name,
+            )
+
+
 def test_bad_input(arm):
     robot, dyn = arm
-    with pytest.raises(SymdynError, match=r"floating base: derive it by the newton-euler method"):
-        symdyn.derive(robot, method="lagrange")
     with pytest.raises(SymdynError, match=r"q has shape \(5,\), expected \(10,\)"):
         dyn.evaluate("M", np.zeros(5))
     with pytest.raises(SymdynError, match=r"rnea: v has 3 entries, expected 9 \(NV = 6 \+ joints"):
@@ -127,6 +151,7 @@ def test_bad_input(arm):
 SIGNATURES = {
     "inverse_dynamics": (("q", "qd", "qdd"), "v"),
     "mass_matrix": (("q",), "M"),
+    "coriolis_matrix": (("q", "qd"), "M"),
     "coriolis": (("q", "qd"), "v"),
     "gravity": (("q",), "v"),
     "friction": (("qd",), "v"),
@@ -175,10 +200,9 @@ def generated(tmp_path_factory):
     return robot, files, _C(files, tmp_path_factory.mktemp("floating_c"), robot.name)
 
 
-def test_generated_functions_equal_the_oracle(generated):
+def test_generated_functions_equal_the_oracle(generated, arm):
     robot, files, c = generated
     assert (c.nq, c.nv, int(c.macros["floating_arm_NDOF"])) == (robot.n + 7, robot.n + 6, robot.n + 6)
-    assert "coriolis_matrix" not in files["floating_arm_numpy.py"]
     numpy_module = _module(files["floating_arm_numpy.py"], "floating_numpy")
     assert (numpy_module.NQ, numpy_module.NV, numpy_module.NDOF) == (10, 9, 9)
     casadi_functions = _module(files["floating_arm_casadi.py"], "floating_casadi").functions()
@@ -188,6 +212,7 @@ def test_generated_functions_equal_the_oracle(generated):
     expected = {
         "inverse_dynamics": ((q, v, a), tau),
         "mass_matrix": ((q,), mass_matrix(robot, q)),
+        "coriolis_matrix": ((q, v), arm[1].evaluate("C", q, v)),
         "coriolis": ((q, v), bias_torque(robot, q, v)),
         "gravity": ((q,), gravity_torque(robot, q)),
         "friction": ((v,), friction_torque(robot, v)),
@@ -202,9 +227,9 @@ def test_generated_functions_equal_the_oracle(generated):
 
 
 def test_other_function_groups_are_refused_on_a_floating_robot(arm):
-    robot, _ = arm
+    _, dyn = arm
     with pytest.raises(SymdynError, match=r"floating base: the regressor functions are not generated"):
-        render(robot, targets=("python",), functions=["dynamics", "regressor"])
+        build_functions(dyn, ["dynamics", "regressor"])
 
 
 def test_command_line(tmp_path, capsys):
@@ -212,7 +237,7 @@ def test_command_line(tmp_path, capsys):
     assert main(["derive", str(ARM)]) == 0
     out = capsys.readouterr().out
     assert out.startswith("# floating_arm: 3 joints and a floating base (NV = 9), method newton-euler\n")
-    assert "C[" not in out and "M[9,9] = " in out
+    assert "C[9,9] = " in out and "M[9,9] = " in out
     urdf = Path(__file__).parent / "data" / "urdf" / "bad_floating.urdf"
     assert main(["generate", str(urdf), "--floating", "--target", "python", "--out", str(tmp_path)]) == 0
     text = (tmp_path / "bad_numpy.py").read_text()

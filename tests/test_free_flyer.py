@@ -60,6 +60,7 @@ ARM = {
 def test_robot_file_base_floating():
     plain = robot_from_data({**ARM, "base": "floating"})
     assert plain.floating and (plain.nq, plain.nv) == (8, 7) and plain.base_body.mass == 0
+    assert repr(plain).startswith("Robot arm: 1 joint on a floating base 'base' (NQ 8, NV 7), ")
     body = robot_from_data(
         {
             **ARM,

@@ -39,10 +39,12 @@ from ..spatial.motion import Force
 from ..symbolic.program import Program
 from .coordinates import project_matrix, project_vector
 from .crba import composite_inertias, gravity_composite, mass_matrix_crba, shift_inertia
+from .floating_coriolis import floating_coriolis_matrix
+from .floating_lagrange import floating_lagrange
 from .frames import joint_frames
 from .newton_euler import LinkAcceleration, body_wrench, newton_euler, tilde
 
-__all__ = ["floating_newton_euler_terms", "base_gravity_vector"]
+__all__ = ["floating_newton_euler_terms", "floating_lagrange_terms", "base_gravity_vector"]
 
 
 def base_gravity_vector(robot: Robot, quaternion: Sequence, program: Program) -> v3.Vec:
@@ -101,7 +103,8 @@ def _base_block(whole: SpatialInertia) -> list[list[sp.Expr]]:
 
 
 def floating_newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:
-    """M (NV x NV), V, G, tau and the rigid-body bias (NV) of a floating robot by Newton-Euler and
+    """M and C (NV x NV; C by symdyn.algorithms.floating_coriolis), V, G, tau and the rigid-body
+    bias (NV) of a floating robot by Newton-Euler and
     the composite bodies, over q (NQ symbols: base position, quaternion, joints), qd and qdd (NV:
     base twist or its derivative, then the joints'); friction and rotor inertia on the joints only.
     """
@@ -126,6 +129,7 @@ def floating_newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> d
     G_base = [*(-whole.mass * g for g in g_b), *v3.cross(g_b, whole.first_moment)]
     zero6 = [0] * 6
     out = {"M": M, "G": sp.Matrix([*G_base, *project_vector(robot, G_joints, program, "G")])}
+    out["C"] = floating_coriolis_matrix(robot, rot, list(qd[:6]), qd_b, program)
     for key, tag, a, gravity, accelerations in (
         ("V", "V", zero6, False, zeros),
         ("bias", "B", zero6, True, zeros),
@@ -138,4 +142,15 @@ def floating_newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> d
                 t + lk.motor.reflected_inertia * x for t, lk, x in zip(tau_b, robot.links, qdd_b, strict=True)
             ]
         out[key] = sp.Matrix([*rows, *project_vector(robot, tau_b, program, key)])
+    return out
+
+
+def floating_lagrange_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:
+    """M, V, G, tau and the bias of a floating robot by the Lagrange route in the tangent space
+    (symdyn.algorithms.floating_lagrange), and C from the bodies' Jacobians
+    (symdyn.algorithms.floating_coriolis: the same matrix as the Newton-Euler route's)."""
+    g_b = base_gravity_vector(robot, list(q[3:7]), program)
+    out = floating_lagrange(robot, q, qd, qdd, g_b, program)
+    rot = joint_frames(robot, robot.body_positions(list(q[7:])))
+    out["C"] = floating_coriolis_matrix(robot, rot, list(qd[:6]), robot.body_rates(list(qd[6:])), program)
     return out

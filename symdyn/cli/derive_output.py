@@ -173,23 +173,18 @@ def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
     return f"{name}[{k // cols + 1},{k % cols + 1}]" if name in ("M", "C") else f"{name}[{k + 1}]"
 
 
-def printed(dyn: Dynamics) -> tuple[str, ...]:
-    """The quantities `derive` prints: M, C, V, G, F (no C for a floating robot: not derived)."""
-    return tuple(k for k in PRINTED if k in dyn.compact)
-
-
 def _matrices(dyn: Dynamics, form: str) -> dict[str, sp.Matrix]:
     if form == "expanded":
-        return {k: sp.Matrix(*dyn.compact[k].shape, dyn.expanded(k)) for k in printed(dyn)}
-    return {k: dyn.closed_form(k) for k in printed(dyn)}
+        return {k: sp.Matrix(*dyn.compact[k].shape, dyn.expanded(k)) for k in PRINTED}
+    return {k: dyn.closed_form(k) for k in PRINTED}
 
 
 def _compact(dyn: Dynamics):
     """The eliminated program: temporaries and M, C, V, G, F over them."""
-    outputs = [e for k in printed(dyn) for e in dyn.compact[k]]
-    code = eliminate(dyn.assignments(printed(dyn)), outputs, prefix="x")
+    outputs = [e for k in PRINTED for e in dyn.compact[k]]
+    code = eliminate(dyn.assignments(PRINTED), outputs, prefix="x")
     mats, k = {}, 0
-    for name in printed(dyn):
+    for name in PRINTED:
         shape = dyn.compact[name].shape
         size = shape[0] * shape[1]
         mats[name] = sp.Matrix(*shape, list(code.outputs[k : k + size]))
@@ -209,7 +204,7 @@ def derive_text(dyn: Dynamics, form: str = "configuration", lumped: bool = False
         lines += [f"{s} = {sp.sstr(e)}" for s, e in temporaries]
     else:
         mats = _matrices(dyn, form)
-    for name in printed(dyn):
+    for name in PRINTED:
         m = mats[name]
         lines.append("")
         lines += [f"{_entry_name(name, m.shape, k)} = {sp.sstr(e)}" for k, e in enumerate(m)]
@@ -248,7 +243,7 @@ def derive_json(dyn: Dynamics, form: str = "configuration", lumped: bool = False
         doc["assignments"] = [[str(s), sp.sstr(e)] for s, e in temporaries]
     else:
         mats = _matrices(dyn, form)
-    for name in printed(dyn):
+    for name in PRINTED:
         doc[name] = _nested(mats[name], name not in ("M", "C"))
     return json.dumps(doc, indent=2) + "\n"
 

@@ -43,7 +43,7 @@ def _derive_text(dyn) -> str:
         + (", ".join(map(str, dyn.params)) or "none"),
         "# tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd",
     ]
-    for name in (k for k in PRINTED if k in dyn.compact):
+    for name in PRINTED:
         m = dyn.closed_form(name)
         lines.append("")
         for k, e in enumerate(m):
@@ -63,7 +63,7 @@ def _derive_json(dyn) -> str:
         "qdd": [str(s) for s in dyn.qdd],
         "params": [str(s) for s in dyn.params],
     }
-    for name in (k for k in PRINTED if k in dyn.compact):
+    for name in PRINTED:
         m = dyn.closed_form(name)
         if name not in ("M", "C"):
             doc[name] = [sp.sstr(e) for e in m]

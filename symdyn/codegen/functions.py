@@ -122,8 +122,6 @@ def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     ]
     rows = []
     for name, doc, inputs, out in table:
-        if out not in c:  # C of a floating robot (not derived)
-            continue
         shape = joint_matrix_output if out in ("M", "C") else vector_output
         rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), tuple(c[out])))
     return rows
@@ -303,8 +301,7 @@ def build_functions(
         members = [row for row in rows if row.cse == group]
         needs = [e for row in members for e in row.exprs] + [e for row in members for _, e in row.steps]
         if not group:
-            needs += [e for name in QUANTITIES if name in dyn.compact for e in dyn.compact[name]]
-            needs += list(dyn.compact["bias"])
+            needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
         steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
         code |= eliminate_many(steps, {row.name: list(row.exprs) for row in members}, reserved=x.symbols)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

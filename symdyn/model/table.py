@@ -126,6 +126,8 @@ def _header(robot) -> str:
     joints = f"{robot.n} joint" + ("" if robot.n == 1 else "s")
     if robot.nb != robot.n:
         joints += f" ({robot.nb} bodies)"
+    if getattr(robot, "floating", False):
+        joints += f" on a floating base '{robot.base_body.name}' (NQ {robot.nq}, NV {robot.nv})"
     shown = [str(p) for p in robot.params[:8]] + (["..."] if len(robot.params) > 8 else [])
     free = f"{len(robot.params)} free parameter" + ("" if len(robot.params) == 1 else "s")
     if shown:
