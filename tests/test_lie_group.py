@@ -158,3 +158,18 @@ def test_octave_agrees_with_pinocchio(tmp_path):
 
 def test_a_fixed_robot_has_no_configuration_functions():
     assert context(example("roger_arm"), functions=("configuration",)).functions == ()
+
+
+def test_a_quaternion_of_another_norm_reads_as_its_unit_quaternion():
+    """Both functions read the orientation of q / |q| (docs/centroidal.md); integrate returns a
+    unit quaternion."""
+    module = _numpy_module()
+    for q, v, q_next in cases()[2:6]:
+        scaled = q.copy()
+        scaled[3:7] *= 3.0
+        got = module.integrate(scaled, v, np.array([1.0]))
+        np.testing.assert_allclose(got, module.integrate(q, v, np.array([1.0])), atol=TOL)
+        assert abs(np.linalg.norm(got[3:7]) - 1.0) < 1e-15
+        np.testing.assert_allclose(
+            module.difference(scaled, q_next), module.difference(q, q_next), atol=TOL * 10
+        )
