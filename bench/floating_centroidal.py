@@ -140,23 +140,14 @@ def make_states(robot, rng) -> tuple[np.ndarray, np.ndarray]:
 
 
 def pinocchio_model_text(robot, Q, V) -> str:
-    """MODEL.txt of bench/pinocchio_centroidal.cpp: the joints (pin_harness), the base body, the states."""
+    """MODEL.txt of bench/pinocchio_centroidal.cpp: the joints (pin_harness), the `floating` line
+    of the base body (bench/pinocchio_model.hpp), the states."""
     zeros = {x: np.zeros((NSTATES, robot.n)) for x in ("q", "qd", "qdd", "tau")}
-    lines = pin_harness.model_and_states_lines(robot, zeros)
-    lines = lines[: next(i for i, line in enumerate(lines) if line.startswith("nstates"))]
+    lines = pin_harness.model_and_states_lines(robot, zeros)[: 2 + robot.n]
     b = robot.numeric().base_body
     I = np.array(b.inertia, dtype=float)
-    values = [
-        float(b.mass),
-        *np.array(b.com, dtype=float).ravel(),
-        I[0, 0],
-        I[0, 1],
-        I[0, 2],
-        I[1, 1],
-        I[1, 2],
-        I[2, 2],
-    ]
-    lines.append("base " + " ".join(repr(float(v)) for v in values))
+    base = [float(b.mass), *np.array(b.com, dtype=float).ravel(), *I[np.triu_indices(3)]]
+    lines.insert(2, "floating " + " ".join(repr(float(x)) for x in base))
     lines.append(f"nstates {NSTATES}")
     lines += [" ".join(repr(float(x)) for x in np.r_[q, v]) for q, v in zip(Q, V, strict=True)]
     return "\n".join(lines) + "\n"

@@ -4,13 +4,9 @@
 //   pinocchio_centroidal MODEL.txt check NCHECK     prints Ag and dAg*v at the first NCHECK states
 //   pinocchio_centroidal MODEL.txt time REPS TARGET_MS
 //
-// MODEL.txt: `n`, `gravity` and the joint lines of bench/pinocchio_harness.cpp (the joints below
-// the base, parent -1 being the base), then
-//   base MASS CX CY CZ IXX IXY IXZ IYY IYZ IZZ        (the base body, base frame, about its CoM)
-//   nstates K
-// and K lines q(7 + n) v(6 + n) in Pinocchio's free-flyer conventions. The model is a
-// JointModelFreeFlyer carrying the base body, with the joints of bench/pinocchio_model.hpp's
-// build_model re-attached below it.
+// MODEL.txt: the floating model of bench/pinocchio_model.hpp (`n`, `gravity`, the line
+// `floating MASS CX CY CZ IXX IXY IXZ IYY IYZ IZZ` of the base body, the joint lines), then
+// `nstates K` and K lines q(7 + n) v(6 + n) in Pinocchio's free-flyer conventions.
 //
 // Timed (each call on the next state):
 //   centroidal_map                 computeCentroidalMap(q)
@@ -19,41 +15,15 @@
 
 #include "pinocchio/algorithm/centroidal.hpp"
 
-static Model floating_model(std::istream & in, int & n)
-{
-  const Model fixed = build_model(in, n);
-  Model model;
-  const pinocchio::JointIndex base =
-    model.addJoint(0, pinocchio::JointModelFreeFlyer(), pinocchio::SE3::Identity(), "base");
-  expect(in, "base");
-  const double mass = read<double>(in, "base mass");
-  Eigen::Vector3d com;
-  for (int j = 0; j < 3; ++j)
-    com[j] = read<double>(in, "base com");
-  double I[6];  // xx xy xz yy yz zz
-  for (int j = 0; j < 6; ++j)
-    I[j] = read<double>(in, "base inertia");
-  model.appendBodyToJoint(
-    base, pinocchio::Inertia(mass, com, pinocchio::Symmetric3(I[0], I[1], I[3], I[2], I[4], I[5])),
-    pinocchio::SE3::Identity());
-  for (pinocchio::JointIndex i = 1; i < fixed.joints.size(); ++i)
-  {
-    const pinocchio::JointIndex parent = fixed.parents[i] + 1;
-    const pinocchio::JointIndex id =
-      model.addJoint(parent, fixed.joints[i], fixed.jointPlacements[i], fixed.names[i]);
-    model.appendBodyToJoint(id, fixed.inertias[i], pinocchio::SE3::Identity());
-  }
-  model.gravity = fixed.gravity;
-  return model;
-}
-
 int main(int argc, char ** argv)
 {
   if (argc < 4)
     fail("usage: pinocchio_centroidal MODEL.txt check NCHECK | time REPS TARGET_MS");
   std::ifstream in(argv[1]);
   int n = 0;
-  const Model model = floating_model(in, n);
+  const Model model = build_model(in, n);
+  if (model.nv != n + 6)
+    fail("MODEL.txt: no floating base");
   Data data(model);
   expect(in, "nstates");
   const int K = read<int>(in, "nstates");
