@@ -22,7 +22,7 @@ import warnings
 from pathlib import Path
 
 from .codegen import TARGETS, file_tools, render
-from .codegen.functions import FRAME_GROUPS, GROUPS
+from .codegen.functions import FRAME_GROUPS, GROUPS, NAMED_ONLY
 from .codegen.output import write_files
 from .errors import SymdynError
 from .model.robot import Robot
@@ -108,8 +108,9 @@ def example_robot(root: Path, name: str) -> Robot:
 
 def render_example(root: Path, name: str) -> dict[str, str | bytes]:
     """{file name: content} of one example robot for every target, with the groups generated/
-    holds for it (every group; the frame groups only for FRAME_EXAMPLES)."""
-    groups = [g for g in GROUPS if g not in FRAME_GROUPS]
+    holds for it (every group but those built only when named; the frame groups for
+    FRAME_EXAMPLES)."""
+    groups = [g for g in GROUPS if g not in NAMED_ONLY]
     frames, axes = FRAME_EXAMPLES.get(name, (None, None))
     if frames is not None:
         groups += list(FRAME_GROUPS)

@@ -176,7 +176,8 @@ def test_generate_builds_the_dynamics_group_unless_told_all(tmp_path, capsys):
     """Without --functions: the seven functions of tau = M qdd + V + G + F and forward dynamics;
     --functions all: every function generated/ holds (written by symdyn.regenerate, which leaves
     the frame groups out but for the Panda), then the kinematics of the default frame (forearm,
-    the leaf link; its operational space is singular at every q, so left out with a warning)."""
+    the leaf link; its operational space is singular at every q, so left out with a warning), then
+    the centroidal functions (com once, in the kinematics group)."""
     robot = str(EXAMPLES / "roger_arm.yaml")
     assert main(["generate", robot, "--target", "c", "--out", str(tmp_path / "default")]) == 0
     assert (
@@ -189,6 +190,7 @@ def test_generate_builds_the_dynamics_group_unless_told_all(tmp_path, capsys):
     assert len(committed) > len(seven) and "roger_arm_regressor" in committed
     kinematics = [f"forearm_{s}" for s in ("pose", "jacobian", "jacobian_local", "jacobian_dot_qd")]
     kinematics += ["com", "com_jacobian", "com_jacobian_dot_qd"]
+    kinematics += ["centroidal_momentum_matrix", "centroidal_momentum_drift", "total_mass"]
     assert _declared(tmp_path / "all" / "roger_arm_dynamics.h") == committed + [
         f"roger_arm_{n}" for n in kinematics
     ]

@@ -233,7 +233,8 @@ def test_other_function_groups_are_refused_on_a_floating_robot(arm):
 
 
 def test_command_line(tmp_path, capsys):
-    """derive and generate take --floating; the other commands refuse a floating robot in one line."""
+    """derive, generate and simulate (docs/centroidal.md) take --floating; the other commands refuse
+    a floating robot in one line."""
     assert main(["derive", str(ARM)]) == 0
     out = capsys.readouterr().out
     assert out.startswith("# floating_arm: 3 joints and a floating base (NV = 9), method newton-euler\n")
@@ -245,8 +246,8 @@ def test_command_line(tmp_path, capsys):
     for argv, message in (
         (["derive", str(ARM), "--form", "configuration"], "derive: a floating robot prints --form compact"),
         (["derive", str(ARM), "--steps"], "derive --steps: robot 'floating_arm' has a floating base"),
-        (["simulate", str(ARM), "--duration", "1", "--dt", "0.1", "--out", str(tmp_path / "s.csv")],
-         "symdyn simulate: robot 'floating_arm' has a floating base, which this command does not handle"),
+        (["excite", str(ARM), "--out", str(tmp_path / "e.csv")],
+         "symdyn excite: robot 'floating_arm' has a floating base, which this command does not handle"),
     ):  # fmt: skip
         assert main(argv) == 1
         err = capsys.readouterr().err

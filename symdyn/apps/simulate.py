@@ -42,6 +42,7 @@ import numpy as np
 from ..errors import SymdynError
 from . import stepping
 from .compiled import CompiledDynamics, compiled_dynamics, with_parameters
+from .floating_stepping import floating_sizes, run_floating
 from .output import write_atomic
 from .singular import divergence_error
 from .stepping import ADAPTIVE, INTEGRATORS, sample_times, torque_rows
@@ -330,6 +331,30 @@ def _adaptive(plant, method, q, qd, t, tau_at, rtol, atol):
     return Q, QD, U
 
 
+def _floating(plant, sizes, q0, v0, duration, dt, tau, integrator) -> Trajectory:
+    """A floating robot's run (symdyn.apps.floating_stepping): q0 of NQ, v0 of NV, one state."""
+    nq, nv = sizes
+    q = _state(q0, nq, "q0")
+    v = np.zeros(nv) if v0 is None else _state(v0, nv, "qd0")
+    if q.ndim != 1 or v.ndim != 1:
+        raise SymdynError(f"robot '{plant.robot.name}' has a floating base: give one initial state")
+    if np.linalg.norm(q[3:7]) == 0:
+        raise SymdynError("q0: the base quaternion (entries 4 to 7) is zero")
+    q[3:7] /= np.linalg.norm(q[3:7])
+    t, h = sample_times(duration, dt)
+    table = _torque_table(tau, nv, torque_rows(t, h))
+    torque = torque_function(tau, nv) if table is None else None
+
+    def tau_at(row, tk, q, v):
+        if table is not None:
+            return table[row]
+        return np.broadcast_to(np.asarray(torque(tk, q, v), dtype=float), v.shape)
+
+    scheme = "euler" if integrator == "lecture" else integrator
+    Q, V, U = run_floating(plant, scheme, q, v, h, t, tau_at)
+    return Trajectory(plant.robot, t, Q, V, U, scheme, plant=plant)
+
+
 def simulate(
     robot: Robot | CompiledDynamics,
     q0,
@@ -376,6 +401,9 @@ def simulate(
         raise SymdynError(
             f"robot '{plant.robot.name}': no forward dynamics (M(q) is singular), cannot simulate"
         )
+    sizes = floating_sizes(plant)
+    if sizes is not None:
+        return _floating(plant, sizes, q0, qd0, duration, dt, tau, integrator)
     q = _state(q0, n, "q0")
     qd = np.zeros_like(q) if qd0 is None else _state(qd0, n, "qd0")
     q, qd = np.broadcast_arrays(q, qd)

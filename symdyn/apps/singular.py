@@ -69,7 +69,8 @@ def guarded(owner, name: str, method: Callable) -> Callable:
 def _message(owner, name: str, q: np.ndarray) -> str:
     """Where M is singular: the first state of a batch whose M is, and its smallest eigenvalue."""
     given = "" if owner.p is None else f" with parameters {_listing(owner)}"
-    rows = q.reshape(-1, owner.n)
+    width = q.shape[-1] if q.ndim else owner.n  # NQ for a floating robot's q
+    rows = q.reshape(-1, width)
     worst, where = math.inf, rows[0]
     for row in rows:
         smallest = float(np.linalg.eigvalsh(owner.mass_matrix(row))[0])

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import SymdynError
+from ..model.free_flyer import BASE_POSITION_NAMES, BASE_VELOCITY_NAMES
 from .csv_format import csv_bytes, csv_text
 from .output import figure, figure_bytes, plot_format, write_atomic
 
@@ -52,12 +53,15 @@ class Trajectory:
     def _columns(self) -> tuple[list[str], np.ndarray]:
         if self.q.ndim != 2:
             raise SymdynError("CSV output holds one trajectory, not a batch")
-        n = self.n
-        header = ["t"] + [f"q{i}" for i in range(1, n + 1)] + [f"qd{i}" for i in range(1, n + 1)]
+        nq, nv = self.q.shape[1], self.qd.shape[1]
+        base_q, base_v = (BASE_POSITION_NAMES, BASE_VELOCITY_NAMES) if nq != nv else ((), ())
+        header = ["t", *base_q] + [f"q{i}" for i in range(1, nq - len(base_q) + 1)]
+        header += [*base_v] + [f"qd{i}" for i in range(1, nv - len(base_v) + 1)]
         return header, np.column_stack([self.t, self.q, self.qd])
 
     def csv_text(self) -> str:
-        """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision ("%.17g")."""
+        """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision ("%.17g"); for a
+        floating robot t, x_b y_b z_b qx_b qy_b qz_b qw_b, q1..qn, vx_b .. wz_b, qd1..qdn."""
         return csv_text(*self._columns())
 
     def csv_bytes(self) -> bytes:

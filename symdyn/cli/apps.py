@@ -167,6 +167,7 @@ def _torques(items, n: int):
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
+    from ..apps.floating_stepping import floating_sizes, initial_configuration
     from ..apps.output import write_atomic
     from ..apps.simulate import simulate
     from ..apps.trajectory import plot_trajectory
@@ -183,7 +184,23 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     plant = _plant(args, params)
     n = plant.n
     tolerances = {"rtol": args.rtol, "atol": args.atol}
-    if args.track is not None:
+    sizes = floating_sizes(plant)
+    if sizes is not None and (args.track is not None or args.plot):
+        flag = "--track" if args.track is not None else "--plot"
+        raise SymdynError(f"{flag} does not apply to a floating robot (docs/centroidal.md)")
+    if sizes is not None:
+        nq, nv = sizes
+        traj = simulate(
+            plant,
+            _vector(args.q0, nq, "--q0", default=initial_configuration(nq)),
+            _vector(args.qd0, nv, "--qd0", default=np.zeros(nv)),
+            duration=args.duration,
+            dt=args.dt,
+            tau=None if args.tau is None else _torques(args.tau, nv),
+            integrator=args.integrator,
+            **tolerances,
+        )
+    elif args.track is not None:
         from ..apps.control import ComputedTorque, Reference, SampledReference, track
 
         words = _words(args.track, "--track")

@@ -230,12 +230,16 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
             "derivatives",
             "kinematics",
             "operational_space",
+            "configuration",
+            "centroidal",
             "all",
         ),
         default=["dynamics"],
         help="the groups of functions to build (default: dynamics, the seven of tau = M qdd + V + G + F "
         "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives, "
-        "kinematics and operational_space (per frame, see --frames); all: every group",
+        "kinematics and operational_space (per frame, see --frames); configuration (a floating robot's "
+        "integrate and difference), centroidal (momentum matrix, its drift, com, total mass); all: "
+        "every group",
     )
     g.add_argument(
         "--frames",

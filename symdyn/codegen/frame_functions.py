@@ -30,13 +30,15 @@ from collections.abc import Sequence
 
 import sympy as sp
 
+from ..algorithms.floating_frames import FloatingFrames
 from ..algorithms.frame_kinematics import FrameKinematics
 from ..algorithms.operational_space import operational_space, task_rows
 from ..dynamics import Dynamics
 from ..errors import SymdynError, SymdynWarning
+from ..model.free_flyer import NQ_BASE, NV_BASE
 from ..model.robot import Robot
-from ..symbolic.program import Program
-from .function_rows import FrameChoice, FunctionRow, Inputs, Output
+from .centroidal_functions import centroidal_of, com_row, floating_inputs
+from .function_rows import FrameChoice, FunctionRow, Inputs, Output, with_steps
 
 __all__ = [
     "FrameChoice",
@@ -49,7 +51,6 @@ __all__ = [
     "COM_FUNCTIONS",
     "FRAME_SUFFIXES",
     "frame_function_names",
-    "with_steps",
 ]
 
 #: The centre-of-mass functions of the kinematics group (an identifier must not shadow them).
@@ -135,24 +136,21 @@ def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
     return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
 
 
-def with_steps(rows: list[tuple], prog: Program, first: int, cse: str) -> list[FunctionRow]:
-    """FunctionRows of one CSE group, the first carrying every step after `first` in `prog` that
-    the rows need (build_functions gathers the rows' steps into one program)."""
-    if not rows:
-        return []
-    new = {s for s, _ in prog.assignments[first:]}
-    steps = [a for a in prog.needed([e for row in rows for e in row[4]]) if a[0] in new]
-    carried = [tuple(steps)] + [()] * (len(rows) - 1)
-    return [FunctionRow(*row, s, cse=cse) for row, s in zip(rows, carried, strict=True)]
-
-
 def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """pose, jacobian, jacobian_local and jacobian_dot_qd of each chosen frame, then the centre
-    of mass's three functions (module docstring)."""
-    n = dyn.n
+    of mass's three functions (module docstring); on a floating robot over q (NQ) and v (NV),
+    with the base's columns (symdyn.algorithms.floating_frames)."""
+    robot = dyn.robot
     prog = dyn.program.copy("K")
     first = len(prog.assignments)
-    fk = FrameKinematics(dyn.robot, list(dyn.q), list(dyn.qd), prog)
+    if robot.floating:
+        q, qd = floating_inputs(dyn, x)
+        n, cols = robot.nv, "nv"
+        joints, rates = q.symbols[NQ_BASE:], qd.symbols[NV_BASE:]
+        fk = FloatingFrames(FrameKinematics(robot, joints, rates, prog), centroidal_of(dyn, x, prog))
+    else:
+        q, qd, n, cols = x.q, x.qd, dyn.n, "n"
+        fk = FrameKinematics(robot, list(dyn.q), list(dyn.qd), prog)
     rows: list[tuple] = []
     for name, ident, link in x.frames.frames:
         on = f"of frame {comment_text(name)} on {link}"
@@ -160,52 +158,46 @@ def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (
                 f"{ident}_pose",
                 f"world_T_F {on}, row-major 4 x 4",
-                (x.q, x.p),
+                (q, x.p),
                 (Output("T", 4, 4, "pose world_T_F: rotation and origin of F in the world", ("4", "4")),),
                 _entries(fk.pose(name)),
             ),
             (
                 f"{ident}_jacobian",
                 f"Jacobian {on}, world-aligned at F's origin, rows v_x v_y v_z w_x w_y w_z",
-                (x.q, x.p),
-                (Output("J", 6, n, "world-aligned Jacobian", ("6", "n")),),
+                (q, x.p),
+                (Output("J", 6, n, "world-aligned Jacobian", ("6", cols)),),
                 _entries(fk.jacobian(name, "world")),
             ),
             (
                 f"{ident}_jacobian_local",
                 f"Jacobian {on}, in F's own axes, rows v_x v_y v_z w_x w_y w_z",
-                (x.q, x.p),
-                (Output("J", 6, n, "Jacobian in F's own axes", ("6", "n")),),
+                (q, x.p),
+                (Output("J", 6, n, "Jacobian in F's own axes", ("6", cols)),),
                 _entries(fk.jacobian(name, "local")),
             ),
             (
                 f"{ident}_jacobian_dot_qd",
                 f"Jdot qd {on} at qdd = 0, world-aligned: classical acceleration of F's origin, "
                 "then F's angular acceleration",
-                (x.q, x.qd, x.p),
+                (q, qd, x.p),
                 (Output("a", 6, 1, "Jdot qd: linear then angular acceleration at qdd = 0", ("6", "1")),),
                 _entries(fk.jacobian_dot_qd(name)),
             ),
         ]
     rows += [
-        (
-            "com",
-            "the centre of mass c(q), world frame",
-            (x.q, x.p),
-            (Output("c", 3, 1, "centre of mass in the world", ("3", "1")),),
-            _entries(fk.com()),
-        ),
+        com_row(q, x.p, fk.com()),
         (
             "com_jacobian",
             "Jc(q) with dc/dt = Jc qd, world frame",
-            (x.q, x.p),
-            (Output("Jc", 3, n, "centre-of-mass Jacobian", ("3", "n")),),
+            (q, x.p),
+            (Output("Jc", 3, n, "centre-of-mass Jacobian", ("3", cols)),),
             _entries(fk.com_jacobian()),
         ),
         (
             "com_jacobian_dot_qd",
             "Jc_dot qd: the centre of mass's acceleration at qdd = 0, world frame",
-            (x.q, x.qd, x.p),
+            (q, qd, x.p),
             (Output("a", 3, 1, "Jc_dot qd", ("3", "1")),),
             _entries(fk.com_jacobian_dot_qd()),
         ),

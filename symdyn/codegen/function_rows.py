@@ -12,6 +12,7 @@ import sympy as sp
 
 from ..algorithms.operational_space import TASK_AXES
 from ..dynamics import Dynamics
+from ..symbolic.program import Program
 from ..symbolic.simplify import Eliminated, OpCount
 
 __all__ = [
@@ -24,6 +25,7 @@ __all__ = [
     "Output",
     "joint_matrix_output",
     "vector_output",
+    "with_steps",
 ]
 
 
@@ -38,10 +40,11 @@ class Input:
 #: Size names of the outputs (Output.dims): "1" for a vector's columns, "n" for the joints, "2n"
 #: for the state x = (q, qd), "3", "4", "6" fixed sizes, "k" the task axes of the
 #: operational-space functions (symdyn.codegen.frame_functions), "nact" and "npas" the actuated
-#: and passive coordinates of a robot with loops (symdyn.codegen.loop_functions); a target
-#: spells each as its own expression (C: a macro), and a family of functions that needs another
-#: size adds the name and every target's spelling.
-DIMS = ("1", "n", "2n", "nstd", "nbase", "3", "4", "6", "k", "nact", "npas")
+#: and passive coordinates of a robot with loops (symdyn.codegen.loop_functions), "nq" and "nv" a
+#: floating robot's configuration and velocity sizes (symdyn.codegen.configuration_functions); a
+#: target spells each as its own expression (C: a macro), and a family of functions that needs
+#: another size adds the name and every target's spelling.
+DIMS = ("1", "n", "2n", "nstd", "nbase", "3", "4", "6", "k", "nact", "npas", "nq", "nv")
 
 
 @dataclass(frozen=True)
@@ -187,3 +190,14 @@ class Inputs:
     @property
     def symbols(self) -> tuple[sp.Symbol, ...]:
         return (*self.q.symbols, *self.qd.symbols, *self.qdd.symbols, *self.tau.symbols, *self.p.symbols)
+
+
+def with_steps(rows: list[tuple], prog: Program, first: int, cse: str) -> list[FunctionRow]:
+    """FunctionRows of one CSE group, the first carrying every step after `first` in `prog` that
+    the rows need (build_functions gathers the rows' steps into one program)."""
+    if not rows:
+        return []
+    new = {s for s, _ in prog.assignments[first:]}
+    steps = [a for a in prog.needed([e for row in rows for e in row[4]]) if a[0] in new]
+    carried = [tuple(steps)] + [()] * (len(rows) - 1)
+    return [FunctionRow(*row, s, cse=cse) for row, s in zip(rows, carried, strict=True)]

@@ -37,6 +37,8 @@ from ..dynamics import QUANTITIES, Dynamics, singular_message
 from ..errors import SymdynError, SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
+from .centroidal_functions import centroidal_rows
+from .configuration_functions import configuration_rows
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
 from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
 from .function_rows import (
@@ -64,6 +66,7 @@ __all__ = [
     "FAMILIES",
     "GROUPS",
     "FRAME_GROUPS",
+    "NAMED_ONLY",
     "build_functions",
     "vector_output",
     "joint_matrix_output",
@@ -187,6 +190,8 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     kinematics_rows,
     operational_space_rows,
     loop_rows,
+    configuration_rows,
+    centroidal_rows,
 )
 
 
@@ -220,19 +225,34 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
     "derivatives": (derivative_rows,),
     "kinematics": (kinematics_rows,),
     "operational_space": (operational_space_rows,),
+    "configuration": (configuration_rows,),
+    "centroidal": (centroidal_rows,),
 }
 
 #: The groups built per frame (symdyn.codegen.frame_functions): only when named, never by default.
 FRAME_GROUPS = ("kinematics", "operational_space")
+#: The groups built only when named (the frame groups and the centroidal functions).
+NAMED_ONLY = (*FRAME_GROUPS, "centroidal")
+#: Functions two groups both have (com: kinematics and centroidal): built once, by the first.
+SHARED_FUNCTIONS = ("com",)
 
 
-#: the groups generated for a floating robot (docs/floating-base.md)
-FLOATING_GROUPS = ("dynamics",)
+def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
+    return next(row for row in rows if row.name == name)
+
+
+#: the groups generated for a floating robot (docs/floating-base.md, docs/centroidal.md)
+FLOATING_GROUPS = ("dynamics", "configuration", "kinematics", "centroidal")
+#: those built by default (the others only when named)
+FLOATING_DEFAULT = ("dynamics", "configuration")
 
 
 def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
-    """The groups of a floating robot: FLOATING_GROUPS by default; any other is a SymdynError."""
-    if groups is None or set(groups) == set(GROUPS):  # the default, or --functions all
+    """The groups of a floating robot: FLOATING_DEFAULT by default, FLOATING_GROUPS for every
+    group (--functions all); any group outside FLOATING_GROUPS is a SymdynError."""
+    if groups is None:
+        return FLOATING_DEFAULT
+    if set(groups) == set(GROUPS):
         return FLOATING_GROUPS
     other = [g for g in groups if g not in FLOATING_GROUPS]
     if other:
@@ -258,21 +278,24 @@ def build_functions(
     frames, symdyn.codegen.frame_functions.choose_frames).
     The regressor and the derivatives add intermediates to `dyn.program`; each family has a pass
     of its own so that it cannot change the other functions' temporaries. `groups` (names of
-    GROUPS; all but FRAME_GROUPS by default) keeps only those families: their code is the same
-    as in a full build.
+    GROUPS; all but NAMED_ONLY, the frame groups and centroidal, by default) keeps only those
+    families: their code is the same as in a full build.
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
     if dyn.robot.floating:
         groups = _floating_groups(dyn, groups)
     per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
-    chosen = set(FAMILIES) - per_frame if groups is None else {b for g in groups for b in GROUPS[g]}
+    named_only = {b for g in NAMED_ONLY for b in GROUPS[g]}
+    chosen = set(FAMILIES) - named_only if groups is None else {b for g in groups for b in GROUPS[g]}
     if frames is None and chosen & per_frame:
         frames = choose_frames(dyn.robot)
     x = Inputs.of(dyn, frames)
     families = [family for family in FAMILIES if family in chosen]
     _warn_singular(dyn, families)
     rows = [row for family in families for row in family(dyn, x)]
+    shared = [row for row in rows if row.name in SHARED_FUNCTIONS]
+    rows = [row for row in rows if row.name not in SHARED_FUNCTIONS or row is _first(shared, row.name)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
     code = {}

@@ -32,8 +32,7 @@ from ..algorithms.derivatives import substitute
 from ..algorithms.frame_kinematics import FrameKinematics
 from ..dynamics import Dynamics
 from ..errors import SymdynWarning
-from .frame_functions import with_steps
-from .function_rows import FunctionRow, Input, Inputs, Output
+from .function_rows import FunctionRow, Input, Inputs, Output, with_steps
 
 __all__ = ["loop_rows", "LOOP_FUNCTION_NAMES", "loop_inputs"]
 

@@ -214,6 +214,8 @@ def c_names(ctx: RenderContext) -> CNames:
             "k": str(_task_size(ctx)),
             "nact": f"{name}_NACT",
             "npas": f"{name}_NPAS",
+            "nq": nq or str(ctx.robot.nq),
+            "nv": nv or str(ctx.robot.nv),
         },
         sincos=sincos,
     )

@@ -88,6 +88,9 @@ class CPrinter(TreePrinter):
         if isinstance(e, sp.Heaviside):
             x, op = step_comparison(e)
             return f"(({self.config.real})({self._print(x)[0]} {op} 0))", ATOM
+        if isinstance(e, sp.atan2):  # the logarithm of a floating base's rotation (lie_group)
+            y, x = (self._print(a)[0] for a in e.args)
+            return f"{self.config.math('atan2')}({y}, {x})", ATOM
         call = MATH_CALLS.get(type(e))
         if call is not None:
             if not e.free_symbols:

@@ -33,6 +33,9 @@ class MatlabPrinter(CPrinter):
         if isinstance(e, sp.Heaviside):
             x, op = step_comparison(e)
             return f"double({self._print(x)[0]} {op} 0)", ATOM
+        if isinstance(e, sp.atan2):  # the logarithm of a floating base's rotation (lie_group)
+            y, x = (self._print(a)[0] for a in e.args)
+            return f"atan2({y}, {x})", ATOM
         call = MATLAB_CALLS.get(type(e))
         if call is None:
             raise SymdynError(f"cannot print '{type(e).__name__}' as MATLAB: {e}")
