@@ -20,6 +20,7 @@ import sympy as sp
 from cbuild import compile_shared, write_files
 
 import symdyn
+from symdyn import SymdynError
 from symdyn.codegen import render
 from symdyn.model.parameters import INERTIAL_NAMES, numeric_parameters, standard_parameters
 from symdyn.regenerate import example_robot_data_folder
@@ -131,3 +132,10 @@ def test_generated_regressor_functions_equal_the_oracle(arm, tmp_path):
             np.testing.assert_allclose(out.reshape(robot.nv, width) @ coeffs, tau, atol=1e-10, err_msg=fname)
             got = np.asarray(getattr(numpy_module, fname)(q, v, a)) @ coeffs
             np.testing.assert_allclose(got, tau, atol=1e-10, err_msg=f"NumPy {fname}")
+
+
+def test_identification_refuses_a_floating_robot(arm):
+    from symdyn.apps.identify import identify
+
+    with pytest.raises(SymdynError, match=r"^identify: robot 'floating_arm' has a floating base"):
+        identify(arm.robot, None, arm.base_parameters)
