@@ -18,16 +18,14 @@ import numpy as np
 import pytest
 import sympy as sp
 from cbuild import compile_shared, write_files
+from robots import floating_solo12
 
 import symdyn
 from symdyn import SymdynError
 from symdyn.codegen import render
 from symdyn.model.parameters import INERTIAL_NAMES, numeric_parameters, standard_parameters
-from symdyn.regenerate import example_robot_data_folder
 
 ARM = Path(__file__).parent / "data" / "floating_arm.yaml"
-ROBOTS = example_robot_data_folder()
-SOLO = ROBOTS / "solo_description/robots/solo12.urdf" if ROBOTS else None
 
 
 def _state(robot, rng):
@@ -52,9 +50,9 @@ def arm():
 
 @pytest.fixture(scope="module")
 def solo():
-    if SOLO is None:
+    if floating_solo12() is None:
         pytest.skip("example-robot-data is not installed")
-    return symdyn.derive(symdyn.load_urdf(SOLO, floating=True))
+    return floating_solo12()
 
 
 def _check(dyn, seed: int, states: int = 12) -> None:
@@ -92,8 +90,9 @@ def test_arm_regressor_and_base_parameters(arm):
 
 def test_solo_regressor_equals_pinocchio(solo):
     pin = pytest.importorskip("pinocchio", reason="the test extra installs pin (Pinocchio)")
+    path, solo = solo
     _check(solo, 5, states=10)
-    model = pin.buildModelFromUrdf(str(SOLO), pin.JointModelFreeFlyer())
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
     data = model.createData()
     f = _compact(solo)
     rng = np.random.default_rng(7)

@@ -227,7 +227,7 @@ FRAME_GROUPS = ("kinematics", "operational_space")
 
 
 #: the groups generated for a floating robot (docs/floating-base.md)
-FLOATING_GROUPS = ("dynamics", "regressor")
+FLOATING_GROUPS = ("dynamics", "regressor", "derivatives")
 
 
 def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
