@@ -12,12 +12,11 @@ pinocchio.integrate of the numeric oracle's inverse and forward dynamics, and M^
 from __future__ import annotations
 
 import ctypes
-import types
 from pathlib import Path
 
 import numpy as np
 import pytest
-from cbuild import compile_shared, write_files
+from cbuild import load_c_and_numpy
 from robots import floating_solo12
 
 import symdyn
@@ -110,10 +109,7 @@ def test_generated_derivatives_equal_finite_differences(tmp_path):
     robot = symdyn.load_robot(ARM)
     name = robot.name
     files = render(robot, targets=("c", "python"), functions=["derivatives"])
-    write_files(files, tmp_path)
-    lib = ctypes.CDLL(str(compile_shared([tmp_path / f"{name}_dynamics.c"], tmp_path / f"lib{name}.so")))
-    numpy_module = types.ModuleType("floating_derivatives_numpy")
-    exec(compile(files[f"{name}_numpy.py"], "gen", "exec"), numpy_module.__dict__)  # symdyn's own output
+    lib, numpy_module = load_c_and_numpy(files, tmp_path, name)
     ptr = ctypes.POINTER(ctypes.c_double)
     nv = robot.nv
     model = _flyer_model(robot.n)

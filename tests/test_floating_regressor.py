@@ -11,13 +11,12 @@ the base regressor has full column rank, the rank of Y, and Y_b pi_b = tau. The 
 from __future__ import annotations
 
 import ctypes
-import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 import sympy as sp
-from cbuild import compile_shared, write_files
+from cbuild import load_c_and_numpy
 from robots import floating_solo12
 
 import symdyn
@@ -108,10 +107,7 @@ def test_generated_regressor_functions_equal_the_oracle(arm, tmp_path):
     robot = arm.robot
     name = robot.name
     files = render(robot, targets=("c", "python"), functions=["regressor"])
-    write_files(files, tmp_path)
-    lib = ctypes.CDLL(str(compile_shared([tmp_path / f"{name}_dynamics.c"], tmp_path / f"lib{name}.so")))
-    numpy_module = types.ModuleType("floating_regressor_numpy")
-    exec(compile(files[f"{name}_numpy.py"], "gen", "exec"), numpy_module.__dict__)  # symdyn's own output
+    lib, numpy_module = load_c_and_numpy(files, tmp_path, name)
     pi = numeric_parameters(robot)
     K = arm.linear_compact()[1].matrix()
     ptr = ctypes.POINTER(ctypes.c_double)
