@@ -31,6 +31,11 @@ vector per pair (j, i) is carried, never the ten wrench columns, and exact zeros
 chain costs O(n^2) small products. Mimic joints: the recursion runs on the nb bodies at q_b, S qd,
 S qdd and the rows are projected, Y = S^T Y_b (symdyn.algorithms.coordinates), so Y is n x 13 nb
 (plus one column per link with direction-dependent Coulomb friction).
+
+Floating base (`floating_regressor`): the recursion starts from the moving base, and six base rows
+(force, then moment about the base origin, base frame) come first: row k is the power of the
+base's unit motion e_k carried out to every body, so every body's 10 inertial columns enter them,
+and the base body's own 10 (m0 ... Izz0, the last columns) enter them alone.
 """
 
 from __future__ import annotations

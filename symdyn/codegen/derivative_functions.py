@@ -19,6 +19,12 @@ The Coulomb friction sign(qd) contributes zero (its derivative almost everywhere
 
 The three functions that invert M are left out, like forward_dynamics, when M is singular
 by construction (Dynamics.singular_joints; symdyn.codegen.functions.build_functions warns).
+
+A floating robot (q of NQ entries, the rest NV; docs/floating-base.md) gets the first three, with
+dtau/dq and dqdd/dq in the tangent space (symdyn.algorithms.derivatives.floating_effort_jacobians:
+Pinocchio's computeRNEADerivatives / computeABADerivatives convention) and dtau/dqd by forward
+mode; M^-1 eliminates the joints before the base. No linearize: the tangent of (q, qd) is not
+[[0, I], ..] in the base's coordinates.
 """
 
 from __future__ import annotations
