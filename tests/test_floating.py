@@ -196,7 +196,7 @@ class _C:
 @pytest.fixture(scope="module")
 def generated(tmp_path_factory):
     robot = symdyn.load_robot(ARM)
-    files = render(robot, targets=("c", "python", "casadi", "matlab"))
+    files = render(robot, targets=("c", "python", "casadi", "matlab"), functions=["dynamics"])
     return robot, files, _C(files, tmp_path_factory.mktemp("floating_c"), robot.name)
 
 
