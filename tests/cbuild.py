@@ -24,6 +24,7 @@ import os
 import re
 import shutil
 import subprocess
+import types
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 
@@ -41,6 +42,7 @@ __all__ = [
     "header_macros",
     "CDynamics",
     "build_dynamics",
+    "load_c_and_numpy",
 ]
 
 STRICT_FLAGS = ("-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror")
@@ -223,3 +225,16 @@ def build_dynamics(
         [out / f"{name}_dynamics.c"], out / f"lib{name}_{precision}_{compiler}.so", compiler, opt, extra=extra
     )
     return CDynamics(lib, name, int(macros[f"{name}_NDOF"]), int(macros[f"{name}_NPARAM"]), precision)
+
+
+def load_c_and_numpy(files: Mapping[str, str | bytes], directory: str | os.PathLike, name: str):
+    """(the compiled NAME_dynamics.c as a ctypes.CDLL, the NumPy target's module): every file
+    written to `directory`, the C compiled with the strict flags."""
+    out = Path(directory)
+    write_files(files, out)
+    lib = ctypes.CDLL(str(compile_shared([out / f"{name}_dynamics.c"], out / f"lib{name}.so")))
+    module = types.ModuleType(f"{name}_numpy")
+    exec(
+        compile(files[f"{name}_numpy.py"], f"{name}_numpy.py", "exec"), module.__dict__
+    )  # symdyn's own output
+    return lib, module

@@ -26,7 +26,8 @@ from hypothesis import strategies as st
 from symdyn.dynamics import derive
 from symdyn.errors import SymdynWarning
 from symdyn.model.robot import Friction, Link, Motor, Robot
-from symdyn.parsers import load_robot, robot_from_data
+from symdyn.parsers import load_robot, load_urdf, robot_from_data
+from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import forward_kinematics as rnea_poses
 from symdyn.spatial.transform import Transform
 
@@ -674,3 +675,14 @@ def spec_arguments(spec, rng: np.random.Generator, batch: tuple[int, ...] = ()) 
             value = np.where(np.abs(value) < 1e-3, 0.5, value)
         args[inp.name] = value
     return args
+
+
+@cache
+def floating_solo12():
+    """(path, derive(load_urdf(path, floating=True), simplify=False)) of example-robot-data's
+    Solo-12 on a free flyer, once per session; None without example-robot-data."""
+    folder = example_robot_data_folder()
+    if folder is None:
+        return None
+    path = folder / "solo_description/robots/solo12.urdf"
+    return path, derive(load_urdf(path, floating=True), simplify=False)

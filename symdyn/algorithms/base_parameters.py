@@ -14,14 +14,16 @@ inertial parameters of robots", 1991; Khalil and Dombre, Modeling, Identificatio
 Robots (2002), sec. 12.3).
 
 Numerically: Y is evaluated at STATES_PER_COLUMN * 13 nb / n + 10 random states (revolute angles
-uniform over a full turn, prismatic positions in +-0.5 m, rates and accelerations in +-2, free
+uniform over a full turn, prismatic positions in +-0.5 m, on a floating base (n = NV rows) the
+base in +-1 m with a random unit quaternion, rates and accelerations in +-2, free
 parameters uniform in [0.5, 2]) and stacked into W. Columns with a norm below ZERO_TOL times the
 largest are zero. The others are scaled to unit norm; a QR factorisation with column pivoting
 (largest remaining norm first) gives the rank r, the number of diagonal entries |R_kk| above
 RANK_TOL |R_00|. The kept columns are then chosen in the order of the standard parameters (body
 1 first, m before the inertias): a column is kept when its distance to the span of the columns
-kept before it exceeds RANK_TOL, so parameters of later bodies regroup into earlier ones. Both
-counts must agree. beta solves W_1 beta = W_2 in the least-squares sense.
+kept before it exceeds RANK_TOL, so parameters of later bodies regroup into earlier ones (on a
+floating base the base body, body 0, comes first). Both counts must agree. beta solves
+W_1 beta = W_2 in the least-squares sense.
 
 Coefficients: when beta depends on the robot's free parameters (symbolic lengths: beta differs at
 two random values of them) it is found exactly.
@@ -93,9 +95,14 @@ def _states(robot: Robot, rng: np.random.Generator, count: int):
     q = np.where(
         revolute, rng.uniform(-np.pi, np.pi, (count, robot.n)), rng.uniform(-0.5, 0.5, (count, robot.n))
     )
-    qd = rng.uniform(-2, 2, (count, robot.n))
+    nv = robot.nv
+    qd = rng.uniform(-2, 2, (count, nv))
     qd[np.abs(qd) < 1e-3] = 0.5
-    return q, qd, rng.uniform(-2, 2, (count, robot.n))
+    if robot.floating:  # base position in +-1 m, a random unit quaternion, then the joints
+        quat = rng.normal(size=(count, 4))
+        quat /= np.linalg.norm(quat, axis=1, keepdims=True)
+        q = np.concatenate([rng.uniform(-1, 1, (count, 3)), quat, q], 1)
+    return q, qd, rng.uniform(-2, 2, (count, nv))
 
 
 def _value(e: sp.Expr, values: dict, memo: dict, count: int):
@@ -211,7 +218,7 @@ def _rational_trig(robot: Robot, q, qd, qdd, rng: np.random.Generator, program: 
             t = sp.Rational(int(rng.integers(-40, 41)), int(rng.integers(1, 41)))
             subs[sp.cos(qi)], subs[sp.sin(qi)] = (1 - t**2) / (1 + t**2), 2 * t / (1 + t**2)
             subs[sp.cos(-qi)], subs[sp.sin(-qi)] = subs[sp.cos(qi)], -subs[sp.sin(qi)]
-            subs[qi] = sp.Rational(int(rng.integers(-50, 51)), 25)
+            subs[qi] = sp.Rational(int(rng.integers(1, 51)) * int(rng.choice([-1, 1])), 25)
         for x in (*qd, *qdd):
             subs[x] = sp.Rational(int(rng.integers(1, 51)) * int(rng.choice([-1, 1])), 25)
         vals = []
@@ -226,7 +233,7 @@ def _rational_trig(robot: Robot, q, qd, qdd, rng: np.random.Generator, program: 
 def _exact_beta(robot, q, qd, qdd, program, Y, kept, dependent, rng, beta_num, p0) -> sp.Matrix:
     """beta over the rational functions of the free parameters, checked against the numeric beta."""
     cols = kept + dependent
-    count = -(-2 * len(kept) // robot.n) + 2
+    count = -(-2 * len(kept) // Y.rows) + 2
     W = _rational_trig(robot, q, qd, qdd, rng, program, Y, cols, count)
     at_p0 = np.array(W.xreplace({s: sp.Float(v) for s, v in p0.items()}).tolist(), dtype=float)
     # r rows independent at p0: pivoted selection on W_1^T
@@ -273,7 +280,7 @@ def find_base_parameters(
     rng = np.random.default_rng(_SEED)
     params = list(robot.params)
     p0 = {s: float(v) for s, v in zip(params, rng.uniform(0.5, 2.0, len(params)), strict=True)}
-    count = -(-STATES_PER_COLUMN * Y.cols // robot.n) + 10
+    count = -(-STATES_PER_COLUMN * Y.cols // Y.rows) + 10
     states = _states(robot, rng, count)
     with np.errstate(all="ignore"):
         W = _stacked(program, Y, (q, qd, qdd), states, p0)
@@ -287,7 +294,12 @@ def find_base_parameters(
     nonzero = [c for c in range(W.shape[1]) if norms[c] > ZERO_TOL * norms.max()]
     A = W[:, nonzero] / norms[nonzero]
     rank = _pivoted_rank(A)
-    kept = [nonzero[k] for k in _kept_in_order(A, list(range(len(nonzero))))]
+    order = list(range(len(nonzero)))
+    if robot.floating:  # the base body (its 10 columns last) first: the links regroup into it
+        order = [k for k in order if nonzero[k] >= Y.cols - 10] + [
+            k for k in order if nonzero[k] < Y.cols - 10
+        ]
+    kept = [nonzero[k] for k in _kept_in_order(A, order)]
     if len(kept) != rank:
         raise SymdynError(
             f"robot '{robot.name}': the numeric rank of the regressor is ambiguous "

@@ -43,6 +43,7 @@ from ..symbolic.program import Program
 __all__ = [
     "jacobian",
     "effort_jacobians",
+    "floating_effort_jacobians",
     "substitute",
     "ldlt_factor",
     "ldlt_inverse",
@@ -103,6 +104,32 @@ def effort_jacobians(
     dF = jacobian(program, F, qd, "DF")
     dqd = sp.Matrix(n, n, lambda i, j: program.let(2 * C[i, j] + dF[i, j], "Dv"))
     return dq, dqd
+
+
+def floating_effort_jacobians(
+    program: Program, tau: Sequence[sp.Expr], q: Sequence[sp.Symbol], qd: Sequence[sp.Symbol]
+) -> tuple[sp.Matrix, sp.Matrix]:
+    """dtau/dq (in the tangent space) and dtau/dqd of a floating robot, NV x NV each.
+
+    Column j of dtau/dq is d/de tau(q + e delta_j) at e = 0 with + the free flyer's integration
+    (Pinocchio's `integrate`, the `computeRNEADerivatives` convention): the base's translations
+    (columns 0-2) do not change tau; a rotation about the base's axis k (columns 3-5) moves the
+    quaternion p = (u, w) as p (x) (e_k / 2, 0), that is dp/de = ((w e_k + u x e_k) / 2, -u_k / 2),
+    so the column is (dtau/dp) dp/de (forward mode over the quaternion's four inputs: tau reads
+    the orientation through R^T g only); the joints' columns as on a fixed base. dtau/dqd by
+    forward mode over the NV rates (the base's velocity terms are not Christoffel-symmetric in
+    the base twist, so the fixed base's 2 C shortcut is not used); tau includes friction, whose
+    Coulomb term contributes zero.
+    """
+    nv = len(qd)
+    dquat = jacobian(program, tau, q[3:7], "Dr")
+    ux, uy, uz, w = q[3:7]
+    # dp/de_k for k = x, y, z: ((w e_k + u x e_k) / 2, -u_k / 2)
+    P = sp.Matrix([[w, -uz, uy], [uz, w, -ux], [-uy, ux, w], [-ux, -uy, -uz]]) / 2
+    rotation = sp.Matrix(nv, 3, lambda i, k: program.let(sum(dquat[i, j] * P[j, k] for j in range(4)), "Dr"))
+    dq = sp.zeros(nv, 3).row_join(rotation).row_join(jacobian(program, tau, q[7:], "Dq"))
+    dv = jacobian(program, tau, qd, "Dv")
+    return dq, sp.Matrix(nv, nv, lambda i, j: program.let(dv[i, j], "Dv"))
 
 
 def substitute(program: Program, outputs: Sequence[sp.Expr], values: dict, hint: str) -> list[sp.Expr]:

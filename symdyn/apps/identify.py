@@ -242,8 +242,13 @@ def identify(robot: Robot, data: Measurements, base: tuple[tuple[str, object], .
             (`Dynamics.base_parameters`).
 
     Raises:
-        SymdynError: fewer equations than base parameters.
+        SymdynError: fewer equations than base parameters; a floating robot.
     """
+    if robot.floating:
+        raise SymdynError(
+            f"identify: robot '{robot.name}' has a floating base, which identification does not handle "
+            "yet (its regressor is generated: docs/floating-base.md)"
+        )
     W3 = base_regressor_samples(robot, data.q, data.qd, data.qdd)
     N, n, nb = W3.shape
     assert nb == len(base), (nb, len(base))

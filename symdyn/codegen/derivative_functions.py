@@ -19,13 +19,26 @@ The Coulomb friction sign(qd) contributes zero (its derivative almost everywhere
 
 The three functions that invert M are left out, like forward_dynamics, when M is singular
 by construction (Dynamics.singular_joints; symdyn.codegen.functions.build_functions warns).
+
+A floating robot (q of NQ entries, the rest NV; docs/floating-base.md) gets the first three, with
+dtau/dq and dqdd/dq in the tangent space (symdyn.algorithms.derivatives.floating_effort_jacobians:
+Pinocchio's computeRNEADerivatives / computeABADerivatives convention) and dtau/dqd by forward
+mode; M^-1 eliminates the joints before the base. No linearize: the tangent of (q, qd) is not
+[[0, I], ..] in the base's coordinates.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-from ..algorithms.derivatives import effort_jacobians, elimination_order, ldlt_inverse, matmul, substitute
+from ..algorithms.derivatives import (
+    effort_jacobians,
+    elimination_order,
+    floating_effort_jacobians,
+    ldlt_inverse,
+    matmul,
+    substitute,
+)
 from ..dynamics import Dynamics
 from .function_rows import FunctionRow, Inputs, Output, joint_matrix_output
 
@@ -67,7 +80,11 @@ def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     c = dyn.compact
     prog = dyn.program.copy("d")
     first = len(prog.assignments)
-    dq, dqd = effort_jacobians(prog, list(c["tau"]), c["C"], list(c["F"]), list(dyn.q), list(dyn.qd))
+    floating = dyn.robot.floating
+    if floating:  # dtau/dq in the tangent space (NV columns)
+        dq, dqd = floating_effort_jacobians(prog, list(c["tau"]), list(dyn.q), list(dyn.qd))
+    else:
+        dq, dqd = effort_jacobians(prog, list(c["tau"]), c["C"], list(c["F"]), list(dyn.q), list(dyn.qd))
     rows = [
         (
             "inverse_dynamics_derivatives",
@@ -81,7 +98,8 @@ def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
         ),
     ]
     if not dyn.singular_joints:
-        Minv = ldlt_inverse(sp.Matrix(c["M"]), elimination_order(n, dyn.robot.is_chain), prog, "Di")
+        order = elimination_order(n, dyn.robot.is_chain and not floating)  # the base last when floating
+        Minv = ldlt_inverse(sp.Matrix(c["M"]), order, prog, "Di")
         # qdd = FD(q, qd, tau) = M^-1 (tau - bias) with the same M^-1, then dtau/dx at that qdd
         b = sp.Matrix([prog.let(x.tau.symbols[i] - c["bias"][i], "Db") for i in range(n)])
         qdd = matmul(Minv, b, prog, "Dqdd")
@@ -109,17 +127,21 @@ def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 (joint_matrix_output("Minv", n, inv_doc),),
                 _entries(Minv),
             ),
-            (
-                "linearize",
-                "xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1]",
-                (x.q, x.qd, x.tau, x.p),
-                (
-                    Output("A", 2 * n, 2 * n, "df/dx", ("2n", "2n")),
-                    Output("B", 2 * n, n, "df/dtau", ("2n", "n")),
-                ),
-                _entries(A, B),
-            ),
         ]
+        if not floating:  # a floating state's q (NQ) and its tangent (NV) differ: no A = [[0, I], ..]
+            rows.append(
+                (
+                    "linearize",
+                    "xd = f(x, tau) linearised at x = (q, qd): "
+                    "A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1]",
+                    (x.q, x.qd, x.tau, x.p),
+                    (
+                        Output("A", 2 * n, 2 * n, "df/dx", ("2n", "2n")),
+                        Output("B", 2 * n, n, "df/dtau", ("2n", "n")),
+                    ),
+                    _entries(A, B),
+                )
+            )
     # build_functions gathers every row's steps into one program: the first row carries them all
     steps = [tuple(prog.assignments[first:])] + [()] * (len(rows) - 1)
     return [FunctionRow(*row, s, cse="derivatives") for row, s in zip(rows, steps, strict=True)]

@@ -242,7 +242,7 @@ def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
 
 
 #: the groups generated for a floating robot (docs/floating-base.md, docs/centroidal.md)
-FLOATING_GROUPS = ("dynamics", "configuration", "kinematics", "centroidal")
+FLOATING_GROUPS = ("dynamics", "configuration", "kinematics", "centroidal", "regressor", "derivatives")
 #: those built by default (the others only when named)
 FLOATING_DEFAULT = ("dynamics", "configuration")
 

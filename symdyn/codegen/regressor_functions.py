@@ -3,7 +3,8 @@
 tau = Y(q, qd, qdd) pi with pi the standard parameters (symdyn.standard_parameters: 13 per body,
 nstd = 13 nb columns) and tau = Y_b(q, qd, qdd) pi_b with pi_b the base parameters
 (`Dynamics.base_parameters`, nbase columns; symdyn.algorithms.base_parameters), both row-major
-n x columns, from the Newton-Euler recursion (symdyn.algorithms.regressor). The size names
+n x columns (NV rows and the base body's 10 columns last on a floating base), from the
+Newton-Euler recursion (symdyn.algorithms.regressor). The size names
 "nstd" and "nbase" (symdyn.codegen.functions.DIMS) are spelled by each target; `columns` gives
 every target the same table of column names (and, for Y_b, each base parameter's definition).
 """
@@ -42,8 +43,10 @@ def regressor_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     n = dyn.n
     state = (x.q, x.qd, x.qdd, x.p)
     per_body = "13 per body"
-    if Y.cols > 13 * dyn.robot.nb:
+    if Y.cols - (10 if dyn.robot.floating else 0) > 13 * dyn.robot.nb:
         per_body += ", then fcn per joint with direction-dependent Coulomb friction"
+    if dyn.robot.floating:
+        per_body += ", then the base body's 10 (m0 ... Izz0)"
     rows = [
         FunctionRow(
             "regressor",

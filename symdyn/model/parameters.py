@@ -11,8 +11,10 @@ then the joint's 3: Ia_i = gear_ratio^2 J_m (reflected rotor inertia), fv_i (vis
 fc_i (Coulomb friction). A link with direction-dependent Coulomb friction (symdyn.model.friction)
 calls its 13th parameter fcp_i (the magnitude for qd_i > 0) and adds fcn_i (the magnitude for
 qd_i < 0); these extra parameters follow the 13 nb others, in link order, so that column 13 i + k
-is always parameter k of body i + 1. The equations of motion are linear in this vector,
-tau = Y(q, qd, qdd) pi (symdyn.oracle.regressor; Atkeson, An and Hollerbach 1986).
+is always parameter k of body i + 1. A floating robot's base body (`Robot.base_body`, body 0)
+adds its 10 inertial parameters last, named m0, mx0, ..., Izz0 (base frame, about its origin).
+The equations of motion are linear in this vector, tau = Y(q, qd, qdd) pi (symdyn.oracle.regressor;
+Atkeson, An and Hollerbach 1986).
 """
 
 from __future__ import annotations
@@ -49,14 +51,19 @@ def _body_names(i: int, asymmetric: bool) -> list[str]:
     return [f"{p}{i}" for p in (*INERTIAL_NAMES, *joint)]
 
 
+def _inertial_parameters(body) -> list[sp.Expr]:
+    """[m, m c, I_O (6 entries)] of a body (a link or a floating robot's base body), its own frame."""
+    m = sp.sympify(body.mass)
+    c = sp.Matrix(body.com)
+    I_origin = sp.Matrix(body.inertia) + m * ((c.T * c)[0, 0] * sp.eye(3) - c * c.T)
+    inertial = [m, *(m * c), *(I_origin[i, j] for i, j in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)))]
+    return [sp.sympify(x) for x in inertial]
+
+
 def _body_parameters(link) -> list[sp.Expr]:
     """[m, m c, I_O (6 entries), Ia, fv, fc] of one link, all in its body frame."""
-    m = sp.sympify(link.mass)
-    c = sp.Matrix(link.com)
-    I_origin = sp.Matrix(link.inertia) + m * ((c.T * c)[0, 0] * sp.eye(3) - c * c.T)
-    inertial = [m, *(m * c), *(I_origin[i, j] for i, j in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)))]
     joint = [link.motor.reflected_inertia, link.friction.viscous, link.friction.coulomb]
-    return [sp.sympify(x) for x in (*inertial, *joint)]
+    return [*_inertial_parameters(link), *(sp.sympify(x) for x in joint)]
 
 
 def standard_parameters(robot) -> tuple[tuple[str, ...], tuple[sp.Expr, ...]]:
@@ -66,7 +73,8 @@ def standard_parameters(robot) -> tuple[tuple[str, ...], tuple[sp.Expr, ...]]:
     Per body i (1-based, every link including mimic joints' bodies): m_i, m_i c_i (body frame i),
     the inertia tensor about body frame i's origin (I_xx, I_xy, I_yy, I_xz, I_yz, I_zz: Pinocchio's
     `Inertia.toDynamicParameters` order), then Ia_i = gear_ratio^2 J_m, fv_i, fc_i (fcp_i when
-    the link's Coulomb friction depends on the direction); then fcn_i of each such link.
+    the link's Coulomb friction depends on the direction); then fcn_i of each such link; then, on a
+    floating base, the base body's 10 inertial parameters m0, mx0, ..., Izz0.
 
     Args:
         robot: a `symdyn.Robot`; its valued parameters are substituted (`Robot.resolved`).
@@ -75,12 +83,16 @@ def standard_parameters(robot) -> tuple[tuple[str, ...], tuple[sp.Expr, ...]]:
         (names, values): names such as "m1", "mx1", ..., "fc1", "m2", ...; values SymPy
         expressions in which only the robot's free parameters stay symbols.
     """
-    links = robot.resolved().links
+    resolved = robot.resolved()
+    links = resolved.links
     extra = asymmetric_bodies(robot)
     names = [name for i, link in enumerate(links, 1) for name in _body_names(i, link.friction.asymmetric)]
     names += [f"fcn{i + 1}" for i in extra]
     values = [x for link in links for x in _body_parameters(link)]
     values += [sp.sympify(links[i].friction.coulomb_minus) for i in extra]
+    if robot.floating:
+        names += [f"{p}0" for p in INERTIAL_NAMES]
+        values += _inertial_parameters(resolved.base_body)
     return tuple(names), tuple(values)
 
 
