@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from symdyn.apps.least_squares import Triangular, combine
+from symdyn.apps.least_squares import Triangular, combine, triangular_factor
 
 
 def test_chunks_give_the_least_squares_of_all_rows():
@@ -31,3 +31,12 @@ def test_chunks_give_the_least_squares_of_all_rows():
     assert abs(whole.condition_number() / np.linalg.cond(Ag) - 1) < 1e-10
     inv = np.linalg.inv(Ag.T @ Ag)
     np.testing.assert_allclose(whole.covariance_factor(), inv, rtol=1e-8, atol=1e-8 * np.abs(inv).max())
+
+
+def test_lapack_factor_is_numpys_up_to_row_signs():
+    a = np.random.default_rng(3).normal(size=(40, 7))
+    r, want = triangular_factor(a), np.linalg.qr(a, mode="r")
+    np.testing.assert_allclose(
+        r * np.sign(np.diag(r))[:, None], want * np.sign(np.diag(want))[:, None], atol=1e-12
+    )
+    np.testing.assert_allclose(r.T @ r, a.T @ a, rtol=1e-12, atol=1e-12 * np.abs(a.T @ a).max())
