@@ -8,7 +8,8 @@ and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.build: CO
 -march=native unless $SYMDYN_MARCH says otherwise) and times, over the same states, the scalar
 function called once per state in a C loop and one call of NAME_batch (the best of 15 rounds,
 interleaved); it also checks that both give the same bits. Then the batch through Python
-(symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2.
+(symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2, over the same
+number of states and over ten times as many.
 Part 2: `symdyn identify` on a million-sample log of the Panda, stage by stage and end to end
 (bench/identify.py).
 The table goes to stdout and to bench/results/batch.txt.
@@ -164,12 +165,13 @@ def main() -> int:
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
     count, samples = (10_000, 100_000) if args.quick else (100_000, 1_000_000)
-    lines = [f"# bench/batch.py: {machine()}; load averages {load_averages()}", ""]
+    lines = [f"# bench/batch.py: {machine()}; load averages at the start {load_averages()}", ""]
     with tempfile.TemporaryDirectory(prefix="symdyn-batch-") as tmp:
         log("C harness")
         width, rows, flags = c_part(count, Path(tmp))
         log("Python methods")
         py = python_part(count)
+        big = python_part(10 * count)
         log("identify")
         ident = identify_part(samples, Path(tmp))
     lines += [
@@ -185,6 +187,9 @@ def main() -> int:
             f"{name:<18}  {scalar:>16.1f}  {batch:>8.1f}  {batch / scalar:>11.2f}x"
             f"  {'yes' if same else 'NO':>9}  {one:>15.1f}  {two:>12.1f}"
         )
+    lines += ["", f"threads through Python at {10 * count:,} states, ns per state (best of 5):"]
+    for name, (one, two) in big.items():
+        lines.append(f"  {name:<18} threads=1 {one:7.1f}  threads=2 {two:7.1f}  ratio {two / one:.2f}")
     target = all(batch / scalar <= 0.4 for _, scalar, batch, _ in rows)
     lines += [
         "",
@@ -193,6 +198,7 @@ def main() -> int:
         "",
         *identify_lines(samples, ident),
     ]
+    lines += ["", f"# load averages at the end {load_averages()}"]
     text = "\n".join(lines) + "\n"
     print(text, end="")
     out = RESULTS / "batch.txt"
