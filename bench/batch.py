@@ -8,10 +8,10 @@ and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.build: CO
 -march=native unless $SYMDYN_MARCH says otherwise) and times, over the same states, the scalar
 function called once per state in a C loop and one call of NAME_batch (the best of 15 rounds,
 interleaved); it also checks that both give the same bits. Then the batch through Python
-(symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2.
-Part 2: `symdyn identify` on a log of the Panda (t, q, qd, qdd, tau; tau from the compiled inverse
-dynamics plus noise), end to end as a command, and its stages in this process: reading the CSV,
-the base regressor at every sample (one batch call), the least squares.
+(symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2, over the same
+number of states and over ten times as many.
+Part 2: `symdyn identify` on a million-sample log of the Panda, stage by stage and end to end
+(bench/identify.py).
 The table goes to stdout and to bench/results/batch.txt.
 """
 
@@ -28,6 +28,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from identify import identify_part  # noqa: E402
+from identify import lines as identify_lines  # noqa: E402
 from machine import RESULTS, load_averages, log, machine, project_path  # noqa: E402
 
 import symdyn  # noqa: E402
@@ -158,72 +160,20 @@ def python_part(count: int) -> dict[str, tuple[float, float]]:
     return result
 
 
-def _log(robot, fast, samples: int, path: Path) -> None:
-    """A Panda log of `samples` samples at 1 kHz (sines), tau from the compiled inverse dynamics + noise."""
-    from symdyn.apps.csv_format import csv_text
-
-    n = robot.n
-    t = np.arange(samples) * 1e-3
-    k = np.arange(1, n + 1)
-    phase = np.outer(t, 0.5 * k) + k
-    q, qd, qdd = 0.8 * np.sin(phase), 0.4 * k * np.cos(phase), -0.2 * k**2 * np.sin(phase)
-    tau = fast.inverse_dynamics(q, qd, qdd) + np.random.default_rng(1).normal(0, 0.01, (samples, n))
-    header = ["t", *(f"{s}{i}" for s in ("q", "qd", "qdd", "tau") for i in k)]
-    path.write_text(csv_text(header, np.column_stack([t, q, qd, qdd, tau])), encoding="utf-8")
-
-
-def identify_part(samples: int, command_samples: int, folder: Path) -> dict[str, float]:
-    """Seconds of the stages of identification on a log of `samples` samples (reading the CSV, the
-    base regressor at every sample: one batch call), and of `symdyn identify` end to end on
-    `command_samples` samples (its least squares holds the stacked regressor, N n x nbase doubles,
-    several times: 3.5 GB a copy at a million Panda samples, more than a shared machine spares)."""
-    from symdyn.apps.identify import base_regressor_samples, read_measurements
-
-    path = ROOT / "examples" / "panda.yaml"
-    robot = symdyn.load_robot(path)
-    fast = symdyn.compile(robot)
-    times = {}
-    big, small = folder / "log.csv", folder / "small.csv"
-    _log(robot, fast, samples, big)
-    _log(robot, fast, command_samples, small)
-    t0 = time.perf_counter()
-    data = read_measurements(big, robot.n)
-    times[f"read the CSV ({samples:,} samples)"] = time.perf_counter() - t0
-    base_regressor_samples(robot, data.q[:10], data.qd[:10], data.qdd[:10])  # warm: cffi's parse
-    t0 = time.perf_counter()
-    Yb = base_regressor_samples(robot, data.q, data.qd, data.qdd)
-    times[f"base regressor, one batch call ({samples:,})"] = time.perf_counter() - t0
-    times["nbase"] = Yb.shape[2]
-    shape = Yb.shape
-    del Yb
-    t0 = time.perf_counter()
-    np.ones(shape)
-    times["for scale: np.ones of the regressor's size"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    base_regressor_samples(robot, data.q[:100_000], data.qd[:100_000], data.qdd[:100_000])
-    times["base regressor, one batch call (100,000)"] = time.perf_counter() - t0
-    del data
-    t0 = time.perf_counter()
-    cmd = [sys.executable, "-m", "symdyn.cli", "identify", str(path), str(small)]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    times[f"symdyn identify, whole command ({command_samples:,})"] = time.perf_counter() - t0
-    assert proc.returncode == 0, proc.stderr
-    return times
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
-    count, samples, command = (10_000, 100_000, 20_000) if args.quick else (100_000, 1_000_000, 100_000)
-    lines = [f"# bench/batch.py: {machine()}; load averages {load_averages()}", ""]
+    count, samples = (10_000, 100_000) if args.quick else (100_000, 1_000_000)
+    lines = [f"# bench/batch.py: {machine()}; load averages at the start {load_averages()}", ""]
     with tempfile.TemporaryDirectory(prefix="symdyn-batch-") as tmp:
         log("C harness")
         width, rows, flags = c_part(count, Path(tmp))
         log("Python methods")
         py = python_part(count)
+        big = python_part(10 * count)
         log("identify")
-        ident = identify_part(samples, command, Path(tmp))
+        ident = identify_part(samples, Path(tmp))
     lines += [
         f"Panda, {count:,} states, flags {' '.join(flags)}; W = {width} doubles per instruction",
         "",
@@ -237,17 +187,18 @@ def main() -> int:
             f"{name:<18}  {scalar:>16.1f}  {batch:>8.1f}  {batch / scalar:>11.2f}x"
             f"  {'yes' if same else 'NO':>9}  {one:>15.1f}  {two:>12.1f}"
         )
+    lines += ["", f"threads through Python at {10 * count:,} states, ns per state (best of 5):"]
+    for name, (one, two) in big.items():
+        lines.append(f"  {name:<18} threads=1 {one:7.1f}  threads=2 {two:7.1f}  ratio {two / one:.2f}")
     target = all(batch / scalar <= 0.4 for _, scalar, batch, _ in rows)
     lines += [
         "",
         f"target batch <= 0.4x scalar per state: {'PASS' if target else 'FAIL'} "
         f"({', '.join(f'{n} {b / s:.2f}x' for n, s, b, _ in rows)})",
         "",
-        f"identification of the Panda ({ident['nbase']} base parameters), seconds:",
+        *identify_lines(samples, ident),
     ]
-    for key, value in ident.items():
-        if key != "nbase":
-            lines.append(f"  {key:<50} {value:8.2f} s")
+    lines += ["", f"# load averages at the end {load_averages()}"]
     text = "\n".join(lines) + "\n"
     print(text, end="")
     out = RESULTS / "batch.txt"

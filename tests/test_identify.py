@@ -21,7 +21,13 @@ from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived
 
 import symdyn
 from symdyn.apps.excite import excite
-from symdyn.apps.identify import Measurements, differentiate, identify, read_measurements
+from symdyn.apps.identify import (
+    Measurements,
+    base_regressor_samples,
+    differentiate,
+    identify,
+    read_measurements,
+)
 from symdyn.apps.simulate import time_expressions
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError
@@ -67,6 +73,31 @@ def test_noisy_round_trip_within_three_standard_deviations():
     clean = measurements().tau
     assert np.all(np.sqrt(np.mean((result.predicted - clean) ** 2, axis=0)) < 0.02 * np.std(clean, axis=0))
     assert np.all(result.residual_rms < 0.03 * np.std(clean, axis=0))
+
+
+def test_chunks_give_the_least_squares_of_the_whole_regressor():
+    """identify in chunks of 37 samples (27 chunks) equals Gautier's weighted least squares done
+    with numpy.linalg on the whole stacked regressor (lstsq, the normal matrix's pinv, cond)."""
+    data = measurements(noise=0.02, seed=5)
+    robot, base = example(ROBOT), derived(ROBOT, "newton-euler").base_parameters
+    result = identify(robot, data, base, chunk=37)
+    W3 = base_regressor_samples(robot, data.q, data.qd, data.qdd)
+    N, n, nb = W3.shape
+    W, y = W3.reshape(N * n, nb), data.tau.reshape(N * n)
+    x0 = np.linalg.lstsq(W, y, rcond=None)[0]
+    sigma = np.sqrt(np.sum((y - W @ x0).reshape(N, n) ** 2, axis=0) / (N - nb / n))
+    g = np.tile(1.0 / sigma, N)
+    x = np.linalg.lstsq(W * g[:, None], y * g, rcond=None)[0]
+    s2 = np.sum((g * (y - W @ x)) ** 2) / (N * n - nb)
+    std = np.sqrt(np.diag(s2 * np.linalg.pinv((W * g[:, None]).T @ (W * g[:, None]))))
+    assert N > 20 * 37
+    np.testing.assert_allclose(result.estimate, x, rtol=1e-9, atol=1e-12 * np.abs(x).max())
+    np.testing.assert_allclose(result.std, std, rtol=1e-7)
+    assert abs(result.condition_number / np.linalg.cond(W) - 1) < 1e-9
+    rms = np.sqrt(np.mean((y - W @ x).reshape(N, n) ** 2, axis=0))
+    np.testing.assert_allclose(result.residual_rms, rms, rtol=1e-9)
+    np.testing.assert_allclose(result.predicted, (W @ x).reshape(N, n), rtol=0, atol=1e-12 * np.abs(y).max())
+    assert identify(robot, data, base, chunk=37, predict=False).predicted is None
 
 
 def test_excite_respects_its_limits_and_improves_the_condition():
@@ -139,7 +170,19 @@ def test_cli_identify_from_positions_only(tmp_path, capsys):
     [
         ("t,q1,q2,q3,q4,tau1,tau2,tau3\n0,0,0,0,0,0,0,0\n", "missing column.*tau4"),
         ("t,q1,q2,q3,q4,qd1,qd2,qd3,qd4,tau1,tau2,tau3,tau4\n", "give both"),
-        ("t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n0,0,0,0,0,0,0,x,0\n", "line 2: not a number"),
+        (
+            "t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n0,0,0,0,0,0,0,x,0\n",
+            "line 2: not a number in column tau3: 'x'",
+        ),
+        (
+            "t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n\n" + "0,0,0,0,0,0,0,0,0\n" * 3 + "0,0,nan,0,0,0,0,0,0\n",
+            "line 6: column q2 is nan",
+        ),
+        (
+            "t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n0,0,0,0,0,0,0,0,0\n0,0,0,0,0,0,0,0\n",
+            "line 3 has 8 values, the header 9",
+        ),
+        ("\n\n", "empty file"),
         ("t,q1,q2,q3,q4,tau1,tau2,tau3,tau4\n0,0,0,0,0,0,0,0,0\n1,0,0,0,0,0,0,0,0\n", "at least 21"),
     ],
 )
@@ -148,6 +191,25 @@ def test_bad_measurement_files_are_one_clear_message(tmp_path, text, match):
     path.write_text(text)
     with pytest.raises(SymdynError, match=match):
         read_measurements(path, 4)
+
+
+def test_csv_values_read_back_exactly_with_blank_lines_and_python_spellings(tmp_path):
+    """The fast reader (numpy.loadtxt) gives the doubles float() gives for "%.17g"; a file it
+    refuses (a quoted number, 1_000) is read by Python as before; blank lines are skipped."""
+    rng = np.random.default_rng(2)
+    values = rng.normal(size=(30, 9)) * 10.0 ** rng.integers(-300, 300, size=(30, 9))
+    header = "t,q1,q2,qd1,qd2,qdd1,qdd2,tau1,tau2"
+    lines = [",".join(f"{x:.17g}" for x in row) for row in values]
+    (tmp_path / "a.csv").write_text(
+        "\n" + header + "\n" + "\n".join(lines[:10]) + "\n\n" + "\n".join(lines[10:])
+    )
+    got = read_measurements(tmp_path / "a.csv", 2)
+    want = np.array([[float(c) for c in line.split(",")] for line in lines])
+    assert np.array_equal(np.column_stack([got.t, got.q, got.qd, got.qdd, got.tau]), want)
+    lines[3] = '"1_000",' + lines[3].split(",", 1)[1]
+    (tmp_path / "b.csv").write_text(header + "\n" + "\n".join(lines) + "\n")
+    got = read_measurements(tmp_path / "b.csv", 2)
+    assert got.t[3] == 1000.0 and np.array_equal(got.tau, want[:, 7:])
 
 
 def test_cli_bad_input_exits_1(tmp_path, capsys):

@@ -2,8 +2,12 @@
 
 tau = Y_b(q, qd, qdd) pi_b (symdyn.algorithms.base_parameters), so N samples stacked give the
 overdetermined linear system  y = W pi_b  with W (N n x nbase) the base regressor at every sample
-(evaluated by the compiled C base_regressor in one batch, `base_regressor_samples`) and y the
-measured torques. Following Gautier ("Dynamic identification of robots with power model", 1997):
+and y the measured torques. W is never held whole: it is evaluated a chunk of samples at a time
+(the compiled C base_regressor's batch call, about CHUNK_BYTES a chunk) and each joint's rows
+[W_j | y_j] are folded into a triangular factor by incremental QR (symdyn.apps.least_squares), from
+which every least squares below, its residuals and the condition number follow exactly as from
+the whole W (to rounding); memory is one chunk whatever N. Following Gautier ("Dynamic
+identification of robots with power model", 1997):
 
 1. ordinary least squares, pi_0 = argmin |y - W pi|, and per joint j the residual variance
    sigma_j^2 = |r_j|^2 / (N - nbase / n)  (the N n - nbase residual degrees of freedom shared
@@ -31,6 +35,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,6 +43,7 @@ import numpy as np
 
 from ..errors import SymdynError
 from ..model.robot import Robot
+from .least_squares import Triangular, combine
 
 __all__ = [
     "Measurements",
@@ -51,6 +57,8 @@ __all__ = [
     "HIGH_RELATIVE_STD",
     "SG_WINDOW",
     "SG_ORDER",
+    "CHUNK_BYTES",
+    "chunk_samples",
 ]
 
 #: condition numbers of the stacked base regressor above this are reported as high
@@ -60,6 +68,8 @@ HIGH_RELATIVE_STD = 10.0
 #: Savitzky-Golay window (samples, odd) and polynomial degree for qd and qdd from q
 SG_WINDOW = 21
 SG_ORDER = 4
+#: bytes of base regressor `identify` evaluates per batch call (the chunk it holds at a time)
+CHUNK_BYTES = 16 * 2**20
 
 
 @dataclass
@@ -85,7 +95,7 @@ class Identification:
     condition_number: float
     residual_rms: np.ndarray
     samples: int
-    predicted: np.ndarray  # (N, n): Y_b pi_b at every sample
+    predicted: np.ndarray | None  # (N, n): Y_b pi_b at every sample (None: not computed)
 
     @property
     def relative_std(self) -> np.ndarray:
@@ -163,30 +173,39 @@ def read_measurements(path: str | os.PathLike, n: int, torques: bool = True) -> 
 
     With torques=False the tau columns are not required (a reference trajectory, e.g. the file
     `symdyn excite` writes, for `symdyn simulate --track FILE.csv`); `tau` is then empty.
+    The values are parsed by numpy.loadtxt (C, about 1 s a million lines of 29 values); a file it
+    refuses is read again line by line (Python's csv and float) for the message, or the values
+    when Python accepts what NumPy does not (a quoted number, 1_000).
 
     Raises:
         SymdynError: no such file, a missing column, a value that is not a finite number,
-            or too few samples; the message names the file (and the line).
+            or too few samples; the message names the file (and the line and column).
     """
     where = str(path)
     try:
-        text = Path(path).read_text()
+        with open(path, newline="") as f:
+            header, skip = None, 0
+            for line in f:
+                skip += 1
+                row = next(csv.reader([line]), [])
+                if row and any(c.strip() for c in row):
+                    header = row
+                    break
+            if header is None:
+                raise SymdynError(f"{where}: empty file (expected a header t,q1..,tau1..)")
+            cols = _columns(header, n, where, torques)
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")  # numpy's "input contained no data"
+                    data = np.loadtxt(f, delimiter=",", comments=None, dtype=np.float64, ndmin=2)
+            except ValueError:
+                data = None
     except OSError as exc:
         raise SymdynError(f"{where}: cannot read ({exc.strerror or exc})") from None
-    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
-    if not rows:
-        raise SymdynError(f"{where}: empty file (expected a header t,q1..,tau1..)")
-    cols = _columns(rows[0], n, where, torques)
-    data = np.empty((len(rows) - 1, len(rows[0])))
-    for k, row in enumerate(rows[1:], start=2):
-        if len(row) != len(rows[0]):
-            raise SymdynError(f"{where}: line {k} has {len(row)} values, the header {len(rows[0])}")
-        try:
-            data[k - 2] = [float(c) for c in row]
-        except ValueError:
-            raise SymdynError(f"{where}: line {k}: not a number in '{','.join(row)}'") from None
-    if not np.all(np.isfinite(data)):
-        raise SymdynError(f"{where}: values must be finite numbers")
+    except UnicodeDecodeError as exc:
+        raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
+    if data is None or (len(data) and data.shape[1] != len(header)) or not np.all(np.isfinite(data)):
+        data = _read_slowly(path, header, skip)
     if len(data) < 2:
         raise SymdynError(f"{where}: too few samples ({len(data)})")
     t, q = data[:, cols["t"][0]], data[:, cols["q"]]
@@ -195,6 +214,29 @@ def read_measurements(path: str | os.PathLike, n: int, torques: bool = True) -> 
         return Measurements(t, q, data[:, cols["qd"]], data[:, cols["qdd"]], tau)
     q, qd, qdd = differentiate(t, q, where)
     return Measurements(t, q, qd, qdd, tau, differentiated=True)
+
+
+def _read_slowly(path: str | os.PathLike, header: list[str], skip: int) -> np.ndarray:
+    """The values after the header (its line is number `skip`) by Python's csv and float; a
+    SymdynError naming the line and column of the first wrong value."""
+    where, width = str(path), len(header)
+    names = [h.strip() for h in header]
+    text = Path(path).read_text()
+    values = []
+    for k, row in enumerate(csv.reader(io.StringIO(text)), start=1):
+        if k <= skip or not row or not any(c.strip() for c in row):
+            continue
+        if len(row) != width:
+            raise SymdynError(f"{where}: line {k} has {len(row)} values, the header {width}")
+        for c, name in zip(row, names, strict=True):
+            try:
+                x = float(c)
+            except ValueError:
+                raise SymdynError(f"{where}: line {k}: not a number in column {name}: '{c}'") from None
+            if not np.isfinite(x):
+                raise SymdynError(f"{where}: line {k}: column {name} is {c.strip()}, not a finite number")
+            values.append(x)
+    return np.array(values, dtype=np.float64).reshape(-1, width)
 
 
 def needs_scipy(module: str):
@@ -219,27 +261,54 @@ def differentiate(t: np.ndarray, q: np.ndarray, where: str = "differentiate", wi
     return tuple(savgol_filter(q, window, SG_ORDER, deriv=d, delta=h, axis=0) for d in (0, 1, 2))
 
 
-def base_regressor_samples(robot: Robot, q, qd, qdd) -> np.ndarray:
-    """Y_b at N samples, (N, n, nbase): one batch call of the compiled C base_regressor
-    (symdyn.compile, cached; its loop over the samples is in C, or the generated NumPy module
-    without a C compiler); the robot's parameters must all have values."""
+def _regressor(robot: Robot):
+    """A function (q, qd, qdd) of N samples -> Y_b, (N, n, nbase): the compiled C base_regressor's
+    batch call (symdyn.compile, cached; its loop over the samples is in C, W samples per
+    instruction), or the generated NumPy module without a C compiler; the robot's parameters
+    must all have values."""
     from .compiled import compiled_dynamics
 
-    cd = compiled_dynamics(robot)
-    Yb = cd.base_regressor(
-        np.asarray(q, dtype=float), np.asarray(qd, dtype=float), np.asarray(qdd, dtype=float)
-    )
-    return np.asarray(Yb, dtype=float).reshape(len(q), robot.n, -1)
+    f = compiled_dynamics(robot).base_regressor
+
+    def evaluate(q, qd, qdd) -> np.ndarray:
+        Yb = f(*(np.asarray(a, dtype=float) for a in (q, qd, qdd)))
+        return np.asarray(Yb, dtype=float).reshape(len(q), robot.n, -1)
+
+    return evaluate
 
 
-def identify(robot: Robot, data: Measurements, base: tuple[tuple[str, object], ...]) -> Identification:
+def base_regressor_samples(robot: Robot, q, qd, qdd) -> np.ndarray:
+    """Y_b at N samples, (N, n, nbase), in one batch call (see `_regressor`)."""
+    return _regressor(robot)(q, qd, qdd)
+
+
+def chunk_samples(n: int, nbase: int) -> int:
+    """Samples per chunk of `identify`: a regressor chunk of about CHUNK_BYTES."""
+    return max(1, CHUNK_BYTES // (8 * n * nbase))
+
+
+def identify(
+    robot: Robot,
+    data: Measurements,
+    base: tuple[tuple[str, object], ...],
+    chunk: int | None = None,
+    predict: bool = True,
+) -> Identification:
     """Weighted least-squares estimates of the base parameters (module docstring).
+
+    The base regressor is evaluated `chunk` samples at a time (default `chunk_samples`) and
+    folded into one triangular factor per joint (symdyn.apps.least_squares), so the memory is
+    one chunk whatever the number of samples; the estimates, standard deviations, residuals
+    and condition number are those of the least squares on the whole stacked regressor.
 
     Args:
         robot: the model (every parameter with a value); its inertial values are not used.
         data: the measurements (N samples).
         base: (name, expression) per base parameter, in the order of base_regressor's columns
             (`Dynamics.base_parameters`).
+        chunk: samples per batch call of the base regressor.
+        predict: compute `predicted` (Y_b pi_b at every sample: a second pass over the chunks);
+            without it `predicted` is None.
 
     Raises:
         SymdynError: fewer equations than base parameters; a floating robot.
@@ -249,33 +318,44 @@ def identify(robot: Robot, data: Measurements, base: tuple[tuple[str, object], .
             f"identify: robot '{robot.name}' has a floating base, which identification does not handle "
             "yet (its regressor is generated: docs/floating-base.md)"
         )
-    W3 = base_regressor_samples(robot, data.q, data.qd, data.qdd)
-    N, n, nb = W3.shape
-    assert nb == len(base), (nb, len(base))
+    N, n = data.tau.shape
+    nb = len(base)
     if N * n <= nb:
         raise SymdynError(
             f"{N} samples of {n} joints give {N * n} equations for {nb} base parameters: need more"
         )
-    W = W3.reshape(N * n, nb)
-    y = data.tau.reshape(N * n)
-    x0 = np.linalg.lstsq(W, y, rcond=None)[0]
-    r = (y - W @ x0).reshape(N, n)
+    regressor = _regressor(robot)
+    step = chunk_samples(n, nb) if chunk is None else max(1, int(chunk))
+    chunks = [slice(s, min(s + step, N)) for s in range(0, N, step)]
+    joints = [Triangular(nb) for _ in range(n)]  # [W_j | y_j]: the rows of joint j
+    for s in chunks:
+        W3 = regressor(data.q[s], data.qd[s], data.qdd[s])
+        assert W3.shape[2] == nb, (W3.shape, nb)
+        for j, part in enumerate(joints):
+            part.add(W3[:, j, :], data.tau[s, j])
+    plain = combine(joints, np.ones(n))
+    x0 = plain.solve()
+    r2 = np.array([part.residual_norm(x0) ** 2 for part in joints])
     floor = 1e-12 * np.maximum(np.sqrt(np.mean(data.tau**2, axis=0)), 1e-300)
-    sigma = np.maximum(np.sqrt(np.sum(r**2, axis=0) / max(N - nb / n, 1.0)), floor)
-    g = np.tile(1.0 / sigma, N)
-    x = np.linalg.lstsq(W * g[:, None], y * g, rcond=None)[0]
-    res = y - W @ x
-    s2 = np.sum((g * res) ** 2) / (N * n - nb)
-    cov = s2 * np.linalg.pinv((W * g[:, None]).T @ (W * g[:, None]))
+    sigma = np.maximum(np.sqrt(r2 / max(N - nb / n, 1.0)), floor)
+    weighted = combine(joints, 1.0 / sigma)
+    x = weighted.solve()
+    s2 = weighted.residual_norm(x) ** 2 / (N * n - nb)
+    cov = s2 * weighted.covariance_factor()
+    predicted = None
+    if predict:
+        predicted = np.empty((N, n))
+        for s in chunks:
+            predicted[s] = regressor(data.q[s], data.qd[s], data.qdd[s]) @ x
     return Identification(
         names=tuple(name for name, _ in base),
         expressions=tuple(str(e) for _, e in base),
         estimate=x,
         std=np.sqrt(np.maximum(np.diag(cov), 0.0)),
-        condition_number=float(np.linalg.cond(W)),
-        residual_rms=np.sqrt(np.mean(res.reshape(N, n) ** 2, axis=0)),
+        condition_number=plain.condition_number(),
+        residual_rms=np.array([part.residual_norm(x) for part in joints]) / np.sqrt(N),
         samples=N,
-        predicted=(W @ x).reshape(N, n),
+        predicted=predicted,
     )
 
 

@@ -72,7 +72,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     robot = _robot(args)
     data = read_measurements(args.data, robot.n)
-    result = identify(robot, data, derive(robot, simplify=False).base_parameters)
+    result = identify(robot, data, derive(robot, simplify=False).base_parameters, predict=bool(args.plot))
     image = plot_identification(result, data) if args.plot else None
     print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else result.text(), end="")
     if args.format == "json":
