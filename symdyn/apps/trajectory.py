@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.free_flyer import BASE_POSITION_NAMES, BASE_VELOCITY_NAMES
+from ..model.free_flyer_names import BASE_POSITION_NAMES, BASE_VELOCITY_NAMES
 from .csv_format import csv_bytes, csv_text
 from .output import figure, figure_bytes, plot_format, write_atomic
 

@@ -28,6 +28,16 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from .free_flyer_names import (
+    BASE_ACCELERATION_NAMES,
+    BASE_NAMES,
+    BASE_POSITION_NAMES,
+    BASE_VELOCITY_NAMES,
+    BASE_WRENCH_NAMES,
+    NQ_BASE,
+    NV_BASE,
+)
+
 __all__ = [
     "BaseBody",
     "BASE_POSITION_NAMES",
@@ -40,19 +50,6 @@ __all__ = [
     "base_symbols",
     "quaternion_rotation",
 ]
-
-#: the free flyer's configuration coordinates: origin, then the quaternion (scalar last)
-BASE_POSITION_NAMES = ("x_b", "y_b", "z_b", "qx_b", "qy_b", "qz_b", "qw_b")
-#: its velocity coordinates: linear then angular velocity of the base, in the base frame
-BASE_VELOCITY_NAMES = ("vx_b", "vy_b", "vz_b", "wx_b", "wy_b", "wz_b")
-#: their time derivatives
-BASE_ACCELERATION_NAMES = ("ax_b", "ay_b", "az_b", "dwx_b", "dwy_b", "dwz_b")
-#: the wrench on the base in the base frame: force then moment
-BASE_WRENCH_NAMES = ("fx_b", "fy_b", "fz_b", "mx_b", "my_b", "mz_b")
-#: every name of the free flyer's symbols: no parameter may take one
-BASE_NAMES = BASE_POSITION_NAMES + BASE_VELOCITY_NAMES + BASE_ACCELERATION_NAMES + BASE_WRENCH_NAMES
-NQ_BASE = len(BASE_POSITION_NAMES)
-NV_BASE = len(BASE_VELOCITY_NAMES)
 
 
 def base_symbols() -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
