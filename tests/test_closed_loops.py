@@ -134,6 +134,21 @@ def test_bad_loops_and_actuated_fields_are_refused_naming_file_loop_and_field(ch
         assert w in text, text
 
 
+def test_loops_on_a_floating_base_are_refused_in_one_line():
+    data = _fourbar_data()
+    data["base"] = "floating"
+    for make in (lambda: robot_from_data(data, "fourbar.yaml"), lambda: _load_floating("fourbar")):
+        with pytest.raises(SymdynError) as err:
+            make()
+        text = str(err.value)
+        assert "fourbar.yaml" in text and "\n" not in text
+        assert "closed loops (field 'loops') on a floating base are not handled yet" in text
+
+
+def _load_floating(name: str):
+    return symdyn.load_robot(LOOPS_DIR / f"{name}.yaml", floating=True)
+
+
 def _refused_generate(capsys, tmp_path, data: dict) -> str:
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(data))
