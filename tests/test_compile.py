@@ -30,6 +30,7 @@ from robots import (
 
 import symdyn
 from symdyn.apps import cache
+from symdyn.apps.calling import numpy_solve_loops
 from symdyn.apps.compile import CompiledDynamics, compile
 from symdyn.apps.control import ComputedTorque, Reference, track
 from symdyn.apps.simulate import simulate
@@ -402,6 +403,9 @@ def test_a_robot_with_loops_gets_its_loop_functions_and_solve_loops_in_c():
             assert np.abs(closure(robot, q)[0]).max() < 1e-12
     its2, Q2 = plant.solve_loops(qa, guesses, threads=2)
     assert np.array_equal(its2, its) and np.array_equal(Q2, Q, equal_nan=True)
+    its3, Q3 = numpy_solve_loops(m, qa[:, None], guesses[:, None], None)  # without a C compiler
+    assert its3.shape == (21, 1) and np.array_equal(its3[:, 0], its)
+    np.testing.assert_allclose(Q3[:, 0][its >= 0], Q[its >= 0], rtol=0, atol=1e-12)
     it, q = plant.solve_loops(np.array([0.7]), guesses[0])
     it_numpy, q_numpy = m.solve_loops([0.7], guesses[0])
     assert isinstance(it, int) and it == it_numpy > 0

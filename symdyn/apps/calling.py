@@ -22,7 +22,15 @@ import numpy as np
 
 from ..errors import SymdynError
 
-__all__ = ["load_library", "c_method", "solve_loops_method", "check_threads", "batch_layout", "CHUNK"]
+__all__ = [
+    "load_library",
+    "c_method",
+    "solve_loops_method",
+    "numpy_solve_loops",
+    "check_threads",
+    "batch_layout",
+    "CHUNK",
+]
 
 #: The states of a thread's chunk are a multiple of this (every vector width W divides it).
 CHUNK = 16
@@ -171,6 +179,20 @@ def solve_loops_method(ffi, lib, solve: dict, p_ptr, owner) -> Callable:
         "method from q_guess with q[actuated] = qa; iterations -1: no convergence (docs/closed-loops.md)."
     )
     return call
+
+
+def numpy_solve_loops(module, qa, q_guess, p):
+    """solve_loops_method's answer from the generated NumPy module `module` (symdyn.compile without
+    a C compiler): its solve_loops, over a batch's states one by one."""
+    qa, q_guess = np.asarray(qa, dtype=np.float64), np.asarray(q_guess, dtype=np.float64)
+    if max(qa.ndim, q_guess.ndim) <= 1 or min(qa.ndim, q_guess.ndim) == 0:  # one state (or refused)
+        return module.solve_loops(qa, q_guess, p)
+    lead = np.broadcast_shapes(qa.shape[:-1], q_guess.shape[:-1])
+    qa = np.broadcast_to(qa, (*lead, qa.shape[-1])).reshape(-1, qa.shape[-1])
+    q_guess = np.broadcast_to(q_guess, (*lead, q_guess.shape[-1])).reshape(-1, q_guess.shape[-1])
+    solved = [module.solve_loops(a, g, p) for a, g in zip(qa, q_guess, strict=True)]
+    iterations = np.array([i for i, _ in solved], dtype=np.int32).reshape(lead)
+    return iterations, np.array([q for _, q in solved]).reshape(*lead, -1)
 
 
 def check_threads(threads) -> int:

@@ -12,7 +12,9 @@ function's name and inputs (without p, which is bound): whatever the code genera
 emits, including functions with several outputs (returned as a tuple) or outputs that
 are not square. One state (vectors of their size) runs one C call; a batch (leading
 axes, e.g. (B, n)) runs one call of NAME_batch, W states per instruction, optionally in
-threads (symdyn.apps.calling: the layout, when arrays are passed without a copy). Joint
+threads (symdyn.apps.calling: the layout, when arrays are passed without a copy). A robot with
+closed loops also gets `solve_loops`, the generated C NAME_solve_loops (one state, or a batch
+looped in C; symdyn.apps.calling.solve_loops_method). Joint
 quantities are in joint space (rad or m), the base frame fixes gravity, as in
 docs/generated-code.md. The robot's cache key is symdyn.apps.robot_key's.
 
@@ -38,7 +40,7 @@ from ..errors import SymdynError, SymdynWarning
 from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
 from . import cache
-from .calling import c_method, check_threads, load_library, solve_loops_method
+from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
 from .robot_key import robot_digest
 from .singular import INVERTING, NotGeneratedError, guarded
@@ -275,7 +277,7 @@ class CompiledDynamics(FrameMethods):
         if solve is None:
             raise SymdynError(f"symdyn.compile: robot '{self.robot.name}' has no closed loops to solve")
         if self._library is None:  # the NumPy module's, one state per call
-            return _numpy_solve(self.module, qa, q_guess, self.p)
+            return numpy_solve_loops(self.module, qa, q_guess, self.p)
         if "_solve_loops" not in self.__dict__:
             ffi, lib, _ = self._loaded()
             p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
@@ -395,16 +397,3 @@ def _numpy_method(owner: CompiledDynamics, name: str) -> Callable:
 
 
 _CDLLS: dict = {}
-
-
-def _numpy_solve(module, qa, q_guess, p):
-    """The NumPy module's solve_loops over a batch's states one by one (no C compiler)."""
-    qa, q_guess = np.asarray(qa, dtype=np.float64), np.asarray(q_guess, dtype=np.float64)
-    if max(qa.ndim, q_guess.ndim) <= 1 or min(qa.ndim, q_guess.ndim) == 0:  # one state (or refused)
-        return module.solve_loops(qa, q_guess, p)
-    lead = np.broadcast_shapes(qa.shape[:-1], q_guess.shape[:-1])
-    qa = np.broadcast_to(qa, (*lead, qa.shape[-1])).reshape(-1, qa.shape[-1])
-    q_guess = np.broadcast_to(q_guess, (*lead, q_guess.shape[-1])).reshape(-1, q_guess.shape[-1])
-    solved = [module.solve_loops(a, g, p) for a, g in zip(qa, q_guess, strict=True)]
-    iterations = np.array([i for i, _ in solved], dtype=np.int32).reshape(lead)
-    return iterations, np.array([q for _, q in solved]).reshape(*lead, -1)
