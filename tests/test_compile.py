@@ -10,7 +10,9 @@ a corrupt or foreign entry and never trust it. Every test uses a temporary cache
 
 from __future__ import annotations
 
+import inspect
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -28,12 +30,14 @@ from robots import (
 
 import symdyn
 from symdyn.apps import cache
+from symdyn.apps.calling import numpy_solve_loops
 from symdyn.apps.compile import CompiledDynamics, compile
 from symdyn.apps.control import ComputedTorque, Reference, track
 from symdyn.apps.simulate import simulate
 from symdyn.cli.main import main
 from symdyn.codegen import functions as fn
 from symdyn.errors import SymdynError, SymdynWarning
+from symdyn.oracle.closed_loops import closure
 from symdyn.rnea import forward_dynamics as oracle_forward
 from symdyn.rnea import rnea as oracle_rnea
 
@@ -369,3 +373,54 @@ def test_direction_dependent_friction_in_c_and_numpy_against_the_oracle(monkeypa
     b = simulate(slow, q0, qd0, duration=0.2, dt=2e-3, tau=["0.5*sin(9*t)"] * 3)
     np.testing.assert_allclose(a.q, b.q, rtol=1e-12, atol=1e-12)
     assert np.any(a.qd < 0) and np.any(a.qd > 0)
+
+
+def test_a_robot_with_loops_gets_its_loop_functions_and_solve_loops_in_c():
+    """symdyn.compile of the four-bar (examples/closed_loops): every loop function a method like
+    the others, one state and a batch, equal to the generated NumPy module (plant.module);
+    solve_loops(qa, q_guess) calls the generated C NAME_solve_loops: (int, q) for one state,
+    (iterations, q) over a batch looped in C (threads give the same bits), the NumPy module's
+    steps and q, closed by the oracle's closure, -1 at a singular or NaN guess."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SymdynWarning)  # the dropped out-of-plane closure row
+        robot = symdyn.load_robot(PLANAR.parent / "closed_loops" / "fourbar.yaml")
+        plant = compile(robot)
+    m = plant.module
+    names = ("loop_residual", "loop_jacobian", "loop_newton_step", "loop_motion")
+    names += ("actuated_inverse_dynamics", "actuated_mass_matrix", "actuated_forward_dynamics", "loop_forces")
+    assert plant.backend == "c" and set(names) <= set(plant.functions)
+    qa = np.linspace(0.0, 2 * np.pi, 21, endpoint=False)[:, None]
+    guesses = np.tile([0.7, -0.2, 1.6], (len(qa), 1))
+    guesses[3], guesses[5, 2] = [qa[3, 0], 1.0 - qa[3, 0], 1.0], np.nan  # coupler || rocker: K_p singular
+    want = [m.solve_loops(a, g) for a, g in zip(qa, guesses, strict=True)]
+    assert want[3][0] == want[5][0] == -1 and sum(i > 0 for i, _ in want) >= 15
+    its, Q = plant.solve_loops(qa, guesses)
+    assert its.shape == (21,) and Q.shape == (21, 3)
+    np.testing.assert_array_equal(its, [i for i, _ in want])
+    for it, q, (_, q_numpy) in zip(its, Q, want, strict=True):
+        if it >= 0:
+            np.testing.assert_allclose(q, q_numpy, rtol=0, atol=1e-12)
+            assert np.abs(closure(robot, q)[0]).max() < 1e-12
+    its2, Q2 = plant.solve_loops(qa, guesses, threads=2)
+    assert np.array_equal(its2, its) and np.array_equal(Q2, Q, equal_nan=True)
+    its3, Q3 = numpy_solve_loops(m, qa[:, None], guesses[:, None], None)  # without a C compiler
+    assert its3.shape == (21, 1) and np.array_equal(its3[:, 0], its)
+    np.testing.assert_allclose(Q3[:, 0][its >= 0], Q[its >= 0], rtol=0, atol=1e-12)
+    it, q = plant.solve_loops(np.array([0.7]), guesses[0])
+    it_numpy, q_numpy = m.solve_loops([0.7], guesses[0])
+    assert isinstance(it, int) and it == it_numpy > 0
+    np.testing.assert_allclose(q, q_numpy, rtol=0, atol=1e-12)
+    closed = Q[its >= 0]
+    rng = np.random.default_rng(8)
+    for name in names:
+        inputs = [a for a in inspect.signature(getattr(m, name)).parameters if a != "p"]
+        args = [closed if a == "q" else rng.standard_normal((len(closed), 1)) for a in inputs]
+        for state in (slice(None), 0):  # a batch, one state
+            got = plant.function(name)(*(a[state] for a in args))
+            exp = getattr(m, name)(*(a[state] for a in args))
+            for g, e in zip(*(x if isinstance(x, tuple) else (x,) for x in (got, exp)), strict=True):
+                np.testing.assert_allclose(g, e, rtol=1e-12, atol=1e-12, err_msg=name)
+    with pytest.raises(ValueError, match=r"qa must have shape \(1,\)"):
+        plant.solve_loops([0.1, 0.2], guesses[0])
+    with pytest.raises(SymdynError, match="has no closed loops"):
+        compile(example("roger_arm"), [9.81, 1, 1, 1, 1]).solve_loops([0.0], [0.0, 0.0])

@@ -21,10 +21,13 @@ import numpy as np
 import pytest
 from robots import example
 
+from symdyn import load_robot
+from symdyn.algorithms.closed_loops import analyse
 from symdyn.cli import main
 from symdyn.codegen import render
 from symdyn.errors import SymdynWarning
 from symdyn.loading import load_module
+from symdyn.oracle import closed_loops as oc
 from symdyn.regenerate import example_robot
 
 jax = pytest.importorskip("jax")
@@ -269,3 +272,94 @@ def test_identification_example(tmp_path):
     np.testing.assert_allclose(
         script.base_parameters(**found), script.base_parameters(**script.TRUE), rtol=1e-6
     )
+
+
+# -- closed loops: solve_loops, and a floating base
+
+
+@pytest.fixture(scope="module")
+def loop_modules(x64, tmp_path_factory):
+    """name -> (Robot, its JAX module, its NumPy module) of examples/closed_loops/NAME.yaml, one
+    render of both targets each, on first use."""
+    folder, out = tmp_path_factory.mktemp("loops_jax"), {}
+
+    def get(name: str):
+        if name not in out:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                robot = load_robot(ROOT / "examples" / "closed_loops" / f"{name}.yaml")
+                files = render(robot, targets=("python", "jax"))
+            mods = []
+            for kind in ("jax", "numpy"):
+                (folder / f"{name}_{kind}.py").write_text(files[f"{name}_{kind}.py"])
+                mods.append(load_module(folder / f"{name}_{kind}.py", f"_symdyn_test_{name}_{kind}_loops"))
+            out[name] = (robot, *mods)
+        return out[name]
+
+    return get
+
+
+@pytest.mark.parametrize("name", ["fourbar", "fivebar"])
+def test_solve_loops_under_jit_and_vmap_equals_numpy_and_closes_the_oracles_loops(name, loop_modules):
+    """solve_loops (a bounded lax.while_loop of Newton steps) vmapped over actuated positions and
+    jitted (solve_loops_batch) takes the NumPy module's steps to
+    the same q, which closes the loops by the oracle's closure (one state at a time under jit on
+    the four-bar); the states where Newton fails
+    (a singular K_p, a NaN guess) give -1 in their own lane without disturbing the others."""
+    robot, jm, nm = loop_modules(name)
+    assert (jm.NACT, jm.ACTUATED, jm.PASSIVE) == (nm.NACT, nm.ACTUATED, nm.PASSIVE)
+    assert (jm.LOOP_TOL, jm.LOOP_MAX_ITERATIONS, jm.LOOP_PIVOT) == (1e-12, 50, 1e-14)
+    q0 = np.array(analyse(robot.resolved()).assembled[0])
+    rng = np.random.default_rng(11)
+    qa = q0[nm.ACTUATED] + rng.uniform(-0.6, 0.6, (8, nm.NACT))
+    guesses = np.tile(q0, (len(qa), 1))
+    guesses[-1, nm.PASSIVE[0]] = np.nan  # a hopeless guess among good ones
+    if name == "fourbar":  # coupler and rocker aligned: K_p singular
+        qa[-2], guesses[-2] = [0.0], [0.0, 1.0, 1.0]
+    want = [nm.solve_loops(a, g) for a, g in zip(qa, guesses, strict=True)]
+    assert want[-1][0] == -1 and all(i > 0 for i, _ in want[:-2]) and (name != "fourbar" or want[-2][0] == -1)
+    results = {"batch (jit of vmap)": jm.solve_loops_batch(qa, guesses)}
+    if name == "fourbar":  # one state at a time: the while_loop without a batched predicate
+        single = jax.jit(jm.solve_loops)
+        results["jit"] = [single(a, g) for a, g in zip(qa, guesses, strict=True)]
+    for how, got in results.items():
+        its, qs = zip(*got, strict=True) if how == "jit" else got
+        its, qs = np.array(its), np.array(qs)
+        assert its.dtype == np.int32, how
+        np.testing.assert_array_equal(its, [i for i, _ in want], err_msg=how)
+        for it, q, (_, q_numpy), a in zip(its, qs, want, qa, strict=True):
+            if it >= 0:
+                np.testing.assert_allclose(q, q_numpy, rtol=0, atol=1e-12, err_msg=how)
+                assert np.array_equal(q[nm.ACTUATED], a) and np.abs(oc.closure(robot, q)[0]).max() < 1e-12
+
+
+def test_jacfwd_through_solve_loops_gives_the_loop_motion(loop_modules):
+    """d q / d qa through the jitted Newton loop (jax.jacfwd) is W, the rates of every joint per
+    unit rate of the crank (loop_motion of the NumPy module)."""
+    _, jm, nm = loop_modules("fourbar")
+    guess = np.array([0.7, -0.2, 1.6])
+    it, q = nm.solve_loops([0.7], guess)
+    W = jax.jit(jax.jacfwd(lambda qa: jm.solve_loops(qa, guess)[1]))(np.array([0.7]))
+    np.testing.assert_allclose(np.asarray(W)[:, 0], nm.loop_motion(q, [1.0], [0.0])[0], atol=1e-8)
+
+
+def test_a_floating_robot_takes_q_of_nq_and_equals_the_oracle(tmp_path):
+    """The JAX module of a floating robot (Roger's arm on a free flyer): NQ = NDOF + 1, q of shape
+    (NQ,) with a quaternion of any norm; its inverse dynamics, vmapped and jitted, equals the
+    oracle's (the NumPy module's floating case: tests/test_floating.py)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SymdynWarning)
+        robot = load_robot(ROOT / "examples" / "roger_arm.yaml", floating=True)
+    files = render(robot, targets=("jax",))
+    (tmp_path / "roger_arm_jax.py").write_text(files["roger_arm_jax.py"])
+    mod = load_module(tmp_path / "roger_arm_jax.py", "_symdyn_test_floating_roger_arm_jax")
+    assert (mod.NQ, mod.NV, mod.NDOF) == (robot.nq, robot.nv, robot.nv) == (9, 8, 8)
+    rng = np.random.default_rng(12)
+    q = np.concatenate([rng.normal(size=(6, 3)), rng.normal(size=(6, 4)), rng.uniform(-1, 1, (6, 2))], axis=1)
+    qd, qdd = rng.normal(size=(2, 6, robot.nv))
+    p = rng.uniform(0.5, 2.0, mod.NPARAM)
+    params = dict(zip(mod.PARAM_NAMES, p, strict=True))
+    want = [rn.rnea(robot, *x, params) for x in zip(q, qd, qdd, strict=True)]
+    _close(mod.inverse_dynamics_batch(q, qd, qdd, p), np.array(want), rtol=1e-10)
+    with pytest.raises(ValueError, match=r"q must have shape \(9,\)"):
+        mod.mass_matrix(q[0, 1:], p)

@@ -22,7 +22,15 @@ import numpy as np
 
 from ..errors import SymdynError
 
-__all__ = ["load_library", "c_method", "check_threads", "batch_layout", "CHUNK"]
+__all__ = [
+    "load_library",
+    "c_method",
+    "solve_loops_method",
+    "numpy_solve_loops",
+    "check_threads",
+    "batch_layout",
+    "CHUNK",
+]
 
 #: The states of a thread's chunk are a multiple of this (every vector width W divides it).
 CHUNK = 16
@@ -30,27 +38,35 @@ CHUNK = 16
 _LIBRARIES: dict[str, tuple] = {}
 
 
-def _declarations(functions: list[dict]) -> str:
-    """The cdef of every generated function, its batch wrapper and the batch's vector width."""
+def _declarations(functions: list[dict], solve: dict | None = None) -> str:
+    """The cdef of every generated function, its batch wrapper and the batch's vector width, and of
+    NAME_solve_loops and its batch when `solve` describes them (runtime.solve_loops_entry)."""
     lines = ["int symdyn_batch_width(void);"]
     for f in functions:
         ins = ", ".join(f"const double {name}[]" for name, _ in f["inputs"])
         outs = ", ".join(f"double {name}[]" for name, *_ in f["outputs"])
         lines.append(f"void {f['c_name']}({ins}, {outs});")
         lines.append(f"void {f['c_name']}_batch(long count, {ins}, {outs});")
+    if solve:
+        ins = "const double qa[], const double q_guess[], const double p[], double q[]"
+        lines.append(f"int {solve['c_name']}({ins});")
+        lines.append(f"void {solve['c_name']}_batch(long count, {ins}, int iterations[]);")
     return "\n".join(lines)
 
 
-def load_library(path: Path, functions: list[dict], width: str, real: str = "double"):
+def load_library(
+    path: Path, functions: list[dict], width: str, real: str = "double", solve: dict | None = None
+):
     """(ffi, lib, W) for the library at `path` (opened once per process); `width` names its
     NAME_batch_width function (the states NAME_batch evaluates per instruction); `real` is the
-    floating type of its functions (symdyn.compile's are double)."""
+    floating type of its functions (symdyn.compile's are double); `solve`: NAME_solve_loops of a
+    robot with loops (symdyn.codegen.c.runtime.solve_loops_entry), or None."""
     key = str(path)
     if key not in _LIBRARIES:
         import cffi
 
         ffi = cffi.FFI()
-        ffi.cdef(_declarations(functions).replace("symdyn_batch_width", width).replace("double", real))
+        ffi.cdef(_declarations(functions, solve).replace("symdyn_batch_width", width).replace("double", real))
         lib = ffi.dlopen(key)
         _LIBRARIES[key] = (ffi, lib, int(getattr(lib, width)()))
     return _LIBRARIES[key]
@@ -114,6 +130,71 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
     return call
 
 
+def solve_loops_method(ffi, lib, solve: dict, p_ptr, owner) -> Callable:
+    """NAME_solve_loops as a Python callable solve_loops(qa, q_guess, threads=None) -> (iterations, q):
+    one state (qa of NACT values, q_guess of n) is one C call returning (int, q of shape (n,)); a
+    batch (leading axes, qa and q_guess broadcast) is one call of NAME_solve_loops_batch, a loop
+    over the states in C, in `threads` chunks, returning (iterations of the leading shape, int32,
+    and q of shape (..., n))."""
+    single, batch = getattr(lib, solve["c_name"]), getattr(lib, solve["c_name"] + "_batch")
+    buf = ffi.from_buffer
+    sizes = {"qa": solve["nact"], "q_guess": solve["n"]}
+
+    def call(qa, q_guess, threads: int | None = None):
+        arrays = {"qa": np.asarray(qa, dtype=np.float64), "q_guess": np.asarray(q_guess, dtype=np.float64)}
+        for name, a in arrays.items():
+            if a.ndim == 0 or a.shape[-1] != sizes[name]:
+                size = sizes[name]
+                raise ValueError(
+                    f"solve_loops: {name} must have shape ({size},) or (..., {size}); got {a.shape}"
+                )
+        lead = np.broadcast_shapes(*(a.shape[:-1] for a in arrays.values()))
+        if not lead:
+            q = np.empty(solve["n"])
+            qa, guess = (np.ascontiguousarray(a) for a in arrays.values())
+            return int(single(buf("double[]", qa), buf("double[]", guess), p_ptr, buf("double[]", q))), q
+        count = int(np.prod(lead, dtype=np.int64))
+        qa, guess = (batch_layout(a, lead, sizes[k], count) for k, a in arrays.items())
+        q, iterations = np.empty((*lead, solve["n"])), np.empty(lead, dtype=np.int32)
+        flat_q, flat_it = q.reshape(count, solve["n"]), iterations.reshape(count)
+
+        def run(chunk: tuple[int, int]) -> None:
+            start, stop = chunk
+            batch(
+                stop - start,
+                buf("double[]", qa[start:stop]),
+                buf("double[]", guess[start:stop]),
+                p_ptr,
+                buf("double[]", flat_q[start:stop]),
+                buf("int[]", flat_it[start:stop]),
+            )
+
+        if count:
+            _each(_chunks(count, owner.threads if threads is None else threads), run)
+        return iterations, q
+
+    call.__name__ = "solve_loops"
+    call.__doc__ = (
+        f"{solve['c_name']} (generated C): (iterations, q), the passive joints solved by Newton's "
+        "method from q_guess with q[actuated] = qa; iterations -1: no convergence (docs/closed-loops.md)."
+    )
+    return call
+
+
+def numpy_solve_loops(module, qa, q_guess, p):
+    """solve_loops_method's answer from the generated NumPy module `module` (symdyn.compile without
+    a C compiler): its solve_loops, over a batch's states one by one."""
+    qa, q_guess = np.asarray(qa, dtype=np.float64), np.asarray(q_guess, dtype=np.float64)
+    if max(qa.ndim, q_guess.ndim) <= 1 or min(qa.ndim, q_guess.ndim) == 0:  # one state (or refused)
+        return module.solve_loops(qa, q_guess, p)
+    lead = np.broadcast_shapes(qa.shape[:-1], q_guess.shape[:-1])
+    qa = np.broadcast_to(qa, (*lead, qa.shape[-1])).reshape(-1, qa.shape[-1])
+    q_guess = np.broadcast_to(q_guess, (*lead, q_guess.shape[-1])).reshape(-1, q_guess.shape[-1])
+    solved = [module.solve_loops(a, g, p) for a, g in zip(qa, q_guess, strict=True)]
+    iterations = np.array([i for i, _ in solved], dtype=np.int32).reshape(lead)
+    return iterations, np.array([q for _, q in solved]).reshape(*lead, -1)
+
+
 def check_threads(threads) -> int:
     """`threads` when it is a whole number >= 1; else SymdynError."""
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
@@ -144,6 +225,11 @@ def _run(batch, buf, chunks, flat, p_args, outs) -> None:
             *[buf("double[]", o[start:stop]) for o in outs],
         )
 
+    _each(chunks, run)
+
+
+def _each(chunks: list[tuple[int, int]], run: Callable) -> None:
+    """run(chunk) for every chunk, each in its own thread when there are several."""
     if len(chunks) == 1:
         run(chunks[0])
         return

@@ -12,7 +12,9 @@ function's name and inputs (without p, which is bound): whatever the code genera
 emits, including functions with several outputs (returned as a tuple) or outputs that
 are not square. One state (vectors of their size) runs one C call; a batch (leading
 axes, e.g. (B, n)) runs one call of NAME_batch, W states per instruction, optionally in
-threads (symdyn.apps.calling: the layout, when arrays are passed without a copy). Joint
+threads (symdyn.apps.calling: the layout, when arrays are passed without a copy). A robot with
+closed loops also gets `solve_loops`, the generated C NAME_solve_loops (one state, or a batch
+looped in C; symdyn.apps.calling.solve_loops_method). Joint
 quantities are in joint space (rad or m), the base frame fixes gravity, as in
 docs/generated-code.md. The robot's cache key is symdyn.apps.robot_key's.
 
@@ -38,7 +40,7 @@ from ..errors import SymdynError, SymdynWarning
 from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
 from . import cache
-from .calling import c_method, check_threads, load_library
+from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
 from .robot_key import robot_digest
 from .singular import INVERTING, NotGeneratedError, guarded
@@ -91,7 +93,7 @@ def _build(robot, method: str, options: dict, frames: dict | None = None) -> Cal
         from ..codegen import c as c_target
         from ..codegen import context
         from ..codegen import python as numpy_target
-        from ..codegen.c.runtime import function_table, render_runtime
+        from ..codegen.c.runtime import function_table, render_runtime, solve_loops_entry
         from .build import compile_library, library_suffix
 
         ctx = context(robot, options["precision"], method, **(frames or {}))
@@ -115,6 +117,7 @@ def _build(robot, method: str, options: dict, frames: dict | None = None) -> Cal
                 "frames": list(ctx.robot.frame_names),
             },
             "functions": function_table(ctx),
+            "solve_loops": solve_loops_entry(ctx),
             "numpy": numpy_target.file_name(ctx.name),
             "library": library,
         }
@@ -251,15 +254,35 @@ class CompiledDynamics(FrameMethods):
             raise NotGeneratedError(self.robot.name, name)
         if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
             raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
-        ffi, lib, _ = load_library(self._library, entry.meta["functions"], self._width_name)
+        ffi, lib, _ = self._loaded()
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
             setattr(self, f["name"], guarded(self, f["name"], c_method(ffi, lib, f, p_ptr, self)))
         return self.__dict__[name]
 
-    @property
-    def _width_name(self) -> str:
-        return f"{self._entry.meta['robot']['name']}_batch_width"
+    def _loaded(self) -> tuple:
+        """(ffi, lib, W) of the library (symdyn.apps.calling.load_library)."""
+        meta = self._entry.meta
+        width = f"{meta['robot']['name']}_batch_width"
+        return load_library(self._library, meta["functions"], width, solve=meta.get("solve_loops"))
+
+    def solve_loops(self, qa, q_guess, threads: int | None = None):
+        """Close the loops of a robot with closed loops: (iterations, q), q with its actuated entries
+        qa and its passive ones solved by Newton's method from q_guess (the generated C
+        NAME_solve_loops: docs/closed-loops.md), iterations -1 when it does not converge. One state
+        gives (int, q of shape (n,)), as the NumPy module's solve_loops; a batch (leading axes on qa
+        or q_guess) gives (iterations of the leading shape, q of shape (..., n)), looped in C, in
+        `threads` threads (the default: this object's)."""
+        solve = self._entry.meta.get("solve_loops")
+        if solve is None:
+            raise SymdynError(f"symdyn.compile: robot '{self.robot.name}' has no closed loops to solve")
+        if self._library is None:  # the NumPy module's, one state per call
+            return numpy_solve_loops(self.module, qa, q_guess, self.p)
+        if "_solve_loops" not in self.__dict__:
+            ffi, lib, _ = self._loaded()
+            p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
+            self._solve_loops = solve_loops_method(ffi, lib, solve, p_ptr, self)
+        return self._solve_loops(qa, q_guess, threads)
 
     @property
     def batch_width(self) -> int:
@@ -267,7 +290,7 @@ class CompiledDynamics(FrameMethods):
         1 on the NumPy backend)."""
         if self._library is None:
             return 1
-        return load_library(self._library, self._entry.meta["functions"], self._width_name)[2]
+        return self._loaded()[2]
 
     @property
     def cdll(self):

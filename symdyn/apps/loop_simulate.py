@@ -2,7 +2,7 @@
 integrated, the passive ones solved from them at every stage.
 
 The state is (q_a, qd_a). At every stage of the integrator the loops are closed by Newton's
-method on the passive coordinates (the generated loop_newton_step, compiled), warm-started
+method on the passive coordinates (the generated NAME_solve_loops, compiled), warm-started
 from the configuration of the stage before, then
 
     qdd_a = actuated_forward_dynamics(q, qd_a, tau_a)          (M_a qdd_a = tau_a - bias_a)
@@ -44,22 +44,14 @@ def _joints(values, n: int, name: str) -> np.ndarray:
 
 def close_loops(plant: CompiledDynamics, qa: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, float]:
     """(q, max |phi|): q with q[ACTUATED] = qa and the passive joints solved by Newton's method
-    from `guess` (the generated module's LOOP_TOL, LOOP_MAX_ITERATIONS and LOOP_PIVOT).
+    from `guess` (the plant's solve_loops: the generated NAME_solve_loops, one C call).
 
     Raises:
         SymdynError: the loops do not close from `guess` (no convergence, K_p singular).
     """
-    m = plant.module
-    q = np.array(guess, dtype=float)
-    q[m.ACTUATED] = qa
-    for _ in range(m.LOOP_MAX_ITERATIONS + 1):
-        phi, dqp, pivots = plant.loop_newton_step(q)
-        largest = float(np.max(np.abs(phi)))
-        if largest <= m.LOOP_TOL:
-            return q, largest
-        if not (math.isfinite(largest) and np.all(pivots > m.LOOP_PIVOT) and np.all(np.isfinite(dqp))):
-            break
-        q[m.PASSIVE] += dqp
+    iterations, q = plant.solve_loops(qa, guess)
+    if iterations >= 0:
+        return q, float(np.max(np.abs(plant.loop_residual(q))))
     raise SymdynError(
         f"robot '{plant.robot.name}': the loops do not close at q_a = {np.round(qa, 6).tolist()} from "
         "the configuration before (a singular configuration, or q0 far from a closed one)"

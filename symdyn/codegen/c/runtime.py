@@ -3,9 +3,12 @@
 `function_table(ctx)` describes every generated function as plain data (its C name,
 its inputs and outputs with their sizes), so the Python binding (symdyn.apps.compile)
 needs no knowledge of which functions exist: whatever `build_functions` generates,
-with any number of outputs of any shape, becomes a method. `render_runtime(ctx)` gives
+with any number of outputs of any shape, becomes a method; `solve_loops_entry(ctx)` describes
+NAME_solve_loops of a robot with closed loops, the one function with a loop (not in the table:
+it returns an int). `render_runtime(ctx)` gives
 NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C, W states
-per instruction through the function's body over vectors: symdyn.codegen.c.vector),
+per instruction through the function's body over vectors: symdyn.codegen.c.vector; and
+NAME_solve_loops_batch, a plain loop over the states),
 symdyn_step.c (the fixed-step integrators of symdyn.apps.simulate) and symdyn_csv.c (the
 CSV writer of symdyn.apps.csv_format), the last two robot-independent. Every C statement
 is spelled in templates/c/batch.c.j2, templates/c/step.c.j2 and templates/c/csv.c.j2.
@@ -13,12 +16,13 @@ is spelled in templates/c/batch.c.j2, templates/c/step.c.j2 and templates/c/csv.
 
 from __future__ import annotations
 
+from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
 from .config import CConfig, c_names
 from .sincos import BLOCK
 from .vector import LANE_CALLS, simd_prefix, vector_view
 
-__all__ = ["function_table", "render_runtime", "STEP_SOURCE", "CSV_SOURCE"]
+__all__ = ["function_table", "solve_loops_entry", "render_runtime", "STEP_SOURCE", "CSV_SOURCE"]
 
 #: The stepping loop's file name (symdyn_simulate, robot-independent).
 STEP_SOURCE = "symdyn_step.c"
@@ -39,6 +43,19 @@ def function_table(ctx: RenderContext) -> list[dict]:
         }
         for spec in ctx.functions
     ]
+
+
+def solve_loops_entry(ctx: RenderContext) -> dict | None:
+    """NAME_solve_loops(qa, q_guess, p, q) as JSON-ready data (its C name, the sizes of qa and of
+    q) for a robot with closed loops; None for a tree."""
+    view = loop_solve_context(ctx)
+    if view is None:
+        return None
+    return {
+        "c_name": f"{ctx.name}_solve_loops",
+        "nact": len(view["actuated"]),
+        "n": len(view["actuated"]) + len(view["passive"]),
+    }
 
 
 def render_runtime(ctx: RenderContext) -> dict[str, str]:
@@ -77,6 +94,7 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
             lane_calls=[config.math(c) for c in LANE_CALLS],
             pow=config.math("pow"),
             sincos={**names.sincos, "block": BLOCK} if angles else None,
+            loops=solve_loops_entry(ctx),
         ),
         STEP_SOURCE: env.get_template("c/step.c.j2").render(header_lines=lines, real=config.real),
         CSV_SOURCE: env.get_template("c/csv.c.j2").render(header_lines=lines),
