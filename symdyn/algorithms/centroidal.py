@@ -17,14 +17,18 @@ floating base, Robot.base's rotation on a fixed one):
    moments instead of the 6 x 6 inertia): m_s, the first moment h_s = sum m_k c_k and the
    rotational inertia about the base origin J_s = sum I_k - m_k [c_k]x^2; their totals over the
    whole robot m, h and J, and c_b = h / m.
-3. The momentum of a unit rate of each coordinate, about the base origin: a revolute joint of
-   axis z through o moves its subtree with angular velocity z about o,
+3. The momentum of a unit rate of each coordinate, about the base origin in base axes: a
+   revolute joint of axis z through o moves its subtree with angular velocity z about o,
 
        P = z x (h_s - m_s o),   L_O = J_s z - h_s x (z x o);
 
    a prismatic joint: P = m_s z, L_O = h_s x z; the base's linear velocity e_k: P = m e_k,
    L_O = h x e_k; its angular velocity e_k: P = e_k x h, L_O = J e_k. About the centre of mass,
    L_G = L_O - c_b x P; a mimic joint's column adds to its coordinate's (A = A_body S).
+   A_g does not use steps 1 and 2: (P, L_O) of joint j is the spatial force I^c_j S_j of its
+   subtree's composite inertia, built in the links' own frames and carried to the base origin
+   by symdyn.algorithms.crba (the base rows of a floating M), and (m, h, J) the whole robot's
+   composite there (A_g is M[0:6] moved to the centre of mass: Orin, Goswami and Lee (2013)).
 4. A_g = blockdiag(R, R) [P; L_G] (world_R_base R), c = p_base + R c_b, and the centre of
    mass's Jacobian Jc = A_g[0:3] / m (linear momentum = m dc/dt).
 
