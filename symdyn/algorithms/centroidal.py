@@ -17,14 +17,18 @@ floating base, Robot.base's rotation on a fixed one):
    moments instead of the 6 x 6 inertia): m_s, the first moment h_s = sum m_k c_k and the
    rotational inertia about the base origin J_s = sum I_k - m_k [c_k]x^2; their totals over the
    whole robot m, h and J, and c_b = h / m.
-3. The momentum of a unit rate of each coordinate, about the base origin: a revolute joint of
-   axis z through o moves its subtree with angular velocity z about o,
+3. The momentum of a unit rate of each coordinate, about the base origin in base axes: a
+   revolute joint of axis z through o moves its subtree with angular velocity z about o,
 
        P = z x (h_s - m_s o),   L_O = J_s z - h_s x (z x o);
 
    a prismatic joint: P = m_s z, L_O = h_s x z; the base's linear velocity e_k: P = m e_k,
    L_O = h x e_k; its angular velocity e_k: P = e_k x h, L_O = J e_k. About the centre of mass,
    L_G = L_O - c_b x P; a mimic joint's column adds to its coordinate's (A = A_body S).
+   A_g does not use steps 1 and 2: (P, L_O) of joint j is the spatial force I^c_j S_j of its
+   subtree's composite inertia, built in the links' own frames and carried to the base origin
+   by symdyn.algorithms.crba (the base rows of a floating M), and (m, h, J) the whole robot's
+   composite there (A_g is M[0:6] moved to the centre of mass: Orin, Goswami and Lee (2013)).
 4. A_g = blockdiag(R, R) [P; L_G] (world_R_base R), c = p_base + R c_b, and the centre of
    mass's Jacobian Jc = A_g[0:3] / m (linear momentum = m dc/dt).
 
@@ -53,7 +57,11 @@ import sympy as sp
 from ..model.free_flyer import quaternion_rotation
 from ..model.robot import Robot
 from ..spatial import vectors as v3
+from ..spatial.inertia import SpatialInertia, body_inertia
+from ..spatial.motion import Force
 from ..symbolic.program import Program
+from .crba import composite_inertias, mass_matrix_crba, shift_inertia
+from .frames import joint_frames
 from .kinematics import forward_kinematics
 
 __all__ = ["Centroidal"]
@@ -157,28 +165,48 @@ class Centroidal:
             self._cache["R"] = sp.Matrix(R)
         return _rows(self._cache["R"])
 
-    def _column(self, P: v3.Vec, L_O: v3.Vec) -> list[sp.Expr]:
-        """[P; L_G] of a unit rate, L_G = L_O - c_b x P (base axes)."""
-        return [*P, *v3.sub(L_O, v3.cross(self.c_base, P))]
-
-    def _body_columns(self) -> list[list[sp.Expr]]:
-        cols = []
-        for i, (T, link) in enumerate(zip(self.poses, self.robot.links, strict=True)):
-            z, o = v3.mul(_rows(T.R), v3.vec(list(link.axis))), v3.vec(list(T.p))
-            hs, ms = self.h_s[i], self.m_s[i]
-            if link.joint == "revolute":
-                P = v3.cross(z, v3.sub(hs, v3.scale(ms, o)))
-                L_O = v3.sub(v3.mul(self.J_s[i], z), v3.cross(hs, v3.cross(z, o)))
+    def composite(self) -> SpatialInertia:
+        """The whole robot's composite inertia (m, h, J) about the base origin, base axes, by the
+        local-frame recursion of symdyn.algorithms.crba (each link's composite in its own frame,
+        moved once into its parent's), the base body included on a floating robot (memoised)."""
+        if "whole" not in self._cache:
+            robot, program = self.robot, self.program
+            frames = joint_frames(robot, robot.body_positions(self.q))
+            composites = composite_inertias(robot, frames, program)
+            if self.base is not None:
+                mb, cb, Ib = self.base
+                own = body_inertia(mb, cb, Ib)
+                own = SpatialInertia(
+                    own.mass,
+                    program.let_vector(own.first_moment, "h"),
+                    program.let_symmetric(own.inertia, "Io"),
+                )
             else:
-                P, L_O = v3.scale(ms, z), v3.cross(hs, z)
-            cols.append(self._column(P, L_O))
-        return cols
+                own = SpatialInertia(sp.S.Zero, v3.ZERO3, v3.ZERO33)
+            for child in (i for i in range(robot.nb) if robot.parents[i] < 0):
+                own = shift_inertia(frames[child], composites[child], own, program, "c")
+            columns: list[Force] = []
+            mass_matrix_crba(robot, frames, composites, program, base_columns=columns)
+            self._cache["whole"], self._cache["forces"] = own, columns
+        return self._cache["whole"]
 
     def matrix_base_axes(self) -> sp.Matrix:
-        """[P; L_G] of every velocity coordinate in base axes (6 x NV, or 6 x n on a fixed base)."""
+        """[P; L_G] of every velocity coordinate in base axes (6 x NV, or 6 x n on a fixed base).
+
+        The momentum of a unit rate of body j's joint is the composite j's spatial force I^c_j S_j
+        carried to the base origin (symdyn.algorithms.crba: the base rows of a floating M); the
+        base's six columns are the whole robot's composite (m, h, J) about the base origin (step 3
+        of the module docstring); L_G = L_O - c_b x P with c_b = h / m."""
         if "Ab" not in self._cache:
+            whole = self.composite()
+            m, h, J = whole.mass, whole.first_moment, whole.inertia
+            c_b = self.program.let_vector(v3.scale(self.program.let(1 / m, "cim"), h), "ccb")
             S = self.robot.selection()
-            body = self._body_columns()
+
+            def column(P: v3.Vec, L_O: v3.Vec) -> list[sp.Expr]:
+                return [*P, *v3.sub(L_O, v3.cross(c_b, P))]
+
+            body = [column(f.linear, f.angular) for f in self._cache["forces"]]
             joint_cols = [
                 [sum((S[i, j] * body[i][r] for i in range(self.robot.nb)), sp.S.Zero) for r in range(6)]
                 for j in range(self.robot.n)
@@ -187,10 +215,10 @@ class Centroidal:
             if self.base is not None:
                 for k in range(3):
                     e = tuple(sp.S.One if r == k else sp.S.Zero for r in range(3))
-                    base_cols.append(self._column(v3.scale(self.mass, e), v3.cross(self.h, e)))
+                    base_cols.append(column(v3.scale(m, e), v3.cross(h, e)))
                 for k in range(3):
                     e = tuple(sp.S.One if r == k else sp.S.Zero for r in range(3))
-                    base_cols.append(self._column(v3.cross(e, self.h), v3.mul(self.J, e)))
+                    base_cols.append(column(v3.cross(e, h), v3.mul(J, e)))
             cols = base_cols + joint_cols
             A = sp.Matrix(6, len(cols), lambda r, j: self.program.let(cols[j][r], "cAb"))
             self._cache["Ab"] = A

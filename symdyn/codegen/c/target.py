@@ -32,6 +32,11 @@ __all__ = ["render", "render_context", "symbol_names", "function_inputs", "TOOLS
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 ACTUATED_INPUTS = ("qda", "qdda", "tau_a")
 
+#: an output with at least this many exact zeros, a third of its entries or more, is zeroed by one
+#: loop (vector stores) before its other entries are stored: a floating robot's or a tree's M has
+#: more zeros than non-zeros (joints on different branches), and one store per zero costs more
+FILL_ZEROS = 16
+
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
 TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
 
@@ -107,12 +112,15 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         else:
             size = f"{rows} values"
         entries = spec.entries(result)
+        zeros = sum(1 for e in entries if e == 0)
+        fill = zeros >= FILL_ZEROS and 3 * zeros >= len(entries)
         outputs.append(
             {
                 "name": result.name,
                 "doc": result.doc,
                 "size": size,
-                "stores": [(k, printer.doprint(e)) for k, e in enumerate(entries)],
+                "fill": len(entries) if fill else 0,
+                "stores": [(k, printer.doprint(e)) for k, e in enumerate(entries) if not (fill and e == 0)],
             }
         )
     return {
