@@ -23,7 +23,7 @@ import symdyn
 from symdyn.algorithms.closed_loops import analyse
 from symdyn.codegen import render
 from symdyn.errors import SymdynError
-from symdyn.loading import load_module
+from symdyn.module_files import load_module
 from symdyn.oracle import closed_loops as oc
 from symdyn.parsers import robot_from_data
 from symdyn.rnea import kinetic_energy, potential_energy, rnea

@@ -1,6 +1,6 @@
 """The package's floors: each imports only lower ones, and no private name crosses a module.
 
-Floors, lowest first (symdyn/__init__.py): errors (with loading and leftovers); spatial and
+Floors, lowest first (symdyn/__init__.py): errors (with module_files and leftovers); spatial and
 symbolic; model; parsers, algorithms and the numeric oracle (symdyn/oracle, with its public
 entry symdyn/rnea.py); dynamics (with lumped, the lumped constants of a derivation); codegen;
 apps; cli; regenerate. A module may import its own floor and any lower one; `__version__` may
@@ -55,7 +55,7 @@ def _imports(path: Path, parts: tuple[str, ...]):
 def _floor(parts: tuple[str, ...]) -> str:
     if parts[0] == "lumped":  # works on a Dynamics, as dynamics does
         return "dynamics"
-    if parts[0] in ("loading", "leftovers"):  # helpers of codegen and apps that use only errors
+    if parts[0] in ("module_files", "leftovers"):  # helpers of codegen and apps that use only errors
         return "errors"
     return "oracle" if parts[0] == "rnea" else parts[0]  # symdyn.rnea: the oracle's public entry
 

@@ -37,8 +37,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SymdynError, SymdynWarning
-from ..loading import load_module
 from ..model.parameter_names import parameter_names_problem
+from ..module_files import load_module
 from . import cache
 from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
