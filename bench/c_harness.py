@@ -16,6 +16,7 @@ from pathlib import Path
 
 import casadi_route
 import numpy as np
+from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench
 from machine import C_COMPILER, FLAGS, run
 from row import FUNCTIONS, Row
 from states import CHECK_TOL, NCHECK, NSTATES, rel_err
@@ -23,67 +24,10 @@ from states import CHECK_TOL, NCHECK, NSTATES, rel_err
 import symdyn
 from symdyn.model.parameters import numeric_parameters
 
-__all__ = ["HARNESS", "C_READ_STATES", "C_TIME_MAIN", "parse_harness", "build_c", "check_c", "time_compiled"]
-
-#: The part of a harness's main that reads the states file argv[1] into Q, QD, QDD, TAU (K states
-#: of N joints; needs `FILE *f` and `int k`). Shared with bench/frames_harness.py.
-C_READ_STATES = r"""    f = fopen(argv[1], "rb");
-    if (!f) {
-        perror(argv[1]);
-        return 2;
-    }
-    for (k = 0; k < K; ++k) {
-        if (fread(Q[k], sizeof(double), N, f) != N || fread(QD[k], sizeof(double), N, f) != N
-            || fread(QDD[k], sizeof(double), N, f) != N || fread(TAU[k], sizeof(double), N, f) != N) {
-            fprintf(stderr, "short states file\n");
-            return 2;
-        }
-    }
-    fclose(f);
-"""
-
-#: The end of a harness's main that times the NB benchmarks of run_bench(b, it) with REPS and
-#: TARGET_MS from argv[3], argv[4] and prints `time LABEL ITERATIONS NS...` lines (needs ns, iters,
-#: b, r, reps, target_ns and LABELS). Shared with bench/frames_harness.py.
-#: the C helper that prints one output of a check state: "check LABEL K v1 v2 ..." (full precision)
-C_PRINT_OUT = r"""static void print_out(const char *label, int k, const double *a, int len)
-{
-    int i;
-    printf("check %s %d", label, k);
-    for (i = 0; i < len; ++i) printf(" %.17g", a[i]);
-    printf("\n");
-}"""
-
-C_TIME_MAIN = r"""    reps = argc > 3 ? atoi(argv[3]) : 11;
-    if (reps < 1) reps = 1;
-    if (reps > MAXREPS) reps = MAXREPS;
-    target_ns = 1e6 * (argc > 4 ? atof(argv[4]) : 10.0);
-    /* calibrate (this also warms up): iterations per repetition for ~target_ns */
-    for (b = 0; b < NB; ++b) {
-        long it = 64;
-        double t;
-        while ((t = run_bench(b, it) * (double)it) < 0.25 * target_ns) it *= 2;
-        iters[b] = (long)(target_ns / (t / (double)it)) + 1;
-        run_bench(b, iters[b]);
-    }
-    /* repetitions interleaved across the functions, so a change of machine load during the run
-       falls on all of them alike */
-    for (r = 0; r < reps; ++r)
-        for (b = 0; b < NB; ++b) ns[b][r] = run_bench(b, iters[b]);
-    for (b = 0; b < NB; ++b) {
-        printf("time %s %ld", LABELS[b], iters[b]);
-        for (r = 0; r < reps; ++r) printf(" %.3f", ns[b][r]);
-        printf("\n");
-    }
-    return 0;
-"""
+__all__ = ["HARNESS", "C_PRINT_OUT", "C_TIME_MAIN", "parse_harness", "build_c", "check_c", "time_compiled"]
 
 HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench/run.py), do not edit. */
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
+{prelude}
 #include "{prefix}_dynamics.h"
 #include "cr_{name}.h"
 
@@ -94,7 +38,6 @@ HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench
 
 static double Q[K][N], QD[K][N], QDD[K][N], TAU[K][N];
 static double OUT[N * N + N * {prefix}_NSTD]; /* the largest output: M or Y */
-static volatile double sink;
 static const double *P = NULL; /* numeric robot: no free parameters */
 static const casadi_real *cr_arg[64];
 static casadi_real *cr_res[64];
@@ -105,13 +48,6 @@ static const char *LABELS[NB] = {{
     "inverse_dynamics", "cr_inverse_dynamics", "mass_matrix", "cr_mass_matrix", "gravity",
     "cr_gravity", "coriolis_matrix", "coriolis", "friction", "forward_dynamics", "regressor",
     "base_regressor"}};
-
-static double now_ns(void)
-{{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
-}}
 
 static void cr_work(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_int *),
                     casadi_int *sz_iw, casadi_int *sz_w)
@@ -134,62 +70,13 @@ static void cr_work(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi
         FN(cr_arg, cr_res, cr_iw, cr_w, 0);                                               \
     }} while (0)
 
-/* IT calls of CALL on states k = 0, 1, ... (cycling: the state changes every call), one output
-   element per call into the volatile sink. */
-#define LOOP(OUTLEN, CALL)                                                                \
-    {{                                                                                     \
-        long i_;                                                                          \
-        int k = 0;                                                                        \
-        for (i_ = 0; i_ < it; ++i_) {{                                                     \
-            CALL;                                                                         \
-            sink += OUT[k % (OUTLEN)];                                                    \
-            if (++k == K) k = 0;                                                          \
-        }}                                                                                 \
-    }}                                                                                     \
-    break
+{run_bench}
 
-/* ns per call of benchmark b over `it` calls */
-static double run_bench(int b, long it)
-{{
-    double s = now_ns();
-    switch (b) {{
-    case 0: LOOP(N, {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT));
-    case 1: LOOP(N, CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]));
-    case 2: LOOP(N * N, {prefix}_mass_matrix(Q[k], P, OUT));
-    case 3: LOOP(N * N, CR(cr_{prefix}_mass_matrix, Q[k]));
-    case 4: LOOP(N, {prefix}_gravity(Q[k], P, OUT));
-    case 5: LOOP(N, CR(cr_{prefix}_gravity, Q[k]));
-    case 6: LOOP(N * N, {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT));
-    case 7: LOOP(N, {prefix}_coriolis(Q[k], QD[k], P, OUT));
-    case 8: LOOP(N, {prefix}_friction(QD[k], P, OUT));
-    case 9: LOOP(N, {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT));
-    case 10: LOOP(N * {prefix}_NSTD, {prefix}_regressor(Q[k], QD[k], QDD[k], P, OUT));
-    case 11: LOOP(N * {prefix}_NBASE, {prefix}_base_regressor(Q[k], QD[k], QDD[k], P, OUT));
-    default: return -1.0;
-    }}
-    return (now_ns() - s) / (double)it;
-}}
-
-static void print_out(const char *label, int k, int len)
-{{
-    int i;
-    printf("check %s %d", label, k);
-    for (i = 0; i < len; ++i) printf(" %.17g", OUT[i]);
-    printf("\n");
-}}
+{print_out}
 
 int main(int argc, char **argv)
 {{
-    static double ns[NB][MAXREPS];
-    long iters[NB];
-    FILE *f;
-    int k, b, r, reps;
-    double target_ns;
-    casadi_int sz_iw = 1, sz_w = 1;
-    if (argc < 3) {{
-        fprintf(stderr, "usage: %s STATES check NCHECK | STATES time REPS TARGET_MS\n", argv[0]);
-        return 2;
-    }}
+{main_head}    casadi_int sz_iw = 1, sz_w = 1;
 {read_states}    cr_work(cr_{prefix}_inverse_dynamics_work, &sz_iw, &sz_w);
     cr_work(cr_{prefix}_mass_matrix_work, &sz_iw, &sz_w);
     cr_work(cr_{prefix}_gravity_work, &sz_iw, &sz_w);
@@ -199,24 +86,42 @@ int main(int argc, char **argv)
     if (strcmp(argv[2], "check") == 0) {{
         int ncheck = argc > 3 ? atoi(argv[3]) : 4;
         for (k = 0; k < ncheck && k < K; ++k) {{
-            {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT); print_out("inverse_dynamics", k, N);
-            {prefix}_mass_matrix(Q[k], P, OUT); print_out("mass_matrix", k, N * N);
-            {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT); print_out("coriolis_matrix", k, N * N);
-            {prefix}_coriolis(Q[k], QD[k], P, OUT); print_out("coriolis", k, N);
-            {prefix}_gravity(Q[k], P, OUT); print_out("gravity", k, N);
-            {prefix}_friction(QD[k], P, OUT); print_out("friction", k, N);
-            {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT); print_out("forward_dynamics", k, N);
-            {prefix}_regressor(Q[k], QD[k], QDD[k], P, OUT); print_out("regressor", k, N * {prefix}_NSTD);
+            {prefix}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT); print_out("inverse_dynamics", k, OUT, N);
+            {prefix}_mass_matrix(Q[k], P, OUT); print_out("mass_matrix", k, OUT, N * N);
+            {prefix}_coriolis_matrix(Q[k], QD[k], P, OUT); print_out("coriolis_matrix", k, OUT, N * N);
+            {prefix}_coriolis(Q[k], QD[k], P, OUT); print_out("coriolis", k, OUT, N);
+            {prefix}_gravity(Q[k], P, OUT); print_out("gravity", k, OUT, N);
+            {prefix}_friction(QD[k], P, OUT); print_out("friction", k, OUT, N);
+            {prefix}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT); print_out("forward_dynamics", k, OUT, N);
+            {prefix}_regressor(Q[k], QD[k], QDD[k], P, OUT);
+            print_out("regressor", k, OUT, N * {prefix}_NSTD);
             {prefix}_base_regressor(Q[k], QD[k], QDD[k], P, OUT);
-            print_out("base_regressor", k, N * {prefix}_NBASE);
-            CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]); print_out("cr_inverse_dynamics", k, N);
-            CR(cr_{prefix}_mass_matrix, Q[k]); print_out("cr_mass_matrix", k, N * N);
-            CR(cr_{prefix}_gravity, Q[k]); print_out("cr_gravity", k, N);
+            print_out("base_regressor", k, OUT, N * {prefix}_NBASE);
+            CR(cr_{prefix}_inverse_dynamics, Q[k], QD[k], QDD[k]);
+            print_out("cr_inverse_dynamics", k, OUT, N);
+            CR(cr_{prefix}_mass_matrix, Q[k]); print_out("cr_mass_matrix", k, OUT, N * N);
+            CR(cr_{prefix}_gravity, Q[k]); print_out("cr_gravity", k, OUT, N);
         }}
         return 0;
     }}
 {time_main}}}
 """
+
+
+LOOPS = (  # run_bench's benchmarks in LABELS order: LOOP(call, one output element)
+    "LOOP({p}_inverse_dynamics(Q[k], QD[k], QDD[k], P, OUT), OUT[k % N])",
+    "LOOP(CR(cr_{p}_inverse_dynamics, Q[k], QD[k], QDD[k]), OUT[k % N])",
+    "LOOP({p}_mass_matrix(Q[k], P, OUT), OUT[k % (N * N)])",
+    "LOOP(CR(cr_{p}_mass_matrix, Q[k]), OUT[k % (N * N)])",
+    "LOOP({p}_gravity(Q[k], P, OUT), OUT[k % N])",
+    "LOOP(CR(cr_{p}_gravity, Q[k]), OUT[k % N])",
+    "LOOP({p}_coriolis_matrix(Q[k], QD[k], P, OUT), OUT[k % (N * N)])",
+    "LOOP({p}_coriolis(Q[k], QD[k], P, OUT), OUT[k % N])",
+    "LOOP({p}_friction(QD[k], P, OUT), OUT[k % N])",
+    "LOOP({p}_forward_dynamics(Q[k], QD[k], TAU[k], P, OUT), OUT[k % N])",
+    "LOOP({p}_regressor(Q[k], QD[k], QDD[k], P, OUT), OUT[k % (N * {p}_NSTD)])",
+    "LOOP({p}_base_regressor(Q[k], QD[k], QDD[k], P, OUT), OUT[k % (N * {p}_NBASE)])",
+)
 
 
 def parse_harness(text: str) -> tuple[dict, dict]:
@@ -245,7 +150,11 @@ def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
         prefix=robot.name,
         n=robot.n,
         nstates=NSTATES,
-        read_states=C_READ_STATES,
+        prelude=C_PRELUDE,
+        run_bench=c_run_bench([loop.format(p=robot.name) for loop in LOOPS]),
+        print_out=C_PRINT_OUT,
+        main_head=C_MAIN_HEAD,
+        read_states=c_read_states(("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N")),
         time_main=C_TIME_MAIN,
     )
     harness.write_text(text)

@@ -36,7 +36,8 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import pin_harness  # noqa: E402
-from c_harness import C_PRINT_OUT, C_TIME_MAIN, parse_harness  # noqa: E402
+from c_harness import parse_harness  # noqa: E402
+from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench  # noqa: E402
 from machine import C_COMPILER, FLAGS, RESULTS, ROOT, load_averages, log, machine, pin_to_one_core, run  # noqa: E402
 from states import NCHECK  # noqa: E402
 
@@ -51,11 +52,7 @@ TARGET = 0.25  # symdyn / Pinocchio
 LOOPS = ROOT / "examples" / "closed_loops"
 
 HARNESS = r"""/* Closed-loop timing harness: written by bench/closed_loops.py, do not edit. */
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
+{prelude}
 #include "{name}_dynamics.h"
 
 #define N {n}
@@ -66,48 +63,15 @@ HARNESS = r"""/* Closed-loop timing harness: written by bench/closed_loops.py, d
 
 static double Q[K][N], QDA[K][A], QDDA[K][A], TAUA[K][A];
 static double OUT[A];
-static volatile double sink;
 static const char *LABELS[NB] = {{"actuated_inverse_dynamics", "actuated_forward_dynamics"}};
 
-static double now_ns(void)
-{{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
-}}
-
-static double run_bench(int b, long it)
-{{
-    double s = now_ns();
-    long i;
-    int k = 0;
-    for (i = 0; i < it; ++i) {{
-        if (b == 0) {name}_actuated_inverse_dynamics(Q[k], QDA[k], QDDA[k], NULL, OUT);
-        else {name}_actuated_forward_dynamics(Q[k], QDA[k], TAUA[k], NULL, OUT);
-        sink += OUT[0];
-        if (++k == K) k = 0;
-    }}
-    return (now_ns() - s) / (double)it;
-}}
+{run_bench}
 
 {print_out}
 
 int main(int argc, char **argv)
 {{
-    static double ns[NB][MAXREPS];
-    long iters[NB];
-    FILE *f;
-    int k, b, r, reps;
-    double target_ns;
-    if (argc < 3) return 2;
-    f = fopen(argv[1], "rb");
-    if (!f) return 2;
-    for (k = 0; k < K; ++k)
-        if (fread(Q[k], sizeof(double), N, f) != N || fread(QDA[k], sizeof(double), A, f) != A
-            || fread(QDDA[k], sizeof(double), A, f) != A || fread(TAUA[k], sizeof(double), A, f) != A)
-            return 2;
-    fclose(f);
-    if (strcmp(argv[2], "check") == 0) {{
+{main_head}{read_states}    if (strcmp(argv[2], "check") == 0) {{
         int ncheck = argc > 3 ? atoi(argv[3]) : 4;
         for (k = 0; k < ncheck && k < K; ++k) {{
             {name}_actuated_inverse_dynamics(Q[k], QDA[k], QDDA[k], NULL, OUT);
@@ -194,8 +158,21 @@ def bench_robot(name, robot, work: Path, pin_exe, opts) -> dict:
     na = st["qda"].shape[1]
     block = np.concatenate([st["q"], st["qda"], st["qdda"], st["tau_a"]], axis=1)
     (work / "states.bin").write_bytes(np.ascontiguousarray(block, dtype="<f8").tobytes())
+    loops = [
+        f"LOOP({robot.name}_actuated_inverse_dynamics(Q[k], QDA[k], QDDA[k], NULL, OUT), OUT[0])",
+        f"LOOP({robot.name}_actuated_forward_dynamics(Q[k], QDA[k], TAUA[k], NULL, OUT), OUT[0])",
+    ]
     src = HARNESS.format(
-        name=robot.name, n=robot.n, na=na, nstates=NSTATES, print_out=C_PRINT_OUT, time_main=C_TIME_MAIN
+        name=robot.name,
+        n=robot.n,
+        na=na,
+        nstates=NSTATES,
+        prelude=C_PRELUDE,
+        run_bench=c_run_bench(loops),
+        print_out=C_PRINT_OUT,
+        main_head=C_MAIN_HEAD,
+        read_states=c_read_states(("Q", "N"), ("QDA", "A"), ("QDDA", "A"), ("TAUA", "A")),
+        time_main=C_TIME_MAIN,
     )
     (work / "harness.c").write_text(src)
     exe = work / "harness"

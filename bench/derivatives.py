@@ -27,7 +27,8 @@ from pathlib import Path
 import casadi_route
 import casadi_route_derivatives as crd
 import numpy as np
-from c_harness import C_PRINT_OUT, parse_harness, time_compiled
+from c_harness import parse_harness, time_compiled
+from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench
 from machine import C_COMPILER, FLAGS, RESULTS, log, run
 from row import Row
 from states import NCHECK, NSTATES
@@ -52,11 +53,7 @@ GOALS = {"pinocchio": 0.5, "casadi": 0.8}
 FD_TOL = 1e-6
 
 HARNESS = r"""/* Derivative timing harness for {name}: written by bench/derivatives.py, do not edit. */
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
+{prelude}
 #include "{prefix}_dynamics.h"
 #include "crd_{name}.h"
 
@@ -67,7 +64,6 @@ HARNESS = r"""/* Derivative timing harness for {name}: written by bench/derivati
 
 static double Q[K][N], QD[K][N], QDD[K][N], TAU[K][N];
 static double O1[4 * N * N], O2[4 * N * N], O3[N * N];
-static volatile double sink;
 static const double *P = NULL;
 static casadi_int *iw;
 static casadi_real *w;
@@ -75,13 +71,6 @@ static casadi_real *w;
 static const char *LABELS[NB] = {{
     "inverse_dynamics_derivatives", "cr_rnea_derivatives", "forward_dynamics_derivatives",
     "cr_aba_derivatives", "mass_matrix_inverse", "cr_minverse", "linearize"}};
-
-static double now_ns(void)
-{{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
-}}
 
 static void cr(int (*f)(const casadi_real **, casadi_real **, casadi_int *, casadi_real *, int),
                const double *a, const double *b, const double *c)
@@ -102,53 +91,14 @@ static void sizes(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_i
     if (ww > *sw) *sw = ww;
 }}
 
-#define LOOP(CALL)                                                                        \
-    {{                                                                                     \
-        long i_;                                                                          \
-        int k = 0;                                                                        \
-        for (i_ = 0; i_ < it; ++i_) {{                                                     \
-            CALL;                                                                         \
-            sink += O1[k % (N * N)] + O2[k % (N * N)];                                    \
-            if (++k == K) k = 0;                                                          \
-        }}                                                                                 \
-    }}                                                                                     \
-    break
-
-static double run_bench(int b, long it)
-{{
-    double s = now_ns();
-    switch (b) {{
-    case 0: LOOP({prefix}_inverse_dynamics_derivatives(Q[k], QD[k], QDD[k], P, O1, O2));
-    case 1: LOOP(cr(crd_{prefix}_rnea_derivatives, Q[k], QD[k], QDD[k]));
-    case 2: LOOP({prefix}_forward_dynamics_derivatives(Q[k], QD[k], TAU[k], P, O1, O2, O3));
-    case 3: LOOP(cr(crd_{prefix}_aba_derivatives, Q[k], QD[k], TAU[k]));
-    case 4: LOOP({prefix}_mass_matrix_inverse(Q[k], P, O1));
-    case 5: LOOP(cr(crd_{prefix}_minverse, Q[k], NULL, NULL));
-    case 6: LOOP({prefix}_linearize(Q[k], QD[k], TAU[k], P, O1, O2));
-    default: return -1.0;
-    }}
-    return (now_ns() - s) / (double)it;
-}}
+{run_bench}
 
 {print_out}
 
 int main(int argc, char **argv)
 {{
-    static double ns[NB][MAXREPS];
-    long iters[NB];
-    FILE *f;
-    int k, b, r, reps;
-    double target_ns;
-    casadi_int si = 1, sw = 1;
-    if (argc < 3) return 2;
-    f = fopen(argv[1], "rb");
-    if (!f) return 2;
-    for (k = 0; k < K; ++k)
-        if (fread(Q[k], sizeof(double), N, f) != N || fread(QD[k], sizeof(double), N, f) != N
-            || fread(QDD[k], sizeof(double), N, f) != N || fread(TAU[k], sizeof(double), N, f) != N)
-            return 2;
-    fclose(f);
-    sizes(crd_{prefix}_rnea_derivatives_work, &si, &sw);
+{main_head}    casadi_int si = 1, sw = 1;
+{read_states}    sizes(crd_{prefix}_rnea_derivatives_work, &si, &sw);
     sizes(crd_{prefix}_aba_derivatives_work, &si, &sw);
     sizes(crd_{prefix}_minverse_work, &si, &sw);
     iw = malloc(sizeof(casadi_int) * (size_t)si);
@@ -172,27 +122,20 @@ int main(int argc, char **argv)
         }}
         return 0;
     }}
-    reps = argc > 3 ? atoi(argv[3]) : 11;
-    if (reps < 1) reps = 1;
-    if (reps > MAXREPS) reps = MAXREPS;
-    target_ns = 1e6 * (argc > 4 ? atof(argv[4]) : 10.0);
-    for (b = 0; b < NB; ++b) {{
-        long it = 16;
-        double t;
-        while ((t = run_bench(b, it) * (double)it) < 0.25 * target_ns) it *= 2;
-        iters[b] = (long)(target_ns / (t / (double)it)) + 1;
-        run_bench(b, iters[b]);
-    }}
-    for (r = 0; r < reps; ++r)
-        for (b = 0; b < NB; ++b) ns[b][r] = run_bench(b, iters[b]);
-    for (b = 0; b < NB; ++b) {{
-        printf("time %s %ld", LABELS[b], iters[b]);
-        for (r = 0; r < reps; ++r) printf(" %.3f", ns[b][r]);
-        printf("\n");
-    }}
-    return 0;
-}}
+{time_main}}}
 """
+
+
+SINK = "O1[k % (N * N)] + O2[k % (N * N)]"
+LOOPS = (  # run_bench's benchmarks in LABELS order
+    f"LOOP({{p}}_inverse_dynamics_derivatives(Q[k], QD[k], QDD[k], P, O1, O2), {SINK})",
+    f"LOOP(cr(crd_{{p}}_rnea_derivatives, Q[k], QD[k], QDD[k]), {SINK})",
+    f"LOOP({{p}}_forward_dynamics_derivatives(Q[k], QD[k], TAU[k], P, O1, O2, O3), {SINK})",
+    f"LOOP(cr(crd_{{p}}_aba_derivatives, Q[k], QD[k], TAU[k]), {SINK})",
+    f"LOOP({{p}}_mass_matrix_inverse(Q[k], P, O1), {SINK})",
+    f"LOOP(cr(crd_{{p}}_minverse, Q[k], NULL, NULL), {SINK})",
+    f"LOOP({{p}}_linearize(Q[k], QD[k], TAU[k], P, O1, O2), {SINK})",
+)
 
 
 def _central(f, x, h=1e-6) -> np.ndarray:
@@ -254,7 +197,17 @@ def bench_derivatives(row: Row, robot, gen_dir: Path, work: Path, states_file: P
     casadi_route.write_c(fns, f"crd_{row.name}", work)
     src = work / f"bench_derivatives_{row.name}.c"
     text = HARNESS.format(
-        name=row.name, prefix=robot.name, n=robot.n, nstates=NSTATES, ncheck=NCHECK, print_out=C_PRINT_OUT
+        name=row.name,
+        prefix=robot.name,
+        n=robot.n,
+        nstates=NSTATES,
+        ncheck=NCHECK,
+        prelude=C_PRELUDE,
+        run_bench=c_run_bench([loop.format(p=robot.name) for loop in LOOPS]),
+        print_out=C_PRINT_OUT,
+        main_head=C_MAIN_HEAD,
+        read_states=c_read_states(("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N")),
+        time_main=C_TIME_MAIN,
     )
     src.write_text(text)
     exe = work / f"bench_derivatives_{row.name}"

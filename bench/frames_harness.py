@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from c_harness import C_PRINT_OUT, C_READ_STATES, C_TIME_MAIN
+from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench
 from machine import C_COMPILER, FLAGS, run
 from states import NSTATES
 
@@ -40,11 +40,7 @@ _ARGS = {  # the inputs of each generated frame function (before p and the outpu
 _LEN = {"pose": "16", "jacobian": "6 * N", "jacobian_dot_qd": "6", "operational_space_inertia": "36"}
 
 HARNESS = r"""/* Frame-function timing harness: written by bench/frames_harness.py, do not edit. */
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
+{prelude}
 #include "{prefix}_dynamics.h"
 
 #define N {n}
@@ -54,56 +50,16 @@ HARNESS = r"""/* Frame-function timing harness: written by bench/frames_harness.
 
 static double Q[K][N], QD[K][N], QDD[K][N], TAU[K][N];
 static double OUT[16 + 6 * N + 36 + 6];
-static volatile double sink;
 static const double *P = NULL; /* numeric robot: no free parameters */
 static const char *LABELS[NB] = {{{labels}}};
 
-static double now_ns(void)
-{{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
-}}
-
-/* `it` calls of CALLS on states k = 0, 1, ... (cycling), one output element per call into the
-   volatile sink. */
-#define LOOP(CALLS)                                                                       \
-    {{                                                                                     \
-        long i_;                                                                          \
-        int k = 0;                                                                        \
-        for (i_ = 0; i_ < it; ++i_) {{                                                     \
-            CALLS;                                                                        \
-            sink += OUT[k % 16];                                                          \
-            if (++k == K) k = 0;                                                          \
-        }}                                                                                 \
-    }}                                                                                     \
-    break
-
-/* ns per call of benchmark b over `it` calls */
-static double run_bench(int b, long it)
-{{
-    double s = now_ns();
-    switch (b) {{
-{cases}
-    default: return -1.0;
-    }}
-    return (now_ns() - s) / (double)it;
-}}
+{run_bench}
 
 {print_out}
 
 int main(int argc, char **argv)
 {{
-    static double ns[NB][MAXREPS];
-    long iters[NB];
-    FILE *f;
-    int k, b, r, reps;
-    double target_ns;
-    if (argc < 3) {{
-        fprintf(stderr, "usage: %s STATES check NCHECK | STATES time REPS TARGET_MS\n", argv[0]);
-        return 2;
-    }}
-{read_states}    if (strcmp(argv[2], "check") == 0) {{
+{main_head}{read_states}    if (strcmp(argv[2], "check") == 0) {{
         int ncheck = argc > 3 ? atoi(argv[3]) : 4;
         for (k = 0; k < ncheck && k < K; ++k) {{
 {checks}
@@ -121,12 +77,12 @@ def _call(prefix: str, frame: str, function: str, out: str) -> str:
 def harness_source(prefix: str, n: int, frame: str) -> str:
     """The harness's C for robot `prefix` (n joints) and frame `frame`."""
     cases = []
-    for b, functions in enumerate(LABELS.values()):
+    for functions in LABELS.values():
         calls, offset = [], 0
         for fn in functions:
             calls.append(_call(prefix, frame, fn, f"OUT + {offset}" if offset else "OUT"))
             offset += 16 if fn == "pose" else 0
-        cases.append(f"    case {b}: LOOP(" + "; ".join(calls) + ");")
+        cases.append("LOOP(" + "; ".join(calls) + ", OUT[k % 16])")
     checks = [
         f'            {_call(prefix, frame, fn, "OUT")}; print_out("{fn}", k, OUT, {_LEN[fn]});'
         for fn in _LEN
@@ -138,10 +94,12 @@ def harness_source(prefix: str, n: int, frame: str) -> str:
         nstates=NSTATES,
         nb=len(LABELS),
         labels=labels,
-        cases="\n".join(cases),
+        prelude=C_PRELUDE,
+        run_bench=c_run_bench(cases),
         checks="\n".join(checks),
-        read_states=C_READ_STATES,
         print_out=C_PRINT_OUT,
+        main_head=C_MAIN_HEAD,
+        read_states=c_read_states(("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N")),
         time_main=C_TIME_MAIN,
     )
 
