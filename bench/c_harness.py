@@ -16,7 +16,7 @@ from pathlib import Path
 
 import casadi_route
 import numpy as np
-from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench
+from c_snippets import C_PRINT_OUT, C_TIME_MAIN, JOINT_STATES, skeleton
 from machine import C_COMPILER, FLAGS, run
 from row import FUNCTIONS, Row
 from states import CHECK_TOL, NCHECK, NSTATES, rel_err
@@ -150,12 +150,7 @@ def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
         prefix=robot.name,
         n=robot.n,
         nstates=NSTATES,
-        prelude=C_PRELUDE,
-        run_bench=c_run_bench([loop.format(p=robot.name) for loop in LOOPS]),
-        print_out=C_PRINT_OUT,
-        main_head=C_MAIN_HEAD,
-        read_states=c_read_states(("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N")),
-        time_main=C_TIME_MAIN,
+        **skeleton([loop.format(p=robot.name) for loop in LOOPS], *JOINT_STATES),
     )
     harness.write_text(text)
     exe = work / f"bench_{row.name}"

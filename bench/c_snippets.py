@@ -20,7 +20,19 @@ c_harness.parse_harness.
 
 from __future__ import annotations
 
-__all__ = ["C_PRELUDE", "C_PRINT_OUT", "C_MAIN_HEAD", "C_TIME_MAIN", "c_run_bench", "c_read_states"]
+__all__ = [
+    "C_PRELUDE",
+    "C_PRINT_OUT",
+    "C_MAIN_HEAD",
+    "C_TIME_MAIN",
+    "c_run_bench",
+    "c_read_states",
+    "skeleton",
+    "JOINT_STATES",
+]
+
+#: the states of a fixed-base robot: q, qd, qdd and tau, N doubles each
+JOINT_STATES = (("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N"))
 
 #: Headers, the sink, a monotonic clock in ns, and LOOP(CALL, SINK): `it` calls of CALL on the
 #: states k = 0, 1, ... (cycling, so that the state changes every call), each adding one output
@@ -137,3 +149,16 @@ def c_read_states(*fields: tuple[str, str]) -> str:
     }}
     fclose(f);
 """
+
+
+def skeleton(loops: list[str], *fields: tuple[str, str]) -> dict[str, str]:
+    """The shared pieces as HARNESS.format's keyword arguments: prelude, run_bench (from `loops`),
+    print_out, main_head, read_states (of `fields`) and time_main."""
+    return {
+        "prelude": C_PRELUDE,
+        "run_bench": c_run_bench(loops),
+        "print_out": C_PRINT_OUT,
+        "main_head": C_MAIN_HEAD,
+        "read_states": c_read_states(*fields),
+        "time_main": C_TIME_MAIN,
+    }

@@ -37,7 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import pin_harness  # noqa: E402
 from c_harness import parse_harness  # noqa: E402
-from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench  # noqa: E402
+from c_snippets import skeleton  # noqa: E402
 from machine import C_COMPILER, FLAGS, RESULTS, ROOT, load_averages, log, machine, pin_to_one_core, run  # noqa: E402
 from states import NCHECK  # noqa: E402
 
@@ -167,12 +167,7 @@ def bench_robot(name, robot, work: Path, pin_exe, opts) -> dict:
         n=robot.n,
         na=na,
         nstates=NSTATES,
-        prelude=C_PRELUDE,
-        run_bench=c_run_bench(loops),
-        print_out=C_PRINT_OUT,
-        main_head=C_MAIN_HEAD,
-        read_states=c_read_states(("Q", "N"), ("QDA", "A"), ("QDDA", "A"), ("TAUA", "A")),
-        time_main=C_TIME_MAIN,
+        **skeleton(loops, ("Q", "N"), ("QDA", "A"), ("QDDA", "A"), ("TAUA", "A")),
     )
     (work / "harness.c").write_text(src)
     exe = work / "harness"

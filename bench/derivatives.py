@@ -28,7 +28,7 @@ import casadi_route
 import casadi_route_derivatives as crd
 import numpy as np
 from c_harness import parse_harness, time_compiled
-from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench
+from c_snippets import JOINT_STATES, skeleton
 from machine import C_COMPILER, FLAGS, RESULTS, log, run
 from row import Row
 from states import NCHECK, NSTATES
@@ -202,12 +202,7 @@ def bench_derivatives(row: Row, robot, gen_dir: Path, work: Path, states_file: P
         n=robot.n,
         nstates=NSTATES,
         ncheck=NCHECK,
-        prelude=C_PRELUDE,
-        run_bench=c_run_bench([loop.format(p=robot.name) for loop in LOOPS]),
-        print_out=C_PRINT_OUT,
-        main_head=C_MAIN_HEAD,
-        read_states=c_read_states(("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N")),
-        time_main=C_TIME_MAIN,
+        **skeleton([loop.format(p=robot.name) for loop in LOOPS], *JOINT_STATES),
     )
     src.write_text(text)
     exe = work / f"bench_derivatives_{row.name}"

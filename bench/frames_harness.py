@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from c_snippets import C_MAIN_HEAD, C_PRELUDE, C_PRINT_OUT, C_TIME_MAIN, c_read_states, c_run_bench
+from c_snippets import JOINT_STATES, skeleton
 from machine import C_COMPILER, FLAGS, run
 from states import NSTATES
 
@@ -94,13 +94,8 @@ def harness_source(prefix: str, n: int, frame: str) -> str:
         nstates=NSTATES,
         nb=len(LABELS),
         labels=labels,
-        prelude=C_PRELUDE,
-        run_bench=c_run_bench(cases),
         checks="\n".join(checks),
-        print_out=C_PRINT_OUT,
-        main_head=C_MAIN_HEAD,
-        read_states=c_read_states(("Q", "N"), ("QD", "N"), ("QDD", "N"), ("TAU", "N")),
-        time_main=C_TIME_MAIN,
+        **skeleton(cases, *JOINT_STATES),
     )
 
 
