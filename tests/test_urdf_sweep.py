@@ -11,7 +11,8 @@ A file symdyn refuses must be refused for a reason listed in REFUSED (and docume
 docs/urdf.md). Where Pinocchio refuses `mimic=True` (a mimic joint it cannot place) but symdyn
 loads the file, Pinocchio's model without mimic joints (every joint free) is used instead, and
 its dynamics are projected onto the independent coordinates with the selection S read from the
-XML's <mimic> elements: tau = S^T tau_b(S q + o, S qd, S qdd), M = S^T M_b S, G = S^T G_b.
+XML's <mimic> elements: tau = S^T tau_b(S q + o, S qd, S qdd), M = S^T M_b S, G = S^T G_b
+(bench/pin_urdf.py, shared with bench/floating_sweep.py and tests/test_oracle_floating.py).
 A file neither can use is listed in PINOCCHIO_REFUSES with Pinocchio's message. No file gives
 the warning about a massless link in the middle of a chain; the other warnings about the
 published data pass silently.
@@ -20,8 +21,8 @@ The table of the sweep prints with `pytest -s tests/test_urdf_sweep.py`.
 
 from __future__ import annotations
 
+import importlib.util
 import warnings
-import xml.etree.ElementTree as ET
 import zlib
 from pathlib import Path
 
@@ -34,6 +35,21 @@ from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import gravity_torque, mass_matrix
 
 pin = pytest.importorskip("pinocchio", reason="the test extra installs pin (Pinocchio)")
+
+
+def _bench_module(name: str):
+    """A helper module of bench/ that the benchmark scripts share with these tests (bench/ is no
+    package: the module is loaded from its file)."""
+    spec = importlib.util.spec_from_file_location(
+        name, Path(__file__).resolve().parents[1] / "bench" / f"{name}.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: the joints matched by name, the mimic joints projected (bench/pin_urdf.py)
+pin_urdf = _bench_module("pin_urdf")
 
 #: the published files' own oddities, which symdyn reports while loading them (tests/test_inertia.py,
 #: test_angles.py and test_urdf.py assert these warnings): not the subject of the sweep
@@ -77,61 +93,6 @@ TOL = 1e-9  # relative to the largest entry (and 1e-9 absolute): both are double
 
 def _rel(path: Path) -> str:
     return str(path.relative_to(ROBOTS))
-
-
-def _child_links(path: Path) -> dict[str, str]:
-    """URDF joint name -> its child link's name (symdyn names a joint's Link after its child)."""
-    root = ET.parse(path).getroot()
-    return {j.get("name"): j.find("child").get("link") for j in root.findall("joint")}
-
-
-def _mimics(path: Path) -> dict[str, tuple[str, float, float]]:
-    """Movable URDF joint -> (master joint, multiplier, offset) for each <mimic>, read from the XML."""
-    out = {}
-    for j in ET.parse(path).getroot().findall("joint"):
-        m = j.find("mimic")
-        if m is not None and j.get("type") != "fixed":
-            out[j.get("name")] = (m.get("joint"), float(m.get("multiplier", 1)), float(m.get("offset", 0)))
-    return out
-
-
-class _Projected:
-    """Pinocchio's model without mimic joints, projected onto the independent coordinates."""
-
-    def __init__(self, path: Path, names: list[str]):
-        self.model = pin.buildModelFromUrdf(str(path))
-        self.data = self.model.createData()
-        self.names = names
-        self.mimics = _mimics(path)
-        nv = self.model.nv
-        self.S = np.zeros((nv, len(names)))
-        self.offset = np.zeros(nv)
-        col = {name: k for k, name in enumerate(names)}
-        for j in range(1, self.model.njoints):
-            joint, name = self.model.joints[j], self.model.names[j]
-            master, k, o = self.mimics.get(name, (name, 1.0, 0.0))
-            self.S[joint.idx_v, col[master]] = k
-            self.offset[joint.idx_v] = o
-
-    def state(self, q, qd, qdd):
-        qb, vb, ab = self.S @ q + self.offset, self.S @ qd, self.S @ qdd
-        qp = pin.neutral(self.model)
-        for j in range(1, self.model.njoints):
-            joint = self.model.joints[j]
-            x = qb[joint.idx_v]
-            if joint.nq == 2:
-                qp[joint.idx_q : joint.idx_q + 2] = np.cos(x), np.sin(x)
-            else:
-                qp[joint.idx_q] = x
-        return qp, vb, ab
-
-    def dynamics(self, q, qd, qdd):
-        qp, v, a = self.state(q, qd, qdd)
-        S = self.S
-        M = pin.crba(self.model, self.data, qp)
-        M = np.triu(M) + np.triu(M, 1).T
-        tau = S.T @ pin.rnea(self.model, self.data, qp, v, a)
-        return tau, S.T @ M @ S, S.T @ pin.computeGeneralizedGravity(self.model, self.data, qp)
 
 
 def _pin_state(model, names: list[str], q, qd, qdd):
@@ -185,9 +146,8 @@ def test_whole_tree_against_pinocchio(path):
     assert rel not in REFUSED, f"{rel}: symdyn loads it now"
     # no file has a massless link mid-chain (docs/urdf.md): the warning fires on none of them
     assert not [str(w.message) for w in caught if "has no <inertial>" in str(w.message)]
-    joint_of = {child: joint for joint, child in _child_links(path).items()}
-    names = [joint_of[link.name] for link in robot.links if link.mimic is None]
-    projected = _Projected(path, names) if mimic_fails else None
+    names = pin_urdf.joint_names(path, robot)
+    projected = pin_urdf.Projected(path, names, floating=False) if mimic_fails else None
     if projected is None:
         assert robot.n == model.nv, (robot.n, model.nv)
     data = model.createData()
@@ -196,13 +156,15 @@ def test_whole_tree_against_pinocchio(path):
     for _ in range(STATES):
         q, qd, qdd = (rng.uniform(-1, 1, robot.n) for _ in range(3))
         if projected is not None:
-            tau_pin, M_pin, G_pin = projected.dynamics(q, qd, qdd)
+            qp, v, a = projected.state(q, qd, qdd)
+            m, d = projected.model, projected.data
+            tau_pin = projected.back(pin.rnea(m, d, qp, v, a))
+            M_pin = projected.back(pin_urdf.symmetric(pin.crba(m, d, qp)))
+            G_pin = projected.back(pin.computeGeneralizedGravity(m, d, qp))
         else:
             qp, v, a, order = _pin_state(model, names, q, qd, qdd)
             tau_pin = pin.rnea(model, data, qp, v, a)[order]
-            M_pin = pin.crba(model, data, qp)
-            M_pin = np.triu(M_pin) + np.triu(M_pin, 1).T
-            M_pin = M_pin[np.ix_(order, order)]
+            M_pin = pin_urdf.symmetric(pin.crba(model, data, qp))[np.ix_(order, order)]
             G_pin = pin.computeGeneralizedGravity(model, data, qp)[order]
         tau = symdyn.rnea(robot, q, qd, qdd, friction=False)
         worst = max(
