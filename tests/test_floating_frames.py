@@ -7,8 +7,9 @@ NumPy and C.
 
 The operational-space group of a floating robot (the small floating chain of `small_floating`):
 Lambda^-1 equals J M^-1 J^T with Pinocchio's computeFrameJacobian and computeMinverse and with the
-oracle's M (the generated Jacobians equal Pinocchio's above), and Lambda a + mu equals the task force F whose J^T F drives Pinocchio's aba to the
-frame's classical acceleration a."""
+oracle's M (the generated Jacobians equal Pinocchio's above), and Lambda a + mu equals the task
+force F whose J^T F drives Pinocchio's aba to the frame's classical acceleration a; Dynamics'
+frame and operational-space methods give the same numbers."""
 
 from __future__ import annotations
 
@@ -135,14 +136,23 @@ def small_floating(folder: Path):
     return symdyn.load_urdf(path, floating=True), pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
 
 
-def test_operational_space_agrees_with_pinocchio_and_the_oracle(tmp_path):
-    robot, model = small_floating(tmp_path)
+@pytest.fixture(scope="module")
+def chain(tmp_path_factory):
+    """(robot, Pinocchio model, render context, NumPy module) of the small floating chain's
+    operational-space group for its last link `c`, derived and rendered once."""
+    folder = tmp_path_factory.mktemp("chain")
+    robot, model = small_floating(folder)
     c = context(robot, functions=("operational_space",), frames=["c"])
     ((file, text),) = numpy_target.render(c).items()
-    (tmp_path / file).write_text(text)
-    spec = importlib.util.spec_from_file_location("small_floating_numpy", tmp_path / file)
+    (folder / file).write_text(text)
+    spec = importlib.util.spec_from_file_location("small_floating_numpy", folder / file)
     gen = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(gen)
+    return robot, model, c, gen
+
+
+def test_operational_space_agrees_with_pinocchio_and_the_oracle(chain):
+    robot, model, c, gen = chain
     data = model.createData()
     fid = model.getFrameId("c")
     pin.seed(9)
@@ -163,3 +173,24 @@ def test_operational_space_agrees_with_pinocchio_and_the_oracle(tmp_path):
         pin.updateFramePlacements(model, data)
         acc = pin.getFrameClassicalAcceleration(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
         _close(Lam @ np.r_[acc.linear, acc.angular] + mu, F, "Lambda a + mu = F (Pinocchio's aba)", RTOL_URDF)
+        # Dynamics' methods, on the same derivation: the Jacobian, Lambda (of three rows too), Jbar
+        dyn = c.dynamics
+        _close(dyn.frame_jacobian("c", q=q), J, "Dynamics.frame_jacobian", RTOL_URDF)
+        _close(dyn.operational_space_inertia("c", q), Lam, "Dynamics Lambda", RTOL_URDF)
+        _close(dyn.operational_space_bias("c", q, v), mu, "Dynamics mu", RTOL_URDF)
+        L3 = dyn.operational_space_inertia("c", q, axes="x,y,z")
+        _close(np.linalg.inv(L3), J[:3] @ Minv @ J[:3].T, "Lambda^-1 of x, y, z", RTOL_URDF)
+        _close(J @ dyn.dynamically_consistent_inverse("c", q), np.eye(6), "J Jbar = 1", RTOL_URDF)
+
+
+def test_operational_space_of_a_floating_robot_refuses_bad_vectors(chain):
+    dyn = chain[2].dynamics
+    q = np.r_[np.zeros(6), 1.0, np.zeros(3)]
+    for bad, message in (
+        (q[:7], r"Dynamics.operational_space_inertia: q has shape \(7,\), expected \(10,\)"),
+        ("q", "Dynamics.operational_space_inertia: q must hold numbers"),
+    ):
+        with pytest.raises(symdyn.SymdynError, match=message):
+            dyn.operational_space_inertia("c", bad)
+    with pytest.raises(symdyn.SymdynError, match=r"Dynamics.operational_space_bias: qd has shape \(3,\)"):
+        dyn.operational_space_bias("c", q, np.zeros(3))
