@@ -15,7 +15,9 @@ world-aligned rows the task axes choose (symdyn.algorithms.operational_space.TAS
 by default, k of them). The quantities are symdyn.algorithms.frame_kinematics' and
 symdyn.algorithms.operational_space's, over named intermediates written into copies of
 `dyn.program` (the derivation is not changed); both inverses are unrolled L D L^T
-factorisations, without square roots.
+factorisations, without square roots. On a floating robot (symdyn.algorithms.floating_frames)
+q has NQ entries and qd NV, J is 6 x NV with the base's columns first and M NV x NV, inverted
+with the joints eliminated before the base (docs/floating-base.md).
 
 The default frames are every leaf link of the tree (a link no other link hangs from) followed
 by every frame of Robot.frames (a URDF's merged fixed links, a robot file's `frames:`, PoE's
