@@ -45,11 +45,13 @@ import sympy as sp
 from sympy.core.parameters import distribute
 
 from .algorithms.base_parameters import BaseParameters, find_base_parameters
+from .algorithms.centroidal import Centroidal
 from .algorithms.configuration_space import ConfigurationSpace, configuration_space
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
 from .algorithms.floating import floating_lagrange_terms, floating_newton_euler_terms
+from .algorithms.floating_frames import FloatingFrames
 from .algorithms.frame_kinematics import FrameKinematics
 from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
@@ -60,7 +62,7 @@ from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.singular import SingularJoint, describe_singular, singular_joints
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
-from .model.free_flyer import base_symbols
+from .model.free_flyer import NQ_BASE, NV_BASE, base_symbols
 from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
@@ -144,7 +146,7 @@ class Dynamics:
     _compiled: dict[str, object] = field(default_factory=dict, repr=False)
     _linear: dict[str, object] = field(default_factory=dict, repr=False)
     _configuration: ConfigurationSpace | None = field(default=None, repr=False)
-    _frames: FrameKinematics | None = field(default=None, repr=False)
+    _frames: FrameKinematics | FloatingFrames | None = field(default=None, repr=False)
 
     @property
     def n(self) -> int:
@@ -385,11 +387,18 @@ class Dynamics:
 
     # -- frames and task space (docs/frames.md; symdyn.algorithms.frame_kinematics)
     @property
-    def frames(self) -> FrameKinematics:
+    def frames(self) -> FrameKinematics | FloatingFrames:
         """The frame quantities over named intermediates of a copy of `program` (intermediates
-        `_F...`), shared by the methods below."""
+        `_F...`), shared by the methods below; of a floating robot over q (NQ) and qd (NV), the
+        Jacobians 6 x NV with the base's columns (symdyn.algorithms.floating_frames)."""
         if self._frames is None:
-            self._frames = FrameKinematics(self.robot, list(self.q), list(self.qd), self.program.copy("F"))
+            r, q, qd, prog = self.robot, list(self.q), list(self.qd), self.program.copy("F")
+            if r.floating:  # the base's coordinates first (symdyn.algorithms.floating_frames)
+                joints, rates = q[NQ_BASE:], qd[NV_BASE:]
+                cen = Centroidal(r, joints, rates, prog, q[:NQ_BASE], qd[:NV_BASE])
+                self._frames = FloatingFrames(FrameKinematics(r, joints, rates, prog), cen)
+            else:
+                self._frames = FrameKinematics(r, q, qd, prog)
         return self._frames
 
     def _frame_value(self, key: tuple, m: sp.Matrix, q, qd, params, where: str):
@@ -405,8 +414,12 @@ class Dynamics:
             args = [list(self.q), list(self.qd), list(self.params)]
             f = sp.lambdify(args, sp.Matrix(m), modules="numpy", cse=lambda exprs: (steps, exprs))
             self._compiled[key] = f
-        vq = self.robot.joint_values(q, "q", where)
-        vqd = self.robot.joint_values(qd, "qd", where)
+        if self.robot.floating:
+            vq = _state_vector(q, self.robot.nq, "q", where)
+            vqd = _state_vector(qd, self.robot.nv, "qd", where)
+        else:
+            vq = self.robot.joint_values(q, "q", where)
+            vqd = self.robot.joint_values(qd, "qd", where)
         values = self.robot.param_values(params, where)
         out = np.asarray(f(vq, vqd, [values[s] for s in self.params]), dtype=float).reshape(m.shape)
         return out[:, 0] if m.cols == 1 else out
@@ -459,7 +472,7 @@ class Dynamics:
                 J.extract(list(rows), list(range(self.n))),
                 self.compact["bias"],
                 fk.jacobian_dot_qd(frame).extract(list(rows), [0]),
-                self.robot.is_chain,
+                self.robot.is_chain and not self.robot.floating,
                 fk.program,
             )
             self._compiled[key] = os

@@ -7,6 +7,11 @@ computeRNEADerivatives and computeABADerivatives define them: on Solo-12 the der
 Pinocchio's computeRNEADerivatives; on the small floating arm of tests/data the generated C
 (strict flags, -Werror) and NumPy functions equal central finite differences through
 pinocchio.integrate of the numeric oracle's inverse and forward dynamics, and M^-1 its inverse.
+
+linearize on the tangent space: on the arm, A and B equal the mixed central differences of the
+deviation dx(t) = (difference(qr, q), v - vr) between two solutions one step apart (the generated
+integrate and difference, the oracle's forward dynamics); on a small floating URDF its dqdd
+blocks and M^-1 equal Pinocchio's computeABADerivatives.
 """
 
 from __future__ import annotations
@@ -18,11 +23,15 @@ import numpy as np
 import pytest
 from cbuild import load_c_and_numpy
 from robots import floating_solo12
+from test_floating_frames import small_floating
 
 import symdyn
 from symdyn.algorithms.base_parameters import evaluate
 from symdyn.algorithms.derivatives import floating_effort_jacobians
 from symdyn.codegen import render
+from symdyn.codegen.derivative_functions import derivative_rows
+from symdyn.codegen.function_rows import Inputs
+from symdyn.oracle.inputs import skew
 from symdyn.rnea import forward_dynamics, mass_matrix
 
 pin = pytest.importorskip("pinocchio", reason="the test extra installs pin (Pinocchio)")
@@ -105,25 +114,41 @@ def _expected(robot, model, q, v, a) -> dict:
     }
 
 
-def test_generated_derivatives_equal_finite_differences(tmp_path):
+@pytest.fixture(scope="module")
+def arm(tmp_path_factory):
+    """(robot, compiled C, NumPy module) of the floating arm's derivatives and configuration
+    groups, rendered and compiled once."""
     robot = symdyn.load_robot(ARM)
-    name = robot.name
-    files = render(robot, targets=("c", "python"), functions=["derivatives"])
-    lib, numpy_module = load_c_and_numpy(files, tmp_path, name)
-    ptr = ctypes.POINTER(ctypes.c_double)
-    nv = robot.nv
-    model = _flyer_model(robot.n)
+    files = render(robot, targets=("c", "python"), functions=["derivatives", "configuration"])
+    lib, numpy_module = load_c_and_numpy(files, tmp_path_factory.mktemp("arm"), robot.name)
+    return robot, lib, numpy_module
 
-    def c_call(fname, args, outputs):
-        out = [np.full(nv * nv, np.nan) for _ in range(outputs)]
-        fn = getattr(lib, f"{name}_{fname}")
-        fn.argtypes = [ptr] * (len(args) + 1 + outputs)
+
+def _c_function(robot, lib, fname: str, shapes):
+    """The generated C function NAME_fname as a Python callable returning its outputs (shapes)."""
+    ptr = ctypes.POINTER(ctypes.c_double)
+    fn = getattr(lib, f"{robot.name}_{fname}")
+
+    def call(*args):
+        out = [np.full(shape, np.nan) for shape in shapes]
+        fn.argtypes = [ptr] * (len(args) + 1 + len(out))
         fn(
             *(np.ascontiguousarray(x).ctypes.data_as(ptr) for x in args),
             None,
             *(o.ctypes.data_as(ptr) for o in out),
         )
         return out
+
+    return call
+
+
+def test_generated_derivatives_equal_finite_differences(arm):
+    robot, lib, numpy_module = arm
+    nv = robot.nv
+    model = _flyer_model(robot.n)
+
+    def c_call(fname, args, outputs):
+        return _c_function(robot, lib, fname, [(nv, nv)] * outputs)(*args)
 
     def numpy_call(fname, args, outputs):
         return getattr(numpy_module, fname)(*args)
@@ -140,3 +165,89 @@ def test_generated_derivatives_equal_finite_differences(tmp_path):
                     np.testing.assert_allclose(
                         np.asarray(g).reshape(nv, nv), e, atol=1e-7 * scale, err_msg=f"{target} {fname} {k}"
                     )
+
+
+EPS = H = 1e-4  # the perturbation and the time step of the mixed differences
+
+
+def _linearisation_differences(robot, gen, q, v, tau) -> tuple[np.ndarray, np.ndarray]:
+    """A and B by mixed central differences: d^2/(de dh) of the deviation
+    (difference(qr(h), q(h)), v(h) - vr(h)) between the solution from (q, v, tau) and the one from
+    (q (+) e dq, v + e dv, tau + e dtau), each advanced by one explicit Euler step of h (exact to
+    first order in h, which is all the derivative at h = 0 sees)."""
+    nv = robot.nv
+
+    def step(q0, v0, t0, h):
+        qdd = forward_dynamics(robot, q0, v0, t0)
+        return gen.integrate(q0, v0, np.array([h])), v0 + h * qdd
+
+    def deviation(d, e, h):
+        q1, v1 = gen.integrate(q, d[:nv], np.array([e])), v + e * d[nv : 2 * nv]
+        qr, vr = step(q, v, tau, h)
+        qp, vp = step(q1, v1, tau + e * d[2 * nv :], h)
+        return np.r_[gen.difference(qr, qp), vp - vr]
+
+    columns = []
+    for d in np.eye(3 * nv):
+        mixed = deviation(d, EPS, H) - deviation(d, -EPS, H) - deviation(d, EPS, -H) + deviation(d, -EPS, -H)
+        columns.append(mixed / (4 * EPS * H))
+    F = np.array(columns).T
+    return F[:, : 2 * nv], F[:, 2 * nv :]
+
+
+def test_linearize_on_the_tangent_space_equals_finite_differences(arm):
+    robot, lib, gen = arm
+    nv = robot.nv
+    c_linearize = _c_function(robot, lib, "linearize", [(2 * nv, 2 * nv), (2 * nv, nv)])
+    rng = np.random.default_rng(8)
+    for _ in range(2):
+        q, v, tau = _state(robot, rng)
+        A_fd, B_fd = _linearisation_differences(robot, gen, q, v, tau)
+        for target, (A, B) in (("NumPy", gen.linearize(q, v, tau)), ("C", c_linearize(q, v, tau))):
+            for got, want, what in ((A, A_fd, "A"), (B, B_fd, "B")):
+                scale = max(1.0, np.abs(want).max())
+                np.testing.assert_allclose(got, want, atol=1e-6 * scale, err_msg=f"{target} {what}")
+            np.testing.assert_allclose(B[nv:], np.linalg.inv(mass_matrix(robot, q)), rtol=1e-9, atol=1e-12)
+
+
+class _Walk:
+    """The derivation's assignments, then a family's steps, in program order: what
+    symdyn.algorithms.base_parameters.evaluate walks (its `needed`) to evaluate the rows' outputs."""
+
+    def __init__(self, dyn, steps) -> None:
+        self.assignments = [*dyn.program.assignments, *steps]
+
+    def needed(self, outputs):
+        return self.assignments
+
+
+def test_linearize_equals_pinocchio_aba_derivatives(tmp_path):
+    robot, model = small_floating(tmp_path)
+    dyn = symdyn.derive(robot, simplify=False)
+    rows = derivative_rows(dyn, Inputs.of(dyn))
+    (linearize,) = (row for row in rows if row.name == "linearize")
+    walk = _Walk(dyn, rows[0].steps)  # the first row carries the family's steps
+    data = model.createData()
+    nv = model.nv
+    pin.seed(4)
+    rng = np.random.default_rng(4)
+    for _ in range(2):
+        q = pin.randomConfiguration(model, -np.ones(model.nq), np.ones(model.nq))
+        v, tau = rng.normal(size=nv), rng.normal(size=nv)
+        # qdd (which linearize does not read: it takes FD(q, v, tau)) is zero for the other rows' steps
+        inputs = (*dyn.q, *dyn.qd, *Inputs.of(dyn).tau.symbols, *dyn.qdd)
+        values = dict(zip(inputs, np.r_[q, v, tau, np.zeros(nv)][:, None], strict=True))
+        A, B = np.split(evaluate(walk, list(linearize.exprs), values, 1)[:, 0], [4 * nv * nv])
+        A, B = A.reshape(2 * nv, 2 * nv), B.reshape(2 * nv, nv)
+        ddq_dq, ddq_dv, Minv = (np.array(m) for m in pin.computeABADerivatives(model, data, q, v, tau))
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T  # Pinocchio may fill the upper triangle only
+        w, nu = v[3:6], v[:3]
+        ad = np.block([[skew(w), skew(nu)], [np.zeros((3, 3)), skew(w)]])
+        want_A = np.block([[np.zeros((nv, nv)), np.eye(nv)], [ddq_dq, ddq_dv]])
+        want_A[:6, :6] = -ad
+        for got, want, what in (
+            (A, want_A, "A"),
+            (B, np.vstack([np.zeros((nv, nv)), Minv]), "B"),
+        ):
+            scale = max(1.0, np.abs(want).max())
+            np.testing.assert_allclose(got, want, atol=1e-10 * scale, err_msg=what)

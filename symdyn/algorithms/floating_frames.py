@@ -27,10 +27,11 @@ from ..spatial.transform import Transform
 from .centroidal import Centroidal
 from .frame_kinematics import FrameKinematics
 
-__all__ = ["FloatingFrames"]
+__all__ = ["FloatingFrames", "skew"]
 
 
-def _skew(r) -> sp.Matrix:
+def skew(r) -> sp.Matrix:
+    """[r]x, the 3 x 3 matrix of r x ."""
     return sp.Matrix([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]])
 
 
@@ -62,7 +63,7 @@ class FloatingFrames:
         """J (6 x NV): world-aligned at F's origin ("world") or in F's axes ("local")."""
         T = self.fk.pose(name)
         r, R_F = T[:3, 3], T[:3, :3]
-        base = sp.Matrix(sp.BlockMatrix([[sp.eye(3), -_skew(r)], [sp.zeros(3), sp.eye(3)]]))
+        base = sp.Matrix(sp.BlockMatrix([[sp.eye(3), -skew(r)], [sp.zeros(3), sp.eye(3)]]))
         if reference == "world":
             rot = sp.diag(self.R, self.R)
             J = sp.Matrix.hstack(rot * base, rot * self.fk.jacobian(name, "world"))

@@ -20,14 +20,26 @@ The Coulomb friction sign(qd) contributes zero (its derivative almost everywhere
 The three functions that invert M are left out, like forward_dynamics, when M is singular
 by construction (Dynamics.singular_joints; symdyn.codegen.functions.build_functions warns).
 
-A floating robot (q of NQ entries, the rest NV; docs/floating-base.md) gets the first three, with
+A floating robot (q of NQ entries, the rest NV; docs/floating-base.md) gets all four, with
 dtau/dq and dqdd/dq in the tangent space (symdyn.algorithms.derivatives.floating_effort_jacobians:
 Pinocchio's computeRNEADerivatives / computeABADerivatives convention) and dtau/dqd by forward
-mode; M^-1 eliminates the joints before the base. No linearize: the tangent of (q, qd) is not
-[[0, I], ..] in the base's coordinates.
+mode; M^-1 eliminates the joints before the base. Its linearize works on the tangent space of
+the state x = (q, v): the deviation of a state x from a reference solution xr(t) is
+dx = (difference(qr, q), v - vr) (2 NV entries; Pinocchio's `difference`, q = qr (+) dq), and
+
+    d(dx)/dt = A dx + B dtau,   A = [[-ad(v_b), I], [dqdd/dq, dqdd/dqd]],  B = [[0], [M^-1]],
+
+A 2NV x 2NV, B 2NV x NV. The block -ad(v_b) sits on the base's six rows and columns only: the
+local error dq of the base pose, q = qr exp(dq), turns with the base twist v_b = (nu, omega)
+(base frame), d(dq)/dt = dv - ad(v_b) dq with ad(nu, omega) = [[omega x, nu x], [0, omega x]]
+(Sola, Deray and Atchuthan, A micro Lie theory for state estimation in robotics (2018), the
+error dynamics of X = Xr Exp(dx)); the joints' block is zero as on a fixed base. B's first six
+columns are the base wrench (unactuated: zero without contacts), the others the joint efforts.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import sympy as sp
 
@@ -39,6 +51,7 @@ from ..algorithms.derivatives import (
     matmul,
     substitute,
 )
+from ..algorithms.floating_frames import skew
 from ..dynamics import Dynamics
 from .function_rows import FunctionRow, Inputs, Output, joint_matrix_output
 
@@ -66,6 +79,19 @@ def state_matrices(dq: sp.Matrix, dqd: sp.Matrix, Minv: sp.Matrix) -> tuple[sp.M
     A[n:, n:] = dqd
     B = sp.zeros(2 * n, n)
     B[n:, :] = Minv
+    return A, B
+
+
+def floating_state_matrices(
+    dq: sp.Matrix, dqd: sp.Matrix, Minv: sp.Matrix, v_base: Sequence[sp.Symbol]
+) -> tuple[sp.Matrix, sp.Matrix]:
+    """A = [[-ad(v_b), I], [dq, dqd]] and B = [[0], [Minv]] of a floating robot's linearize on
+    the tangent space (module docstring): -ad(v_b) = -[[omega x, nu x], [0, omega x]] on the base's
+    six rows and columns, v_b = (nu, omega) the base twist in the base frame."""
+    A, B = state_matrices(dq, dqd, Minv)
+    nu, omega = sp.Matrix(v_base[:3]), sp.Matrix(v_base[3:6])
+    A[:3, :3] = A[3:6, 3:6] = -skew(omega)
+    A[:3, 3:6] = -skew(nu)
     return A, B
 
 
@@ -106,7 +132,10 @@ def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
         at_fd = substitute(prog, _entries(dq), dict(zip(dyn.qdd, qdd, strict=True)), "Dfd")
         ddq = matmul(-Minv, sp.Matrix(n, n, at_fd), prog, "Ddq")
         ddqd = matmul(-Minv, dqd, prog, "Ddv")  # dtau/dqd does not depend on qdd
-        A, B = state_matrices(ddq, ddqd, Minv)
+        if floating:  # on the tangent space: the base's error turns with its twist
+            A, B = floating_state_matrices(ddq, ddqd, Minv, list(dyn.qd)[:6])
+        else:
+            A, B = state_matrices(ddq, ddqd, Minv)
         inv_doc = "M(q)^-1 = dqdd/dtau"
         rows += [
             (
@@ -128,20 +157,23 @@ def derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 _entries(Minv),
             ),
         ]
-        if not floating:  # a floating state's q (NQ) and its tangent (NV) differ: no A = [[0, I], ..]
-            rows.append(
+        linear = (
+            "A = [[-ad(v_b), I], [dqdd/dq, dqdd/dqd]] on the tangent space"
+            if floating
+            else ("A = [[0, I], [dqdd/dq, dqdd/dqd]]")
+        )
+        rows.append(
+            (
+                "linearize",
+                f"xd = f(x, tau) linearised at x = (q, qd): {linear}, B = [0; M^-1]",
+                (x.q, x.qd, x.tau, x.p),
                 (
-                    "linearize",
-                    "xd = f(x, tau) linearised at x = (q, qd): "
-                    "A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1]",
-                    (x.q, x.qd, x.tau, x.p),
-                    (
-                        Output("A", 2 * n, 2 * n, "df/dx", ("2n", "2n")),
-                        Output("B", 2 * n, n, "df/dtau", ("2n", "n")),
-                    ),
-                    _entries(A, B),
-                )
+                    Output("A", 2 * n, 2 * n, "df/dx", ("2n", "2n")),
+                    Output("B", 2 * n, n, "df/dtau", ("2n", "n")),
+                ),
+                _entries(A, B),
             )
+        )
     # build_functions gathers every row's steps into one program: the first row carries them all
     steps = [tuple(prog.assignments[first:])] + [()] * (len(rows) - 1)
     return [FunctionRow(*row, s, cse="derivatives") for row, s in zip(rows, steps, strict=True)]

@@ -15,7 +15,9 @@ world-aligned rows the task axes choose (symdyn.algorithms.operational_space.TAS
 by default, k of them). The quantities are symdyn.algorithms.frame_kinematics' and
 symdyn.algorithms.operational_space's, over named intermediates written into copies of
 `dyn.program` (the derivation is not changed); both inverses are unrolled L D L^T
-factorisations, without square roots.
+factorisations, without square roots. On a floating robot (symdyn.algorithms.floating_frames)
+q has NQ entries and qd NV, J is 6 x NV with the base's columns first and M NV x NV, inverted
+with the joints eliminated before the base (docs/floating-base.md).
 
 The default frames are every leaf link of the tree (a link no other link hangs from) followed
 by every frame of Robot.frames (a URDF's merged fixed links, a robot file's `frames:`, PoE's
@@ -136,21 +138,25 @@ def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
     return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
 
 
+def _frames_of(dyn: Dynamics, x: Inputs, prog) -> tuple:
+    """(frame quantities, q, qd, columns of a Jacobian, their size name) over `prog`: on a
+    floating robot FloatingFrames over q (NQ) and v (NV), else FrameKinematics over the joints."""
+    robot = dyn.robot
+    if robot.floating:
+        q, qd = floating_inputs(dyn, x)
+        joints, rates = q.symbols[NQ_BASE:], qd.symbols[NV_BASE:]
+        fk = FloatingFrames(FrameKinematics(robot, joints, rates, prog), centroidal_of(dyn, x, prog))
+        return fk, q, qd, robot.nv, "nv"
+    return FrameKinematics(robot, list(dyn.q), list(dyn.qd), prog), x.q, x.qd, dyn.n, "n"
+
+
 def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """pose, jacobian, jacobian_local and jacobian_dot_qd of each chosen frame, then the centre
     of mass's three functions (module docstring); on a floating robot over q (NQ) and v (NV),
     with the base's columns (symdyn.algorithms.floating_frames)."""
-    robot = dyn.robot
     prog = dyn.program.copy("K")
     first = len(prog.assignments)
-    if robot.floating:
-        q, qd = floating_inputs(dyn, x)
-        n, cols = robot.nv, "nv"
-        joints, rates = q.symbols[NQ_BASE:], qd.symbols[NV_BASE:]
-        fk = FloatingFrames(FrameKinematics(robot, joints, rates, prog), centroidal_of(dyn, x, prog))
-    else:
-        q, qd, n, cols = x.q, x.qd, dyn.n, "n"
-        fk = FrameKinematics(robot, list(dyn.q), list(dyn.qd), prog)
+    fk, q, qd, n, cols = _frames_of(dyn, x, prog)
     rows: list[tuple] = []
     for name, ident, link in x.frames.frames:
         on = f"of frame {comment_text(name)} on {link}"
@@ -207,12 +213,14 @@ def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
 
 def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """operational_space_inertia and operational_space_bias of each chosen frame over the task
-    axes' rows of its world-aligned Jacobian (module docstring)."""
-    n = dyn.n
+    axes' rows of its world-aligned Jacobian (module docstring); on a floating robot J is k x NV
+    with the base's columns (symdyn.algorithms.floating_frames) and M NV x NV, inverted with
+    the joints eliminated before the base, as forward dynamics does."""
     c = dyn.compact
     prog = dyn.program.copy("O")
     first = len(prog.assignments)
-    fk = FrameKinematics(dyn.robot, list(dyn.q), list(dyn.qd), prog)
+    fk, _, _, n, _ = _frames_of(dyn, x, prog)
+    chain = dyn.robot.is_chain and not dyn.robot.floating
     keep = list(x.frames.rows)
     k = len(keep)
     axes = ", ".join(x.frames.axes)
@@ -223,7 +231,7 @@ def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
         J = fk.jacobian(name, "world").extract(keep, list(range(n)))
         drift = fk.jacobian_dot_qd(name).extract(keep, [0])
         mark = len(prog.assignments)
-        os = operational_space(sp.Matrix(c["M"]), J, sp.Matrix(c["bias"]), drift, dyn.robot.is_chain, prog)
+        os = operational_space(sp.Matrix(c["M"]), J, sp.Matrix(c["bias"]), drift, chain, prog)
         made = [e for _, e in prog.assignments[mark:]] + list(os.inertia) + list(os.bias)
         if any(sp.sympify(e).has(sp.zoo, sp.nan, sp.oo) for e in made):
             warnings.warn(

@@ -242,7 +242,15 @@ def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
 
 
 #: the groups generated for a floating robot (docs/floating-base.md, docs/centroidal.md)
-FLOATING_GROUPS = ("dynamics", "configuration", "kinematics", "centroidal", "regressor", "derivatives")
+FLOATING_GROUPS = (
+    "dynamics",
+    "configuration",
+    "kinematics",
+    "operational_space",
+    "centroidal",
+    "regressor",
+    "derivatives",
+)
 #: those built by default (the others only when named)
 FLOATING_DEFAULT = ("dynamics", "configuration")
 
