@@ -77,6 +77,9 @@ QUANTITIES = ("M", "C", "V", "G", "F", "tau")
 #: every name `Dynamics.closed_form` and `Dynamics.evaluate` accept: QUANTITIES and the bias V + G + F
 ALL_QUANTITIES = (*QUANTITIES, "bias")
 AUTO_SIMPLIFY_MAX_JOINTS = 3
+#: how many random states decide a floating base's pivots (Dynamics.singular_joints), and their seed
+SINGULAR_SAMPLES = 3
+SINGULAR_SEED = 20231
 
 
 def _check_quantity(name, where: str) -> str:
@@ -201,12 +204,27 @@ class Dynamics:
     @cached_property
     def singular_joints(self) -> tuple[SingularJoint, ...]:
         """The joints that make M(q) singular for every q, with the cause: the exactly zero
-        pivots of M = L D L^T and the joints that move no mass (symdyn.algorithms.singular).
-        Empty when M can be inverted as far as its numbers tell (and for a floating robot, whose M
-        is checked numerically by the oracle instead)."""
-        if self.robot.floating:
-            return ()
-        return singular_joints(self.robot, self.compact["M"])
+        pivots of M = L D L^T and the joints that move no mass (symdyn.algorithms.singular);
+        on a floating base also the base's coordinates that can move while no body with mass
+        does, decided on M at three random states (SINGULAR_SAMPLES). Empty when M can be
+        inverted as far as its numbers tell."""
+        return singular_joints(self.robot, self.compact["M"], self._singular_samples())
+
+    def _singular_samples(self) -> list[np.ndarray]:
+        """A floating robot's M at SINGULAR_SAMPLES random joint positions, the free parameters at
+        random values in [0.5, 1.5] (seeded: the same every time); a fixed base's: none."""
+        if not self.robot.floating:
+            return []
+        rng = np.random.default_rng(SINGULAR_SEED)
+        base = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])  # M does not read the base's pose
+        f = self._numeric("M")
+        zero = np.zeros(len(self.qd))
+        out = []
+        for _ in range(SINGULAR_SAMPLES):
+            q = np.concatenate([base, rng.uniform(-np.pi, np.pi, self.n - NV_BASE)])
+            p = list(rng.uniform(0.5, 1.5, len(self.params)))
+            out.append(np.asarray(f(q, zero, zero, p), dtype=float))
+        return out
 
     @property
     def configuration_space(self) -> ConfigurationSpace:

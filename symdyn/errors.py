@@ -16,6 +16,10 @@ SINGULAR_REASONS = {
     "dependent": (
         "moves the bodies only as the joints before it do (its column of M is a combination of theirs)"
     ),
+    "base": (
+        "moves the floating base while every body with mass stands still, the joints taking the motion "
+        "up (the base body and the bodies fixed to it lack the mass or inertia to resist it)"
+    ),
 }
 
 

@@ -274,3 +274,66 @@ def test_a_urdf_joint_is_named_as_the_file_names_it(tmp_path):
         f"robot 'urdf_arm': M(q) is singular: the joint of link 'fore' (joint 'elbow', link 2) {ON_AXIS}; "
         "so forward_dynamics is not generated (the other functions are)"
     ]
+
+
+#: A floating robot whose base body is massless: the base turns about joint 1's axis while the
+#: links stand still (M singular for every q); the same robot on a base with mass is not singular.
+FLOATING_ARM = """\
+name: {name}
+base: {base}
+links:
+  - {{name: l1, joint: revolute, a: 0.5, alpha: 0.3, d: 0.1, theta: 0, mass: 1, com: [-0.25, 0.1, 0.02],
+     inertia: {{ixx: 0.01, iyy: 0.02, izz: 0.03}}}}
+  - {{name: l2, joint: revolute, a: 0.4, alpha: 0, d: 0, theta: 0.3, mass: 1, com: [-0.2, 0.01, 0],
+     inertia: {{ixx: 0.01, iyy: 0.02, izz: 0.02}}}}
+"""
+FLOATING_BASES = {
+    "massless_base": "floating",
+    "massive_base": (
+        "{floating: true, mass: 2, com: [0.05, -0.02, 0.1], inertia: {ixx: 0.1, iyy: 0.12, izz: 0.2}}"
+    ),
+}
+
+
+def floating_arm(tmp_path: Path, name: str) -> symdyn.Robot:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(FLOATING_ARM.format(name=name, base=FLOATING_BASES[name]))
+    return symdyn.load_robot(path)
+
+
+def test_a_massless_floating_base_on_a_revolute_joint_is_singular(tmp_path):
+    """The base's pivot wz_b (joint 1's axis is the base's z) is zero: reported with the cause
+    "base", and the oracle's M has rank NV - 1 at random q; forward dynamics and the other
+    functions that invert M are left out with one warning, the rest generated."""
+    robot = floating_arm(tmp_path, "massless_base")
+    rng = np.random.default_rng(5)
+    for joints in rng.uniform(-np.pi, np.pi, (3, robot.n)):
+        quat = rng.normal(size=4)
+        q = np.concatenate([rng.normal(size=3), quat / np.linalg.norm(quat), joints])
+        assert np.linalg.matrix_rank(rn.mass_matrix(robot, q)) == robot.nv - 1
+    clause = f"the base's coordinate wz_b (entry 6 of qd) {SINGULAR_REASONS['base']}"
+    with pytest.warns(SymdynWarning) as record:
+        dyn = symdyn.derive(robot, simplify=False)
+    assert symdyn_warnings(record) == [
+        f"robot 'massless_base': M(q) is singular: {clause}; forward dynamics is undefined"
+    ]
+    assert [(j.coordinate, j.link, j.reason) for j in dyn.singular_joints] == [(5, None, "base")]
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        names = [spec.name for spec in context(robot, functions=("dynamics", "derivatives")).functions]
+    assert symdyn_warnings(record) == [
+        f"robot 'massless_base': M(q) is singular: {clause}; so forward_dynamics, "
+        "forward_dynamics_derivatives, mass_matrix_inverse and linearize are not generated "
+        "(the other functions are)"
+    ]
+    assert "inverse_dynamics" in names and "mass_matrix" in names
+    assert not set(LEFT_OUT) & set(names)
+
+
+def test_a_floating_base_with_mass_is_not_singular(tmp_path):
+    robot = floating_arm(tmp_path, "massive_base")
+    q = np.array([0.1, 0.2, 0.3, 0.0, 0.0, np.sin(0.2), np.cos(0.2), 0.4, -0.9])
+    assert np.linalg.matrix_rank(rn.mass_matrix(robot, q)) == robot.nv
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SymdynWarning)
+        assert symdyn.derive(robot, simplify=False).singular_joints == ()

@@ -23,6 +23,18 @@ A free parameter may take any value: a pivot that depends on one is not zero, so
 symbolic masses only pivots that are identically zero count (and the massless joints that
 Robot.idle_joints finds on the values given). A pivot that is zero only through an identity
 the factorisation does not apply (sin^2 + cos^2 = 1 across intermediates) is not seen here.
+
+A floating robot's M (NV x NV, the base's six coordinates first) is factorised as its forward
+dynamics does: the joints from the last to the first, then the base's block, last. The joints'
+pivots are those of the joint block M[6:, 6:] (the base is eliminated after them) and are found
+as above. The base's six pivots are those of the Schur complement the joints leave, the base's
+articulated-body inertia: a zero one means the base can move while every body with mass stands
+still ("base": a massless base body on a revolute joint turns about that joint's axis while the
+links do not move). They are intermediates of every joint, zero only through identities, so they
+are decided on numbers instead: on `samples`, M evaluated at random joint positions (and random
+values of the free parameters, which keeps the test generic: a pivot zero at random values is
+zero everywhere, with probability one), a base pivot at most BASE_TOLERANCE of M's largest
+diagonal entry in every sample is zero.
 """
 
 from __future__ import annotations
@@ -30,26 +42,34 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
 import sympy as sp
 
 from ..errors import SINGULAR_REASONS as REASONS
+from ..model.free_flyer_names import BASE_VELOCITY_NAMES, NV_BASE
 from ..model.robot import Robot
 from ..symbolic.program import Program
 from .derivatives import elimination_order
 
-__all__ = ["SingularJoint", "REASONS", "singular_joints", "describe_singular"]
+__all__ = ["SingularJoint", "REASONS", "BASE_TOLERANCE", "singular_joints", "describe_singular"]
+
+#: A floating robot's base pivot at most this fraction of M's largest diagonal entry is zero
+#: (rounding leaves a true zero near 1e-16 of it; a real one is far above).
+BASE_TOLERANCE = 1e-10
 
 
 @dataclass(frozen=True)
 class SingularJoint:
     """An independent coordinate whose pivot of M = L D L^T is exactly zero (module docstring).
 
-    `coordinate` is its index in q, `link` the index in Robot.links of the link its joint
-    moves (the link whose own coordinate it is), `reason` a key of REASONS.
+    `coordinate` is its index in qd (in q too on a fixed base; on a floating base the index in
+    the velocity vector of NV entries, the base's six first), `link` the index in Robot.links of
+    the link its joint moves (the link whose own coordinate it is; None for a coordinate of the
+    base), `reason` a key of REASONS.
     """
 
     coordinate: int
-    link: int
+    link: int | None
     reason: str
 
 
@@ -73,22 +93,54 @@ def _zero_pivots(M: sp.Matrix, order: Sequence[int]) -> list[int]:
     return sorted(zero)
 
 
-def singular_joints(robot: Robot, M: sp.Matrix) -> tuple[SingularJoint, ...]:
+def _zero_base_pivots(M: np.ndarray, zero_joints: set[int]) -> set[int]:
+    """The base coordinates (0..5) whose pivot is zero in the numeric NV x NV M of a floating
+    robot, eliminated joints last to first then the base (module docstring); the joints of
+    `zero_joints` (indices in M) have a zero pivot and a zero column of L."""
+    nv = M.shape[0]
+    order = list(reversed(range(nv)))
+    A = M[np.ix_(order, order)].astype(float)
+    scale = max(float(np.max(np.abs(np.diag(A)))), np.finfo(float).tiny)
+    zero = set()
+    for j, c in enumerate(order):
+        d = A[j, j]
+        if c in zero_joints or abs(d) <= BASE_TOLERANCE * scale:
+            zero |= {c} & set(range(NV_BASE))  # a joint's numeric zero only skipped: decided above
+            continue
+        col = A[j + 1 :, j] / d
+        A[j + 1 :, j + 1 :] -= np.outer(col, A[j, j + 1 :])
+    return zero
+
+
+def singular_joints(
+    robot: Robot, M: sp.Matrix, samples: Sequence[np.ndarray] = ()
+) -> tuple[SingularJoint, ...]:
     """The joints whose pivot of M is exactly zero, with their causes (module docstring).
 
     Args:
         robot: the robot M was derived from (its valued parameters substituted).
-        M: its n x n mass matrix, over named intermediates or closed-form.
+        M: its n x n mass matrix (NV x NV on a floating base), over named intermediates or
+            closed-form.
+        samples: on a floating base, M's values at a few random states (module docstring), which
+            decide the base's pivots; none: the base's pivots are not checked.
 
     Returns:
         One SingularJoint per such coordinate, in increasing order; empty when M can be inverted
         as far as its numbers tell.
     """
-    idle = {robot.coordinates[i].index for i in robot.idle_joints()}
-    zero = set(_zero_pivots(M, elimination_order(robot.n, robot.is_chain))) | idle
-    own = {c.index: i for i, c in enumerate(robot.coordinates) if robot.links[i].mimic is None}
+    base = NV_BASE if robot.floating else 0
+    idle = {robot.coordinates[i].index + base for i in robot.idle_joints()}
+    joints = M[base:, base:]
+    order = elimination_order(robot.n, robot.is_chain and not robot.floating)
+    zero = {c + base for c in _zero_pivots(joints, order)} | idle
+    if robot.floating and samples:
+        zero |= set.intersection(*(_zero_base_pivots(np.asarray(s), zero) for s in samples))
+    own = {c.index + base: i for i, c in enumerate(robot.coordinates) if robot.links[i].mimic is None}
     out = []
     for c in sorted(zero):
+        if c < base:
+            out.append(SingularJoint(c, None, "base"))
+            continue
         reason = "massless" if c in idle else "on_axis" if M[c, c] == 0 else "dependent"
         out.append(SingularJoint(c, own[c], reason))
     return tuple(out)
@@ -99,10 +151,12 @@ def describe_singular(robot: Robot, joints: Sequence[SingularJoint]) -> str:
     by the link's name and number, and by its own name where the file names joints: URDF, MJCF)
     and why: "the joint of link 'l2' (link 2) moves ..."."""
 
-    def name(k: int) -> str:
+    def name(k: int | None, coordinate: int) -> str:
+        if k is None:
+            return f"the base's coordinate {BASE_VELOCITY_NAMES[coordinate]} (entry {coordinate + 1} of qd)"
         link = robot.links[k]
         own = "" if link.joint_name is None else f"joint '{link.joint_name}', "
         return f"the joint of link '{link.name}' ({own}link {k + 1})"
 
-    names = [name(j.link) for j in joints]
+    names = [name(j.link, j.coordinate) for j in joints]
     return "; ".join(f"{name} {REASONS[j.reason]}" for name, j in zip(names, joints, strict=True))
