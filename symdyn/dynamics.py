@@ -598,6 +598,8 @@ def state_symbols(robot: Robot) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
     if not robot.floating:
         return q, qd, qdd
     bq, bv, ba = base_symbols()
+    if robot.n == 0:  # a single rigid body: the base's coordinates only
+        return bq, bv, ba
     return sp.Matrix.vstack(bq, q), sp.Matrix.vstack(bv, qd), sp.Matrix.vstack(ba, qdd)
 
 
@@ -662,7 +664,7 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
             terms["V"] = sp.Matrix([program.let(v, "V") for v in terms["C"] * qd])
         F = friction_vector(r, qd[6:, :] if r.floating else qd)
         if r.floating:
-            F = sp.Matrix.vstack(sp.zeros(6, 1), F)
+            F = sp.Matrix([*[sp.S.Zero] * 6, *F])  # (a list: F of no joints is 0 x 0)
         terms["F"] = F
         if method == "lagrange" and not r.floating:
             terms["tau"] = terms["M"] * qdd + terms["V"] + terms["G"] + F

@@ -67,10 +67,14 @@ ROBOTS = example_robot_data_folder()
 FILES = sorted(ROBOTS.rglob("*.urdf")) if ROBOTS else []
 
 #: files symdyn refuses, with the documented reason (a fragment of its message)
-REFUSED = {
-    # no movable joint at all: nothing to derive (Pinocchio builds a model with nv = 0)
+#: single rigid bodies: no movable joint, so nothing to derive on a fixed base (Pinocchio builds a
+#: model with nv = 0); a floating one is a free body (tests/test_oracle_floating.py loads them)
+SINGLE_BODIES = {
     "hector_description/robots/quadrotor_base.urdf": "has no links below it",
     "iris_description/robots/iris_simple.urdf": "no movable joint below the base link",
+}
+REFUSED = {
+    **SINGLE_BODIES,
     # two hip links carry inertia tensors with a negative principal moment: impossible data
     "romeo_description/urdf/romeo_laas_small.urdf": "inertia tensor is not positive semi-definite",
     # a <mimic> names joints missing from the file (index_q1 for Left_index_q1, ...)

@@ -121,10 +121,11 @@ def floating_newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> d
     M_b = mass_matrix_crba(robot, rot, composites, program, base_columns=columns)
     M = sp.zeros(n + 6, n + 6)
     M[:6, :6] = sp.Matrix(_base_block(whole))
-    coupling = sp.Matrix([[*c.linear, *c.angular] for c in columns]).T  # 6 x nb, the bodies' joints
-    M[:6, 6:] = coupling * robot.selection()
-    M[6:, :6] = M[:6, 6:].T
-    M[6:, 6:] = project_matrix(robot, M_b, program, "M")
+    if n:  # (a single rigid body, n = 0, has the base block only)
+        coupling = sp.Matrix([[*c.linear, *c.angular] for c in columns]).T  # 6 x nb, the bodies' joints
+        M[:6, 6:] = coupling * robot.selection()
+        M[6:, :6] = M[:6, 6:].T
+        M[6:, 6:] = project_matrix(robot, M_b, program, "M")
     G_joints = gravity_composite(robot, rot, composites, program, g_base=g_b)
     G_base = [*(-whole.mass * g for g in g_b), *v3.cross(g_b, whole.first_moment)]
     zero6 = [0] * 6

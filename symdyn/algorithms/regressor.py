@@ -144,7 +144,8 @@ def body_regressor(
         W_base = tilde(program, base.w, base.wd, "Tb")
     motions, Ws = _motions(robot, frames, base, W_base, qd_b, qdd_b, program)
     extra = {i: PER_BODY * nb + k for k, i in enumerate(asymmetric_bodies(robot))}
-    Y: list[list[sp.Expr]] = [[sp.S.Zero] * (PER_BODY * nb + len(extra)) for _ in range(nb)]
+    width = PER_BODY * nb + len(extra)
+    Y: list[list[sp.Expr]] = [[sp.S.Zero] * width for _ in range(nb)]
     for j, link in enumerate(robot.links):
         carried = {j: motion_subspace(link.joint, link.axis)}  # joint j's unit motion, frame i
         Y[j][PER_BODY * j : PER_BODY * j + 10] = _row_columns(
@@ -162,7 +163,7 @@ def body_regressor(
         if j in extra:
             Y[j][extra[j]] = coulomb[1]
     if base_rows is not None:
-        base_rows.extend(_base_rows(robot, frames, (motions, Ws), (base, W_base), len(Y[0]), program))
+        base_rows.extend(_base_rows(robot, frames, (motions, Ws), (base, W_base), width, program))
     return Y
 
 
@@ -237,7 +238,7 @@ def floating_regressor(robot: Robot, q: Sequence, qd: Sequence, qdd: Sequence, p
     base = LinkAcceleration(w, v3.vec(qdd[3:6]), vd)
     rows: list[list[sp.Expr]] = []
     Y_b = body_regressor(robot, q_b, qd_b, qdd_b, program, base=base, base_rows=rows)
-    width = len(Y_b[0])
+    width = len(rows[0]) - 10  # (Y_b has no rows on a single rigid body)
     columns = [project_vector(robot, [row[c] for row in Y_b], program, "Y") for c in range(width)]
     return sp.Matrix(
         robot.n + 6, width + 10, lambda r, c: rows[r][c] if r < 6 else (columns[c][r - 6] if c < width else 0)

@@ -188,6 +188,8 @@ class RobotFileReader:
                 raise self.error("missing required field", field=key)
         for key, value in data.items():
             getattr(self, f"_read_{key}")(value)
+        if not self.links and self.base_body is None:  # a floating base alone is a rigid body
+            raise self.error("a robot needs at least one link (or a floating base)", field="links")
 
     def _read_name(self, value: object) -> None:
         if not isinstance(value, str):
@@ -262,8 +264,6 @@ class RobotFileReader:
     def _read_links(self, value: object) -> None:
         if not isinstance(value, list):
             raise self.error(f"expected a list of links, got {_kind(value)}", field="links")
-        if not value:
-            raise self.error("a robot needs at least one link", field="links")
         names: dict[str, int] = {}
         for i, raw in enumerate(value, start=1):
             link = self._read_link(i, raw)

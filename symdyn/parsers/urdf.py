@@ -168,14 +168,17 @@ def _refuse_unmodelled(
         )
 
 
-def _loaded(reader: UrdfReader, tree: UrdfTree, base: str, tip: str | None) -> tuple[list[UrdfJoint], str]:
-    """The movable joints that become links, in joint order, and where they lie (for messages)."""
+def _loaded(
+    reader: UrdfReader, tree: UrdfTree, base: str, tip: str | None, floating: bool = False
+) -> tuple[list[UrdfJoint], str]:
+    """The movable joints that become links, in joint order, and where they lie (for messages).
+    A floating base may have none (a single rigid body: a quadrotor's frame); a fixed one may not."""
     if tip is None:
         joints = tree.depth_first(base)
         where = f"below the base '{base}'"
-        if not joints:
+        if not joints and not floating:
             raise SymdynError(f"the base link '{base}' has no links below it", file=reader.file)
-        if not any(j.movable for j in joints):
+        if not floating and not any(j.movable for j in joints):
             raise SymdynError(f"no movable joint below the base link '{base}'", file=reader.file)
     else:
         tip = link_name(reader, tip, "tip")
@@ -245,7 +248,7 @@ def _build(
                 file=reader.file,
             )
         base = _floating_root(reader, tree, base)
-    loaded, where = _loaded(reader, tree, base, tip)
+    loaded, where = _loaded(reader, tree, base, tip, floating)
     index = {j.name: i for i, j in enumerate(loaded)}
 
     links: list[Link] = []
