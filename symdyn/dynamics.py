@@ -391,14 +391,21 @@ class Dynamics:
         applies to its environment, in the end-effector frame (Modern Robotics' F_tip;
         symdyn.algorithms.tip_wrench). Add it to tau for MR's InverseDynamics.
 
+        On a floating base J_b has the base's six columns too, and the six base rows are the
+        wrench the tip wrench puts on the base (force, then moment about the base origin, base
+        frame; symdyn.algorithms.tip_wrench).
+
         Returns:
-            With q None: an n x 1 SymPy matrix over q (and F, if it holds symbols);
-            with q (n numbers) and params: an (n,) array.
+            With q None: an n x 1 (NV x 1) SymPy matrix over q (and F, if it holds symbols);
+            with q (n numbers; NQ on a floating base) and params: an (n,) ((NV,)) array.
         """
         if q is None:
             return tip_wrench_torque(self.robot, F, list(self.q))
         where = "Dynamics.tip_wrench_torque"
-        q = self.robot.joint_values(q, "q", where)
+        if self.robot.floating:
+            q = _state_vector(q, self.robot.nq, "q", where)
+        else:
+            q = self.robot.joint_values(q, "q", where)
         self.robot.param_values(params, where)
         robot = self.robot.numeric(params)
         return np.asarray(tip_wrench_torque(robot, F, [float(x) for x in q]), dtype=float)[:, 0]

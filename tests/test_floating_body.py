@@ -25,6 +25,7 @@ from cbuild import compile_shared, header_macros, write_files
 import symdyn
 from symdyn.codegen import render
 from symdyn.model.parameters import numeric_parameters
+from symdyn.oracle.centroidal import floating_frame_jacobian
 from symdyn.rnea import mass_matrix
 
 MASS = 2.0
@@ -211,3 +212,49 @@ def test_a_single_body_loads_when_floating_only(tmp_path):
     fixed.write_text("name: nothing\nlinks: []\n")
     with pytest.raises(symdyn.SymdynError, match="a robot needs at least one link \\(or a floating base\\)"):
         symdyn.load_robot(fixed)
+
+
+#: a two-joint product-of-exponentials arm on a floating base with mass
+POE_ARM = """\
+name: poe_arm
+convention: poe
+base: {floating: true, mass: 3, com: [0, 0.01, 0.05], inertia: {ixx: 0.05, iyy: 0.06, izz: 0.08}}
+links:
+  - name: l1
+    frame: {position: [0, 0, 0.1], rotation: [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}
+    spatial_inertia: [0.01, 0.012, 0.005, 1, 1, 1]
+    screw: [0, 0, 1, 0, 0, 0]
+  - name: l2
+    frame: {position: [0.45, 0, 0.1], rotation: [[1, 0, 0], [0, 0, -1], [0, 1, 0]]}
+    spatial_inertia: [0.004, 0.02, 0.02, 0.8, 0.8, 0.8]
+    screw: [0, 1, 0, -0.2, 0, 0.3]
+end_effector:
+  position: [0.2, 0, 0.05]
+  rotation: [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+"""
+
+
+def test_tip_wrench_on_a_floating_base(tmp_path):
+    """tau_tip = J_b^T F with the base's six columns in J_b: J_b from the oracle's world-aligned
+    frame Jacobian (floating_frame_jacobian) turned into the end-effector frame, angular rows
+    first; virtual work tau_tip . v = F . V_tip; the generated NumPy function gives the same."""
+    path = tmp_path / "poe_arm.yaml"
+    path.write_text(POE_ARM)
+    robot = symdyn.load_robot(path)
+    dyn = symdyn.derive(robot, simplify=False)
+    files = render(robot, targets=("python",), functions=["tip_wrench"])
+    write_files(files, tmp_path)
+    numpy_module = _module(tmp_path / "poe_arm_numpy.py", "poe_arm_numpy")
+    rng = np.random.default_rng(6)
+    for q, v in states(3, 7):
+        q = np.concatenate([q, rng.uniform(-np.pi, np.pi, robot.n)])
+        v = np.concatenate([v, rng.normal(size=robot.n)])
+        F = rng.normal(size=6)
+        T, J = floating_frame_jacobian(robot, q, "end_effector")
+        R = T[:3, :3]
+        J_b = np.vstack([R.T @ J[3:], R.T @ J[:3]])
+        tau_tip = dyn.tip_wrench_torque(F, q)
+        assert tau_tip.shape == (robot.nv,)
+        np.testing.assert_allclose(tau_tip, J_b.T @ F, atol=1e-12)
+        assert np.isclose(tau_tip @ v, F @ (J_b @ v), atol=1e-12)
+        np.testing.assert_allclose(numpy_module.tip_wrench_torque(q, F), tau_tip, atol=1e-12)

@@ -34,7 +34,7 @@ from collections.abc import Callable, Sequence
 import sympy as sp
 
 from ..dynamics import QUANTITIES, Dynamics, singular_message
-from ..errors import SymdynError, SymdynWarning
+from ..errors import SymdynWarning
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .centroidal_functions import centroidal_rows
@@ -241,34 +241,9 @@ def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
     return next(row for row in rows if row.name == name)
 
 
-#: the groups generated for a floating robot (docs/floating-base.md, docs/centroidal.md)
-FLOATING_GROUPS = (
-    "dynamics",
-    "configuration",
-    "kinematics",
-    "operational_space",
-    "centroidal",
-    "regressor",
-    "derivatives",
-)
-#: those built by default (the others only when named)
+#: the groups a floating robot gets by default (every group is generated for it when named:
+#: docs/floating-base.md, docs/centroidal.md)
 FLOATING_DEFAULT = ("dynamics", "configuration")
-
-
-def _floating_groups(dyn: Dynamics, groups: Sequence[str] | None) -> Sequence[str]:
-    """The groups of a floating robot: FLOATING_DEFAULT by default, FLOATING_GROUPS for every
-    group (--functions all); any group outside FLOATING_GROUPS is a SymdynError."""
-    if groups is None:
-        return FLOATING_DEFAULT
-    if set(groups) == set(GROUPS):
-        return FLOATING_GROUPS
-    other = [g for g in groups if g not in FLOATING_GROUPS]
-    if other:
-        raise SymdynError(
-            f"robot '{dyn.robot.name}' has a floating base: the {other[0]} functions are not generated "
-            f"for a floating robot (available: {', '.join(FLOATING_GROUPS)})"
-        )
-    return groups
 
 
 def build_functions(
@@ -291,8 +266,8 @@ def build_functions(
     Every row's outputs and extra steps draw on `dyn.program` (with the bias V + G + F always
     among the needs, so adding a family never changes the others' temporaries).
     """
-    if dyn.robot.floating:
-        groups = _floating_groups(dyn, groups)
+    if dyn.robot.floating and groups is None:
+        groups = FLOATING_DEFAULT
     per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
     named_only = {b for g in NAMED_ONLY for b in GROUPS[g]}
     chosen = set(FAMILIES) - named_only if groups is None else {b for g in groups for b in GROUPS[g]}
