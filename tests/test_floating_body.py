@@ -258,3 +258,28 @@ def test_tip_wrench_on_a_floating_base(tmp_path):
         np.testing.assert_allclose(tau_tip, J_b.T @ F, atol=1e-12)
         assert np.isclose(tau_tip @ v, F @ (J_b @ v), atol=1e-12)
         np.testing.assert_allclose(numpy_module.tip_wrench_torque(q, F), tau_tip, atol=1e-12)
+
+
+def test_compile_builds_the_groups_asked_for(body):
+    """symdyn.compile(..., functions=): the groups named (a floating robot's centroidal functions
+    reachable from Python), each set of groups its own cache entry; an unknown group is one line."""
+    robot = body[0]
+    centroidal = symdyn.compile(robot, functions=("centroidal",))
+    assert centroidal.functions == (
+        "centroidal_momentum_matrix",
+        "centroidal_momentum_drift",
+        "com",
+        "total_mass",
+    )
+    dynamics = symdyn.compile(robot, functions="dynamics")
+    assert "forward_dynamics" in dynamics.functions and "com" not in dynamics.functions
+    for q, v in states(2, 9):
+        np.testing.assert_allclose(centroidal.com(q), q[:3] + rotation(q[3:]) @ COM, atol=1e-14)
+        np.testing.assert_allclose(centroidal.total_mass(), [MASS])
+        np.testing.assert_allclose(
+            dynamics.inverse_dynamics(q, v, v), symdyn.rnea(robot, q, v, v), atol=1e-12
+        )
+    with pytest.raises(
+        symdyn.SymdynError, match=r"^symdyn.compile: unknown function group\(s\) 'centroid' \("
+    ):
+        symdyn.compile(robot, functions=["dynamics", "centroid"])

@@ -131,22 +131,30 @@ def _loaded_files(meta: dict) -> list[str]:
 
 
 def cached_dynamics(
-    key_parts: dict, make_robot: Callable, params=None, method: str = "newton-euler", threads: int = 1
+    key_parts: dict,
+    make_robot: Callable,
+    params=None,
+    method: str = "newton-euler",
+    threads: int = 1,
+    functions: tuple[str, ...] | None = None,
 ):
     """A CompiledDynamics from the cache entry of `key_parts` (plus the options), built when missing.
 
     make_robot() is called only to build the entry (a cache hit never derives nor loads it);
     the result then carries a RobotInfo instead of the Robot. A hit verifies the digest of the
     file it loads (the library); the others are verified when first read (cache.Entry.file).
+    `functions`: the groups to build (checked names of symdyn.codegen.functions.GROUPS, or "all";
+    None: symdyn.codegen.context's default groups); `key_parts` must tell them apart.
     """
     check_threads(threads)
     options = _options(method)
     key = cache.entry_key(**key_parts, **options)
     entry = cache.lookup(key, _loaded_files)
     robot = None
+    chosen = None if functions is None else {"functions": list(functions)}
     if entry is None:
         robot = make_robot()
-        entry = cache.get_or_build(key, _build(robot, method, options))
+        entry = cache.get_or_build(key, _build(robot, method, options, chosen))
     self = CompiledDynamics._from_entry(entry, robot, params)
     self.threads = threads
     self._source = ({**key_parts, "method": method}, make_robot)
@@ -154,25 +162,57 @@ def cached_dynamics(
     self._options = options
 
     def rebuild() -> cache.Entry:
-        return cache.get_or_build(key, _build(robot if robot is not None else make_robot(), method, options))
+        made = robot if robot is not None else make_robot()
+        return cache.get_or_build(key, _build(made, method, options, chosen))
 
     self._rebuild = rebuild
     return self
 
 
-def compile(robot, params=None, method: str = "newton-euler", threads: int = 1) -> CompiledDynamics:
+def _function_groups(functions) -> tuple[str, ...] | None:
+    """`functions` checked: None, or group names of symdyn.codegen.functions.GROUPS (a single name
+    or a sequence; "all" for every group), as `symdyn generate --functions` takes them."""
+    if functions is None:
+        return None
+    from ..codegen.functions import GROUPS
+
+    names = (functions,) if isinstance(functions, str) else functions
+    try:
+        names = tuple(names)
+    except TypeError:
+        names = (functions,)
+    unknown = [g for g in names if not isinstance(g, str) or (g not in GROUPS and g != "all")]
+    if unknown or not names:
+        raise SymdynError(
+            f"symdyn.compile: unknown function group(s) {', '.join(map(repr, unknown)) or '(none given)'} "
+            f"(one or more of {', '.join(GROUPS)}, or all)"
+        )
+    return tuple(GROUPS) if "all" in names else tuple(dict.fromkeys(names))
+
+
+def compile(
+    robot, params=None, method: str = "newton-euler", threads: int = 1, functions=None
+) -> CompiledDynamics:
     """The robot's generated functions compiled to C, with its free parameters bound to `params`.
 
     params: None (no free parameters), a map name -> value, or one value per free parameter
     in the robot's order. threads: how many threads a batch call uses by default (each method
-    also takes threads=; symdyn.apps.calling). The library is built for the machine it runs on
-    (symdyn.apps.build: -march=native unless $SYMDYN_MARCH says otherwise) and cached
-    (docs/speed.md: the cache); the second compile of an unchanged robot loads it in milliseconds.
+    also takes threads=; symdyn.apps.calling). functions: the groups of generated functions to
+    build, as `symdyn generate --functions` (names of symdyn.codegen.functions.GROUPS, or "all");
+    None: the default ones (every group but kinematics, operational_space and centroidal; dynamics
+    and configuration for a floating robot). The library is built for the machine it runs on
+    (symdyn.apps.build: -march=native unless $SYMDYN_MARCH says otherwise) and cached under the
+    robot, the options and the groups (docs/speed.md: the cache); the second compile of an
+    unchanged robot loads it in milliseconds.
+
+    Raises:
+        SymdynError: not a Robot, bad parameter values, an unknown group.
     """
     from ..model.robot import Robot
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
+    groups = _function_groups(functions)
     if robot.params:  # the values pass the robot file's physical checks (mass >= 0, ...)
         from ..model.physical import check_values
 
@@ -180,9 +220,10 @@ def compile(robot, params=None, method: str = "newton-euler", threads: int = 1) 
     from ..codegen.functions import FAMILIES
 
     families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
-    return cached_dynamics(
-        {"robot": robot_digest(robot), "families": families}, lambda: robot, params, method, threads
-    )
+    key = {"robot": robot_digest(robot), "families": families}
+    if groups is not None:  # (the default's key is unchanged: its cache entries stay valid)
+        key["functions"] = list(groups)
+    return cached_dynamics(key, lambda: robot, params, method, threads, groups)
 
 
 def _bind(names: list[str], robot, params) -> np.ndarray | None:
@@ -220,8 +261,10 @@ class CompiledDynamics(FrameMethods):
     NumPy module; `robot` the Robot (or a RobotInfo when it came from the cache alone).
     """
 
-    def __init__(self, robot, params=None, method: str = "newton-euler", threads: int = 1) -> None:
-        other = compile(robot, params, method, threads)
+    def __init__(
+        self, robot, params=None, method: str = "newton-euler", threads: int = 1, functions=None
+    ) -> None:
+        other = compile(robot, params, method, threads, functions)
         self.__dict__.update(other.__dict__)
 
     @classmethod
