@@ -283,3 +283,34 @@ def test_compile_builds_the_groups_asked_for(body):
         symdyn.SymdynError, match=r"^symdyn.compile: unknown function group\(s\) 'centroid' \("
     ):
         symdyn.compile(robot, functions=["dynamics", "centroid"])
+
+
+SATELLITE = """<mujoco model="sat">
+  <worldbody>
+    <body name="bus" pos="0 0 1">
+      <freejoint/>
+      <geom type="box" size="0.2 0.3 0.4" mass="5"/>
+      <body name="panel" pos="0.5 0 0.1" euler="0 0 30">
+        <geom type="box" size="0.3 0.01 0.2" mass="0.5"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_an_mjcf_free_body_alone(tmp_path):
+    """A free body with a body welded to it and no hinge: a floating rigid body whose M equals
+    MuJoCo's at the identity orientation (where MuJoCo's world-frame linear velocity is the
+    base frame's)."""
+    mujoco = pytest.importorskip("mujoco", reason="the test extra installs mujoco")
+    path = tmp_path / "sat.xml"
+    path.write_text(SATELLITE)
+    robot = symdyn.load_robot(path)
+    assert (robot.floating, robot.n) == (True, 0)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    theirs = np.zeros((6, 6))
+    mujoco.mj_fullM(model, data, theirs)
+    np.testing.assert_allclose(mass_matrix(robot, [0, 0, 1, 0, 0, 0, 1]), theirs, atol=1e-12)

@@ -142,7 +142,7 @@ def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) 
             continue
         where = {"file": file, "field": f"site({site_names[s]}).quat"}
         walk.frames.append(Frame(site_names[s], k, T @ pose(model.site_pos[s], model.site_quat[s], **where)))
-    if not walk.links:
+    if not walk.links and free is None:  # (a free body alone is a floating rigid body)
         raise SymdynError("no hinge or slide joint: the model has nothing that moves", file=file)
     gravity = [sp.S.Zero] * 3 if "gravity" in flags else [number(g) for g in model.opt.gravity]
     return Robot(
