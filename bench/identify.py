@@ -5,7 +5,7 @@
 
 The log (t, q, qd, qdd, tau at 1 kHz, sines; tau from the compiled inverse dynamics plus noise)
 is written to a temporary folder (never committed). Timed in this process: reading the CSV
-(symdyn.apps.identify.read_measurements), the derivation of the base parameters (SymPy), the base
+(symdyn.apps.measurements.read_measurements), the derivation of the base parameters (SymPy), the base
 regressor alone over the chunks identify uses (batch calls into one reused-size buffer), and
 identify itself (regressor chunks folded by incremental QR, both least squares, no prediction);
 then the whole command `symdyn identify panda.yaml LOG.csv` as a subprocess, with its peak
@@ -50,7 +50,8 @@ def write_log(robot, fast, samples: int, path: Path) -> None:
 def identify_part(samples: int, folder: Path) -> dict[str, float]:
     """Seconds of each stage of identification on a Panda log of `samples` samples, and of the
     whole command; 'nbase', 'chunk' and 'peak MB' (the command's maximum resident set)."""
-    from symdyn.apps.identify import base_regressor_samples, chunk_samples, identify, read_measurements
+    from symdyn.apps.identify import base_regressor_samples, chunk_samples, identify
+    from symdyn.apps.measurements import read_measurements
     from symdyn.dynamics import derive
 
     path = ROOT / "examples" / "panda.yaml"

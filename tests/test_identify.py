@@ -21,13 +21,8 @@ from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived
 
 import symdyn
 from symdyn.apps.excite import excite
-from symdyn.apps.identify import (
-    Measurements,
-    base_regressor_samples,
-    differentiate,
-    identify,
-    read_measurements,
-)
+from symdyn.apps.identify import base_regressor_samples, identify
+from symdyn.apps.measurements import Measurements, differentiate, read_measurements
 from symdyn.apps.simulate import time_expressions
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError

@@ -372,6 +372,21 @@ class CompiledDynamics(FrameMethods):
             self._frame_libraries[key] = frames
         return self._frame_libraries[key]
 
+    def group_functions(self, group: str) -> CompiledDynamics:
+        """The compiled functions of the group `group` of symdyn.codegen.functions.GROUPS that this
+        entry leaves out (a floating robot's regressor: its default groups are dynamics and
+        configuration), in a cache entry of their own built on first use."""
+        if group not in self._frame_libraries:
+            options = {"functions": (group,)}
+            entry = self.derived_entry(  # keyed by the compiler options too, as the robot's own entry
+                json.dumps({"group": group, **self._options}, sort_keys=True),
+                lambda robot, folder: self._build_frames(robot, folder, options),
+            )
+            functions = CompiledDynamics._from_entry(entry, self.robot, self._params)
+            functions.threads = self.threads
+            self._frame_libraries[group] = functions
+        return self._frame_libraries[group]
+
     def __repr__(self) -> str:
         names = ", ".join(self.functions)
         return f"<CompiledDynamics {self.robot.name}: {self.n} joints, {self.backend}, {names}>"

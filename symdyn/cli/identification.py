@@ -67,11 +67,12 @@ def _per_joint(items, n: int, what: str):
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
-    from ..apps.identify import identify, plot_identification, read_measurements
+    from ..apps.identify import identify, plot_identification
+    from ..apps.measurements import read_measurements
     from ..dynamics import derive
 
     robot = _robot(args)
-    data = read_measurements(args.data, robot.n)
+    data = read_measurements(args.data, robot.n, floating=robot.floating)
     result = identify(robot, data, derive(robot, simplify=False).base_parameters, predict=bool(args.plot))
     image = plot_identification(result, data) if args.plot else None
     print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else result.text(), end="")
@@ -80,7 +81,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
     for line in result.warnings():
         print(f"symdyn: warning: {line}", file=sys.stderr)
     if data.differentiated:
-        print("symdyn: note: qd and qdd estimated from q (Savitzky-Golay filter)", file=sys.stderr)
+        what = "qdd estimated from qd" if robot.floating else "qd and qdd estimated from q"
+        print(f"symdyn: note: {what} (Savitzky-Golay filter)", file=sys.stderr)
     if image is not None:
         from ..apps.output import write_atomic
 
