@@ -45,7 +45,7 @@ from .compiled_frames import FrameMethods
 from .robot_key import robot_digest
 from .singular import INVERTING, NotGeneratedError, guarded
 
-__all__ = ["CompiledDynamics", "RobotInfo", "compile", "robot_digest", "cached_dynamics"]
+__all__ = ["CompiledDynamics", "RobotInfo", "compile", "compile_group", "robot_digest", "cached_dynamics"]
 
 #: The slowdown the fallback warning quotes (measured, docs/speed.md).
 _FALLBACK_NOTE = (
@@ -131,14 +131,21 @@ def _loaded_files(meta: dict) -> list[str]:
 
 
 def cached_dynamics(
-    key_parts: dict, make_robot: Callable, params=None, method: str = "newton-euler", threads: int = 1
+    key_parts: dict,
+    make_robot: Callable,
+    params=None,
+    method: str = "newton-euler",
+    threads: int = 1,
+    functions: tuple[str, ...] | None = None,
 ):
     """A CompiledDynamics from the cache entry of `key_parts` (plus the options), built when missing.
 
     make_robot() is called only to build the entry (a cache hit never derives nor loads it);
     the result then carries a RobotInfo instead of the Robot. A hit verifies the digest of the
     file it loads (the library); the others are verified when first read (cache.Entry.file).
+    `functions`: the groups to build (None: symdyn.codegen.context's default ones).
     """
+    groups = None if functions is None else {"functions": tuple(functions)}
     check_threads(threads)
     options = _options(method)
     key = cache.entry_key(**key_parts, **options)
@@ -146,7 +153,7 @@ def cached_dynamics(
     robot = None
     if entry is None:
         robot = make_robot()
-        entry = cache.get_or_build(key, _build(robot, method, options))
+        entry = cache.get_or_build(key, _build(robot, method, options, groups))
     self = CompiledDynamics._from_entry(entry, robot, params)
     self.threads = threads
     self._source = ({**key_parts, "method": method}, make_robot)
@@ -154,7 +161,8 @@ def cached_dynamics(
     self._options = options
 
     def rebuild() -> cache.Entry:
-        return cache.get_or_build(key, _build(robot if robot is not None else make_robot(), method, options))
+        robot_now = robot if robot is not None else make_robot()
+        return cache.get_or_build(key, _build(robot_now, method, options, groups))
 
     self._rebuild = rebuild
     return self
@@ -183,6 +191,17 @@ def compile(robot, params=None, method: str = "newton-euler", threads: int = 1) 
     return cached_dynamics(
         {"robot": robot_digest(robot), "families": families}, lambda: robot, params, method, threads
     )
+
+
+def compile_group(robot, group: str, params=None, method: str = "newton-euler") -> CompiledDynamics:
+    """The functions of one group of symdyn.codegen.functions.GROUPS alone, compiled into a cache
+    entry of their own: e.g. a floating robot's regressor, which its default groups (dynamics and
+    configuration) leave out, without building those."""
+    from ..codegen.functions import FAMILIES
+
+    families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
+    key_parts = {"robot": robot_digest(robot), "families": families, "group": group}
+    return cached_dynamics(key_parts, lambda: robot, params, method, 1, (group,))
 
 
 def _bind(names: list[str], robot, params) -> np.ndarray | None:
@@ -371,21 +390,6 @@ class CompiledDynamics(FrameMethods):
             frames.threads = self.threads
             self._frame_libraries[key] = frames
         return self._frame_libraries[key]
-
-    def group_functions(self, group: str) -> CompiledDynamics:
-        """The compiled functions of the group `group` of symdyn.codegen.functions.GROUPS that this
-        entry leaves out (a floating robot's regressor: its default groups are dynamics and
-        configuration), in a cache entry of their own built on first use."""
-        if group not in self._frame_libraries:
-            options = {"functions": (group,)}
-            entry = self.derived_entry(  # keyed by the compiler options too, as the robot's own entry
-                json.dumps({"group": group, **self._options}, sort_keys=True),
-                lambda robot, folder: self._build_frames(robot, folder, options),
-            )
-            functions = CompiledDynamics._from_entry(entry, self.robot, self._params)
-            functions.threads = self.threads
-            self._frame_libraries[group] = functions
-        return self._frame_libraries[group]
 
     def __repr__(self) -> str:
         names = ", ".join(self.functions)

@@ -128,12 +128,14 @@ def _regressor(robot: Robot):
     batch call (symdyn.compile, cached; its loop over the samples is in C, W samples per
     instruction), or the generated NumPy module without a C compiler; the robot's parameters
     must all have values."""
-    from .compiled import compiled_dynamics
-
-    compiled = compiled_dynamics(robot)
     if robot.floating:  # the regressor group is not among a floating robot's default groups
-        compiled = compiled.group_functions("regressor")
-    f = compiled.base_regressor
+        from .compile import compile_group
+
+        f = compile_group(robot, "regressor").base_regressor
+    else:
+        from .compiled import compiled_dynamics
+
+        f = compiled_dynamics(robot).base_regressor
 
     def evaluate(q, qd, qdd) -> np.ndarray:
         Yb = f(*(np.asarray(a, dtype=float) for a in (q, qd, qdd)))

@@ -134,9 +134,10 @@ def read_measurements(
         from .measurements_binary import read_binary
 
         header, data = read_binary(path, log_columns(n, floating))
+        cols = _columns(header, n, where, torques, floating)
     else:
-        header, data = _read_csv(path, where)
-    cols = _columns(header, n, where, torques, floating)
+        header, data, line = _read_csv(path, where)
+        cols = _columns(header, n, f"{where}: line {line}", torques, floating)
     if len(data) < 2:
         raise SymdynError(f"{where}: too few samples ({len(data)})")
     t, q = data[:, cols["t"][0]], data[:, cols["q"]]
@@ -150,8 +151,9 @@ def read_measurements(
     return Measurements(t, q, qd, qdd, tau, differentiated=True)
 
 
-def _read_csv(path: str | os.PathLike, where: str) -> tuple[list[str], np.ndarray]:
-    """(header, values (N, columns)) of a CSV log: the C parser, else numpy.loadtxt, else Python."""
+def _read_csv(path: str | os.PathLike, where: str) -> tuple[list[str], np.ndarray, int]:
+    """(header, values (N, columns), the header's line number) of a CSV log: the C parser, else
+    numpy.loadtxt, else Python."""
     try:
         text = Path(path).read_bytes()
     except OSError as exc:
@@ -176,7 +178,7 @@ def _read_csv(path: str | os.PathLike, where: str) -> tuple[list[str], np.ndarra
         data = _loadtxt(text[start:], len(header))
     if data is None or not np.all(np.isfinite(data)):
         data = _read_slowly(path, header, skip)
-    return header, data
+    return header, data, skip
 
 
 def _loadtxt(body: bytes, width: int) -> np.ndarray | None:
