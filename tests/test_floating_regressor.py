@@ -136,5 +136,5 @@ def test_identification_checks_the_floating_sizes(arm):
     from symdyn.apps.measurements import Measurements
 
     z = np.zeros((50, 3))
-    with pytest.raises(SymdynError, match=r"^identify: robot 'floating_arm' has NQ = 10 positions and NV = 9"):
+    with pytest.raises(SymdynError, match=r"^identify: robot 'floating_arm' has NQ = 10 positions and NV = "):
         identify(arm.robot, Measurements(z[:, 0], z, z, z, z), arm.base_parameters)
