@@ -44,7 +44,7 @@ def read_binary(path: str | os.PathLike, columns: dict[str, list[str]]) -> tuple
 def _real(where: str, a: np.ndarray, what: str) -> np.ndarray:
     """`a` as float64, finite; else SymdynError naming `what`."""
     if not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)):
-        raise SymdynError(f"{where}: {what} hold {a.dtype}, not real numbers")
+        raise SymdynError(f"{where}: {what}: {a.dtype} values, not real numbers")
     a = np.asarray(a, dtype=np.float64)
     bad = np.argwhere(~np.isfinite(a))
     if len(bad):
