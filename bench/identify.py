@@ -5,7 +5,8 @@
 
 The log (t, q, qd, qdd, tau at 1 kHz, sines; tau from the compiled inverse dynamics plus noise)
 is written to a temporary folder (never committed). Timed in this process: reading the CSV
-(symdyn.apps.measurements.read_measurements), the derivation of the base parameters (SymPy), the base
+(symdyn.apps.measurements.read_measurements: the C parser), the same file by numpy.loadtxt (the
+reader before) and the same values as a .npz log, the derivation of the base parameters (SymPy), the base
 regressor alone over the chunks identify uses (batch calls into one reused-size buffer), and
 identify itself (regressor chunks folded by incremental QR, both least squares, no prediction);
 then the whole command `symdyn identify panda.yaml LOG.csv` as a subprocess, with its peak
@@ -62,7 +63,21 @@ def identify_part(samples: int, folder: Path) -> dict[str, float]:
     times: dict[str, float] = {}
     t0 = time.perf_counter()
     data = read_measurements(big, robot.n)
-    times[f"read the CSV ({big.stat().st_size / 1e6:.0f} MB)"] = time.perf_counter() - t0
+    times[f"read the CSV ({big.stat().st_size / 1e6:.0f} MB), C parser in threads"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    with open(big, "rb") as f:
+        f.readline()
+        slow = np.loadtxt(f, delimiter=",", comments=None, dtype=np.float64, ndmin=2)
+    times["the same CSV by numpy.loadtxt (the read before)"] = time.perf_counter() - t0
+    assert np.array_equal(slow, np.column_stack([data.t, data.q, data.qd, data.qdd, data.tau]))
+    del slow
+    binary = folder / "log.npz"
+    np.savez(binary, t=data.t, q=data.q, qd=data.qd, qdd=data.qdd, tau=data.tau)
+    t0 = time.perf_counter()
+    again = read_measurements(binary, robot.n)
+    times[f"read the same log as .npz ({binary.stat().st_size / 1e6:.0f} MB)"] = time.perf_counter() - t0
+    assert np.array_equal(again.tau, data.tau)
+    del again
     t0 = time.perf_counter()
     base = derive(robot, simplify=False).base_parameters
     times["derive the base parameters (SymPy)"] = time.perf_counter() - t0
