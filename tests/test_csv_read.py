@@ -32,6 +32,9 @@ def test_values_equal_pythons_in_one_part_and_in_threads(monkeypatch):
     for threads in (2, 3, 8):
         assert np.array_equal(csv_read.parse_rows(text, start, 5, threads=threads), want)
     assert csv_read.parse_rows(text + b"\n", start, 5, threads=3).shape == (400, 5)
+    plain = ("t,a,b,c,d\n" + "\n".join(lines)).encode()  # no blank line: the parts fill one array
+    for end in (b"", b"\n"):
+        assert np.array_equal(csv_read.parse_rows(plain + end, start, 5, threads=3), want)
     assert csv_read.parse_rows(b"t\n", 2, 1).shape == (0, 1)
 
 

@@ -132,7 +132,11 @@ def parse_rows(text: bytes, start: int, width: int, threads: int | None = None) 
     parts = _parts(text, start, max(1, min(threads, (len(text) - start) // PART_BYTES)))
     if not parts:
         return np.empty((0, width))
-    outs = [np.empty((text.count(b"\n", a, b) + 1, width)) for a, b in parts]
+    lines = [text.count(b"\n", a, b) for a, b in parts]  # at least the rows of each part: every part
+    lines[-1] += 1  # but the last ends with a newline, the last maybe not
+    first = np.cumsum([0, *lines])
+    values = np.empty((int(first[-1]), width))  # one array: part k's rows from row first[k] on
+    outs = [values[first[k] : first[k + 1]] for k in range(len(parts))]
 
     def run(k: int) -> int:
         (a, b), out = parts[k], outs[k]
@@ -147,6 +151,6 @@ def parse_rows(text: bytes, start: int, width: int, threads: int | None = None) 
         rows = [run(k) for k in range(len(parts))]
     if any(r < 0 for r in rows):
         return None
-    if len(outs) == 1:
-        return outs[0][: rows[0]]
+    if all(r == len(out) for r, out in zip(rows[:-1], outs[:-1], strict=True)):  # full: no blank line
+        return values[: first[-2] + rows[-1]]
     return np.concatenate([out[:r] for out, r in zip(outs, rows, strict=True)])
