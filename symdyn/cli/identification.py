@@ -121,7 +121,11 @@ def cmd_excite(args: argparse.Namespace) -> int:
 
 def _identify_arguments(i: argparse.ArgumentParser) -> None:
     add_robot_argument(i)
-    i.add_argument("data", help="CSV with columns t, q1..qn, [qd1..qdn, qdd1..qddn,] tau1..taun")
+    i.add_argument(
+        "data",
+        help="CSV with columns t, q1..qn, [qd1..qdn, qdd1..qddn,] tau1..taun (a floating robot: its free "
+        "flyer's columns too, as symdyn simulate writes them), or a .npz/.npy of the same values",
+    )
     i.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
     i.add_argument("--format", choices=("text", "json"), default="text")
     i.add_argument("--plot", help="draw measured and predicted torques to this PNG (or .pdf, .svg)")
