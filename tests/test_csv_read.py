@@ -57,3 +57,20 @@ def test_values_equal_pythons_in_one_part_and_in_threads(monkeypatch):
 def test_anything_else_is_refused(row):
     text = f"a,b,c\n0,0,0\n{row}\n0,0,0\n".encode()
     assert csv_read.parse_rows(text, 6, 3, threads=1) is None
+
+
+def test_without_the_parser_the_caller_reads_the_file_itself(tmp_path, monkeypatch):
+    """A cache that cannot be written (or a failing compiler) is no error: parse_rows gives None
+    and read_measurements reads the file with numpy.loadtxt."""
+    from symdyn.apps import cache
+    from symdyn.apps.measurements import read_measurements
+    from symdyn.errors import SymdynError
+
+    def refuse(*args):
+        raise SymdynError("the symdyn cache cannot be written")
+
+    monkeypatch.setattr(csv_read, "_LIBRARY", [])
+    monkeypatch.setattr(cache, "get_or_build", refuse)
+    assert csv_read.parse_rows(b"a\n1\n", 2, 1) is None
+    (tmp_path / "m.csv").write_text("t,q1,qd1,qdd1,tau1\n0,1,2,3,4\n1,5,6,7,8\n")
+    assert read_measurements(tmp_path / "m.csv", 1).tau.tolist() == [[4.0], [8.0]]

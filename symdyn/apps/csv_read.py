@@ -10,8 +10,8 @@ tabs around it and a '\\r' before the newline, `width` values a line, blank line
 strtod rounds correctly (as numpy and Python do), so every value it gives is the one
 numpy.loadtxt gives. Anything else (another syntax, a wrong count, a value strtod would read
 differently under another locale) makes `parse_rows` return None and the caller reads the file
-the slow way, which names the line and column of the problem. Without a C compiler it returns
-None too.
+the slow way, which names the line and column of the problem. Without a C compiler (or a
+writable symdyn cache) it returns None too.
 """
 
 from __future__ import annotations
@@ -19,6 +19,8 @@ from __future__ import annotations
 import os
 
 import numpy as np
+
+from ..errors import SymdynError
 
 __all__ = ["parse_rows", "READER_SOURCE", "PART_BYTES"]
 
@@ -95,12 +97,15 @@ def _library():
             compile_library(compiler, {"symdyn_read.c": READER_SOURCE}, folder / name)
             return {"library": name}
 
-        entry = cache.get_or_build(cache.entry_key(kind="csv-reader", compiler=compiler), build)
         import cffi
 
-        ffi = cffi.FFI()
-        ffi.cdef("long symdyn_parse_rows(const char *, long, long, double *, long);")
-        _LIBRARY.append((ffi, ffi.dlopen(str(entry.file(name)))))
+        try:  # a cache that cannot be written, a compiler that fails: numpy.loadtxt reads the file
+            entry = cache.get_or_build(cache.entry_key(kind="csv-reader", compiler=compiler), build)
+            ffi = cffi.FFI()
+            ffi.cdef("long symdyn_parse_rows(const char *, long, long, double *, long);")
+            _LIBRARY.append((ffi, ffi.dlopen(str(entry.file(name)))))
+        except (SymdynError, OSError):
+            _LIBRARY.append(None)
     return _LIBRARY[0]
 
 
