@@ -39,9 +39,15 @@ import numpy as np
 from ..errors import SymdynError
 from ..model.robot import Robot
 from .least_squares import Triangular, combine
-from .measurements import Measurements
+from .measurements import SG_ORDER, SG_WINDOW, Measurements, differentiate, needs_scipy, read_measurements
 
-__all__ = [
+__all__ = [  # the log reading lives in symdyn.apps.measurements; its names stay importable from here
+    "Measurements",
+    "read_measurements",
+    "differentiate",
+    "needs_scipy",
+    "SG_WINDOW",
+    "SG_ORDER",
     "Identification",
     "base_regressor_samples",
     "identify",
