@@ -8,8 +8,8 @@ and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.build: CO
 -march=native unless $SYMDYN_MARCH says otherwise) and times, over the same states, the scalar
 function called once per state in a C loop and one call of NAME_batch (the best of 15 rounds,
 interleaved); it also checks that both give the same bits. Then the batch through Python
-(symdyn.compile's method, arrays allocated per call) with threads=1 and threads=2, over the same
-number of states and over ten times as many.
+(symdyn.compile's method: output arrays allocated per call, and out= reusing one) with threads=1
+and threads=2, over the same number of states and over ten times as many.
 Part 2: `symdyn identify` on a million-sample log of the Panda, stage by stage and end to end
 (bench/identify.py).
 The table goes to stdout and to bench/results/batch.txt.
@@ -135,28 +135,28 @@ def c_part(count: int, folder: Path) -> tuple[int, list[tuple[str, float, float,
     return int(lines[0]), rows, flags
 
 
-def python_part(count: int) -> dict[str, tuple[float, float]]:
-    """ns per state of symdyn.compile's batch methods (threads=1, threads=2; best of 5)."""
+def python_part(count: int) -> dict[str, dict[tuple[int, bool], float]]:
+    """ns per state of symdyn.compile's batch methods, {(threads, out=): ns} for threads 1 and 2,
+    each with a fresh output array and with out= (one array reused); best of 5, interleaved."""
     robot = symdyn.load_robot(ROOT / "examples" / "panda.yaml")
     fast = symdyn.compile(robot)
     rng = np.random.default_rng(7)
     q, qd, u = (rng.uniform(-2, 2, (count, robot.n)) for _ in range(3))
+    T, M = np.empty((count, robot.n)), np.empty((count, robot.n, robot.n))
     calls = {
-        "inverse_dynamics": lambda t: fast.inverse_dynamics(q, qd, u, threads=t),
-        "mass_matrix": lambda t: fast.mass_matrix(q, threads=t),
-        "forward_dynamics": lambda t: fast.forward_dynamics(q, qd, u, threads=t),
+        "inverse_dynamics": lambda t, o: fast.inverse_dynamics(q, qd, u, threads=t, out=T if o else None),
+        "mass_matrix": lambda t, o: fast.mass_matrix(q, threads=t, out=M if o else None),
+        "forward_dynamics": lambda t, o: fast.forward_dynamics(q, qd, u, threads=t, out=T if o else None),
     }
     result = {}
     for name, call in calls.items():
-        best = {}
-        for threads in (1, 2):
-            times = []
-            for _ in range(5):
+        best = {(t, o): float("inf") for t in (1, 2) for o in (False, True)}
+        for _ in range(5):
+            for key in best:
                 t0 = time.perf_counter()
-                call(threads)
-                times.append(time.perf_counter() - t0)
-            best[threads] = 1e9 * min(times) / count
-        result[name] = (best[1], best[2])
+                call(*key)
+                best[key] = min(best[key], 1e9 * (time.perf_counter() - t0) / count)
+        result[name] = best
     return result
 
 
@@ -178,18 +178,25 @@ def main() -> int:
         f"Panda, {count:,} states, flags {' '.join(flags)}; W = {width} doubles per instruction",
         "",
         f"{'function':<18}  {'scalar C loop ns':>16}  {'batch ns':>8}  {'batch/scalar':>12}"
-        f"  {'same bits':>9}  {'Python batch ns':>15}  {'threads=2 ns':>12}",
-        "-" * 104,
+        f"  {'same bits':>9}  {'Python batch ns':>15}  {'with out= ns':>12}  {'threads=2 ns':>12}",
+        "-" * 118,
     ]
     for name, scalar, batch, same in rows:
-        one, two = py[name]
+        b = py[name]
         lines.append(
             f"{name:<18}  {scalar:>16.1f}  {batch:>8.1f}  {batch / scalar:>11.2f}x"
-            f"  {'yes' if same else 'NO':>9}  {one:>15.1f}  {two:>12.1f}"
+            f"  {'yes' if same else 'NO':>9}  {b[1, False]:>15.1f}  {b[1, True]:>12.1f}  {b[2, False]:>12.1f}"
         )
-    lines += ["", f"threads through Python at {10 * count:,} states, ns per state (best of 5):"]
-    for name, (one, two) in big.items():
-        lines.append(f"  {name:<18} threads=1 {one:7.1f}  threads=2 {two:7.1f}  ratio {two / one:.2f}")
+    lines += [
+        "",
+        f"threads through Python at {10 * count:,} states, ns per state (best of 5), a fresh output"
+        " array / out= (one reused):",
+    ]
+    for name, b in big.items():
+        lines.append(
+            f"  {name:<18} threads=1 {b[1, False]:7.1f} / {b[1, True]:7.1f}  threads=2 {b[2, False]:7.1f} /"
+            f" {b[2, True]:7.1f}  ratio {b[2, False] / b[1, False]:.2f} / {b[2, True] / b[1, True]:.2f}"
+        )
     target = all(batch / scalar <= 0.4 for _, scalar, batch, _ in rows)
     lines += [
         "",

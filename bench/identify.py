@@ -5,17 +5,18 @@
 
 The log (t, q, qd, qdd, tau at 1 kHz, sines; tau from the compiled inverse dynamics plus noise)
 is written to a temporary folder (never committed). Timed in this process: reading the CSV
-(symdyn.apps.identify.read_measurements), the derivation of the base parameters (SymPy), the base
+(symdyn.apps.measurements.read_measurements: the C parser), the same file by numpy.loadtxt (the
+reader before) and the same values as a .npz log, the derivation of the base parameters (SymPy), the base
 regressor alone over the chunks identify uses (batch calls into one reused-size buffer), and
 identify itself (regressor chunks folded by incremental QR, both least squares, no prediction);
-then the whole command `symdyn identify panda.yaml LOG.csv` as a subprocess, with its peak
-resident memory. bench/batch.py puts these lines in bench/results/batch.txt.
+then the whole command `symdyn identify panda.yaml LOG.csv` (and LOG.npz) as a subprocess, with
+its peak resident memory (measured by a wrapper process whose only child it is).
+bench/batch.py puts these lines in bench/results/batch.txt.
 """
 
 from __future__ import annotations
 
 import argparse
-import resource
 import subprocess
 import sys
 import tempfile
@@ -49,8 +50,10 @@ def write_log(robot, fast, samples: int, path: Path) -> None:
 
 def identify_part(samples: int, folder: Path) -> dict[str, float]:
     """Seconds of each stage of identification on a Panda log of `samples` samples, and of the
-    whole command; 'nbase', 'chunk' and 'peak MB' (the command's maximum resident set)."""
-    from symdyn.apps.identify import base_regressor_samples, chunk_samples, identify, read_measurements
+    whole command (on the CSV and on the .npz); 'nbase', 'chunk' and 'peak MB', 'peak MB on the
+    .npz log' (the command's maximum resident set)."""
+    from symdyn.apps.identify import base_regressor_samples, chunk_samples, identify
+    from symdyn.apps.measurements import read_measurements
     from symdyn.dynamics import derive
 
     path = ROOT / "examples" / "panda.yaml"
@@ -61,7 +64,21 @@ def identify_part(samples: int, folder: Path) -> dict[str, float]:
     times: dict[str, float] = {}
     t0 = time.perf_counter()
     data = read_measurements(big, robot.n)
-    times[f"read the CSV ({big.stat().st_size / 1e6:.0f} MB)"] = time.perf_counter() - t0
+    times[f"read the CSV ({big.stat().st_size / 1e6:.0f} MB), C parser in threads"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    with open(big, "rb") as f:
+        f.readline()
+        slow = np.loadtxt(f, delimiter=",", comments=None, dtype=np.float64, ndmin=2)
+    times["the same CSV by numpy.loadtxt (the read before)"] = time.perf_counter() - t0
+    assert np.array_equal(slow, np.column_stack([data.t, data.q, data.qd, data.qdd, data.tau]))
+    del slow
+    binary = folder / "log.npz"
+    np.savez(binary, t=data.t, q=data.q, qd=data.qd, qdd=data.qdd, tau=data.tau)
+    t0 = time.perf_counter()
+    again = read_measurements(binary, robot.n)
+    times[f"read the same log as .npz ({binary.stat().st_size / 1e6:.0f} MB)"] = time.perf_counter() - t0
+    assert np.array_equal(again.tau, data.tau)
+    del again
     t0 = time.perf_counter()
     base = derive(robot, simplify=False).base_parameters
     times["derive the base parameters (SymPy)"] = time.perf_counter() - t0
@@ -75,16 +92,25 @@ def identify_part(samples: int, folder: Path) -> dict[str, float]:
     identify(robot, data, base, predict=False)
     times["identify (regressor + incremental QR + solves)"] = time.perf_counter() - t0
     del data
-    cmd = [sys.executable, "-m", "symdyn.cli", "identify", str(path), str(big)]
-    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    t0 = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    times["symdyn identify, whole command"] = time.perf_counter() - t0
-    assert proc.returncode == 0, proc.stderr
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    for name, log_file in (("", big), (" on the .npz log", binary)):
+        t0 = time.perf_counter()
+        proc = subprocess.run(
+            [sys.executable, "-c", PEAK, str(path), str(log_file)], capture_output=True, text=True
+        )
+        times[f"symdyn identify, whole command{name}"] = time.perf_counter() - t0
+        assert proc.returncode == 0, proc.stderr
+        times[f"peak MB{name}"] = int(proc.stdout.split()[-1]) / 1024
     times["nbase"], times["chunk"] = len(base), step
-    times["peak MB"] = peak / 1024 if peak > before else float("nan")
     return times
+
+
+#: Runs `symdyn identify ROBOT LOG` as its only child and prints its peak resident memory (KiB):
+#: the bench's own children (the compiler) do not count.
+PEAK = (
+    "import resource, subprocess, sys; "
+    "subprocess.run([sys.executable, '-m', 'symdyn.cli', 'identify', *sys.argv[1:]], check=True, "
+    "stdout=subprocess.DEVNULL); print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)"
+)
 
 
 def lines(samples: int, times: dict[str, float]) -> list[str]:
@@ -94,9 +120,12 @@ def lines(samples: int, times: dict[str, float]) -> list[str]:
         f"(t, q, qd, qdd, tau), chunks of {times['chunk']:.0f} samples, seconds:"
     ]
     for key, value in times.items():
-        if key not in ("nbase", "chunk", "peak MB"):
+        if key not in ("nbase", "chunk") and not key.startswith("peak MB"):
             out.append(f"  {key:<50} {value:8.2f} s")
-    out.append(f"  {'the command: peak resident memory':<50} {times['peak MB']:8.0f} MB")
+    for name in ("", " on the .npz log"):
+        out.append(
+            f"  {'the command' + name + ': peak resident memory':<50} {times['peak MB' + name]:8.0f} MB"
+        )
     return out
 
 

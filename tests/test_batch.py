@@ -26,7 +26,7 @@ from cbuild import SANITIZE_FLAGS, STRICT_FLAGS, TEST_OPT, compile_program, comp
 from robots import example, y_robot
 
 import symdyn
-from symdyn.apps import build
+from symdyn.apps import build, calling
 from symdyn.apps.calling import batch_layout, load_library
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
@@ -243,10 +243,25 @@ def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch)
     assert np.array_equal(one, np.array([fast.inverse_dynamics(*s) for s in zip(q, qd, qdd, strict=True)]))
     oracle = symdyn.rnea(robot, q[:5], qd[:5], qdd[:5])
     np.testing.assert_allclose(one[:5], oracle, rtol=1e-10, atol=1e-10)
+    monkeypatch.setattr(calling, "MIN_STATES_PER_THREAD", 16)  # 1001 states in up to 63 chunks
     for threads in (2, 3, 64):
         assert fast.inverse_dynamics(q, qd, qdd, threads=threads).tobytes() == one.tobytes()
         M = fast.mass_matrix(q, threads=threads)
         assert M.tobytes() == fast.mass_matrix(q).tobytes()
+    M = np.full((1001, n, n), np.nan)  # out=: filled in place, the same bits, threads or not
+    assert fast.mass_matrix(q, out=M, threads=3) is M and M.tobytes() == fast.mass_matrix(q).tobytes()
+    tau = np.empty(n)
+    assert fast.inverse_dynamics(q[0], qd[0], qdd[0], out=tau) is tau and np.array_equal(tau, one[0])
+    for bad, message in (
+        (np.empty((1001, n, n), dtype=np.float32), "C-contiguous float64 array of shape"),
+        (np.empty((1000, n, n)), r"shape \(1001, 3, 3\), got float64 \(1000, 3, 3\)"),
+        (np.empty((n, n, 1001)).T, "C-contiguous"),
+        ((M, M), r"takes 1 array\(s\), got 2"),
+    ):
+        with pytest.raises(SymdynError, match=message):
+            fast.mass_matrix(q, out=bad)
+    with pytest.raises(SymdynError, match="share no memory with the inputs"):
+        fast.inverse_dynamics(q, qd, qdd, out=q)
     threaded = symdyn.compile(robot, threads=2)
     assert threaded.threads == 2 and threaded.forward_dynamics(q, qd, qdd).tobytes() == (
         fast.forward_dynamics(q, qd, qdd).tobytes()

@@ -129,8 +129,12 @@ def test_generated_regressor_functions_equal_the_oracle(arm, tmp_path):
             np.testing.assert_allclose(got, tau, atol=1e-10, err_msg=f"NumPy {fname}")
 
 
-def test_identification_refuses_a_floating_robot(arm):
+def test_identification_checks_the_floating_sizes(arm):
+    """identify takes a floating robot (tests/test_identify.py identifies this arm) but not
+    measurements of a fixed base's sizes."""
     from symdyn.apps.identify import identify
+    from symdyn.apps.measurements import Measurements
 
-    with pytest.raises(SymdynError, match=r"^identify: robot 'floating_arm' has a floating base"):
-        identify(arm.robot, None, arm.base_parameters)
+    z = np.zeros((50, 3))
+    with pytest.raises(SymdynError, match=r"^identify: robot 'floating_arm' has NQ = 10 positions and NV = "):
+        identify(arm.robot, Measurements(z[:, 0], z, z, z, z), arm.base_parameters)

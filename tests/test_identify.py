@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 from functools import cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,13 +22,8 @@ from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived
 
 import symdyn
 from symdyn.apps.excite import excite
-from symdyn.apps.identify import (
-    Measurements,
-    base_regressor_samples,
-    differentiate,
-    identify,
-    read_measurements,
-)
+from symdyn.apps.identify import base_regressor_samples, identify
+from symdyn.apps.measurements import Measurements, differentiate, log_columns, read_measurements
 from symdyn.apps.simulate import time_expressions
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError
@@ -238,3 +234,83 @@ def test_direction_dependent_coulomb_friction_is_identified_per_direction():
         assert got[name] == pytest.approx(value, rel=1e-8), name
     K = dyn.linear_compact()[1].matrix()
     np.testing.assert_allclose(result.estimate, K @ numeric_parameters(robot), rtol=1e-8, atol=1e-10)
+
+
+FLOATING_ARM = Path(__file__).parent / "data" / "floating_arm.yaml"
+
+
+def _floating_log(robot, N: int, rng) -> dict[str, np.ndarray]:
+    """t, q (unit quaternions), qd, qdd and the oracle's tau (base wrench, joint efforts) at N states."""
+    x = rng.normal(size=(N, 4))
+    q = np.column_stack(
+        [rng.normal(size=(N, 3)), x / np.linalg.norm(x, axis=1)[:, None], rng.uniform(-1, 1, (N, 3))]
+    )
+    qd, qdd = rng.normal(size=(N, robot.nv)), rng.normal(size=(N, robot.nv))
+    tau = np.array([symdyn.rnea(robot, *state) for state in zip(q, qd, qdd, strict=True)])
+    return {"t": np.arange(N) * 0.01, "q": q, "qd": qd, "qdd": qdd, "tau": tau}
+
+
+def test_floating_robot_identified_from_a_csv_log_and_an_npz_log(tmp_path):
+    """The small floating arm (base body with mass, friction, rotor inertia): noise-free torques of
+    the oracle at random states with random unit quaternions, written with the columns `symdyn
+    simulate` writes (log_columns), give back its base parameters (K pi) to 1e-8 relative, from a
+    CSV and from the same values in a .npz; a log without the base's columns is one line naming
+    the file, the header's line and NQ/NV."""
+    robot = symdyn.load_robot(FLOATING_ARM)
+    dyn = derived_robot(robot, "newton-euler")
+    arrays = _floating_log(robot, 40, np.random.default_rng(4))
+    columns = log_columns(robot.n, floating=True)
+    header = [name for head in columns for name in columns[head]]
+    values = np.column_stack(list(arrays.values()))
+    lines = [",".join(f"{x:.17g}" for x in row) for row in values]
+    (tmp_path / "log.csv").write_text(",".join(header) + "\n" + "\n".join(lines) + "\n")
+    np.savez(tmp_path / "log.npz", **arrays)
+    want = dyn.linear_compact()[1].matrix() @ numeric_parameters(robot)
+    for name in ("log.csv", "log.npz"):
+        data = read_measurements(tmp_path / name, robot.n, floating=True)
+        assert np.array_equal(np.column_stack([data.t, data.q, data.qd, data.qdd, data.tau]), values)
+        result = identify(robot, data, dyn.base_parameters)
+        big = np.abs(want) > 1e-10 * np.abs(want).max()
+        assert np.all(np.abs(result.estimate - want)[big] <= 1e-8 * np.abs(want)[big]), name
+        assert np.all(np.abs(result.estimate - want)[~big] <= 1e-10 * np.abs(want).max()), name
+        np.testing.assert_allclose(result.predicted, data.tau, rtol=0, atol=1e-9 * np.abs(data.tau).max())
+    fixed = ["t", *(f"{h}{i}" for h in ("q", "qd", "qdd", "tau") for i in (1, 2, 3))]
+    (tmp_path / "fixed.csv").write_text("\n" + ",".join(fixed) + "\n" + "0," * 12 + "0\n")
+    with pytest.raises(SymdynError) as info:
+        read_measurements(tmp_path / "fixed.csv", robot.n, floating=True)
+    message = str(info.value)
+    assert "\n" not in message and message.startswith(
+        f"{tmp_path / 'fixed.csv'}: line 2: missing column(s) x_b"
+    )
+    assert "NQ = 10 position columns, NV = 9 for qd, qdd and tau" in message
+
+
+#: a body with one link (small: its libraries compile in a second or two)
+FLYER = """name: flyer1
+base: {floating: true, mass: 3, com: [0.02, -0.01, 0.05],
+       inertia: {ixx: 0.05, iyy: 0.06, izz: 0.07, ixy: 0.004}}
+links:
+  - {joint: revolute, a: 0.4, alpha: 0.7, d: 0.1, theta: 0, mass: 1, com: [-0.2, 0.01, 0.02],
+     inertia: {ixx: 0.002, iyy: 0.01, izz: 0.01}}
+"""
+
+
+def test_simulated_floating_log_is_identified(tmp_path, capsys):
+    """`symdyn simulate` on a floating robot writes t, q (NQ), qd, qdd, tau (NV) (its qdd the forward
+    dynamics at each sample), which `symdyn identify` reads as it is: its predictions are the
+    simulated torques, base wrench (zero: free flight) included."""
+    robot_file, out = tmp_path / "flyer1.yaml", tmp_path / "flight.csv"
+    robot_file.write_text(FLYER)
+    qd0, tau = "0.1 0 0 0.3 -0.2 0.1 1", "0 0 0 0 0 0 sin(9*t)+0.5*cos(4*t)"
+    argv = ["simulate", str(robot_file), "--qd0", *qd0.split(" "), "--tau", *tau.split(" ")]
+    assert main([*argv, "--duration", "0.5", "--dt", "0.005", "--out", str(out)]) == 0
+    header = out.read_text().split("\n", 1)[0].split(",")
+    columns = log_columns(1, floating=True)
+    assert header == [name for head in columns for name in columns[head]]
+    capsys.readouterr()
+    assert main(["identify", str(robot_file), str(out), "--format", "json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["samples"] == 101 and len(report["residual_rms"]) == 7
+    data = read_measurements(out, 1, floating=True)
+    assert np.all(data.tau[:, :6] == 0)
+    assert max(report["residual_rms"]) <= 1e-9 * np.abs(data.tau).max()

@@ -8,7 +8,8 @@ passed to C without a copy when they are C-contiguous float64 of the batch's ful
 values contiguous, the states one after the other); any other array (another dtype, a strided
 view, an input broadcast against the others) is copied once into that layout. With threads > 1 a
 batch is cut into that many chunks (a multiple of 16 states each, so every chunk keeps whole
-vectors of any W), evaluated at once by Python threads (cffi releases the GIL during the call):
+vectors of any W, and at least MIN_STATES_PER_THREAD states), evaluated at once by the threads of
+a pool kept between calls (cffi releases the GIL during the call):
 each state's result is computed by the same instructions whatever the chunk, so it equals the
 one-thread result bit for bit.
 """
@@ -30,10 +31,16 @@ __all__ = [
     "check_threads",
     "batch_layout",
     "CHUNK",
+    "MIN_STATES_PER_THREAD",
 ]
 
 #: The states of a thread's chunk are a multiple of this (every vector width W divides it).
 CHUNK = 16
+#: A thread gets at least this many states: below, starting and joining it (tens of microseconds)
+#: costs more than it saves (about 100 ns a state), so a small batch runs in the calling thread.
+MIN_STATES_PER_THREAD = 4096
+
+_POOL: list = []  # [(workers, ThreadPoolExecutor)], kept between calls; replaced by a larger one when needed
 
 _LIBRARIES: dict[str, tuple] = {}
 
@@ -97,12 +104,18 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
     f64, ndarray = np.dtype(np.float64), np.ndarray
     one_state = [(size,) for size in sizes]
 
-    def call(*args, threads: int | None = None):
+    def call(*args, threads: int | None = None, out=None):
         if len(args) != len(sizes):
             raise TypeError(f"{f['name']}({', '.join(names)}) takes {len(sizes)} arguments, got {len(args)}")
         pointers = []
         for a, shape in zip(args, one_state, strict=True):  # the fast path: one state, float64 arrays
-            if a.__class__ is not ndarray or a.dtype != f64 or a.shape != shape or not a.flags.c_contiguous:
+            if (
+                out is not None
+                or a.__class__ is not ndarray
+                or a.dtype != f64
+                or a.shape != shape
+                or not a.flags.c_contiguous
+            ):
                 break
             pointers.append(buf("double[]", a))
         else:
@@ -110,7 +123,7 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
             single(*pointers, *p_args, *[buf("double[]", o) for o in outs])
             return outs[0] if one else tuple(outs)
         arrays = [a if isinstance(a, ndarray) else np.asarray(a, dtype=f64) for a in args]
-        if all(a.shape == shape for a, shape in zip(arrays, one_state, strict=True)):
+        if out is None and all(a.shape == shape for a, shape in zip(arrays, one_state, strict=True)):
             return call(*[np.ascontiguousarray(a, dtype=f64) for a in arrays])
         for a, s, n in zip(arrays, sizes, names, strict=True):
             if a.ndim == 0 or a.shape[-1] != s:
@@ -118,7 +131,11 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
         lead = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
         count = int(np.prod(lead, dtype=np.int64))
         flat = [batch_layout(a, lead, s, count) for a, s in zip(arrays, sizes, strict=True)]
-        outs = [np.empty((*lead, *shape)) for shape in shapes]
+        outs = (
+            [np.empty((*lead, *shape)) for shape in shapes]
+            if out is None
+            else _given(f, out, lead, shapes, flat)
+        )
         flat_outs = [o.reshape(count, int(np.prod(shape))) for o, shape in zip(outs, shapes, strict=True)]
         chunks = _chunks(count, owner.threads if threads is None else threads)
         if count:
@@ -126,7 +143,10 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
         return outs[0] if one else tuple(outs)
 
     call.__name__ = f["name"]
-    call.__doc__ = f"{f['doc']} (generated C; inputs {', '.join(names)}; a batch may give threads=)."
+    call.__doc__ = (
+        f"{f['doc']} (generated C; inputs {', '.join(names)}; a batch may give threads= and out=, "
+        "arrays it fills and returns)"
+    )
     return call
 
 
@@ -195,6 +215,27 @@ def numpy_solve_loops(module, qa, q_guess, p):
     return iterations, np.array([q for _, q in solved]).reshape(*lead, -1)
 
 
+def _given(f: dict, out, lead: tuple, shapes: list[tuple], inputs: list[np.ndarray]) -> list[np.ndarray]:
+    """The arrays of out= (one array, or a tuple of one per output) when each is a C-contiguous
+    float64 array of its output's shape over the batch's leading axes `lead`, sharing no memory with
+    the inputs; else SymdynError."""
+    given = list(out) if isinstance(out, tuple) else [out]
+    if len(given) != len(shapes):
+        raise SymdynError(f"{f['name']}: out= takes {len(shapes)} array(s), got {len(given)}")
+    for o, shape in zip(given, shapes, strict=True):
+        want = (*lead, *shape)
+        if not (
+            isinstance(o, np.ndarray) and o.dtype == np.float64 and o.shape == want and o.flags.c_contiguous
+        ):
+            got = f"{o.dtype} {o.shape}" if isinstance(o, np.ndarray) else type(o).__name__
+            raise SymdynError(
+                f"{f['name']}: out= must be a C-contiguous float64 array of shape {want}, got {got}"
+            )
+        if not o.flags.writeable or any(np.may_share_memory(o, a) for a in inputs):
+            raise SymdynError(f"{f['name']}: out= must be writeable and share no memory with the inputs")
+    return given
+
+
 def check_threads(threads) -> int:
     """`threads` when it is a whole number >= 1; else SymdynError."""
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
@@ -205,7 +246,7 @@ def check_threads(threads) -> int:
 def _chunks(count: int, threads) -> list[tuple[int, int]]:
     """(start, stop) of each thread's states: `threads` chunks of a multiple of CHUNK states."""
     check_threads(threads)
-    per = -(-count // int(threads))
+    per = max(-(-count // int(threads)), MIN_STATES_PER_THREAD)
     per = -(-per // CHUNK) * CHUNK
     if per >= count:
         return [(0, count)]
@@ -233,7 +274,10 @@ def _each(chunks: list[tuple[int, int]], run: Callable) -> None:
     if len(chunks) == 1:
         run(chunks[0])
         return
-    from concurrent.futures import ThreadPoolExecutor
+    if not _POOL or _POOL[0][0] < len(chunks):
+        from concurrent.futures import ThreadPoolExecutor
 
-    with ThreadPoolExecutor(max_workers=len(chunks)) as pool:
-        list(pool.map(run, chunks))
+        if _POOL:
+            _POOL.pop()[1].shutdown(wait=False)
+        _POOL.append((len(chunks), ThreadPoolExecutor(len(chunks), thread_name_prefix="symdyn-batch")))
+    list(_POOL[0][1].map(run, chunks))

@@ -87,8 +87,8 @@ class SampledReference:
     @classmethod
     def from_csv(cls, path, n: int) -> SampledReference:
         """The columns t, q1..qn and (optionally) qd1..qdn, qdd1..qddn of a CSV file
-        (symdyn.apps.identify.read_measurements: without them, a Savitzky-Golay estimate)."""
-        from .identify import read_measurements
+        (symdyn.apps.measurements.read_measurements: without them, a Savitzky-Golay estimate)."""
+        from .measurements import read_measurements
 
         data = read_measurements(path, n, torques=False)
         return cls(data.t, data.q, data.qd, data.qdd, where=str(path))

@@ -29,7 +29,8 @@ import numpy as np
 
 from ..errors import SymdynError
 from ..model.robot import Robot
-from .identify import base_regressor_samples, needs_scipy
+from .identify import base_regressor_samples
+from .measurements import needs_scipy
 from .output import write_atomic
 
 __all__ = ["FourierTrajectory", "excite", "DEFAULTS"]

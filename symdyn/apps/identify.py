@@ -11,8 +11,8 @@ identification of robots with power model", 1997):
 
 1. ordinary least squares, pi_0 = argmin |y - W pi|, and per joint j the residual variance
    sigma_j^2 = |r_j|^2 / (N - nbase / n)  (the N n - nbase residual degrees of freedom shared
-   equally by the n joints; a floor of 1e-12 times the joint's torque RMS keeps noise-free data
-   finite);
+   equally by the n joints; a floor of 1e-12 times the joint's torque RMS, at least 1e-6 of the
+   largest joint's, keeps noise-free data finite);
 2. weighted least squares with every row of joint j divided by sigma_j:
    pi_b = argmin |G (y - W pi)|, covariance C = s^2 (W^T G^2 W)^-1 with
    s^2 = |G (y - W pi_b)|^2 / (N n - nbase); the standard deviation of estimate k is sqrt(C_kk)
@@ -22,41 +22,37 @@ The condition number is that of the stacked base regressor W (2-norm: largest ov
 singular value); the residual RMS is per joint, with the final estimates. Warnings: a condition
 number above HIGH_CONDITION, or a relative standard deviation above HIGH_RELATIVE_STD percent.
 
-Measurements (`read_measurements`): a CSV file with a header naming the columns t, q1..qn,
-optionally qd1..qdn and qdd1..qddn, and tau1..taun. Without velocities and accelerations they are
-estimated from q by a Savitzky-Golay filter (scipy.signal.savgol_filter; Savitzky and Golay, 1964):
-a polynomial of degree SG_ORDER fitted by least squares to each window of SG_WINDOW samples
-(odd), whose value and first two derivatives at the window's centre replace q, qd and qdd; the
-samples must then be evenly spaced in t.
+Measurements: symdyn.apps.measurements (CSV, .npz or .npy logs). A floating robot (NV = 6 + n
+rows per sample, symdyn.model.free_flyer) is identified the same way with its floating regressor:
+the six base rows (the wrench on the base in the base frame, zero in free flight) are rows like
+the joints' (each with its own sigma), so a log of a robot in flight also constrains the
+parameters through its zero base wrench; "joint" above then means "row of NV".
 """
 
 from __future__ import annotations
 
-import csv
-import io
 import os
-import warnings
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import SymdynError
 from ..model.robot import Robot
 from .least_squares import Triangular, combine
+from .measurements import SG_ORDER, SG_WINDOW, Measurements, differentiate, needs_scipy, read_measurements
 
-__all__ = [
+__all__ = [  # the log reading lives in symdyn.apps.measurements; its names stay importable from here
     "Measurements",
-    "Identification",
     "read_measurements",
     "differentiate",
     "needs_scipy",
+    "SG_WINDOW",
+    "SG_ORDER",
+    "Identification",
     "base_regressor_samples",
     "identify",
     "HIGH_CONDITION",
     "HIGH_RELATIVE_STD",
-    "SG_WINDOW",
-    "SG_ORDER",
     "CHUNK_BYTES",
     "chunk_samples",
 ]
@@ -65,23 +61,8 @@ __all__ = [
 HIGH_CONDITION = 1000.0
 #: relative standard deviations (percent) above this are reported
 HIGH_RELATIVE_STD = 10.0
-#: Savitzky-Golay window (samples, odd) and polynomial degree for qd and qdd from q
-SG_WINDOW = 21
-SG_ORDER = 4
 #: bytes of base regressor `identify` evaluates per batch call (the chunk it holds at a time)
 CHUNK_BYTES = 16 * 2**20
-
-
-@dataclass
-class Measurements:
-    """N samples: times t (N,), joint positions q, velocities qd, accelerations qdd, torques tau (N, n)."""
-
-    t: np.ndarray
-    q: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
-    tau: np.ndarray
-    differentiated: bool = False  # qd and qdd were estimated from q (Savitzky-Golay)
 
 
 @dataclass
@@ -148,131 +129,23 @@ class Identification:
         return "\n".join(lines) + "\n"
 
 
-def _columns(header: list[str], n: int, where: str, torques: bool = True) -> dict[str, list[int]]:
-    """Indices of t, q, qd, qdd (and tau when `torques`) in the header (qd and qdd may be missing)."""
-    index = {name.strip(): k for k, name in enumerate(header)}
-    out: dict[str, list[int]] = {}
-    for head in ("t", "q", "qd", "qdd", "tau") if torques else ("t", "q", "qd", "qdd"):
-        names = ["t"] if head == "t" else [f"{head}{i}" for i in range(1, n + 1)]
-        present = [c for c in names if c in index]
-        if head in ("qd", "qdd") and not present:
-            continue
-        missing = [c for c in names if c not in index]
-        if missing:
-            raise SymdynError(
-                f"{where}: missing column(s) {', '.join(missing)} (the header is {','.join(header)})"
-            )
-        out[head] = [index[c] for c in names]
-    if ("qd" in out) != ("qdd" in out):
-        raise SymdynError(f"{where}: give both qd1..qd{n} and qdd1..qdd{n}, or neither")
-    return out
-
-
-def read_measurements(path: str | os.PathLike, n: int, torques: bool = True) -> Measurements:
-    """Measurements of an n-joint robot from a CSV file (see the module docstring).
-
-    With torques=False the tau columns are not required (a reference trajectory, e.g. the file
-    `symdyn excite` writes, for `symdyn simulate --track FILE.csv`); `tau` is then empty.
-    The values are parsed by numpy.loadtxt (C, about 1 s a million lines of 29 values); a file it
-    refuses is read again line by line (Python's csv and float) for the message, or the values
-    when Python accepts what NumPy does not (a quoted number, 1_000).
-
-    Raises:
-        SymdynError: no such file, a missing column, a value that is not a finite number,
-            or too few samples; the message names the file (and the line and column).
-    """
-    where = str(path)
-    try:
-        with open(path, newline="") as f:
-            header, skip = None, 0
-            for line in f:
-                skip += 1
-                row = next(csv.reader([line]), [])
-                if row and any(c.strip() for c in row):
-                    header = row
-                    break
-            if header is None:
-                raise SymdynError(f"{where}: empty file (expected a header t,q1..,tau1..)")
-            cols = _columns(header, n, where, torques)
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")  # numpy's "input contained no data"
-                    data = np.loadtxt(f, delimiter=",", comments=None, dtype=np.float64, ndmin=2)
-            except ValueError:
-                data = None
-    except OSError as exc:
-        raise SymdynError(f"{where}: cannot read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
-    if data is None or (len(data) and data.shape[1] != len(header)) or not np.all(np.isfinite(data)):
-        data = _read_slowly(path, header, skip)
-    if len(data) < 2:
-        raise SymdynError(f"{where}: too few samples ({len(data)})")
-    t, q = data[:, cols["t"][0]], data[:, cols["q"]]
-    tau = data[:, cols["tau"]] if torques else np.empty((len(data), 0))
-    if "qd" in cols:
-        return Measurements(t, q, data[:, cols["qd"]], data[:, cols["qdd"]], tau)
-    q, qd, qdd = differentiate(t, q, where)
-    return Measurements(t, q, qd, qdd, tau, differentiated=True)
-
-
-def _read_slowly(path: str | os.PathLike, header: list[str], skip: int) -> np.ndarray:
-    """The values after the header (its line is number `skip`) by Python's csv and float; a
-    SymdynError naming the line and column of the first wrong value."""
-    where, width = str(path), len(header)
-    names = [h.strip() for h in header]
-    text = Path(path).read_text()
-    values = []
-    for k, row in enumerate(csv.reader(io.StringIO(text)), start=1):
-        if k <= skip or not row or not any(c.strip() for c in row):
-            continue
-        if len(row) != width:
-            raise SymdynError(f"{where}: line {k} has {len(row)} values, the header {width}")
-        for c, name in zip(row, names, strict=True):
-            try:
-                x = float(c)
-            except ValueError:
-                raise SymdynError(f"{where}: line {k}: not a number in column {name}: '{c}'") from None
-            if not np.isfinite(x):
-                raise SymdynError(f"{where}: line {k}: column {name} is {c.strip()}, not a finite number")
-            values.append(x)
-    return np.array(values, dtype=np.float64).reshape(-1, width)
-
-
-def needs_scipy(module: str):
-    """scipy.<module>, or a SymdynError saying how to install it (the `ident` extra)."""
-    import importlib
-
-    try:
-        return importlib.import_module(f"scipy.{module}")
-    except ImportError:
-        raise SymdynError("identification needs scipy (pip install 'symdyn[ident]')") from None
-
-
-def differentiate(t: np.ndarray, q: np.ndarray, where: str = "differentiate", window: int = SG_WINDOW):
-    """(q, qd, qdd) by a Savitzky-Golay filter of q (module docstring); t evenly spaced."""
-    savgol_filter = needs_scipy("signal").savgol_filter
-    dt = np.diff(t)
-    if len(t) < window:
-        raise SymdynError(f"{where}: {len(t)} samples, the Savitzky-Golay filter needs at least {window}")
-    if not (np.all(dt > 0) and np.ptp(dt) <= 1e-6 * np.mean(dt)):
-        raise SymdynError(f"{where}: without qd and qdd columns the times t must be evenly spaced")
-    h = float(np.mean(dt))
-    return tuple(savgol_filter(q, window, SG_ORDER, deriv=d, delta=h, axis=0) for d in (0, 1, 2))
-
-
 def _regressor(robot: Robot):
     """A function (q, qd, qdd) of N samples -> Y_b, (N, n, nbase): the compiled C base_regressor's
     batch call (symdyn.compile, cached; its loop over the samples is in C, W samples per
     instruction), or the generated NumPy module without a C compiler; the robot's parameters
     must all have values."""
-    from .compiled import compiled_dynamics
+    if robot.floating:  # the regressor group is not among a floating robot's default groups
+        from .compile import compile
 
-    f = compiled_dynamics(robot).base_regressor
+        f = compile(robot, functions=("regressor",)).base_regressor
+    else:
+        from .compiled import compiled_dynamics
+
+        f = compiled_dynamics(robot).base_regressor
 
     def evaluate(q, qd, qdd) -> np.ndarray:
         Yb = f(*(np.asarray(a, dtype=float) for a in (q, qd, qdd)))
-        return np.asarray(Yb, dtype=float).reshape(len(q), robot.n, -1)
+        return np.asarray(Yb, dtype=float).reshape(len(q), robot.nv, -1)
 
     return evaluate
 
@@ -311,18 +184,18 @@ def identify(
             without it `predicted` is None.
 
     Raises:
-        SymdynError: fewer equations than base parameters; a floating robot.
+        SymdynError: fewer equations than base parameters; measurements of another size.
     """
-    if robot.floating:
-        raise SymdynError(
-            f"identify: robot '{robot.name}' has a floating base, which identification does not handle "
-            "yet (its regressor is generated: docs/floating-base.md)"
-        )
     N, n = data.tau.shape
     nb = len(base)
+    if n != robot.nv or data.q.shape[1] != robot.nq:
+        raise SymdynError(
+            f"identify: robot '{robot.name}' has NQ = {robot.nq} positions and NV = {robot.nv} torques, "
+            f"the measurements {data.q.shape[1]} and {n}"
+        )
     if N * n <= nb:
         raise SymdynError(
-            f"{N} samples of {n} joints give {N * n} equations for {nb} base parameters: need more"
+            f"{N} samples of {n} rows give {N * n} equations for {nb} base parameters: need more"
         )
     regressor = _regressor(robot)
     step = chunk_samples(n, nb) if chunk is None else max(1, int(chunk))
@@ -336,7 +209,8 @@ def identify(
     plain = combine(joints, np.ones(n))
     x0 = plain.solve()
     r2 = np.array([part.residual_norm(x0) ** 2 for part in joints])
-    floor = 1e-12 * np.maximum(np.sqrt(np.mean(data.tau**2, axis=0)), 1e-300)
+    rms = np.sqrt(np.mean(data.tau**2, axis=0))  # a row of zeros (free flight's base wrench): the others'
+    floor = 1e-12 * np.maximum(rms, max(1e-6 * rms.max(), 1e-300))
     sigma = np.maximum(np.sqrt(r2 / max(N - nb / n, 1.0)), floor)
     weighted = combine(joints, 1.0 / sigma)
     x = weighted.solve()

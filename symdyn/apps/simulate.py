@@ -352,7 +352,8 @@ def _floating(plant, sizes, q0, v0, duration, dt, tau, integrator) -> Trajectory
 
     scheme = "euler" if integrator == "lecture" else integrator
     Q, V, U = run_floating(plant, scheme, q, v, h, t, tau_at)
-    return Trajectory(plant.robot, t, Q, V, U, scheme, plant=plant)
+    A = np.asarray(plant.forward_dynamics(Q, V, U), dtype=float)  # for the CSV: an identification log
+    return Trajectory(plant.robot, t, Q, V, U, scheme, plant=plant, qdd=A)
 
 
 def simulate(

@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import SymdynError
-from ..model.free_flyer_names import BASE_POSITION_NAMES, BASE_VELOCITY_NAMES
+from ..model.free_flyer_names import NQ_BASE
 from .csv_format import csv_bytes, csv_text
+from .measurements import log_columns
 from .output import figure, figure_bytes, plot_format, write_atomic
 
 if TYPE_CHECKING:
@@ -45,6 +46,7 @@ class Trajectory:
     q_ref: np.ndarray | None = None
     qd_ref: np.ndarray | None = None
     plant: CompiledDynamics | None = field(default=None, repr=False, compare=False)
+    qdd: np.ndarray | None = None  # a floating robot's accelerations (forward dynamics at each sample)
 
     @property
     def n(self) -> int:
@@ -54,14 +56,20 @@ class Trajectory:
         if self.q.ndim != 2:
             raise SymdynError("CSV output holds one trajectory, not a batch")
         nq, nv = self.q.shape[1], self.qd.shape[1]
-        base_q, base_v = (BASE_POSITION_NAMES, BASE_VELOCITY_NAMES) if nq != nv else ((), ())
-        header = ["t", *base_q] + [f"q{i}" for i in range(1, nq - len(base_q) + 1)]
-        header += [*base_v] + [f"qd{i}" for i in range(1, nv - len(base_v) + 1)]
+        if nq != nv:  # floating: the log symdyn identify reads (symdyn.apps.measurements)
+            columns = log_columns(nq - NQ_BASE, floating=True)
+            values = {"t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau}
+            heads = [head for head, a in values.items() if a is not None]  # qdd: None in a hand-made run
+            header = [name for head in heads for name in columns[head]]
+            return header, np.column_stack([values[head] for head in heads])
+        header = ["t"] + [f"q{i}" for i in range(1, nq + 1)] + [f"qd{i}" for i in range(1, nv + 1)]
         return header, np.column_stack([self.t, self.q, self.qd])
 
     def csv_text(self) -> str:
         """Columns t, q1..qn, qd1..qdn, one row per sample, full double precision ("%.17g"); for a
-        floating robot t, x_b y_b z_b qx_b qy_b qz_b qw_b, q1..qn, vx_b .. wz_b, qd1..qdn."""
+        floating robot t, x_b y_b z_b qx_b qy_b qz_b qw_b, q1..qn, vx_b .. wz_b, qd1..qdn, then the
+        accelerations ax_b .. dwz_b, qdd1..qddn and the efforts fx_b .. mz_b, tau1..taun (a log
+        `symdyn identify` reads)."""
         return csv_text(*self._columns())
 
     def csv_bytes(self) -> bytes:

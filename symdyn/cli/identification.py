@@ -67,11 +67,12 @@ def _per_joint(items, n: int, what: str):
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
-    from ..apps.identify import identify, plot_identification, read_measurements
+    from ..apps.identify import identify, plot_identification
+    from ..apps.measurements import read_measurements
     from ..dynamics import derive
 
     robot = _robot(args)
-    data = read_measurements(args.data, robot.n)
+    data = read_measurements(args.data, robot.n, floating=robot.floating)
     result = identify(robot, data, derive(robot, simplify=False).base_parameters, predict=bool(args.plot))
     image = plot_identification(result, data) if args.plot else None
     print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else result.text(), end="")
@@ -80,7 +81,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
     for line in result.warnings():
         print(f"symdyn: warning: {line}", file=sys.stderr)
     if data.differentiated:
-        print("symdyn: note: qd and qdd estimated from q (Savitzky-Golay filter)", file=sys.stderr)
+        what = "qdd estimated from qd" if robot.floating else "qd and qdd estimated from q"
+        print(f"symdyn: note: {what} (Savitzky-Golay filter)", file=sys.stderr)
     if image is not None:
         from ..apps.output import write_atomic
 
@@ -119,7 +121,11 @@ def cmd_excite(args: argparse.Namespace) -> int:
 
 def _identify_arguments(i: argparse.ArgumentParser) -> None:
     add_robot_argument(i)
-    i.add_argument("data", help="CSV with columns t, q1..qn, [qd1..qdn, qdd1..qddn,] tau1..taun")
+    i.add_argument(
+        "data",
+        help="CSV with columns t, q1..qn, [qd1..qdn, qdd1..qddn,] tau1..taun (a floating robot: its free "
+        "flyer's columns too, as symdyn simulate writes them), or a .npz/.npy of the same values",
+    )
     i.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
     i.add_argument("--format", choices=("text", "json"), default="text")
     i.add_argument("--plot", help="draw measured and predicted torques to this PNG (or .pdf, .svg)")
