@@ -5,7 +5,7 @@
 
 The log (t, q, qd, qdd, tau at 1 kHz, sines; tau from the compiled inverse dynamics plus noise)
 is written to a temporary folder (never committed). Timed in this process: reading the CSV
-(symdyn.apps.measurements.read_measurements: the C parser), the same file by numpy.loadtxt (the
+(symdyn.apps.measurements.read_measurements: pandas' parser), the same file by numpy.loadtxt (the
 reader before) and the same values as a .npz log, the derivation of the base parameters (SymPy), the base
 regressor alone over the chunks identify uses (batch calls into one reused-size buffer), and
 identify itself (regressor chunks folded by incremental QR, both least squares, no prediction);
@@ -64,7 +64,7 @@ def identify_part(samples: int, folder: Path) -> dict[str, float]:
     times: dict[str, float] = {}
     t0 = time.perf_counter()
     data = read_measurements(big, robot.n)
-    times[f"read the CSV ({big.stat().st_size / 1e6:.0f} MB), C parser in threads"] = time.perf_counter() - t0
+    times[f"read the CSV ({big.stat().st_size / 1e6:.0f} MB), pandas.read_csv"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     with open(big, "rb") as f:
         f.readline()

@@ -13,10 +13,10 @@ same values in NumPy's binary formats:
 * `.npz`: arrays t (N,), q (N, NQ), qd and qdd (N, NV; optional as in the CSV), tau (N, NV);
   `.npy`: one structured array whose field names are the CSV's column names.
 
-The CSV's numbers are parsed by a small C parser in threads (symdyn.apps.csv_read), else by
-numpy.loadtxt; a file either refuses is read again line by line (Python's csv and float) for a
-message naming the line and column, or for its values when Python reads what they do not (a
-quoted number, 1_000). Missing velocities and accelerations of a fixed-base log are estimated
+The CSV's numbers are parsed by pandas' C parser when pandas is installed (symdyn.apps.csv_read;
+the `ident` extra installs it), else by numpy.loadtxt; a file both refuse is read again line by
+line (Python's csv and float) for a message naming the line and column, or for its values when
+Python reads what they do not (1_000). Missing velocities and accelerations of a fixed-base log are estimated
 from q by a Savitzky-Golay filter (scipy.signal.savgol_filter; Savitzky and Golay, 1964): a
 polynomial of degree SG_ORDER fitted by least squares to each window of SG_WINDOW samples (odd),
 whose value and first two derivatives at the window's centre replace q, qd and qdd; a floating
@@ -152,42 +152,40 @@ def read_measurements(
 
 
 def _read_csv(path: str | os.PathLike, where: str) -> tuple[list[str], np.ndarray, int]:
-    """(header, values (N, columns), the header's line number) of a CSV log: the C parser, else
+    """(header, values (N, columns), the header's line number) of a CSV log: pandas' parser, else
     numpy.loadtxt, else Python."""
+    header, skip = None, 0
     try:
-        text = Path(path).read_bytes()
+        with open(path, "rb") as f:
+            for line in f:
+                skip += 1
+                try:
+                    row = next(csv.reader([line.decode()]), [])
+                except UnicodeDecodeError as exc:
+                    raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
+                if row and any(c.strip() for c in row):
+                    header = row
+                    break
     except OSError as exc:
         raise SymdynError(f"{where}: cannot read ({exc.strerror or exc})") from None
-    header, skip, start = None, 0, 0
-    while start < len(text):
-        stop = text.find(b"\n", start)
-        stop = len(text) if stop < 0 else stop + 1
-        skip += 1
-        try:
-            row = next(csv.reader([text[start:stop].decode()]), [])
-        except UnicodeDecodeError as exc:
-            raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
-        start = stop
-        if row and any(c.strip() for c in row):
-            header = row
-            break
     if header is None:
         raise SymdynError(f"{where}: empty file (expected a header t,q1..,tau1..)")
-    data = parse_rows(text, start, len(header))
-    if data is None or not np.all(np.isfinite(data)):
-        data = _loadtxt(text[start:], len(header))
+    data = parse_rows(path, skip, len(header))
+    if data is None:
+        data = _loadtxt(path, skip, len(header))
     if data is None or not np.all(np.isfinite(data)):
         data = _read_slowly(path, header, skip)
     return header, data, skip
 
 
-def _loadtxt(body: bytes, width: int) -> np.ndarray | None:
-    """The values by numpy.loadtxt, or None when it refuses them or finds another count a line."""
+def _loadtxt(path: str | os.PathLike, skip: int, width: int) -> np.ndarray | None:
+    """The values after the first `skip` lines by numpy.loadtxt, or None when it refuses them or
+    finds another count a line."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # numpy's "input contained no data"
-            data = np.loadtxt(io.BytesIO(body), delimiter=",", comments=None, dtype=np.float64, ndmin=2)
-    except (ValueError, UnicodeDecodeError):
+            data = np.loadtxt(path, delimiter=",", comments=None, dtype=np.float64, ndmin=2, skiprows=skip)
+    except (ValueError, UnicodeDecodeError, OSError):
         return None
     return data if not len(data) or data.shape[1] == width else None
 
