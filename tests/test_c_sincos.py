@@ -30,9 +30,19 @@ from cbuild import (
     compilers,
     write_files,
 )
-from robots import assert_close, random_params, random_state, tree_robot, y_robot
+from robots import (
+    EXAMPLE_NAMES,
+    assert_close,
+    example,
+    example_context,
+    random_params,
+    random_state,
+    tree_robot,
+    y_robot,
+)
 
 import symdyn.codegen
+from symdyn.codegen import c as c_backend
 from symdyn.codegen.c.sincos import BLOCK, gather
 from symdyn.model.robot import Mimic
 from symdyn.parsers import load_robot
@@ -82,8 +92,8 @@ def _mimic_chain():
 
 
 ROBOTS = {
-    "puma560": lambda: _load("puma560"),
-    "panda": lambda: _load("panda"),
+    "puma560": lambda: example("puma560"),
+    "panda": lambda: example("panda"),
     "ytree": y_robot,
     "mimic3": _mimic_chain,
 }
@@ -261,8 +271,11 @@ def test_helper_is_vector_code(puma_files, tmp_path):
 
 @functools.cache
 def _rendered(name: str):
+    """(robot, context, C files), the files rendered from the context: one derivation, for the
+    example robots the one of the whole test process (tests/robots.py)."""
     robot = ROBOTS[name]()
-    return robot, symdyn.codegen.context(robot), symdyn.codegen.render(robot, targets=("c",))
+    ctx = example_context(name) if name in EXAMPLE_NAMES else symdyn.codegen.context(robot)
+    return robot, ctx, c_backend.render(ctx)
 
 
 #: The optimisation level of each robot's AVX2 build. -O3 (the vector code as it is meant to be
