@@ -271,6 +271,13 @@ def rational_example(name: str) -> Robot:
         return robot_from_data(_rational(raw_example(name)), source=f"{name} (rational)")
 
 
+@cache
+def derived_rational(name: str, method: str):
+    """derive(rational_example(name), method), unsimplified, once per session (the exact-data
+    tests of the configuration and product forms share it, and its cached forms)."""
+    return derive(rational_example(name), method=method, simplify=False)
+
+
 def trig_zero(expr: sp.Expr, n: int) -> bool:
     """Exact test that a polynomial in sin(q_i), cos(q_i) (and other symbols) vanishes.
 
