@@ -23,6 +23,8 @@ import sympy as sp
 import yaml
 from hypothesis import strategies as st
 
+from symdyn.codegen.functions import build_functions
+from symdyn.codegen.render import RenderContext
 from symdyn.dynamics import derive
 from symdyn.errors import SymdynWarning
 from symdyn.model.robot import Friction, Link, Motor, Robot
@@ -86,6 +88,16 @@ def raw_value(value, parameters: dict | None = None) -> sp.Expr:
 def derived(name: str, method: str, simplify: bool | None = False):
     """derive(example(name), method) once per session (closed forms unsimplified by default)."""
     return derive(example(name), method=method, simplify=simplify)
+
+
+@cache
+def example_context(name: str) -> RenderContext:
+    """What symdyn.codegen.context(example(name)) builds (double precision, Newton-Euler, the
+    default function groups), over the session-wide cached derivation: once per test process
+    for every test file that renders the example robots (a RenderContext is frozen; a test
+    that wants another precision takes dataclasses.replace of it)."""
+    dyn = derived(name, "newton-euler")
+    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), "double")
 
 
 @cache
@@ -257,6 +269,13 @@ def rational_example(name: str) -> Robot:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SymdynWarning)
         return robot_from_data(_rational(raw_example(name)), source=f"{name} (rational)")
+
+
+@cache
+def derived_rational(name: str, method: str):
+    """derive(rational_example(name), method), unsimplified, once per session (the exact-data
+    tests of the configuration and product forms share it, and its cached forms)."""
+    return derive(rational_example(name), method=method, simplify=False)
 
 
 def trig_zero(expr: sp.Expr, n: int) -> bool:

@@ -36,7 +36,7 @@ from cbuild import (
     header_macros,
     write_files,
 )
-from robots import regressor_oracle
+from robots import example_context, regressor_oracle
 
 import symdyn.codegen
 from symdyn.codegen import c as c_backend
@@ -73,7 +73,7 @@ class Builds:
 
     def context(self, robot: str) -> RenderContext:
         if robot not in self._ctx:
-            self._ctx[robot] = symdyn.codegen.context(_load(EXAMPLES / f"{robot}.yaml"))
+            self._ctx[robot] = example_context(robot)  # derived once per test process (tests/robots.py)
         return self._ctx[robot]
 
     def files(self, robot: str, precision: str = "double") -> dict[str, str]:

@@ -35,9 +35,9 @@ from robots import (
     EXAMPLE_NAMES,
     assert_close,
     asymmetric_friction,
-    derived,
     derived_robot,
     example,
+    example_context,
     friction_closed_form,
     friction_states,
     random_params,
@@ -58,11 +58,9 @@ RTOL = 1e-9
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@cache
 def _context(name: str) -> RenderContext:
     """What symdyn.codegen.context builds, over the session-wide cached derivation."""
-    dyn = derived(name, "newton-euler")
-    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), "double")
+    return example_context(name)
 
 
 @cache

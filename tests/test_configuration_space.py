@@ -13,9 +13,9 @@ import sympy as sp
 from robots import (
     EXAMPLE_NAMES,
     derived,
+    derived_rational,
     random_params,
     random_state,
-    rational_example,
     solo_robot,
     y_robot,
 )
@@ -59,7 +59,7 @@ def _texts(dyn) -> list[str]:
 @pytest.mark.parametrize("name", EXAMPLE_NAMES)
 def test_routes_give_identical_strings_exact_data(name):
     """The Panda too (228,647 terms; the Lagrange route writes its Jacobians in body frames)."""
-    a, b = _both(rational_example(name))
+    a, b = (derived_rational(name, m) for m in ("newton-euler", "lagrange"))  # session-cached
     _assert_same_terms(a, b, exact=True, what=name)
     assert _texts(a) == _texts(b), name
     if a.configuration_space.readable:
@@ -171,7 +171,7 @@ def test_christoffel_symbols_of_a_two_link_arm():
 
 def test_puma_velocity_terms_are_compact():
     """V of the PUMA 560 (exact data) from the Christoffel symbols: within 2x their size."""
-    dyn = derive(rational_example("puma560"), simplify=False)
+    dyn = derived_rational("puma560", "newton-euler")
     gamma = count_ops([], list(dyn.christoffel.values())).total
     assert len(dyn.christoffel) == 84
     assert count_ops([], list(dyn.V)).total <= 2 * gamma

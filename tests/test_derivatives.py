@@ -27,9 +27,12 @@ import numpy as np
 import pytest
 import sympy as sp
 from cbuild import SANITIZE_FLAGS, STRICT_FLAGS, compile_program, compile_shared, write_files
-from robots import EXAMPLE_NAMES, example, random_params, tree_robot
+from robots import EXAMPLE_NAMES, example, example_context, random_params, tree_robot
 
-from symdyn.codegen import render
+from symdyn.codegen import c as c_backend
+from symdyn.codegen import casadi as casadi_backend
+from symdyn.codegen import context, render
+from symdyn.codegen import python as python_backend
 from symdyn.codegen.derivative_functions import DERIVATIVE_FUNCTION_NAMES
 from symdyn.model.topology import Mimic
 
@@ -59,7 +62,10 @@ def _module(text: str, name: str) -> types.ModuleType:
 def generated(request, tmp_path_factory):
     """Each robot rendered once for the module: C (compiled), NumPy and CasADi."""
     robot = ROBOTS[request.param]()
-    files = render(robot, targets=("c", "python", "casadi"))
+    # what render(robot, targets=("c", "python", "casadi")) gives, over one context: for the
+    # example robots the one derived once per test process (tests/robots.py)
+    ctx = example_context(request.param) if request.param in EXAMPLE_NAMES else context(robot)
+    files = {k: v for t in (c_backend, python_backend, casadi_backend) for k, v in t.render(ctx).items()}
     out = tmp_path_factory.mktemp(request.param)
     write_files({k: v for k, v in files.items() if k.startswith(f"{robot.name}_dynamics.")}, out)
     lib = compile_shared([out / f"{robot.name}_dynamics.c"], out / "lib.so", opt="-O0")  # fast to build

@@ -30,13 +30,17 @@ from robots import (
     assert_close,
     asymmetric_friction,
     example,
+    example_context,
     friction_closed_form,
     friction_states,
     random_params,
     random_state,
 )
 
-from symdyn.codegen import context, render
+from symdyn.codegen import c as c_backend
+from symdyn.codegen import matlab as matlab_backend
+from symdyn.codegen import python as python_backend
+from symdyn.codegen import render
 from symdyn.codegen.matlab import MatlabPrinter
 from symdyn.codegen.render import header_lines
 from symdyn.errors import SymdynError
@@ -51,9 +55,10 @@ OCTAVE = shutil.which("octave-cli")
 pytestmark = pytest.mark.skipif(OCTAVE is None, reason="GNU Octave (octave-cli) is not installed")
 
 
-@cache
 def _context(name: str):
-    return context(example(name))
+    """symdyn.codegen.context of the example robot, derived once per test process (tests/robots.py):
+    the MATLAB, C and NumPy files compared here are all rendered from it."""
+    return example_context(name)
 
 
 def _numbers(values) -> str:
@@ -70,7 +75,7 @@ def octave(tmp_path_factory):
     for name in ROBOTS:
         folder = root / name
         folder.mkdir()
-        for file, text in render(example(name), targets=("matlab",)).items():
+        for file, text in matlab_backend.render(_context(name)).items():
             (folder / file).write_text(text)
         lines.append(f"addpath('{folder}');")
         robot = example(name)
@@ -116,11 +121,11 @@ def octave(tmp_path_factory):
 
 @cache
 def _c_library(name: str, folder: str):
-    return build_dynamics(render(example(name), targets=("c",)), folder, name)
+    return build_dynamics(c_backend.render(_context(name)), folder, name)
 
 
 def _numpy_module(name: str, folder: Path):
-    files = render(example(name), targets=("python",))
+    files = python_backend.render(_context(name))
     ((file, text),) = files.items()
     path = folder / file
     path.write_text(text)

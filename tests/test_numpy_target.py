@@ -20,11 +20,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from robots import derived, example, spec_arguments
+from robots import example, example_context, spec_arguments
 
 from symdyn.codegen import python as numpy_backend
 from symdyn.codegen import render as render_targets
-from symdyn.codegen.functions import build_functions
 from symdyn.codegen.render import RenderContext
 
 rn = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
@@ -38,11 +37,9 @@ def _robot(path: Path):
     return example(path.stem)
 
 
-@cache
 def _context(path: Path) -> RenderContext:
     """What symdyn.codegen.context builds, over the session-wide cached derivation."""
-    dyn = derived(path.stem, "newton-euler")
-    return RenderContext(dyn.robot, dyn, tuple(build_functions(dyn)), "double")
+    return example_context(path.stem)
 
 
 @cache

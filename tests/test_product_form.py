@@ -8,12 +8,11 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
-from functools import cache
 
 import numpy as np
 import pytest
 import sympy as sp
-from robots import EXAMPLE_NAMES, EXAMPLES_DIR, derived, example, random_state, rational_example, trig_zero
+from robots import EXAMPLE_NAMES, EXAMPLES_DIR, derived, derived_rational, example, random_state, trig_zero
 
 from symdyn import rnea
 from symdyn.algorithms.configuration_space import pair_columns
@@ -24,9 +23,8 @@ from symdyn.dynamics import derive
 SMALL = [n for n in EXAMPLE_NAMES if n != "panda"]  # the Panda's configuration form is 228,647 terms
 
 
-@cache
 def _rational(name: str, method: str):
-    return derive(rational_example(name), method=method, simplify=False)
+    return derived_rational(name, method)  # once per session, shared with test_configuration_space
 
 
 def _texts(pf) -> list[str]:

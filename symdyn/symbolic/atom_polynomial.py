@@ -99,7 +99,10 @@ class Atoms:
         self._gens: dict[int, int] = {}
         self._angles: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by (block, multiple)
         self._sums: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by k
+        self._prefixes: dict[tuple, tuple[AtomPoly, AtomPoly]] = {}  # by leading (block, multiple)s
         self._floats: dict[tuple, list] = {}  # by (k, kind), float coefficients
+        self._monomials: list[tuple] = []  # atom monomials met in float sums, by number
+        self._monomial_numbers: dict[tuple, int] = {}
         self._names: list[str] = []
         self._taken = set(taken)
         self._sep = "" if ring.n < 10 else "_"
@@ -214,12 +217,18 @@ class Atoms:
         n = self.ring.n
         cos: AtomPoly = {(): Fraction(1)}
         sin: AtomPoly = {}
+        prefix: tuple = ()
         for block, m in split_blocks(k[:n], self.groups):
-            cb, sb = self._cos_sin(block, m)
-            cos, sin = (
-                _sub(self.multiply(cos, cb), self.multiply(sin, sb)),
-                _sub(self.multiply(sin, cb), self.multiply(cos, sb), plus=True),
-            )
+            # angles that begin with the same blocks share the products of those blocks
+            prefix += ((block, m),)
+            hit = self._prefixes.get(prefix)
+            if hit is None:
+                cb, sb = self._cos_sin(block, m)
+                hit = self._prefixes[prefix] = (
+                    _sub(self.multiply(cos, cb), self.multiply(sin, sb)),
+                    _sub(self.multiply(sin, cb), self.multiply(cos, sb), plus=True),
+                )
+            cos, sin = hit
         r = k[n]
         if r:
             cr, sr = (number(f(to_sympy_number(r))) for f in (sp.cos, sp.sin))
@@ -229,30 +238,46 @@ class Atoms:
             )
         return cos, sin
 
-    def _float_angle(self, k: tuple, kind: int) -> list[tuple[tuple, float]]:
-        """angle(k)[kind] with float coefficients, for terms with float coefficients."""
+    def _float_angle(self, k: tuple, kind: int) -> list[tuple[int, float]]:
+        """angle(k)[kind] with float coefficients, for terms with float coefficients: pairs
+        (number of the atom monomial in self._monomials, coefficient)."""
         hit = self._floats.get((k, kind))
         if hit is None:
-            hit = self._floats[(k, kind)] = [(m, float(x)) for m, x in self.angle(k)[kind].items()]
+            hit = self._floats[(k, kind)] = [
+                (self._monomial_number(m), float(x)) for m, x in self.angle(k)[kind].items()
+            ]
         return hit
+
+    def _monomial_number(self, mono: tuple) -> int:
+        number = self._monomial_numbers.get(mono)
+        if number is None:
+            number = self._monomial_numbers[mono] = len(self._monomials)
+            self._monomials.append(mono)
+        return number
 
     def convert(self, p: TrigPoly) -> AtomPoly:
         """The TrigPoly p over the atoms: each term's angle expanded, times its monomial. Terms
         with float coefficients are summed in floats (the Panda: 15 million products)."""
         out: AtomPoly = {}
-        floats: dict[tuple, float] = {}
+        # Float sums keyed by the pair (atom monomial, generator monomial) packed in one int,
+        # factor number << 32 | atom monomial number: the two monomials use disjoint variables,
+        # so a pair is one monomial, merged (mono_mul) once per pair rather than once per product.
+        floats: dict[int, float] = {}
+        factors: dict[tuple, int] = {}
         for (mono, k, kind), c in p.items():
             factor = tuple(sorted((self.generator(g), e) for g, e in mono))
             if type(c) is float:
-                for tm, x in self._float_angle(k, kind):
-                    key = mono_mul(tm, factor)
+                base = factors.setdefault(factor, len(factors)) << 32
+                for number, x in self._float_angle(k, kind):
+                    key = base | number
                     floats[key] = floats.get(key, 0.0) + c * x
                 continue
             for tm, x in self.angle(k)[kind].items():
                 _put(out, mono_mul(tm, factor), _mul_coef(c, x))
+        by_number = list(factors)
         for key, x in floats.items():
             if x != 0.0:
-                _put(out, key, x)
+                _put(out, mono_mul(self._monomials[key & 0xFFFFFFFF], by_number[key >> 32]), x)
         return out
 
 

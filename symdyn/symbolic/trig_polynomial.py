@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from fractions import Fraction
+from operator import add, neg, sub
 
 import sympy as sp
 from sympy.core.add import _addsort
@@ -133,29 +134,30 @@ def mono_mul(a: Monomial, b: Monomial) -> Monomial:
     return tuple(sorted(d.items()))
 
 
-def _normal(k: tuple, kind: int, c):
-    """(k, kind, c) with k's first non-zero component positive; None for sin(0)."""
+def _put(acc: TrigPoly, mono: Monomial, k: tuple, kind: int, c) -> None:
+    """acc += c mono cos(k . q) (kind 0) or c mono sin(k . q) (kind 1), stored with k's first
+    non-zero component positive (sin(-a) = -sin a); sin(0) adds nothing. Written out in one
+    function: multiply calls it millions of times on the Panda."""
     for x in k:
         if x != 0:
             if x < 0:
-                k = tuple(-y for y in k)
+                k = tuple(map(neg, k))
                 if kind:
                     c = -c
-            return k, kind, c
-    return None if kind else (k, 0, c)
-
-
-def _put(acc: TrigPoly, mono: Monomial, k: tuple, kind: int, c) -> None:
-    n = _normal(k, kind, c)
-    if n is None:
-        return
-    key = (mono, n[0], n[1])
+            break
+    else:
+        if kind:  # sin(0)
+            return
+    key = (mono, k, kind)
     old = acc.get(key)
-    new = _canonical(n[2] if old is None else old + n[2])
-    if _is_zero(new):
+    if old is not None:
+        c = old + c
+    if type(c) is not Fraction and type(c) is not float:
+        c = _canonical(c)
+    if c == 0:
         acc.pop(key, None)
     else:
-        acc[key] = new
+        acc[key] = c
 
 
 def multiply(p: TrigPoly, r: TrigPoly) -> TrigPoly:
@@ -175,8 +177,8 @@ def multiply(p: TrigPoly, r: TrigPoly) -> TrigPoly:
                 _put(out, mono, ka, ta, c)
                 continue
             h = c / 2
-            plus = tuple(x + y for x, y in zip(ka, kb, strict=True))
-            minus = tuple(x - y for x, y in zip(ka, kb, strict=True))
+            plus = tuple(map(add, ka, kb))  # keys of one ring: of one length
+            minus = tuple(map(sub, ka, kb))
             if ta == 0 and tb == 0:  # cos a cos b = (cos(a - b) + cos(a + b)) / 2
                 _put(out, mono, minus, 0, h)
                 _put(out, mono, plus, 0, h)

@@ -19,6 +19,8 @@ expressions); every Python statement is spelled in templates/python/module.py.j2
 
 from __future__ import annotations
 
+import weakref
+
 from ..functions import FunctionSpec
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
@@ -73,10 +75,40 @@ def function_view(spec: FunctionSpec, printer: NumpyPrinter, floating: bool = Fa
     }
 
 
+#: Printed in place of the array namespace, then replaced by the module's own ("xp", "jnp"), so
+#: that one printing of a context's expressions serves both the NumPy and the JAX module (the
+#: printer writes the namespace only as the prefix of its functions; NUL is never in printed code).
+_NAMESPACE = "\x00"
+#: [weak reference to the last context printed, its function views with _NAMESPACE]
+_last: list = [None, None]
+
+
+def _printed_views(ctx: RenderContext) -> list[dict]:
+    ref, views = _last
+    if ref is None or ref() is not ctx:
+        printer = NumpyPrinter(local_names(ctx), module=_NAMESPACE)
+        views = [function_view(spec, printer, ctx.robot.floating) for spec in ctx.functions]
+        _last[:] = [weakref.ref(ctx), views]
+    return views
+
+
+def _in_namespace(view: dict, namespace: str) -> dict:
+    """A view of _printed_views with its printed expressions calling `namespace`."""
+
+    def fix(text: str) -> str:
+        return text.replace(_NAMESPACE, namespace)
+
+    return {
+        **view,
+        "unpack": [(fix(name), inp, k) for name, inp, k in view["unpack"]],
+        "temporaries": [(fix(name), fix(value)) for name, value in view["temporaries"]],
+        "outputs": [{**out, "entries": [fix(e) for e in out["entries"]]} for out in view["outputs"]],
+    }
+
+
 def render_module(ctx: RenderContext, template: str, namespace: str) -> str:
     """The text of a Python module of the robot of `ctx` from `template` (a path under templates/),
     its expressions printed with the array namespace `namespace` ("xp", "jnp")."""
-    printer = NumpyPrinter(local_names(ctx), module=namespace)
     return (
         environment()
         .get_template(template)
@@ -87,7 +119,7 @@ def render_module(ctx: RenderContext, template: str, namespace: str) -> str:
             nq=ctx.robot.nq if ctx.robot.floating else None,
             param_names=[s.name for s in ctx.dynamics.params],
             dtype=dtype(ctx.precision),
-            functions=[function_view(spec, printer, ctx.robot.floating) for spec in ctx.functions],
+            functions=[_in_namespace(view, namespace) for view in _printed_views(ctx)],
             loops=loop_solve_context(ctx),
         )
     )
