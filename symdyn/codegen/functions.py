@@ -305,5 +305,7 @@ def build_functions(
         if not group:
             needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
         steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
-        code |= eliminate_many(steps, {row.name: list(row.exprs) for row in members}, reserved=x.symbols)
+        visits = {row.name: row.visit for row in members if row.visit is not None}
+        groups = {row.name: list(row.exprs) for row in members}
+        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

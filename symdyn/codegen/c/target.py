@@ -15,6 +15,8 @@ templates/c/*.j2.
 
 from __future__ import annotations
 
+import sympy as sp
+
 from ...errors import SymdynError
 from ..frame_functions import comment_text
 from ..functions import FunctionSpec
@@ -124,6 +126,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
             }
         )
     return {
+        "body": _body(spec, temporaries, outputs, printer),
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
@@ -136,6 +139,28 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         "sincos": sincos,
         "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in temporaries],
     }
+
+
+def _body(spec: FunctionSpec, temporaries: list, outputs: list[dict], printer: CPrinter) -> list:
+    """The statements of a function after its inputs are read: ("let", name, value) for each
+    temporary and ("store", "OUT[k]", value) for each output entry, every store right after the
+    last temporary it reads (or first, when it reads none). A value stored as soon as it is known
+    needs no register or stack slot to the end of the function: the stores of a large M at the
+    end made the compiler spill hundreds of temporaries to the stack and load them back."""
+    position = {sym: k for k, (sym, _) in enumerate(temporaries)}
+    after: dict[int, list] = {}
+    for result, view in zip(spec.results, outputs, strict=True):
+        fill = view["fill"]
+        for k, e in enumerate(spec.entries(result)):
+            if fill and e == 0:
+                continue
+            last = max((position[s] for s in sp.sympify(e).free_symbols if s in position), default=-1)
+            after.setdefault(last, []).append(("store", f"{view['name']}[{k}]", printer.doprint(e)))
+    body = list(after.get(-1, []))
+    for k, (sym, expr) in enumerate(temporaries):
+        body.append(("let", sym.name, printer.doprint(expr)))
+        body.extend(after.get(k, []))
+    return body
 
 
 def render_context(ctx: RenderContext) -> dict:
