@@ -124,7 +124,12 @@ def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     rows = []
     for name, doc, inputs, out in table:
         shape = joint_matrix_output if out in ("M", "C") else vector_output
-        rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), tuple(c[out])))
+        exprs = tuple(c[out])
+        # M's temporaries laid out from its last entry back: column by column from the leaves, as
+        # the composite bodies are built, each column's carried force used as soon as it is known
+        # (row by row from the first kept every column's force alive: Talos M 920 -> 820 ns)
+        visit = tuple(reversed(range(len(exprs)))) if out == "M" else None
+        rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), exprs, visit=visit))
     return rows
 
 
