@@ -34,9 +34,10 @@ __all__ = ["render", "render_context", "symbol_names", "function_inputs", "TOOLS
 JOINT_INPUTS = ("q", "qd", "qdd", "tau")
 ACTUATED_INPUTS = ("qda", "qdda", "tau_a")
 
-#: an output with at least this many exact zeros, a third of its entries or more, is zeroed by one
-#: loop (vector stores) before its other entries are stored: a floating robot's or a tree's M has
-#: more zeros than non-zeros (joints on different branches), and one store per zero costs more
+#: an output with at least this many exact zeros, a third of its entries or more, has its runs of
+#: consecutive zeros zeroed by loops (vector stores) before its other entries are stored: a
+#: floating robot's or a tree's M has more zeros than non-zeros (joints on different branches),
+#: and one store per zero costs more
 FILL_ZEROS = 16
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
@@ -122,6 +123,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
                 "doc": result.doc,
                 "size": size,
                 "fill": len(entries) if fill else 0,
+                "zero_runs": _zero_runs(entries) if fill else [],
                 "stores": [(k, printer.doprint(e)) for k, e in enumerate(entries) if not (fill and e == 0)],
             }
         )
@@ -139,6 +141,20 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         "sincos": sincos,
         "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in temporaries],
     }
+
+
+def _zero_runs(entries: list) -> list[tuple[int, int]]:
+    """The runs [start, end) of consecutive exact zeros among an output's entries (row-major): each
+    is zeroed by one loop that the compiler turns into vector stores. Zeroing the whole output and
+    then storing the rest wrote a Talos M (1444 entries, 762 of them zero) twice: 150 of its 750 ns."""
+    runs: list[list[int]] = []
+    for k, e in enumerate(entries):
+        if e == 0:
+            if runs and runs[-1][1] == k:
+                runs[-1][1] = k + 1
+            else:
+                runs.append([k, k + 1])
+    return [(a, b) for a, b in runs]
 
 
 def _body(spec: FunctionSpec, temporaries: list, outputs: list[dict], printer: CPrinter) -> list:
