@@ -156,6 +156,9 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (vector_output("qdd", n, _OUTPUT_DOCS["qdd"]),),
             tuple(qdd_out),
             tuple(fd.needed(qdd_out)),
+            # a floating robot's temporaries laid out from the last output back (measured on Talos:
+            # 2400 -> 2330 ns; fixed bases keep their order)
+            visit=tuple(reversed(range(n))) if dyn.robot.floating else None,
         )
     ]
 
