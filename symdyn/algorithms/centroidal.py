@@ -26,9 +26,11 @@ floating base, Robot.base's rotation on a fixed one):
    L_O = h x e_k; its angular velocity e_k: P = e_k x h, L_O = J e_k. About the centre of mass,
    L_G = L_O - c_b x P; a mimic joint's column adds to its coordinate's (A = A_body S).
    A_g does not use steps 1 and 2: (P, L_O) of joint j is the spatial force I^c_j S_j of its
-   subtree's composite inertia, built in the links' own frames and carried to the base origin
-   by symdyn.algorithms.crba (the base rows of a floating M), and (m, h, J) the whole robot's
-   composite there (A_g is M[0:6] moved to the centre of mass: Orin, Goswami and Lee (2013)).
+   subtree's composite inertia, built in the links' own frames (symdyn.algorithms.crba), and
+   (m, h, J) the whole robot's composite about the base origin (A_g is M[0:6] moved to the
+   centre of mass: Orin, Goswami and Lee (2013)). Each column goes in one step from link j's
+   frame to the centre of mass with world axes, through link j's world-aligned frame composed
+   from the base (`Centroidal.momentum_matrix`).
 4. A_g = blockdiag(R, R) [P; L_G] (world_R_base R), c = p_base + R c_b, and the centre of
    mass's Jacobian Jc = A_g[0:3] / m (linear momentum = m dc/dt).
 
