@@ -8,16 +8,26 @@ child process: the generation target is <= 60 s); the generated inverse_dynamics
 forward_dynamics are compiled with machine.FLAGS into a small harness, checked against
 symdyn.rnea at the first NCHECK states and timed; bench/pinocchio_floating.cpp (Pinocchio's free
 flyer, compiled header-only by bench/pin_harness.py) checks its rnea, crba and aba against the same
-numbers and times them on the same states. Timings are medians over repetitions interleaved across
-the functions (the protocol of bench/run.py). The table goes to stdout and
-bench/results/floating.txt; the targets are symdyn <= 0.25 x Pinocchio.
+numbers and times them on the same states.
+
+How it is timed (both sides alike): each function runs in its own hot loop, one call after the
+other on the NSTATES states in turn (the state changes every call), for about TARGET_MS per
+repetition, after a calibration that also warms the caches; the repetitions are interleaved
+across the functions, and the C and Pinocchio programs run in alternating rounds
+(bench/c_harness.time_compiled), so that a change of machine load falls on both; the figure is
+the median over all repetitions. The clock is the thread's CPU time (CLOCK_THREAD_CPUTIME_ID),
+not the wall clock: on a machine with more runnable processes than cores a repetition of a few
+milliseconds otherwise either runs in one scheduler slice or also counts the slices of other
+processes, which made single repetitions 2-7 times slower and medians unstable (docs/speed.md).
+The generated functions write every entry of their outputs, M's zeros included, on every call.
+The table goes to stdout and bench/results/floating.txt; the targets are symdyn <= 0.25 x
+Pinocchio.
 """
 
 from __future__ import annotations
 
 import argparse
 import resource
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -25,9 +35,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-from c_harness import C_PRINT_OUT, C_TIME_MAIN, parse_harness
-from machine import C_COMPILER, FLAGS, RESULTS, machine, run
+from c_harness import C_PRINT_OUT, C_TIME_MAIN, parse_harness, time_compiled
+from machine import C_COMPILER, FLAGS, RESULTS, load_averages, machine, run
 from pin_harness import model_and_states_lines, prepare
+from row import Row
 from states import NCHECK, NSTATES, SEED, rel_err
 
 import symdyn
@@ -68,7 +79,7 @@ static const char *LABELS[NB] = {{{labels}}};
 static double now_ns(void)
 {{
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); /* CPU time: not the slices of other processes */
     return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
 }}
 
@@ -222,15 +233,17 @@ def bench_robot(name: str, path: Path, work: Path, pin_exe: Path | None, opts) -
         for fn, want in ref.items():
             errors[fn] = max(errors.get(fn, 0.0), rel_err(checks[fn][k], want))
     result = {"name": name, "joints": robot.n, "nv": robot.nv, "wall": wall, "cpu": cpu, "errors": errors}
-    text = run([str(exe), str(states_file), "time", str(opts.reps), str(opts.target_ms)]).stdout
-    result["symdyn"] = {fn: statistics.median(ns) for fn, ns in parse_harness(text)[1].items()}
+    pin_cmd = None
     if pin_exe is not None:
         model = work / f"{name}_model.txt"
         model.write_text(pinocchio_text(robot, st))
-        out = run([str(pin_exe), str(model), str(opts.reps), str(opts.target_ms)]).stdout
-        pin_checks, pin_times = parse_harness(out)
-        result["pin_errors"] = pin_checks
-        result["pinocchio"] = {fn: statistics.median(ns) for fn, ns in pin_times.items()}
+        result["pin_errors"] = parse_harness(run([str(pin_exe), str(model), "1", "0.1"]).stdout)[0]
+        pin_cmd = [pin_exe, model]
+    row = Row(name)
+    time_compiled(row, [exe, states_file, "time"], pin_cmd, opts)
+    result["symdyn"] = row.c_ns
+    if pin_cmd is not None:
+        result["pinocchio"] = row.pin_ns
     return result
 
 
@@ -267,6 +280,7 @@ def table(results: list[dict], note: str) -> str:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--reps", type=int, default=21)
+    parser.add_argument("--rounds", type=int, default=7, help="alternating rounds, C and Pinocchio")
     parser.add_argument("--target-ms", type=float, default=2.0)
     parser.add_argument("--build-dir", type=Path, default=RESULTS / "build")
     opts = parser.parse_args(argv)
@@ -278,6 +292,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         results = [bench_robot(name, folder / rel, Path(tmp), pin_exe, opts) for name, rel in ROBOTS.items()]
     text = table(results, note)
+    text += f"load averages at the end: {', '.join(f'{x:.2f}' for x in load_averages())}\n"
     sys.stdout.write(text)
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "floating.txt").write_text(text)

@@ -10,7 +10,10 @@ Pinocchio's computeCentroidalMap and computeCentroidalMapTimeVariation + dAg v
 (bench/pinocchio_centroidal.cpp, the model of bench/pinocchio_model.hpp under a free flyer), both
 checked against the numeric oracle (symdyn.oracle.centroidal) at NCHECK states, then timed on the
 same NSTATES states (random configurations with unit quaternions) in alternating rounds
-(bench/c_harness.time_compiled, medians; the target ratio is 0.25). The table goes to stdout and
+(bench/c_harness.time_compiled, medians; the target ratio is 0.25). Each function runs in its own
+hot loop on the states in turn; both programs read the thread's CPU time
+(CLOCK_THREAD_CPUTIME_ID), not the wall clock, so that the scheduler slices of other processes on
+a loaded machine are not counted (bench/floating.py says why). The table goes to stdout and
 bench/results/floating_centroidal.txt, every number to bench/results/floating_centroidal.json.
 """
 
@@ -72,7 +75,7 @@ static const char *LABELS[NB] = {{"centroidal_momentum_matrix", "map_and_drift"}
 static double now_ns(void)
 {{
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); /* CPU time: not the slices of other processes */
     return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
 }}
 

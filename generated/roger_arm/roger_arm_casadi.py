@@ -114,20 +114,20 @@ def build_mass_matrix() -> ca.Function:
     """
     q = ca.SX.sym("q", 2)
     p = ca.SX.sym("p", 5)
-    x0 = p[1]*p[1]
+    x0 = p[4]*p[3]*p[3]
     x1 = p[3]*p[4]
     x2 = ca.cos(q[1])
     x3 = x1*x2
     x4 = x3*p[1]
-    x5 = p[4]*p[3]*p[3]
-    x6 = p[2]*x0
-    x7 = x5 + x6 + p[4]*x0 + 2*x4
-    x8 = x5 + x4
+    x5 = x0 + x4
+    x6 = p[1]*p[1]
+    x7 = p[2]*x6
+    x8 = x0 + x7 + p[4]*x6 + 2*x4
     M = ca.SX.zeros(2, 2)
-    M[0, 0] = x7
-    M[0, 1] = x8
-    M[1, 0] = x8
-    M[1, 1] = x5
+    M[0, 0] = x8
+    M[0, 1] = x5
+    M[1, 0] = x5
+    M[1, 1] = x0
     return ca.Function(
         "mass_matrix",
         [q, p],

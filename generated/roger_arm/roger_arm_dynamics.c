@@ -141,6 +141,7 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double x13 = x12 + x4*l2;
     const double x14 = x13*m2;
     const double x15 = x14*l2;
+    tau[1] = x15;
     const double x16 = qd1 + qd2;
     const double x17 = x16*x16;
     const double x18 = x17*l2;
@@ -151,7 +152,6 @@ void roger_arm_inverse_dynamics(const double q[], const double qd[], const doubl
     const double x23 = x22*x6 + x14*x5;
     const double x24 = x3 + x15 + x23*l1;
     tau[0] = x24;
-    tau[1] = x15;
 }
 
 /* M(q), row-major n x n (14 operations: 9 multiplications, 4 additions, 0 divisions, 1 trigonometric calls, 0 other calls) */
@@ -172,19 +172,19 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     double sine[4], cosine[4];
     roger_arm_sincos(1, angle, sine, cosine);
 #endif
-    const double x0 = l1*l1;
+    const double x0 = m2*l2*l2;
+    M[3] = x0;
     const double x1 = l2*m2;
     const double x2 = roger_arm_COS(0, q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
-    const double x5 = m2*l2*l2;
-    const double x6 = m1*x0;
-    const double x7 = x5 + x6 + m2*x0 + 2.0*x4;
-    const double x8 = x5 + x4;
-    M[0] = x7;
-    M[1] = x8;
-    M[2] = x8;
-    M[3] = x5;
+    const double x5 = x0 + x4;
+    M[1] = x5;
+    M[2] = x5;
+    const double x6 = l1*l1;
+    const double x7 = m1*x6;
+    const double x8 = x0 + x7 + m2*x6 + 2.0*x4;
+    M[0] = x8;
 }
 
 /* C(q, qd) from Christoffel symbols, row-major; C qd = V (32 operations: 21 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
@@ -211,6 +211,7 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double x2 = l1*qd1;
     const double x3 = x1*x2;
     const double x4 = x0*x3;
+    C[2] = x4;
     const double x5 = roger_arm_COS(0, q2);
     const double x6 = x3*m2;
     const double x7 = 0.5*x6;
@@ -220,15 +221,14 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double x11 = 0.5*x9 + 0.5*x0*x10;
     const double x12 = x7*x5 - x11*x1;
     const double x13 = x4 + 2.0*x12*l1;
+    C[0] = x13;
     const double x14 = x4 - x0*x3;
+    C[3] = x14;
     const double x15 = -2.0*x11 + x9;
     const double x16 = 2.0*x7 - x6;
     const double x17 = x15*x1 + x16*x5;
     const double x18 = x14 + x17*l1;
-    C[0] = x13;
     C[1] = x18;
-    C[2] = x4;
-    C[3] = x14;
 }
 
 /* V(q, qd) = C(q, qd) qd (18 operations: 12 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
@@ -256,6 +256,7 @@ void roger_arm_coriolis(const double q[], const double qd[], const double p[], d
     const double x3 = x0*x2;
     const double x4 = x3*m2;
     const double x5 = x4*l2;
+    V[1] = x5;
     const double x6 = roger_arm_COS(0, q2);
     const double x7 = qd1 + qd2;
     const double x8 = x7*x7;
@@ -266,7 +267,6 @@ void roger_arm_coriolis(const double q[], const double qd[], const double p[], d
     const double x13 = x12*x0 + x4*x6;
     const double x14 = x5 + x13*l1;
     V[0] = x14;
-    V[1] = x5;
 }
 
 /* G(q) (20 operations: 12 multiplications, 4 additions, 0 divisions, 4 trigonometric calls, 0 other calls) */
@@ -298,9 +298,9 @@ void roger_arm_gravity(const double q[], const double p[], double G[])
     const double x6 = x5 + x3 + l1*m2;
     const double x7 = g*roger_arm_COS(1, q1);
     const double x8 = g*roger_arm_SIN(1, q1);
+    G[0] = x2*x7 + x6*x8;
     const double x9 = x8*x4;
     const double x10 = -x9 - x7*x1;
-    G[0] = x2*x7 + x6*x8;
     G[1] = -x0*x10;
 }
 
@@ -375,9 +375,9 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x35 = tau2 - x21;
     const double x36 = x35 - x33*x31;
     const double x37 = x36/x34;
+    qdd[1] = x37;
     const double x38 = x31*x8 - x33*x37;
     qdd[0] = x38;
-    qdd[1] = x37;
 }
 
 /* Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body) (35 operations: 18 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 2 other calls) */
@@ -391,6 +391,12 @@ void roger_arm_regressor(const double q[], const double qd[], const double qdd[]
     const double qdd2 = qdd[1];
     const double g = p[roger_arm_P_g];
     const double l1 = p[roger_arm_P_l1];
+    /* the runs of zeros of Y (the inputs are read), then the rest as it is known */
+    Y[0] = 0;
+    for (int k = 3; k < 9; ++k) Y[k] = 0;
+    for (int k = 16; k < 22; ++k) Y[k] = 0;
+    for (int k = 23; k < 40; ++k) Y[k] = 0;
+    for (int k = 42; k < 48; ++k) Y[k] = 0;
 #ifdef roger_arm_SINCOS_VECTOR
     const double angle[4] = {
         q1,
@@ -401,41 +407,40 @@ void roger_arm_regressor(const double q[], const double qd[], const double qdd[]
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
+    Y[9] = qdd1;
+    Y[10] = qdd1;
+    Y[11] = qd1;
+    Y[49] = qdd2;
+    Y[50] = qd2;
     const double x0 = g*roger_arm_SIN(0, q1);
+    Y[1] = x0;
     const double x1 = g*roger_arm_COS(0, q1);
+    Y[2] = x1;
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
+    Y[12] = x2;
     const double x3 = x0 + l1*qdd1;
     const double x4 = roger_arm_SIN(1, q2);
     const double x5 = qd1*qd1;
     const double x6 = -x1 - x5*l1;
     const double x7 = roger_arm_COS(1, q2);
     const double x8 = x3*x4 + x6*x7;
+    Y[41] = -x8;
     const double x9 = x3*x7 - x4*x6;
+    Y[40] = x9;
     const double x10 = l1*x4;
     const double x11 = l1*x7;
     const double x12 = x10*x8 + x11*x9;
+    Y[13] = x12;
     const double x13 = qd1 + qd2;
     const double x14 = x13*x13;
     const double x15 = qdd1 + qdd2;
-    const double x16 = x9 + x11*x15 - x10*x14;
-    const double x17 = -x8 - x10*x15 - x11*x14;
-    const double x18 = ((double)((qd2 > 0) - (qd2 < 0)));
-    for (int k = 0; k < 52; ++k) Y[k] = 0; /* the zeros, then the rest */
-    Y[1] = x0;
-    Y[2] = x1;
-    Y[9] = qdd1;
-    Y[10] = qdd1;
-    Y[11] = qd1;
-    Y[12] = x2;
-    Y[13] = x12;
-    Y[14] = x16;
-    Y[15] = x17;
     Y[22] = x15;
-    Y[40] = x9;
-    Y[41] = -x8;
     Y[48] = x15;
-    Y[49] = qdd2;
-    Y[50] = qd2;
+    const double x16 = x9 + x11*x15 - x10*x14;
+    Y[14] = x16;
+    const double x17 = -x8 - x10*x15 - x11*x14;
+    Y[15] = x17;
+    const double x18 = ((double)((qd2 > 0) - (qd2 < 0)));
     Y[51] = x18;
 }
 
@@ -460,32 +465,8 @@ void roger_arm_base_regressor(const double q[], const double qd[], const double 
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
-    const double x0 = g*roger_arm_SIN(0, q1);
-    const double x1 = g*roger_arm_COS(0, q1);
-    const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
-    const double x3 = qd1 + qd2;
-    const double x4 = x3*x3;
-    const double x5 = qdd1 + qdd2;
-    const double x6 = x0 + l1*qdd1;
-    const double x7 = roger_arm_SIN(1, q2);
-    const double x8 = qd1*qd1;
-    const double x9 = -x1 - x8*l1;
-    const double x10 = roger_arm_COS(1, q2);
-    const double x11 = x6*x10 - x7*x9;
-    const double x12 = l1*x7;
-    const double x13 = l1*x10;
-    const double x14 = x11 + x13*x5 - x12*x4;
-    const double x15 = x6*x7 + x9*x10;
-    const double x16 = -x15 - x12*x5 - x13*x4;
-    const double x17 = ((double)((qd2 > 0) - (qd2 < 0)));
-    Yb[0] = x0;
-    Yb[1] = x1;
     Yb[2] = qdd1;
     Yb[3] = qd1;
-    Yb[4] = x2;
-    Yb[5] = x14;
-    Yb[6] = x16;
-    Yb[7] = x5;
     Yb[8] = 0.0;
     Yb[9] = 0.0;
     Yb[10] = 0.0;
@@ -494,11 +475,35 @@ void roger_arm_base_regressor(const double q[], const double qd[], const double 
     Yb[13] = 0.0;
     Yb[14] = 0.0;
     Yb[15] = 0.0;
-    Yb[16] = x11;
-    Yb[17] = -x15;
-    Yb[18] = x5;
     Yb[19] = qdd2;
     Yb[20] = qd2;
+    const double x0 = g*roger_arm_SIN(0, q1);
+    Yb[0] = x0;
+    const double x1 = g*roger_arm_COS(0, q1);
+    Yb[1] = x1;
+    const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
+    Yb[4] = x2;
+    const double x3 = qd1 + qd2;
+    const double x4 = x3*x3;
+    const double x5 = qdd1 + qdd2;
+    Yb[7] = x5;
+    Yb[18] = x5;
+    const double x6 = x0 + l1*qdd1;
+    const double x7 = roger_arm_SIN(1, q2);
+    const double x8 = qd1*qd1;
+    const double x9 = -x1 - x8*l1;
+    const double x10 = roger_arm_COS(1, q2);
+    const double x11 = x6*x10 - x7*x9;
+    Yb[16] = x11;
+    const double x12 = l1*x7;
+    const double x13 = l1*x10;
+    const double x14 = x11 + x13*x5 - x12*x4;
+    Yb[5] = x14;
+    const double x15 = x6*x7 + x9*x10;
+    Yb[17] = -x15;
+    const double x16 = -x15 - x12*x5 - x13*x4;
+    Yb[6] = x16;
+    const double x17 = ((double)((qd2 > 0) - (qd2 < 0)));
     Yb[21] = x17;
 }
 
@@ -536,11 +541,13 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x7 = x0*x3 - x6;
     const double x8 = x7*m2;
     const double x9 = x8*l2;
+    dtau_dq[2] = x9;
     const double x10 = x5*x3;
     const double x11 = x0*x4 + x10;
     const double x12 = x11*m2;
     const double x13 = x12*x4 + x8*x3;
     const double x14 = x9 + x2 + x13*l1;
+    dtau_dq[0] = x14;
     const double x15 = qd1*qd1;
     const double x16 = -x0 - x15*l1;
     const double x17 = x16*x3;
@@ -548,6 +555,7 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x19 = x18*x4 + x17;
     const double x20 = -x19*m2;
     const double x21 = x20*l2;
+    dtau_dq[3] = x21;
     const double x22 = qd1 + qd2;
     const double x23 = x22*x22;
     const double x24 = -x23*l2;
@@ -561,6 +569,7 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x32 = x29*m2;
     const double x33 = x26*x3 + x32*x4 + x20*x3 - x31*x4;
     const double x34 = x21 + x33*l1;
+    dtau_dq[1] = x34;
     const double x35 = l2*m2;
     const double x36 = l1*qd1;
     const double x37 = x4*x36;
@@ -573,21 +582,17 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x44 = x40*x3 - x43*x4;
     const double x45 = x38 + 2.0*x44*l1;
     const double x46 = 2.0*x45;
+    dtau_dqd[0] = x46;
     const double x47 = x38 - x35*x37;
     const double x48 = -2.0*x43 + x42;
     const double x49 = 2.0*x40 - x39;
     const double x50 = x48*x4 + x49*x3;
     const double x51 = x47 + x50*l1;
     const double x52 = 2.0*x51;
-    const double x53 = 2.0*x38;
-    const double x54 = 2.0*x47;
-    dtau_dq[0] = x14;
-    dtau_dq[1] = x34;
-    dtau_dq[2] = x9;
-    dtau_dq[3] = x21;
-    dtau_dqd[0] = x46;
     dtau_dqd[1] = x52;
+    const double x53 = 2.0*x38;
     dtau_dqd[2] = x53;
+    const double x54 = 2.0*x47;
     dtau_dqd[3] = x54;
 }
 
@@ -642,9 +647,14 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x24 = x23*x22;
     const double x25 = x19 - x21*x24*x24;
     const double x26 = 1.0/x25;
+    Minv[3] = x26;
     const double x27 = x24*x26;
+    Minv[1] = -x27;
+    Minv[2] = -x27;
     const double x28 = x22 + x24*x27;
+    Minv[0] = x28;
     const double x29 = x27*x7 - x28*x14;
+    dqdd_dq[0] = x29;
     const double x30 = qd1*qd1;
     const double x31 = -x4 - x30*l1;
     const double x32 = x31*x0;
@@ -680,8 +690,11 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x62 = x55*x0 + x61*x1 + x52*x0 - x1*x60;
     const double x63 = x53 + x62*l1;
     const double x64 = x53*x27 - x63*x28;
+    dqdd_dq[1] = x64;
     const double x65 = x27*x14 - x26*x7;
+    dqdd_dq[2] = x65;
     const double x66 = x63*x27 - x53*x26;
+    dqdd_dq[3] = x66;
     const double x67 = l1*qd1;
     const double x68 = x1*x67;
     const double x69 = x16*x68;
@@ -695,6 +708,7 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x77 = 2.0*x76;
     const double x78 = 2.0*x69;
     const double x79 = -x77*x28 + x78*x27;
+    dqdd_dqd[0] = x79;
     const double x80 = x69 - x16*x68;
     const double x81 = -2.0*x74 + x73;
     const double x82 = 2.0*x71 - x70;
@@ -703,20 +717,11 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x85 = 2.0*x84;
     const double x86 = 2.0*x80;
     const double x87 = -x85*x28 + x86*x27;
-    const double x88 = -x78*x26 + x77*x27;
-    const double x89 = -x86*x26 + x85*x27;
-    dqdd_dq[0] = x29;
-    dqdd_dq[1] = x64;
-    dqdd_dq[2] = x65;
-    dqdd_dq[3] = x66;
-    dqdd_dqd[0] = x79;
     dqdd_dqd[1] = x87;
+    const double x88 = -x78*x26 + x77*x27;
     dqdd_dqd[2] = x88;
+    const double x89 = -x86*x26 + x85*x27;
     dqdd_dqd[3] = x89;
-    Minv[0] = x28;
-    Minv[1] = -x27;
-    Minv[2] = -x27;
-    Minv[3] = x26;
 }
 
 /* M(q)^-1 by the unrolled L D L^T factorisation (23 operations: 14 multiplications, 6 additions, 2 divisions, 1 trigonometric calls, 0 other calls) */
@@ -750,12 +755,12 @@ void roger_arm_mass_matrix_inverse(const double q[], const double p[], double Mi
     const double x10 = x9*x8;
     const double x11 = x5 - x7*x10*x10;
     const double x12 = 1.0/x11;
+    Minv[3] = x12;
     const double x13 = x10*x12;
-    const double x14 = x8 + x10*x13;
-    Minv[0] = x14;
     Minv[1] = -x13;
     Minv[2] = -x13;
-    Minv[3] = x12;
+    const double x14 = x8 + x10*x13;
+    Minv[0] = x14;
 }
 
 /* xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1] (155 operations: 100 multiplications, 49 additions, 2 divisions, 4 trigonometric calls, 0 other calls) */
@@ -782,6 +787,18 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
+    A[0] = 0.0;
+    A[1] = 0.0;
+    A[2] = 1.0;
+    A[3] = 0.0;
+    A[4] = 0.0;
+    A[5] = 0.0;
+    A[6] = 0.0;
+    A[7] = 1.0;
+    B[0] = 0.0;
+    B[1] = 0.0;
+    B[2] = 0.0;
+    B[3] = 0.0;
     const double x0 = roger_arm_COS(0, q2);
     const double x1 = roger_arm_SIN(0, q2);
     const double x2 = g*roger_arm_SIN(1, q1);
@@ -809,9 +826,14 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x24 = x23*x22;
     const double x25 = x19 - x21*x24*x24;
     const double x26 = 1.0/x25;
+    B[7] = x26;
     const double x27 = x24*x26;
+    B[5] = -x27;
+    B[6] = -x27;
     const double x28 = x22 + x24*x27;
+    B[4] = x28;
     const double x29 = x27*x7 - x28*x14;
+    A[8] = x29;
     const double x30 = qd1*qd1;
     const double x31 = -x4 - x30*l1;
     const double x32 = x31*x0;
@@ -847,6 +869,7 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x62 = x55*x0 + x61*x1 + x52*x0 - x1*x60;
     const double x63 = x53 + x62*l1;
     const double x64 = x53*x27 - x63*x28;
+    A[9] = x64;
     const double x65 = l1*qd1;
     const double x66 = x1*x65;
     const double x67 = x16*x66;
@@ -860,6 +883,7 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x75 = 2.0*x74;
     const double x76 = 2.0*x67;
     const double x77 = -x75*x28 + x76*x27;
+    A[10] = x77;
     const double x78 = x67 - x16*x66;
     const double x79 = -2.0*x72 + x71;
     const double x80 = 2.0*x69 - x68;
@@ -868,32 +892,13 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x83 = 2.0*x82;
     const double x84 = 2.0*x78;
     const double x85 = -x83*x28 + x84*x27;
-    const double x86 = x27*x14 - x26*x7;
-    const double x87 = x63*x27 - x53*x26;
-    const double x88 = -x76*x26 + x75*x27;
-    const double x89 = -x84*x26 + x83*x27;
-    A[0] = 0.0;
-    A[1] = 0.0;
-    A[2] = 1.0;
-    A[3] = 0.0;
-    A[4] = 0.0;
-    A[5] = 0.0;
-    A[6] = 0.0;
-    A[7] = 1.0;
-    A[8] = x29;
-    A[9] = x64;
-    A[10] = x77;
     A[11] = x85;
+    const double x86 = x27*x14 - x26*x7;
     A[12] = x86;
+    const double x87 = x63*x27 - x53*x26;
     A[13] = x87;
+    const double x88 = -x76*x26 + x75*x27;
     A[14] = x88;
+    const double x89 = -x84*x26 + x83*x27;
     A[15] = x89;
-    B[0] = 0.0;
-    B[1] = 0.0;
-    B[2] = 0.0;
-    B[3] = 0.0;
-    B[4] = x28;
-    B[5] = -x27;
-    B[6] = -x27;
-    B[7] = x26;
 }

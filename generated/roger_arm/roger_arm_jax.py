@@ -152,21 +152,21 @@ def mass_matrix(q, p=None):
     m1 = p[2]
     l2 = p[3]
     m2 = p[4]
-    x0 = l1*l1
+    x0 = (l2*l2)*m2
     x1 = l2*m2
     x2 = jnp.cos(q2)
     x3 = x1*x2
     x4 = l1*x3
-    x5 = (l2*l2)*m2
-    x6 = m1*x0
-    x7 = m2*x0 + 2*x4 + x5 + x6
-    x8 = x4 + x5
+    x5 = x0 + x4
+    x6 = l1*l1
+    x7 = m1*x6
+    x8 = m2*x6 + x0 + 2*x4 + x7
     return jnp.array(
         [
-            x7,
-            x8,
             x8,
             x5,
+            x5,
+            x0,
         ],
         dtype=DTYPE,
     ).reshape((2, 2))

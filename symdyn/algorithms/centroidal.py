@@ -26,9 +26,11 @@ floating base, Robot.base's rotation on a fixed one):
    L_O = h x e_k; its angular velocity e_k: P = e_k x h, L_O = J e_k. About the centre of mass,
    L_G = L_O - c_b x P; a mimic joint's column adds to its coordinate's (A = A_body S).
    A_g does not use steps 1 and 2: (P, L_O) of joint j is the spatial force I^c_j S_j of its
-   subtree's composite inertia, built in the links' own frames and carried to the base origin
-   by symdyn.algorithms.crba (the base rows of a floating M), and (m, h, J) the whole robot's
-   composite there (A_g is M[0:6] moved to the centre of mass: Orin, Goswami and Lee (2013)).
+   subtree's composite inertia, built in the links' own frames (symdyn.algorithms.crba), and
+   (m, h, J) the whole robot's composite about the base origin (A_g is M[0:6] moved to the
+   centre of mass: Orin, Goswami and Lee (2013)). Each column goes in one step from link j's
+   frame to the centre of mass with world axes, through link j's world-aligned frame composed
+   from the base (`Centroidal.momentum_matrix`).
 4. A_g = blockdiag(R, R) [P; L_G] (world_R_base R), c = p_base + R c_b, and the centre of
    mass's Jacobian Jc = A_g[0:3] / m (linear momentum = m dc/dt).
 
@@ -57,10 +59,9 @@ import sympy as sp
 from ..model.free_flyer import quaternion_rotation
 from ..model.robot import Robot
 from ..spatial import vectors as v3
-from ..spatial.inertia import SpatialInertia, body_inertia
-from ..spatial.motion import Force
+from ..spatial.inertia import SpatialInertia, apply_inertia, body_inertia
 from ..symbolic.program import Program
-from .crba import composite_inertias, mass_matrix_crba, shift_inertia
+from .crba import composite_inertias, link_subspace, shift_inertia
 from .frames import joint_frames
 from .kinematics import forward_kinematics
 
@@ -168,7 +169,8 @@ class Centroidal:
     def composite(self) -> SpatialInertia:
         """The whole robot's composite inertia (m, h, J) about the base origin, base axes, by the
         local-frame recursion of symdyn.algorithms.crba (each link's composite in its own frame,
-        moved once into its parent's), the base body included on a floating robot (memoised)."""
+        moved once into its parent's), the base body included on a floating robot (memoised;
+        the links' composites are kept for `momentum_matrix`)."""
         if "whole" not in self._cache:
             robot, program = self.robot, self.program
             frames = joint_frames(robot, robot.body_positions(self.q))
@@ -185,57 +187,75 @@ class Centroidal:
                 own = SpatialInertia(sp.S.Zero, v3.ZERO3, v3.ZERO33)
             for child in (i for i in range(robot.nb) if robot.parents[i] < 0):
                 own = shift_inertia(frames[child], composites[child], own, program, "c")
-            columns: list[Force] = []
-            mass_matrix_crba(robot, frames, composites, program, base_columns=columns)
-            self._cache["whole"], self._cache["forces"] = own, columns
+            self._cache["whole"], self._cache["links"] = own, (frames, composites)
         return self._cache["whole"]
 
-    def matrix_base_axes(self) -> sp.Matrix:
-        """[P; L_G] of every velocity coordinate in base axes (6 x NV, or 6 x n on a fixed base).
+    def _world_frames(self, frames) -> list[tuple[v3.Mat, v3.Vec]]:
+        """(world_R_i, o_i) per link: its axes in the world and its origin from the base origin in
+        world axes, composed from the root (world_R_base R_i on the base, then world_R_p R_i and
+        o_p + world_R_p p_i: one joint rotation per link)."""
+        let, R_wb = self.program.let, self.rotation
+        out: list[tuple[v3.Mat, v3.Vec]] = []
+        for i, frame in enumerate(frames):
+            p = self.robot.parents[i]
+            R_p, o_p = out[p] if p >= 0 else (R_wb, v3.ZERO3)
+            R = _matmul(R_p, frame.R)
+            R = tuple(tuple(let(x, "cRw") for x in row) for row in R)
+            o = self.program.let_vector(v3.add(o_p, v3.mul(R_p, frame.p)), "cow")
+            out.append((R, o))  # type: ignore[arg-type]
+        return out
 
-        The momentum of a unit rate of body j's joint is the composite j's spatial force I^c_j S_j
-        carried to the base origin (symdyn.algorithms.crba: the base rows of a floating M); the
-        base's six columns are the whole robot's composite (m, h, J) about the base origin (step 3
-        of the module docstring); L_G = L_O - c_b x P with c_b = h / m."""
-        if "Ab" not in self._cache:
+    def momentum_matrix(self) -> sp.Matrix:
+        """A_g (6 x NV): h_g = A_g v, linear then angular momentum about c, world-aligned.
+
+        Joint j's column is its composite's spatial force I^c_j S_j (symdyn.algorithms.crba, in
+        frame j: n = I^c a, f = a x h^c for a revolute axis a, n = h^c x a, f = m^c a for a
+        prismatic one) moved in one step to the centre of mass in world axes:
+        P = world_R_j f, L_G = world_R_j n + (o_j - c) x P, with c - o_base = world_R_base c_b,
+        c_b = h / m of the whole composite (Orin, Goswami and Lee (2013): A_g is the base rows of
+        M moved to the centre of mass). The base's columns are the whole composite's: a unit
+        linear velocity u = world_R_base e_k gives (m u, 0); a unit angular velocity gives
+        P = world_R_base (e_k x h), L_G = world_R_base J_G e_k, J_G = J - m (|c_b|^2 1 - c_b c_b^T)
+        the rotational inertia about the centre of mass (base axes). A mimic joint's column adds
+        to its coordinate's (A = A_body S)."""
+        if "Ag" not in self._cache:
+            program, let_vector = self.program, self.program.let_vector
             whole = self.composite()
+            frames, composites = self._cache["links"]  # type: ignore[misc]
             m, h, J = whole.mass, whole.first_moment, whole.inertia
-            c_b = self.program.let_vector(v3.scale(self.program.let(1 / m, "cim"), h), "ccb")
+            c_b = let_vector(v3.scale(program.let(1 / m, "cim"), h), "ccb")
+            R_wb = self.rotation
+            c_w = let_vector(v3.mul(R_wb, c_b), "ccw")
+            body = []
+            for (R, o), link, comp in zip(
+                self._world_frames(frames), self.robot.links, composites, strict=True
+            ):
+                force = apply_inertia(comp, link_subspace(link))
+                P = let_vector(v3.mul(R, force.linear), "cP")
+                arm = v3.sub(o, c_w)
+                body.append([*P, *v3.add(v3.mul(R, force.angular), v3.cross(arm, P))])
             S = self.robot.selection()
-
-            def column(P: v3.Vec, L_O: v3.Vec) -> list[sp.Expr]:
-                return [*P, *v3.sub(L_O, v3.cross(c_b, P))]
-
-            body = [column(f.linear, f.angular) for f in self._cache["forces"]]
-            joint_cols = [
+            cols = [
                 [sum((S[i, j] * body[i][r] for i in range(self.robot.nb)), sp.S.Zero) for r in range(6)]
                 for j in range(self.robot.n)
             ]
-            base_cols = []
             if self.base is not None:
-                for k in range(3):
-                    e = tuple(sp.S.One if r == k else sp.S.Zero for r in range(3))
-                    base_cols.append(column(v3.scale(m, e), v3.cross(h, e)))
-                for k in range(3):
-                    e = tuple(sp.S.One if r == k else sp.S.Zero for r in range(3))
-                    base_cols.append(column(v3.cross(e, h), v3.mul(J, e)))
-            cols = base_cols + joint_cols
-            A = sp.Matrix(6, len(cols), lambda r, j: self.program.let(cols[j][r], "cAb"))
-            self._cache["Ab"] = A
-        return self._cache["Ab"]
+                J_G = _about_origin(-m, c_b, J)  # J - m (|c|^2 1 - c c^T)
+                Rt = _transpose(R_wb)  # rows: the columns world_R_base e_k
+                base_lin = [[*v3.scale(m, Rt[k]), 0, 0, 0] for k in range(3)]
+                e = [tuple(sp.S.One if r == k else sp.S.Zero for r in range(3)) for k in range(3)]
+                base_ang = [
+                    [*v3.mul(R_wb, v3.cross(e[k], h)), *v3.mul(R_wb, tuple(J_G[r][k] for r in range(3)))]
+                    for k in range(3)
+                ]
+                cols = base_lin + base_ang + cols
+            self._cache["Ag"] = sp.Matrix(6, len(cols), lambda r, j: program.let(cols[j][r], "cAg"))
+        return self._cache["Ag"]
 
     def _to_world(self, six: Sequence, hint: str) -> sp.Matrix:
         R = self.rotation
         out = [*v3.mul(R, tuple(six[:3])), *v3.mul(R, tuple(six[3:]))]
         return sp.Matrix(6, 1, [self.program.let(x, hint) for x in out])
-
-    def momentum_matrix(self) -> sp.Matrix:
-        """A_g (6 x NV): h_g = A_g v, linear then angular momentum about c, world-aligned."""
-        if "Ag" not in self._cache:
-            Ab = self.matrix_base_axes()
-            cols = [self._to_world(list(Ab[:, j]), "cAg") for j in range(Ab.cols)]
-            self._cache["Ag"] = sp.Matrix.hstack(*cols) if cols else sp.zeros(6, 0)
-        return self._cache["Ag"]
 
     def com(self) -> sp.Matrix:
         """c (3 x 1), world frame: p_base + R c_b (Robot.base's origin on a fixed base)."""

@@ -14,6 +14,8 @@ columns are absent. `floating_inputs` gives these two inputs for any family of f
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import sympy as sp
 
 from ..algorithms.centroidal import Centroidal
@@ -89,4 +91,9 @@ def centroidal_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (cen.mass,),
         ),
     ]
-    return with_steps(rows, prog, first, "centroidal")
+    out = with_steps(rows, prog, first, "centroidal")
+    # A_g's temporaries laid out column by column (each coordinate's momentum at once): row by
+    # row kept every column's intermediates alive to the last row (stack spills, 1.4x the time)
+    ncols = cen.momentum_matrix().cols
+    column_major = tuple(r * ncols + j for j in range(ncols) for r in range(6))
+    return [replace(r, visit=column_major) if r.name == "centroidal_momentum_matrix" else r for r in out]

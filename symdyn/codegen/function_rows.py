@@ -136,7 +136,8 @@ class FunctionRow:
     `exprs` are the outputs' row-major entries over the program's intermediates (in the order
     of `results`); `steps` the assignments they need beyond the dynamics' own program. Rows of
     one `cse` group share a CSE pass; a family in a group of its own cannot change the code of
-    the others.
+    the others. `visit`, if given, is the order of the entries in which their temporaries are laid
+    out (symdyn.symbolic.simplify.eliminate_many).
     """
 
     name: str
@@ -146,6 +147,7 @@ class FunctionRow:
     exprs: tuple[sp.Expr, ...]
     steps: tuple = ()
     cse: str = ""
+    visit: tuple[int, ...] | None = None
 
 
 @dataclass(frozen=True)

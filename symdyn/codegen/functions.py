@@ -124,7 +124,12 @@ def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     rows = []
     for name, doc, inputs, out in table:
         shape = joint_matrix_output if out in ("M", "C") else vector_output
-        rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), tuple(c[out])))
+        exprs = tuple(c[out])
+        # M's temporaries laid out from its last entry back: column by column from the leaves, as
+        # the composite bodies are built, each column's carried force used as soon as it is known
+        # (row by row from the first kept every column's force alive: Talos M 920 -> 820 ns)
+        visit = tuple(reversed(range(len(exprs)))) if out == "M" else None
+        rows.append(FunctionRow(name, doc, inputs, (shape(out, n, _OUTPUT_DOCS[out]),), exprs, visit=visit))
     return rows
 
 
@@ -151,6 +156,9 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (vector_output("qdd", n, _OUTPUT_DOCS["qdd"]),),
             tuple(qdd_out),
             tuple(fd.needed(qdd_out)),
+            # a floating robot's temporaries laid out from the last output back (measured on Talos:
+            # 2400 -> 2330 ns; fixed bases keep their order)
+            visit=tuple(reversed(range(n))) if dyn.robot.floating else None,
         )
     ]
 
@@ -288,5 +296,7 @@ def build_functions(
         if not group:
             needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
         steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
-        code |= eliminate_many(steps, {row.name: list(row.exprs) for row in members}, reserved=x.symbols)
+        visits = {row.name: row.visit for row in members if row.visit is not None}
+        groups = {row.name: list(row.exprs) for row in members}
+        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

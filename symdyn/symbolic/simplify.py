@@ -210,11 +210,16 @@ def _inputs(nodes: dict[sp.Symbol, sp.Expr], outputs: Sequence[sp.Expr]) -> set[
 
 
 def _extract(
-    nodes: dict[sp.Symbol, sp.Expr], outputs: Sequence[sp.Expr], prefix: str, taken: set[sp.Symbol]
+    nodes: dict[sp.Symbol, sp.Expr],
+    outputs: Sequence[sp.Expr],
+    prefix: str,
+    taken: set[sp.Symbol],
+    visit: Sequence[int] | None = None,
 ) -> Eliminated:
-    """The temporaries the outputs need, in order; fresh names that no input (a parameter
-    called x0) already has, for every function generated from the same robot."""
-    order = _topological(nodes, outputs)
+    """The temporaries the outputs need, in order (each output's, depth first, the outputs taken
+    in the order `visit` of their indices, or in their own); fresh names that no input (a
+    parameter called x0) already has, for every function generated from the same robot."""
+    order = _topological(nodes, [outputs[k] for k in visit] if visit is not None else outputs)
     fresh = (t for t in (sp.Symbol(f"{prefix}{k}") for k in itertools.count()) if t not in taken)
     rename = {s: next(fresh) for s in order}
     memo: dict = {}
@@ -236,16 +241,20 @@ def eliminate_many(
     groups: dict[str, Sequence[sp.Expr]],
     prefix: str = "x",
     reserved: Iterable[sp.Symbol] = (),
+    visits: dict[str, Sequence[int]] | None = None,
 ) -> dict[str, Eliminated]:
     """`eliminate` for several functions sharing one program: one CSE pass, then each
     group keeps only the temporaries its outputs need (renamed from prefix0 per group,
-    skipping the names of inputs and of the `reserved` symbols)."""
+    skipping the names of inputs and of the `reserved` symbols). `visits` may give, per group,
+    the order in which its outputs' temporaries are laid out (the order of the computation: a
+    matrix column by column keeps fewer values alive at once than row by row)."""
     outputs = [sp.sympify(e) for name in groups for e in groups[name]]
     nodes, reduced = _cse_nodes(assignments, outputs)
     taken = _inputs(nodes, reduced) | set(reserved)
     result: dict[str, Eliminated] = {}
     k = 0
     for name, outs in groups.items():
-        result[name] = _extract(nodes, reduced[k : k + len(outs)], prefix, taken)
+        visit = (visits or {}).get(name)
+        result[name] = _extract(nodes, reduced[k : k + len(outs)], prefix, taken, visit)
         k += len(outs)
     return result
