@@ -38,7 +38,7 @@ import numpy as np
 
 from ..errors import SymdynError
 from ..model.robot import Robot
-from .least_squares import Triangular, combine
+from .least_squares import Triangular, combine, one_blas_thread
 from .measurements import SG_ORDER, SG_WINDOW, Measurements, differentiate, needs_scipy, read_measurements
 
 __all__ = [  # the log reading lives in symdyn.apps.measurements; its names stay importable from here
@@ -201,11 +201,12 @@ def identify(
     step = chunk_samples(n, nb) if chunk is None else max(1, int(chunk))
     chunks = [slice(s, min(s + step, N)) for s in range(0, N, step)]
     joints = [Triangular(nb) for _ in range(n)]  # [W_j | y_j]: the rows of joint j
-    for s in chunks:
-        W3 = regressor(data.q[s], data.qd[s], data.qdd[s])
-        assert W3.shape[2] == nb, (W3.shape, nb)
-        for j, part in enumerate(joints):
-            part.add(W3[:, j, :], data.tau[s, j])
+    with one_blas_thread():
+        for s in chunks:
+            W3 = regressor(data.q[s], data.qd[s], data.qdd[s])
+            assert W3.shape[2] == nb, (W3.shape, nb)
+            for j, part in enumerate(joints):
+                part.add(W3[:, j, :], data.tau[s, j])
     plain = combine(joints, np.ones(n))
     x0 = plain.solve()
     r2 = np.array([part.residual_norm(x0) ** 2 for part in joints])
