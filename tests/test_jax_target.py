@@ -350,7 +350,10 @@ def test_a_floating_robot_takes_q_of_nq_and_equals_the_oracle(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SymdynWarning)
         robot = load_robot(ROOT / "examples" / "roger_arm.yaml", floating=True)
-    files = render(robot, targets=("jax",))
+    # a massless base under a planar arm: M is singular (the base slides and turns in the plane
+    # while the links stand still), so forward dynamics is left out with this warning
+    with pytest.warns(SymdynWarning, match=r"M\(q\) is singular: the base's coordinate vx_b"):
+        files = render(robot, targets=("jax",))
     (tmp_path / "roger_arm_jax.py").write_text(files["roger_arm_jax.py"])
     mod = load_module(tmp_path / "roger_arm_jax.py", "_symdyn_test_floating_roger_arm_jax")
     assert (mod.NQ, mod.NV, mod.NDOF) == (robot.nq, robot.nv, robot.nv) == (9, 8, 8)
