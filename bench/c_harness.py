@@ -16,7 +16,7 @@ from pathlib import Path
 
 import casadi_route
 import numpy as np
-from c_snippets import C_PRINT_OUT, C_TIME_MAIN, JOINT_STATES, skeleton
+from c_snippets import JOINT_STATES, skeleton
 from machine import C_COMPILER, FLAGS, run
 from row import FUNCTIONS, Row
 from states import CHECK_TOL, NCHECK, NSTATES, rel_err
@@ -24,7 +24,7 @@ from states import CHECK_TOL, NCHECK, NSTATES, rel_err
 import symdyn
 from symdyn.model.parameters import numeric_parameters
 
-__all__ = ["HARNESS", "C_PRINT_OUT", "C_TIME_MAIN", "parse_harness", "build_c", "check_c", "time_compiled"]
+__all__ = ["HARNESS", "parse_harness", "build_c", "check_c", "time_compiled"]
 
 HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench/run.py), do not edit. */
 {prelude}

@@ -35,7 +35,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-from c_harness import C_PRINT_OUT, C_TIME_MAIN, parse_harness, time_compiled
+from c_harness import parse_harness, time_compiled
+from c_snippets import CPU_CLOCK, skeleton
 from machine import C_COMPILER, FLAGS, RESULTS, load_averages, machine, run
 from pin_harness import model_and_states_lines, prepare
 from row import Row
@@ -57,11 +58,8 @@ FUNCTIONS = (
 )
 
 HARNESS = r"""/* Floating-base timing harness: written by bench/floating.py, do not edit. */
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-#include <time.h>
+{clock}
+{prelude}
 #include "{prefix}_dynamics.h"
 
 #define NQ {prefix}_NQ
@@ -72,50 +70,16 @@ HARNESS = r"""/* Floating-base timing harness: written by bench/floating.py, do 
 
 static double Q[K][NQ], V[K][NV], A[K][NV], T[K][NV];
 static double OUT[NV * NV];
-static volatile double sink;
 static const double *P = NULL;
 static const char *LABELS[NB] = {{{labels}}};
 
-static double now_ns(void)
-{{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); /* CPU time: not the slices of other processes */
-    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
-}}
-
-static double run_bench(int b, long it)
-{{
-    long i;
-    int k = 0;
-    double s = now_ns();
-    for (i = 0; i < it; ++i) {{
-        switch (b) {{
-{cases}
-        }}
-        sink += OUT[0];
-        if (++k == K) k = 0;
-    }}
-    return (now_ns() - s) / (double)it;
-}}
+{run_bench}
 
 {print_out}
 
 int main(int argc, char **argv)
 {{
-    static double ns[NB][MAXREPS];
-    long iters[NB];
-    FILE *f;
-    int k, b, r, reps;
-    double target_ns;
-    if (argc < 3) return 2;
-    f = fopen(argv[1], "rb");
-    if (!f) return 2;
-    for (k = 0; k < K; ++k)
-        if (fread(Q[k], sizeof(double), NQ, f) != NQ || fread(V[k], sizeof(double), NV, f) != NV
-            || fread(A[k], sizeof(double), NV, f) != NV || fread(T[k], sizeof(double), NV, f) != NV)
-            return 2;
-    fclose(f);
-    if (strcmp(argv[2], "check") == 0) {{
+{main_head}{read_states}    if (strcmp(argv[2], "check") == 0) {{
         for (k = 0; k < {ncheck}; ++k) {{
 {checks}
         }}
@@ -126,12 +90,9 @@ int main(int argc, char **argv)
 
 
 def harness_source(prefix: str) -> str:
-    cases = [
-        f"        case {b}: {prefix}_{fn}({args}, P, OUT); break;"
-        for b, (fn, args, _, _) in enumerate(FUNCTIONS)
-    ]
+    loops = [f"LOOP({prefix}_{fn}({args}, P, OUT), OUT[0])" for fn, args, _, _ in FUNCTIONS]
     checks = [
-        f'            {prefix}_{fn}({args.replace("[k]", "[k]")}, P, OUT); print_out("{fn}", k, OUT, {size});'
+        f'            {prefix}_{fn}({args}, P, OUT); print_out("{fn}", k, OUT, {size});'
         for fn, args, size, _ in FUNCTIONS
     ]
     return HARNESS.format(
@@ -139,10 +100,9 @@ def harness_source(prefix: str) -> str:
         nstates=NSTATES,
         ncheck=NCHECK,
         labels=", ".join(f'"{fn}"' for fn, *_ in FUNCTIONS),
-        cases="\n".join(cases),
         checks="\n".join(checks),
-        print_out=C_PRINT_OUT,
-        time_main=C_TIME_MAIN,
+        clock=CPU_CLOCK,
+        **skeleton(loops, ("Q", "NQ"), ("V", "NV"), ("A", "NV"), ("T", "NV")),
     )
 
 

@@ -32,7 +32,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import pin_harness  # noqa: E402
-from c_harness import C_PRINT_OUT, C_TIME_MAIN, parse_harness, time_compiled  # noqa: E402
+from c_harness import parse_harness, time_compiled  # noqa: E402
+from c_snippets import CPU_CLOCK, skeleton  # noqa: E402
 from machine import C_COMPILER, FLAGS, RESULTS, load_averages, log, machine, pin_to_one_core, run  # noqa: E402
 from row import Row  # noqa: E402
 from states import CHECK_TOL, NCHECK, NSTATES, SEED, rel_err  # noqa: E402
@@ -55,10 +56,8 @@ ROWS = {
 TARGET = 0.25
 
 HARNESS = r"""/* Centroidal timing harness: written by bench/floating_centroidal.py, do not edit. */
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
+{clock}
+{prelude}
 #include "{prefix}_dynamics.h"
 
 #define NQ {nq}
@@ -69,55 +68,17 @@ HARNESS = r"""/* Centroidal timing harness: written by bench/floating_centroidal
 
 static double Q[K][NQ], V[K][NV];
 static double AG[6 * NV], H[6];
-static volatile double sink;
 static const char *LABELS[NB] = {{"centroidal_momentum_matrix", "map_and_drift"}};
-
-static double now_ns(void)
-{{
-    struct timespec t;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t); /* CPU time: not the slices of other processes */
-    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
-}}
 
 {print_out}
 
-static double run_bench(int b, long it)
-{{
-    long i;
-    int k = 0;
-    const double s = now_ns();
-    for (i = 0; i < it; ++i) {{
-        {prefix}_centroidal_momentum_matrix(Q[k], NULL, AG);
-        if (b == 1) {{
-            {prefix}_centroidal_momentum_drift(Q[k], V[k], NULL, H);
-            sink += H[0];
-        }}
-        sink += AG[0];
-        if (++k == K) k = 0;
-    }}
-    return (now_ns() - s) / (double)it;
-}}
+{run_bench}
 
 int main(int argc, char **argv)
 {{
-    FILE *f;
-    int k, b, r, reps;
-    long iters[NB];
-    double ns[NB][MAXREPS], target_ns;
-    f = fopen(argv[1], "rb");
-    if (!f) {{
-        perror(argv[1]);
-        return 2;
-    }}
-    for (k = 0; k < K; ++k) {{
-        if (fread(Q[k], sizeof(double), NQ, f) != NQ || fread(V[k], sizeof(double), NV, f) != NV) {{
-            fprintf(stderr, "short states file\n");
-            return 2;
-        }}
-    }}
-    fclose(f);
-    if (argc > 2 && argv[2][0] == 'c') {{
-        for (k = 0; k < atoi(argv[3]); ++k) {{
+{main_head}{read_states}    if (strcmp(argv[2], "check") == 0) {{
+        int ncheck = argc > 3 ? atoi(argv[3]) : 4;
+        for (k = 0; k < ncheck && k < K; ++k) {{
             {prefix}_centroidal_momentum_matrix(Q[k], NULL, AG);
             print_out("Ag", k, AG, 6 * NV);
             {prefix}_centroidal_momentum_drift(Q[k], V[k], NULL, H);
@@ -184,8 +145,16 @@ def bench_robot(name: str, work: Path, opts, pin_exe: Path | None) -> dict:
             nq=robot.nq,
             nv=robot.nv,
             nstates=NSTATES,
-            print_out=C_PRINT_OUT,
-            time_main=C_TIME_MAIN,
+            clock=CPU_CLOCK,
+            **skeleton(
+                [
+                    f"LOOP({prefix}_centroidal_momentum_matrix(Q[k], NULL, AG), AG[0])",
+                    f"LOOP({prefix}_centroidal_momentum_matrix(Q[k], NULL, AG); "
+                    f"{prefix}_centroidal_momentum_drift(Q[k], V[k], NULL, H), AG[0] + H[0])",
+                ],
+                ("Q", "NQ"),
+                ("V", "NV"),
+            ),
         )
     )
     exe = folder / "harness"
