@@ -127,8 +127,9 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
                 "stores": [(k, printer.doprint(e)) for k, e in enumerate(entries) if not (fill and e == 0)],
             }
         )
+    printed = [(sym.name, printer.doprint(expr)) for sym, expr in temporaries]
     return {
-        "body": _body(spec, temporaries, outputs, printer),
+        "body": _body(spec, temporaries, printed, outputs),
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
@@ -139,7 +140,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         "unused": unused,
         "reads": reads,
         "sincos": sincos,
-        "temporaries": [(sym.name, printer.doprint(expr)) for sym, expr in temporaries],
+        "temporaries": printed,
     }
 
 
@@ -157,24 +158,25 @@ def _zero_runs(entries: list) -> list[tuple[int, int]]:
     return [(a, b) for a, b in runs]
 
 
-def _body(spec: FunctionSpec, temporaries: list, outputs: list[dict], printer: CPrinter) -> list:
+def _body(spec: FunctionSpec, temporaries: list, printed: list[tuple[str, str]], outputs: list[dict]) -> list:
     """The statements of a function after its inputs are read: ("let", name, value) for each
-    temporary and ("store", "OUT[k]", value) for each output entry, every store right after the
-    last temporary it reads (or first, when it reads none). A value stored as soon as it is known
-    needs no register or stack slot to the end of the function: the stores of a large M at the
-    end made the compiler spill hundreds of temporaries to the stack and load them back."""
+    temporary (`printed`: their names and printed values) and ("store", "OUT[k]", value) for each
+    output entry of `outputs` (their printed stores), every store right after the last temporary
+    it reads (or first, when it reads none). A value stored as soon as it is known needs no register
+    or stack slot to the end of the function: the stores of a large M at the end made the compiler
+    spill hundreds of temporaries to the stack and load them back."""
     position = {sym: k for k, (sym, _) in enumerate(temporaries)}
     after: dict[int, list] = {}
     for result, view in zip(spec.results, outputs, strict=True):
-        fill = view["fill"]
-        for k, e in enumerate(spec.entries(result)):
-            if fill and e == 0:
-                continue
-            last = max((position[s] for s in sp.sympify(e).free_symbols if s in position), default=-1)
-            after.setdefault(last, []).append(("store", f"{view['name']}[{k}]", printer.doprint(e)))
+        entries = spec.entries(result)
+        for k, value in view["stores"]:
+            last = max(
+                (position[s] for s in sp.sympify(entries[k]).free_symbols if s in position), default=-1
+            )
+            after.setdefault(last, []).append(("store", f"{view['name']}[{k}]", value))
     body = list(after.get(-1, []))
-    for k, (sym, expr) in enumerate(temporaries):
-        body.append(("let", sym.name, printer.doprint(expr)))
+    for k, (name, value) in enumerate(printed):
+        body.append(("let", name, value))
         body.extend(after.get(k, []))
     return body
 
