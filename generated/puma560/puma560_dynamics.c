@@ -42,7 +42,7 @@
  */
 static void puma560_sincos(int n, const double *restrict x, double *restrict s, double *restrict c)
 {
-    const double invpio2 = 6.36619772367581382433e-01, shift = 0x1.8p52, chop = 0x1.8p28;
+    const double invpio2 = 6.36619772367581382433e-01, shift = 0x1.8p52;
     const double pio2_1 = 1.57079632673412561417e+00, pio2_2 = 6.07710050630396597660e-11;
     const double pio2_3 = 2.02226624871116645580e-21, pio2_3t = 8.47842766036889956997e-32;
     const double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03;
@@ -68,17 +68,14 @@ static void puma560_sincos(int n, const double *restrict x, double *restrict s, 
             /* a - fn pi/2 = y0 + y1, |y0| <= pi/4 */
             const double y0 = r3 + tail;
             const double y1 = (r3 - y0) + tail;
-            const double z = y0 * y0, v = z * y0;
+            const double z = y0 * y0, v = z * y0, hz = 0.5 * z, w = 1.0 - hz;
             /* fdlibm's __kernel_sin(y0, y1, 1) */
             const double rs = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
             const double ks = y0 - ((z * (0.5 * y1 - v * rs) - y1) - v * S1);
-            /* fdlibm's __kernel_cos(y0, y1): qx = 0 below 0.3, 0.28125 above 0.78125, else
-               |y0|/4 cut to its leading bits */
+            /* FreeBSD's __kernel_cos(y0, y1) (k_cos.c since 2008): 1 - z/2 split as w plus the
+               rounding error of w, which is exact */
             const double rc = z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
-            const double ay = fabs(y0);
-            const double big = ay > 0.78125, mid = ay >= 0.3;
-            const double qx = mid * ((1.0 - big) * ((0.25 * ay + chop) - chop) + big * 0.28125);
-            const double kc = (1.0 - qx) - ((0.5 * z - qx) - (z * rc - y0 * y1));
+            const double kc = w + (((1.0 - w) - hz) + (z * rc - y0 * y1));
             /* the quadrant f4 = fn mod 4 in 0 .. 3 */
             const double m4 = fn - 4.0 * ((fn * 0.25 + shift) - shift);
             const double f4 = m4 + 4.0 * (double)(m4 < 0.0);
