@@ -106,6 +106,35 @@ def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
     return x
 
 
+def _column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
+    n = M.rows
+    L: dict[tuple[int, int], sp.Expr] = {}
+    U: dict[tuple[int, int], sp.Expr] = {}
+    r: list[sp.Expr] = [sp.S.Zero] * n
+    y: list[sp.Expr] = [sp.S.Zero] * n
+    for j in range(n):
+        below = [k for k in range(j) if (j, k) in L]  # the coordinates eliminated before j that j couples to
+        rows = [i for i in range(j + 1, n) if M[i, j] != 0 or any((i, k) in L for k in below)]
+        acc = {i: prog.let(M[i, j], "fdM") for i in [j, *rows]}
+        acc_y = b[j]
+        for k in below:
+            for i in acc:
+                if (i, k) in U:
+                    acc[i] = prog.let(acc[i] - L[(j, k)] * U[(i, k)], "fdH")
+            acc_y = prog.let(acc_y - L[(j, k)] * y[k], "fdy")
+        y[j] = prog.let(acc_y, "fdy")
+        r[j] = prog.let(1 / acc[j], "fdr")
+        for i in rows:
+            U[(i, j)] = acc[i]
+            L[(i, j)] = prog.let(acc[i] * r[j], "fdL")
+        U[(j, j)] = acc[j]
+    x: list[sp.Expr] = [sp.S.Zero] * n
+    for j in reversed(range(n)):
+        s = y[j] * r[j] - sum((L[(i, j)] * x[i] for i in range(j + 1, n) if (i, j) in L), sp.S.Zero)
+        x[j] = prog.let(s, "fdx")
+    return x
+
+
 def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     """The six functions of tau = M qdd + V + G + F and its terms (slide 16), over `dyn.program`."""
     n = dyn.n
@@ -141,12 +170,16 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     n = dyn.n
     c = dyn.compact
     fd = Program()
-    b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
     # a floating base is the root of the tree, its six coordinates first: eliminating the last
     # coordinate first leaves its 6 x 6 block, dense, for the end and fills nothing else in
     chain = dyn.robot.is_chain and not dyn.robot.floating
     order = list(range(n)) if chain else list(reversed(range(n)))
-    solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+    if dyn.robot.floating:
+        b = [x.tau.symbols[i] - c["bias"][i] for i in range(n)]
+        solved = _column_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+    else:
+        b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
+        solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
     qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
         FunctionRow(
@@ -159,6 +192,7 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             # a floating robot's temporaries laid out from the last output back (measured on Talos:
             # 2400 -> 2330 ns; fixed bases keep their order)
             visit=tuple(reversed(range(n))) if dyn.robot.floating else None,
+            lead=tuple(sym for sym, _ in fd.assignments) if dyn.robot.floating else (),
         )
     ]
 
@@ -297,6 +331,7 @@ def build_functions(
             needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
         steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
         visits = {row.name: row.visit for row in members if row.visit is not None}
+        leads = {row.name: row.lead for row in members if row.lead}
         groups = {row.name: list(row.exprs) for row in members}
-        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits)
+        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits, leads=leads)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]
