@@ -106,33 +106,39 @@ def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
     return x
 
 
-def _column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
+def _column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> tuple[list[sp.Expr], list[sp.Expr]]:
     n = M.rows
-    L: dict[tuple[int, int], sp.Expr] = {}
+    layout: list[sp.Expr] = []
+
+    def let(e, hint, always=False):
+        out = prog.name(e, hint) if always else prog.let(e, hint)
+        if out.is_Symbol:
+            layout.append(out)
+        return out
+
     U: dict[tuple[int, int], sp.Expr] = {}
     r: list[sp.Expr] = [sp.S.Zero] * n
     y: list[sp.Expr] = [sp.S.Zero] * n
     for j in range(n):
-        below = [k for k in range(j) if (j, k) in L]  # the coordinates eliminated before j that j couples to
-        rows = [i for i in range(j + 1, n) if M[i, j] != 0 or any((i, k) in L for k in below)]
-        acc = {i: prog.let(M[i, j], "fdM") for i in [j, *rows]}
-        acc_y = b[j]
+        below = [k for k in range(j) if (j, k) in U]  # the coordinates eliminated before j that j couples to
+        rows = [i for i in range(j + 1, n) if M[i, j] != 0 or any((i, k) in U for k in below)]
+        acc = {i: let(M[i, j], "fdM") for i in [j, *rows]}
+        acc_y = let(b[j], "fdb")
         for k in below:
+            l = let(U[(j, k)] * r[k], "fdL", always=True)
             for i in acc:
                 if (i, k) in U:
-                    acc[i] = prog.let(acc[i] - L[(j, k)] * U[(i, k)], "fdH")
-            acc_y = prog.let(acc_y - L[(j, k)] * y[k], "fdy")
-        y[j] = prog.let(acc_y, "fdy")
-        r[j] = prog.let(1 / acc[j], "fdr")
+                    acc[i] = let(acc[i] - l * U[(i, k)], "fdH")
+            acc_y = let(acc_y - l * y[k], "fdy")
+        y[j] = acc_y
+        r[j] = let(1 / acc[j], "fdr")
         for i in rows:
             U[(i, j)] = acc[i]
-            L[(i, j)] = prog.let(acc[i] * r[j], "fdL")
-        U[(j, j)] = acc[j]
     x: list[sp.Expr] = [sp.S.Zero] * n
     for j in reversed(range(n)):
-        s = y[j] * r[j] - sum((L[(i, j)] * x[i] for i in range(j + 1, n) if (i, j) in L), sp.S.Zero)
-        x[j] = prog.let(s, "fdx")
-    return x
+        s = y[j] - sum((U[(i, j)] * x[i] for i in range(j + 1, n) if (i, j) in U), sp.S.Zero)
+        x[j] = let(r[j] * let(s, "fds"), "fdx", always=True)  # a number r_j must not distribute over s
+    return x, layout
 
 
 def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
@@ -176,10 +182,11 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     order = list(range(n)) if chain else list(reversed(range(n)))
     if dyn.robot.floating:
         b = [x.tau.symbols[i] - c["bias"][i] for i in range(n)]
-        solved = _column_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+        solved, layout = _column_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
     else:
         b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
         solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+        layout = []
     qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
         FunctionRow(
@@ -192,7 +199,7 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             # a floating robot's temporaries laid out from the last output back (measured on Talos:
             # 2400 -> 2330 ns; fixed bases keep their order)
             visit=tuple(reversed(range(n))) if dyn.robot.floating else None,
-            lead=tuple(sym for sym, _ in fd.assignments) if dyn.robot.floating else (),
+            lead=tuple(dict.fromkeys(layout)),
         )
     ]
 
