@@ -8,14 +8,21 @@ derived program, and `build_functions` eliminates all rows in one CSE pass. Prin
 CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
 
 forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
-unrolled symbolically (no square roots):
-    D_j = M_jj - sum_{k<j} L_jk^2 D_k,  L_ij = (M_ij - sum_{k<j} L_ik L_jk D_k) / D_j,
-then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away. Unless the robot
-is a serial chain (Robot.is_chain) the coordinates are eliminated from the last to the
-first instead, M = L^T D L (Featherstone, Rigid Body Dynamics Algorithms (2008), ch. 6, the
-LTDL factorization that exploits branch-induced sparsity): on a tree numbered parents
-first this creates no fill-in, so L keeps the zeros of joints on different branches. A
-chain, whose M is dense, keeps the forward order.
+unrolled symbolically (no square roots), left-looking, one column j at a time:
+    U_ij = M_ij - sum_{k<j} L_jk U_ik  (i >= j),  D_j = U_jj,  L_jk = U_jk / D_k,
+    y_j = b_j - sum_{k<j} L_jk y_k,  then  qdd_j = (y_j - sum_{i>j} U_ij qdd_i) / D_j
+(U_ij = L_ij D_j: each product L_jk U_ik is one multiply-add, and L_jk, formed in column j
+from the shared reciprocal 1/D_k, is never stored). The temporaries are laid out in this order
+(FunctionRow.lead): column j's entries of M and of b, then its updates descendant k by
+descendant k, so the column's running sums stay in registers and the code that computes M
+and the bias is emitted just before the column that reads it (Talos floating: 2420 -> 2125 ns,
+Solo-12 floating 658 -> 455 ns, Panda 253 -> 246 ns, gcc -O3 -march=native). Structural
+zeros of M fold away. Unless the robot is a serial chain (Robot.is_chain) the coordinates are
+eliminated from the last to the first instead, M = L^T D L (Featherstone, Rigid Body Dynamics
+Algorithms (2008), ch. 6, the LTDL factorization that exploits branch-induced sparsity): on a
+tree numbered parents first this creates no fill-in, so L keeps the zeros of joints on
+different branches, and a floating base's dense 6 x 6 block is factored last. A chain, whose
+M is dense, keeps the forward order.
 
 A generated function cannot raise, so the functions that invert M (INVERTING: forward_dynamics
 and three derivative functions) are not generated for a robot whose M is singular by
@@ -86,34 +93,17 @@ FUNCTION_NAMES = (
 )
 
 
-def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
-    n = M.rows
-    L = sp.zeros(n, n)
-    D: list[sp.Expr] = [sp.S.Zero] * n
-    for j in range(n):
-        d = M[j, j] - sum((L[j, k] ** 2 * D[k] for k in range(j)), sp.S.Zero)
-        D[j] = prog.let(d, "fdD")
-        for i in range(j + 1, n):
-            s = M[i, j] - sum((L[i, k] * L[j, k] * D[k] for k in range(j)), sp.S.Zero)
-            L[i, j] = prog.let(s / D[j], "fdL") if s != 0 else sp.S.Zero
-    y: list[sp.Expr] = []
-    for i in range(n):
-        y.append(prog.let(b[i] - sum((L[i, k] * y[k] for k in range(i)), sp.S.Zero), "fdy"))
-    x: list[sp.Expr] = [sp.S.Zero] * n
-    for i in reversed(range(n)):
-        zi = y[i] / D[i]
-        x[i] = prog.let(zi - sum((L[k, i] * x[k] for k in range(i + 1, n)), sp.S.Zero), "fdx")
-    return x
-
-
-def _column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> tuple[list[sp.Expr], list[sp.Expr]]:
+def ldlt_column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """x solving M x = b by the left-looking LDL^T of the module docstring (M in elimination
+    order, entries over the program; exact zeros and fill-in tracked), and the intermediates in
+    the order to lay them out: (x, layout)."""
     n = M.rows
     layout: list[sp.Expr] = []
 
     def let(e, hint, always=False):
         out = prog.name(e, hint) if always else prog.let(e, hint)
-        if out.is_Symbol:
-            layout.append(out)
+        if out.is_Symbol or (-out).is_Symbol:  # let names -e's positive form
+            layout.append(out if out.is_Symbol else -out)
         return out
 
     U: dict[tuple[int, int], sp.Expr] = {}
@@ -180,13 +170,8 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     # coordinate first leaves its 6 x 6 block, dense, for the end and fills nothing else in
     chain = dyn.robot.is_chain and not dyn.robot.floating
     order = list(range(n)) if chain else list(reversed(range(n)))
-    if dyn.robot.floating:
-        b = [x.tau.symbols[i] - c["bias"][i] for i in range(n)]
-        solved, layout = _column_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
-    else:
-        b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
-        solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
-        layout = []
+    b = [x.tau.symbols[i] - c["bias"][i] for i in order]
+    solved, layout = ldlt_column_solve(sp.Matrix(c["M"]).extract(order, order), b, fd)
     qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
         FunctionRow(
@@ -196,9 +181,6 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (vector_output("qdd", n, _OUTPUT_DOCS["qdd"]),),
             tuple(qdd_out),
             tuple(fd.needed(qdd_out)),
-            # a floating robot's temporaries laid out from the last output back (measured on Talos:
-            # 2400 -> 2330 ns; fixed bases keep their order)
-            visit=tuple(reversed(range(n))) if dyn.robot.floating else None,
             lead=tuple(dict.fromkeys(layout)),
         )
     ]
