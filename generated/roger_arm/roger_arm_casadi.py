@@ -267,7 +267,7 @@ def build_forward_dynamics() -> ca.Function:
     """casadi.Function forward_dynamics(q[2], qd[2], tau[2], p[5]) -> qdd[2].
 
     qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T).
-    39 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
+    41 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
@@ -281,7 +281,7 @@ def build_forward_dynamics() -> ca.Function:
     x5 = p[4]*p[3]*p[3]
     x6 = p[2]*x0
     x7 = x5 + x6 + p[4]*x0 + 2*x4
-    x8 = 1/x7
+    x8 = x5 + x4
     x9 = p[0]*ca.sin(q[0])
     x10 = x9*p[2]
     x11 = x10*p[1]
@@ -305,16 +305,18 @@ def build_forward_dynamics() -> ca.Function:
     x29 = x28*x13 + x20*x2
     x30 = x11 + x21 + x29*p[1]
     x31 = tau[0] - x30
-    x32 = x5 + x4
-    x33 = x32*x8
-    x34 = x5 - x7*x33*x33
-    x35 = tau[1] - x21
-    x36 = x35 - x33*x31
-    x37 = x36/x34
-    x38 = x31*x8 - x33*x37
+    x32 = 1/x7
+    x33 = tau[1] - x21
+    x34 = x8*x32
+    x35 = x5 - x8*x34
+    x36 = x33 - x34*x31
+    x37 = 1/x35
+    x38 = x37*x36
+    x39 = x31 - x8*x38
+    x40 = x32*x39
     qdd = ca.SX.zeros(2, 1)
-    qdd[0] = x38
-    qdd[1] = x37
+    qdd[0] = x40
+    qdd[1] = x38
     return ca.Function(
         "forward_dynamics",
         [q, qd, tau, p],

@@ -345,7 +345,7 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x5 = m2*l2*l2;
     const double x6 = m1*x0;
     const double x7 = x5 + x6 + m2*x0 + 2.0*x4;
-    const double x8 = 1.0/x7;
+    const double x8 = x5 + x4;
     const double x9 = g*roger_arm_SIN(1, q1);
     const double x10 = x9*m1;
     const double x11 = x10*l1;
@@ -369,15 +369,17 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double x29 = x28*x13 + x20*x2;
     const double x30 = x11 + x21 + x29*l1;
     const double x31 = tau1 - x30;
-    const double x32 = x5 + x4;
-    const double x33 = x32*x8;
-    const double x34 = x5 - x7*x33*x33;
-    const double x35 = tau2 - x21;
-    const double x36 = x35 - x33*x31;
-    const double x37 = x36/x34;
-    qdd[1] = x37;
-    const double x38 = x31*x8 - x33*x37;
-    qdd[0] = x38;
+    const double x32 = 1.0/x7;
+    const double x33 = tau2 - x21;
+    const double x34 = x8*x32;
+    const double x35 = x5 - x8*x34;
+    const double x36 = x33 - x34*x31;
+    const double x37 = 1.0/x35;
+    const double x38 = x37*x36;
+    qdd[1] = x38;
+    const double x39 = x31 - x8*x38;
+    const double x40 = x32*x39;
+    qdd[0] = x40;
 }
 
 /* Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body) (35 operations: 18 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 2 other calls) */

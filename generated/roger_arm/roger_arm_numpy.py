@@ -350,7 +350,7 @@ def forward_dynamics(q, qd, tau, p=None):
     x5 = (l2*l2)*m2
     x6 = m1*x0
     x7 = m2*x0 + 2*x4 + x5 + x6
-    x8 = 1/x7
+    x8 = x4 + x5
     x9 = g*xp.sin(q1)
     x10 = m1*x9
     x11 = l1*x10
@@ -374,21 +374,23 @@ def forward_dynamics(q, qd, tau, p=None):
     x29 = x13*x28 + x2*x20
     x30 = l1*x29 + x11 + x21
     x31 = tau1 - x30
-    x32 = x4 + x5
-    x33 = x32*x8
-    x34 = -(x33*x33)*x7 + x5
-    x35 = tau2 - x21
-    x36 = -x31*x33 + x35
-    x37 = x36/x34
-    x38 = x31*x8 - x33*x37
+    x32 = 1/x7
+    x33 = tau2 - x21
+    x34 = x32*x8
+    x35 = -x34*x8 + x5
+    x36 = -x31*x34 + x33
+    x37 = 1/x35
+    x38 = x36*x37
+    x39 = x31 - x38*x8
+    x40 = x32*x39
     return _assemble(
         xp,
         device,
         _lead,
         (2,),
         [
+            x40,
             x38,
-            x37,
         ],
     )
 
