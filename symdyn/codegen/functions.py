@@ -13,11 +13,13 @@ unrolled symbolically (no square roots), left-looking, one column j at a time:
     y_j = b_j - sum_{k<j} L_jk y_k,  then  qdd_j = (y_j - sum_{i>j} U_ij qdd_i) / D_j
 (U_ij = L_ij D_j: each product L_jk U_ik is one multiply-add, and L_jk, formed in column j
 from the shared reciprocal 1/D_k, is never stored). The temporaries are laid out in this order
-(FunctionRow.lead): column j's entries of M and of b, then its updates descendant k by
-descendant k, so the column's running sums stay in registers and the code that computes M
-and the bias is emitted just before the column that reads it (Talos floating: 2420 -> 2125 ns,
-Solo-12 floating 658 -> 455 ns, Panda 253 -> 246 ns, gcc -O3 -march=native). Structural
-zeros of M fold away. Unless the robot is a serial chain (Robot.is_chain) the coordinates are
+(FunctionRow.lead): column j's b_j, then its updates descendant k by descendant k (the entries
+of M and the bias computed where first read, so the code of the CRBA and of the bias is emitted
+just before the column that reads it), so the column's running sums stay in registers
+(measured standalone, gcc -O3 -march=native: Talos floating 2420 -> 2025 ns, Solo-12 floating
+660 -> 450 ns, Panda 253 -> 250 ns; the code is bound by instruction fetch, about 50 bytes of
+machine code per ns, so spills and reloads count as much as arithmetic). Structural zeros of
+M fold away. Unless the robot is a serial chain (Robot.is_chain) the coordinates are
 eliminated from the last to the first instead, M = L^T D L (Featherstone, Rigid Body Dynamics
 Algorithms (2008), ch. 6, the LTDL factorization that exploits branch-induced sparsity): on a
 tree numbered parents first this creates no fill-in, so L keeps the zeros of joints on
@@ -102,8 +104,9 @@ def ldlt_column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> tuple[li
 
     def let(e, hint, always=False):
         out = prog.name(e, hint) if always else prog.let(e, hint)
-        if out.is_Symbol or (-out).is_Symbol:  # let names -e's positive form
-            layout.append(out if out.is_Symbol else -out)
+        named = out if out.is_Symbol else -out  # let names -e's positive form
+        if named.is_Symbol and prog.is_intermediate(named):
+            layout.append(named)
         return out
 
     U: dict[tuple[int, int], sp.Expr] = {}
