@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import random
 
+import numpy as np
 import pytest
 import sympy as sp
 from robots import derived
 
 from symdyn.codegen.functions import build_functions
 from symdyn.symbolic.cse import fast_cse
-from symdyn.symbolic.simplify import count_ops
+from symdyn.symbolic.simplify import count_ops, eliminate_many
 
 x, y, z, u, v, w = sp.symbols("x y z u v w")
 
@@ -93,3 +94,21 @@ def test_operation_counts_match_sympy_cse(name):
     ours = count_ops(*fast_cse(exprs + outputs, "t"))
     theirs = count_ops(*sp.cse(exprs + outputs, symbols=sp.numbered_symbols("t"), order="none"))
     assert ours.total <= 1.01 * theirs.total, (ours, theirs)
+
+
+def test_leads_lay_out_intermediates_first_in_their_order():
+    a, b, c = sp.symbols("_a _b _c")
+    x, y, z = sp.symbols("x y z")
+    steps = [(a, sp.sin(x) * y), (b, sp.cos(y) * z), (c, a * b + x)]
+    plain = eliminate_many(steps, {"f": [c * z]})["f"]
+    led = eliminate_many(steps, {"f": [c * z]}, leads={"f": [b, a]})["f"]
+    assert [e.has(sp.sin) for _, e in plain.temporaries] == [True, False, False]  # a, b, c
+    assert [e.has(sp.cos) for _, e in led.temporaries] == [True, False, False]  # b, a, c
+    values = {x: 0.3, y: -1.2, z: 0.7}
+    for got in (plain, led):  # the same function either way
+        env = dict(values)
+        for t, e in got.temporaries:
+            env[t] = float(e.xreplace(env))
+        assert float(got.outputs[0].xreplace(env)) == pytest.approx(
+            (np.sin(0.3) * -1.2 * np.cos(-1.2) * 0.7 + 0.3) * 0.7
+        )

@@ -15,11 +15,13 @@ import types
 
 import numpy as np
 import pytest
+import sympy as sp
 from cbuild import compile_shared, header_macros, write_files
 from robots import derived, example
 
 from symdyn.codegen import functions as fn
 from symdyn.codegen import render
+from symdyn.symbolic.program import Program
 
 rn = importlib.import_module("symdyn.rnea")
 ROBOT = "planar_3r"
@@ -160,3 +162,49 @@ def test_groups_select_families_with_unchanged_code():
         assert body in full_source, name
     with pytest.raises(SymdynError, match="unknown function group"):
         render(robot, targets=("c",), functions=("dynamic",))
+
+
+def _solved(M: sp.Matrix, b: list, order: list[int], values: dict) -> np.ndarray:
+    """x of ldlt_column_solve for M x = b eliminated in `order`, at `values`; and checks that its
+    layout lists every intermediate, each after those it reads."""
+    prog = Program()
+    x, layout = fn.ldlt_column_solve(M.extract(order, order), [b[i] for i in order], prog)
+    laid_out = [s for s in dict.fromkeys(layout) if prog.is_intermediate(s)]  # and M's own symbols
+    assert sorted(laid_out, key=str) == sorted((s for s, _ in prog.assignments), key=str)
+    done: set = set()
+    for s in laid_out:
+        assert not {t for t in dict(prog.assignments)[s].free_symbols if prog.is_intermediate(t)} - done
+        done.add(s)
+    got = np.array([float(e.xreplace(values)) for e in prog.expand(x)])
+    return got[np.argsort(order)]
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_ldlt_column_solve_with_fill_in_matches_numpy(seed):
+    # a star: coordinate 0 coupled to every other, the others to none; eliminated first to last,
+    # coordinate 0 fills in every zero; diagonally dominant, so M is positive definite
+    n = 5
+    off = {(i, 0): sp.Symbol(f"m{i}") for i in range(1, n)}
+    M = sp.Matrix(n, n, lambda i, j: 5 + sp.Symbol(f"d{i}") if i == j else off.get((max(i, j), min(i, j)), 0))
+    b = list(sp.symbols(f"b0:{n}"))
+    symbols = sorted(M.free_symbols | set(b), key=str)
+    values = dict(zip(symbols, np.random.default_rng(seed).uniform(-1, 1, len(symbols)), strict=True))
+    Mn, bn = np.array(M.xreplace(values), dtype=float), np.array([values[s] for s in b])
+    for order in (list(range(n)), list(reversed(range(n)))):  # with fill-in, and without
+        assert np.allclose(_solved(M, b, order, values), np.linalg.solve(Mn, bn), rtol=1e-13, atol=0)
+
+
+def test_ldlt_column_solve_of_a_tree_keeps_its_zeros():
+    # a root (0) and two branches (1, 2), eliminated last to first (the module docstring): no
+    # fill-in, so no coordinate of one branch is ever multiplied by one of the other
+    m = dict(zip(("m00", "m01", "m02", "m11", "m22"), sp.symbols("m00 m01 m02 m11 m22"), strict=True))
+    M = sp.Matrix([[m["m00"], m["m01"], m["m02"]], [m["m01"], m["m11"], 0], [m["m02"], 0, m["m22"]]])
+    b = list(sp.symbols("b0:3"))
+    prog = Program()
+    fn.ldlt_column_solve(M.extract([2, 1, 0], [2, 1, 0]), b[::-1], prog)
+    updates = [e for s, e in prog.assignments if s.name.startswith("_fdH")]
+    assert len(updates) == 2  # the root's pivot, once from each branch; nothing between them
+    values = {m["m00"]: 3.0, m["m01"]: 0.4, m["m02"]: -0.7, m["m11"]: 2.0, m["m22"]: 1.5}
+    values |= dict(zip(b, (0.3, -1.1, 0.8), strict=True))
+    Mn, bn = np.array(M.xreplace(values), dtype=float), np.array([values[s] for s in b])
+    assert np.allclose(_solved(M, b, [2, 1, 0], values), np.linalg.solve(Mn, bn), rtol=1e-13, atol=0)

@@ -36,6 +36,15 @@ def test_let_names_and_dedups():
     assert u != t and len(p) == 2
 
 
+def test_name_names_what_let_finds_trivial():
+    p = Program()
+    t = p.name(2 * x, "c")
+    assert isinstance(t, sp.Symbol) and p.assignments == [(t, 2 * x)]
+    assert p.name(2 * x) == t and p.let(x * y) != t  # shared like let's names
+    assert p.name(x) == x and p.name(sp.Float(0.5)) == sp.Float(0.5)  # atoms pass through
+    assert p.expand([t + 1]) == [2 * x + 1]
+
+
 def test_let_stores_the_positive_form_of_a_negation():
     p = Program()
     neg = p.let(-x * y)

@@ -17,7 +17,7 @@ function Yb = panda_base_regressor(q, qd, qdd, p)
 %   coriolis                           743 ops: 398 mul, 333 add, 0 div, 12 trig, 0 other
 %   gravity                             98 ops: 50 mul, 36 add, 0 div, 12 trig, 0 other
 %   friction                             0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
-%   forward_dynamics                  1415 ops: 771 mul, 625 add, 7 div, 12 trig, 0 other
+%   forward_dynamics                  1380 ops: 736 mul, 625 add, 7 div, 12 trig, 0 other
 %   regressor                         1743 ops: 1020 mul, 704 add, 0 div, 12 trig, 7 other
 %   base_regressor                    1429 ops: 841 mul, 569 add, 0 div, 12 trig, 7 other
 %   inverse_dynamics_derivatives      5585 ops: 2983 mul, 2590 add, 0 div, 12 trig, 0 other

@@ -8,7 +8,7 @@
  *   coriolis                           743 ops: 398 mul, 333 add, 0 div, 12 trig, 0 other
  *   gravity                             98 ops: 50 mul, 36 add, 0 div, 12 trig, 0 other
  *   friction                             0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
- *   forward_dynamics                  1415 ops: 771 mul, 625 add, 7 div, 12 trig, 0 other
+ *   forward_dynamics                  1380 ops: 736 mul, 625 add, 7 div, 12 trig, 0 other
  *   regressor                         1743 ops: 1020 mul, 704 add, 0 div, 12 trig, 7 other
  *   base_regressor                    1429 ops: 841 mul, 569 add, 0 div, 12 trig, 7 other
  *   inverse_dynamics_derivatives      5585 ops: 2983 mul, 2590 add, 0 div, 12 trig, 0 other
@@ -294,7 +294,7 @@ void panda_friction(const double qd[], const double p[], double F[]);
  * @param[in]  p    free parameters: none (panda_NPARAM is 0), so p may be NULL; not read by this function
  * @param[out] qdd  joint accelerations, panda_NDOF values
  *
- * Cost per call: 1415 operations: 771 multiplications, 625 additions, 7 divisions, 12 trigonometric calls, 0 other calls.
+ * Cost per call: 1380 operations: 736 multiplications, 625 additions, 7 divisions, 12 trigonometric calls, 0 other calls.
  */
 void panda_forward_dynamics(const double q[], const double qd[], const double tau[], const double p[], double qdd[]);
 

@@ -16,7 +16,7 @@ function C = puma560_coriolis_matrix(q, qd, p)
 %   coriolis                        352 ops: 199 mul, 143 add, 0 div, 10 trig, 0 other
 %   gravity                          43 ops: 23 mul, 12 add, 0 div, 8 trig, 0 other
 %   friction                         24 ops: 12 mul, 6 add, 0 div, 0 trig, 6 other
-%   forward_dynamics                749 ops: 419 mul, 308 add, 6 div, 10 trig, 6 other
+%   forward_dynamics                725 ops: 395 mul, 308 add, 6 div, 10 trig, 6 other
 %   regressor                      1007 ops: 574 mul, 417 add, 0 div, 10 trig, 6 other
 %   base_regressor                  819 ops: 472 mul, 331 add, 0 div, 10 trig, 6 other
 %   inverse_dynamics_derivatives   2288 ops: 1279 mul, 999 add, 0 div, 10 trig, 0 other

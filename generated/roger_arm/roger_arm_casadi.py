@@ -267,54 +267,56 @@ def build_forward_dynamics() -> ca.Function:
     """casadi.Function forward_dynamics(q[2], qd[2], tau[2], p[5]) -> qdd[2].
 
     qdd solving M(q) qdd = tau - V(q, qd) - G(q) - F(qd) (unrolled LDL^T).
-    39 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
+    41 temporaries; 56 operations (33 mul, 17 add, 2 div, 4 trig, 0 other).
     """
     q = ca.SX.sym("q", 2)
     qd = ca.SX.sym("qd", 2)
     tau = ca.SX.sym("tau", 2)
     p = ca.SX.sym("p", 5)
-    x0 = p[1]*p[1]
-    x1 = p[3]*p[4]
-    x2 = ca.cos(q[1])
-    x3 = x1*x2
-    x4 = x3*p[1]
-    x5 = p[4]*p[3]*p[3]
-    x6 = p[2]*x0
-    x7 = x5 + x6 + p[4]*x0 + 2*x4
-    x8 = 1/x7
-    x9 = p[0]*ca.sin(q[0])
-    x10 = x9*p[2]
-    x11 = x10*p[1]
-    x12 = x9*x2
-    x13 = ca.sin(q[1])
-    x14 = qd[0]*qd[0]
-    x15 = x14*p[1]
-    x16 = p[0]*ca.cos(q[0])
-    x17 = -x15 - x16
-    x18 = -x17*x13
-    x19 = x12 + x18
+    x0 = p[0]*ca.sin(q[0])
+    x1 = x0*p[2]
+    x2 = x1*p[1]
+    x3 = ca.cos(q[1])
+    x4 = x0*x3
+    x5 = ca.sin(q[1])
+    x6 = qd[0]*qd[0]
+    x7 = x6*p[1]
+    x8 = p[0]*ca.cos(q[0])
+    x9 = -x7 - x8
+    x10 = -x9*x5
+    x11 = x4 + x10
+    x12 = x11*p[4]
+    x13 = x12*p[3]
+    x14 = qd[0] + qd[1]
+    x15 = x14*x14
+    x16 = x15*p[3]
+    x17 = x9*x3
+    x18 = x0*x5 + x17
+    x19 = x18 - x16
     x20 = x19*p[4]
-    x21 = x20*p[3]
-    x22 = qd[0] + qd[1]
-    x23 = x22*x22
-    x24 = x23*p[3]
-    x25 = x17*x2
-    x26 = x9*x13 + x25
-    x27 = x26 - x24
-    x28 = x27*p[4]
-    x29 = x28*x13 + x20*x2
-    x30 = x11 + x21 + x29*p[1]
-    x31 = tau[0] - x30
-    x32 = x5 + x4
-    x33 = x32*x8
-    x34 = x5 - x7*x33*x33
-    x35 = tau[1] - x21
-    x36 = x35 - x33*x31
-    x37 = x36/x34
-    x38 = x31*x8 - x33*x37
+    x21 = x20*x5 + x12*x3
+    x22 = x2 + x13 + x21*p[1]
+    x23 = tau[0] - x22
+    x24 = p[1]*p[1]
+    x25 = p[3]*p[4]
+    x26 = x25*x3
+    x27 = x26*p[1]
+    x28 = p[4]*p[3]*p[3]
+    x29 = p[2]*x24
+    x30 = x28 + x29 + p[4]*x24 + 2*x27
+    x31 = 1/x30
+    x32 = tau[1] - x13
+    x33 = x28 + x27
+    x34 = x33*x31
+    x35 = x28 - x33*x34
+    x36 = x32 - x34*x23
+    x37 = 1/x35
+    x38 = x37*x36
+    x39 = x23 - x33*x38
+    x40 = x31*x39
     qdd = ca.SX.zeros(2, 1)
-    qdd[0] = x38
-    qdd[1] = x37
+    qdd[0] = x40
+    qdd[1] = x38
     return ca.Function(
         "forward_dynamics",
         [q, qd, tau, p],

@@ -326,55 +326,57 @@ void roger_arm_forward_dynamics(const double q[], const double qd[], const doubl
     const double m2 = p[roger_arm_P_m2];
 #ifdef roger_arm_SINCOS_VECTOR
     const double angle[4] = {
-        q2,
         q1,
+        q2,
         0.0,
         0.0
     };
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
-    const double x0 = l1*l1;
-    const double x1 = l2*m2;
-    const double x2 = roger_arm_COS(0, q2);
-    const double x3 = x1*x2;
-    const double x4 = x3*l1;
-    const double x5 = m2*l2*l2;
-    const double x6 = m1*x0;
-    const double x7 = x5 + x6 + m2*x0 + 2.0*x4;
-    const double x8 = 1.0/x7;
-    const double x9 = g*roger_arm_SIN(1, q1);
-    const double x10 = x9*m1;
-    const double x11 = x10*l1;
-    const double x12 = x9*x2;
-    const double x13 = roger_arm_SIN(0, q2);
-    const double x14 = qd1*qd1;
-    const double x15 = x14*l1;
-    const double x16 = g*roger_arm_COS(1, q1);
-    const double x17 = -x15 - x16;
-    const double x18 = -x17*x13;
-    const double x19 = x12 + x18;
+    const double x0 = g*roger_arm_SIN(0, q1);
+    const double x1 = x0*m1;
+    const double x2 = x1*l1;
+    const double x3 = roger_arm_COS(1, q2);
+    const double x4 = x0*x3;
+    const double x5 = roger_arm_SIN(1, q2);
+    const double x6 = qd1*qd1;
+    const double x7 = x6*l1;
+    const double x8 = g*roger_arm_COS(0, q1);
+    const double x9 = -x7 - x8;
+    const double x10 = -x9*x5;
+    const double x11 = x4 + x10;
+    const double x12 = x11*m2;
+    const double x13 = x12*l2;
+    const double x14 = qd1 + qd2;
+    const double x15 = x14*x14;
+    const double x16 = x15*l2;
+    const double x17 = x9*x3;
+    const double x18 = x0*x5 + x17;
+    const double x19 = x18 - x16;
     const double x20 = x19*m2;
-    const double x21 = x20*l2;
-    const double x22 = qd1 + qd2;
-    const double x23 = x22*x22;
-    const double x24 = x23*l2;
-    const double x25 = x17*x2;
-    const double x26 = x9*x13 + x25;
-    const double x27 = x26 - x24;
-    const double x28 = x27*m2;
-    const double x29 = x28*x13 + x20*x2;
-    const double x30 = x11 + x21 + x29*l1;
-    const double x31 = tau1 - x30;
-    const double x32 = x5 + x4;
-    const double x33 = x32*x8;
-    const double x34 = x5 - x7*x33*x33;
-    const double x35 = tau2 - x21;
-    const double x36 = x35 - x33*x31;
-    const double x37 = x36/x34;
-    qdd[1] = x37;
-    const double x38 = x31*x8 - x33*x37;
-    qdd[0] = x38;
+    const double x21 = x20*x5 + x12*x3;
+    const double x22 = x2 + x13 + x21*l1;
+    const double x23 = tau1 - x22;
+    const double x24 = l1*l1;
+    const double x25 = l2*m2;
+    const double x26 = x25*x3;
+    const double x27 = x26*l1;
+    const double x28 = m2*l2*l2;
+    const double x29 = m1*x24;
+    const double x30 = x28 + x29 + m2*x24 + 2.0*x27;
+    const double x31 = 1.0/x30;
+    const double x32 = tau2 - x13;
+    const double x33 = x28 + x27;
+    const double x34 = x33*x31;
+    const double x35 = x28 - x33*x34;
+    const double x36 = x32 - x34*x23;
+    const double x37 = 1.0/x35;
+    const double x38 = x37*x36;
+    qdd[1] = x38;
+    const double x39 = x23 - x33*x38;
+    const double x40 = x31*x39;
+    qdd[0] = x40;
 }
 
 /* Y(q, qd, qdd) with tau = Y pi, pi the standard parameters (13 per body) (35 operations: 18 multiplications, 11 additions, 0 divisions, 4 trigonometric calls, 2 other calls) */

@@ -342,53 +342,55 @@ def forward_dynamics(q, qd, tau, p=None):
     m1 = p[..., 2]
     l2 = p[..., 3]
     m2 = p[..., 4]
-    x0 = l1*l1
-    x1 = l2*m2
-    x2 = xp.cos(q2)
-    x3 = x1*x2
-    x4 = l1*x3
-    x5 = (l2*l2)*m2
-    x6 = m1*x0
-    x7 = m2*x0 + 2*x4 + x5 + x6
-    x8 = 1/x7
-    x9 = g*xp.sin(q1)
-    x10 = m1*x9
-    x11 = l1*x10
-    x12 = x2*x9
-    x13 = xp.sin(q2)
-    x14 = qd1*qd1
-    x15 = l1*x14
-    x16 = g*xp.cos(q1)
-    x17 = -x15 - x16
-    x18 = -x13*x17
-    x19 = x12 + x18
+    x0 = g*xp.sin(q1)
+    x1 = m1*x0
+    x2 = l1*x1
+    x3 = xp.cos(q2)
+    x4 = x0*x3
+    x5 = xp.sin(q2)
+    x6 = qd1*qd1
+    x7 = l1*x6
+    x8 = g*xp.cos(q1)
+    x9 = -x7 - x8
+    x10 = -x5*x9
+    x11 = x10 + x4
+    x12 = m2*x11
+    x13 = l2*x12
+    x14 = qd1 + qd2
+    x15 = x14*x14
+    x16 = l2*x15
+    x17 = x3*x9
+    x18 = x0*x5 + x17
+    x19 = -x16 + x18
     x20 = m2*x19
-    x21 = l2*x20
-    x22 = qd1 + qd2
-    x23 = x22*x22
-    x24 = l2*x23
-    x25 = x17*x2
-    x26 = x13*x9 + x25
-    x27 = -x24 + x26
-    x28 = m2*x27
-    x29 = x13*x28 + x2*x20
-    x30 = l1*x29 + x11 + x21
-    x31 = tau1 - x30
-    x32 = x4 + x5
-    x33 = x32*x8
-    x34 = -(x33*x33)*x7 + x5
-    x35 = tau2 - x21
-    x36 = -x31*x33 + x35
-    x37 = x36/x34
-    x38 = x31*x8 - x33*x37
+    x21 = x12*x3 + x20*x5
+    x22 = l1*x21 + x13 + x2
+    x23 = tau1 - x22
+    x24 = l1*l1
+    x25 = l2*m2
+    x26 = x25*x3
+    x27 = l1*x26
+    x28 = (l2*l2)*m2
+    x29 = m1*x24
+    x30 = m2*x24 + 2*x27 + x28 + x29
+    x31 = 1/x30
+    x32 = tau2 - x13
+    x33 = x27 + x28
+    x34 = x31*x33
+    x35 = x28 - x33*x34
+    x36 = -x23*x34 + x32
+    x37 = 1/x35
+    x38 = x36*x37
+    x39 = x23 - x33*x38
+    x40 = x31*x39
     return _assemble(
         xp,
         device,
         _lead,
         (2,),
         [
+            x40,
             x38,
-            x37,
         ],
     )
 

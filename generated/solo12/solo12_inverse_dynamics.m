@@ -17,7 +17,7 @@ function tau = solo12_inverse_dynamics(q, qd, qdd, p)
 %   coriolis                        724 ops: 420 mul, 288 add, 0 div, 16 trig, 0 other
 %   gravity                         108 ops: 60 mul, 24 add, 0 div, 24 trig, 0 other
 %   friction                          0 ops: 0 mul, 0 add, 0 div, 0 trig, 0 other
-%   forward_dynamics               1156 ops: 652 mul, 472 add, 8 div, 24 trig, 0 other
+%   forward_dynamics               1144 ops: 640 mul, 472 add, 8 div, 24 trig, 0 other
 %   regressor                       928 ops: 512 mul, 380 add, 0 div, 24 trig, 12 other
 %   base_regressor                  772 ops: 424 mul, 312 add, 0 div, 24 trig, 12 other
 %   inverse_dynamics_derivatives   3256 ops: 1720 mul, 1512 add, 0 div, 24 trig, 0 other

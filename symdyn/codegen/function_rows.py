@@ -137,7 +137,8 @@ class FunctionRow:
     of `results`); `steps` the assignments they need beyond the dynamics' own program. Rows of
     one `cse` group share a CSE pass; a family in a group of its own cannot change the code of
     the others. `visit`, if given, is the order of the entries in which their temporaries are laid
-    out (symdyn.symbolic.simplify.eliminate_many).
+    out (symdyn.symbolic.simplify.eliminate_many); `lead`, intermediates of `steps` laid out first,
+    in their order.
     """
 
     name: str
@@ -148,6 +149,7 @@ class FunctionRow:
     steps: tuple = ()
     cse: str = ""
     visit: tuple[int, ...] | None = None
+    lead: tuple[sp.Symbol, ...] = ()
 
 
 @dataclass(frozen=True)

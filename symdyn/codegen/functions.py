@@ -8,14 +8,23 @@ derived program, and `build_functions` eliminates all rows in one CSE pass. Prin
 CasADi, NumPy and LaTeX render these specs; nothing here is target-specific.
 
 forward_dynamics solves M qdd = tau - (V + G + F) with an LDL^T factorisation
-unrolled symbolically (no square roots):
-    D_j = M_jj - sum_{k<j} L_jk^2 D_k,  L_ij = (M_ij - sum_{k<j} L_ik L_jk D_k) / D_j,
-then L y = b, z = D^-1 y, L^T qdd = z. Structural zeros of M fold away. Unless the robot
-is a serial chain (Robot.is_chain) the coordinates are eliminated from the last to the
-first instead, M = L^T D L (Featherstone, Rigid Body Dynamics Algorithms (2008), ch. 6, the
-LTDL factorization that exploits branch-induced sparsity): on a tree numbered parents
-first this creates no fill-in, so L keeps the zeros of joints on different branches. A
-chain, whose M is dense, keeps the forward order.
+unrolled symbolically (no square roots), left-looking, one column j at a time:
+    U_ij = M_ij - sum_{k<j} L_jk U_ik  (i >= j),  D_j = U_jj,  L_jk = U_jk / D_k,
+    y_j = b_j - sum_{k<j} L_jk y_k,  then  qdd_j = (y_j - sum_{i>j} U_ij qdd_i) / D_j
+(U_ij = L_ij D_j: each product L_jk U_ik is one multiply-add, and L_jk, formed in column j
+from the shared reciprocal 1/D_k, is never stored). The temporaries are laid out in this order
+(FunctionRow.lead): column j's b_j, then its updates descendant k by descendant k (the entries
+of M and the bias computed where first read, so the code of the CRBA and of the bias is emitted
+just before the column that reads it), so the column's running sums stay in registers
+(measured standalone, gcc -O3 -march=native: Talos floating 2420 -> 2025 ns, Solo-12 floating
+660 -> 450 ns, Panda 253 -> 250 ns; the code is bound by instruction fetch, about 50 bytes of
+machine code per ns, so spills and reloads count as much as arithmetic). Structural zeros of
+M fold away. Unless the robot is a serial chain (Robot.is_chain) the coordinates are
+eliminated from the last to the first instead, M = L^T D L (Featherstone, Rigid Body Dynamics
+Algorithms (2008), ch. 6, the LTDL factorization that exploits branch-induced sparsity): on a
+tree numbered parents first this creates no fill-in, so L keeps the zeros of joints on
+different branches, and a floating base's dense 6 x 6 block is factored last. A chain, whose
+M is dense, keeps the forward order.
 
 A generated function cannot raise, so the functions that invert M (INVERTING: forward_dynamics
 and three derivative functions) are not generated for a robot whose M is singular by
@@ -86,24 +95,43 @@ FUNCTION_NAMES = (
 )
 
 
-def _ldlt_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> list[sp.Expr]:
+def ldlt_column_solve(M: sp.Matrix, b: list[sp.Expr], prog: Program) -> tuple[list[sp.Expr], list[sp.Expr]]:
+    """x solving M x = b by the left-looking LDL^T of the module docstring (M in elimination
+    order, entries over the program; exact zeros and fill-in tracked), and the intermediates in
+    the order to lay them out: (x, layout)."""
     n = M.rows
-    L = sp.zeros(n, n)
-    D: list[sp.Expr] = [sp.S.Zero] * n
+    layout: list[sp.Expr] = []
+
+    def let(e, hint, always=False):
+        out = prog.name(e, hint) if always else prog.let(e, hint)
+        named = out if out.is_Symbol else -out  # let names -e's positive form
+        if named.is_Symbol and prog.is_intermediate(named):
+            layout.append(named)
+        return out
+
+    U: dict[tuple[int, int], sp.Expr] = {}
+    r: list[sp.Expr] = [sp.S.Zero] * n
+    y: list[sp.Expr] = [sp.S.Zero] * n
     for j in range(n):
-        d = M[j, j] - sum((L[j, k] ** 2 * D[k] for k in range(j)), sp.S.Zero)
-        D[j] = prog.let(d, "fdD")
-        for i in range(j + 1, n):
-            s = M[i, j] - sum((L[i, k] * L[j, k] * D[k] for k in range(j)), sp.S.Zero)
-            L[i, j] = prog.let(s / D[j], "fdL") if s != 0 else sp.S.Zero
-    y: list[sp.Expr] = []
-    for i in range(n):
-        y.append(prog.let(b[i] - sum((L[i, k] * y[k] for k in range(i)), sp.S.Zero), "fdy"))
+        below = [k for k in range(j) if (j, k) in U]  # the coordinates eliminated before j that j couples to
+        rows = [i for i in range(j + 1, n) if M[i, j] != 0 or any((i, k) in U for k in below)]
+        acc = {i: let(M[i, j], "fdM") for i in [j, *rows]}
+        acc_y = let(b[j], "fdb")
+        for k in below:
+            l = let(U[(j, k)] * r[k], "fdL", always=True)
+            for i in acc:
+                if (i, k) in U:
+                    acc[i] = let(acc[i] - l * U[(i, k)], "fdH")
+            acc_y = let(acc_y - l * y[k], "fdy")
+        y[j] = acc_y
+        r[j] = let(1 / acc[j], "fdr")
+        for i in rows:
+            U[(i, j)] = acc[i]
     x: list[sp.Expr] = [sp.S.Zero] * n
-    for i in reversed(range(n)):
-        zi = y[i] / D[i]
-        x[i] = prog.let(zi - sum((L[k, i] * x[k] for k in range(i + 1, n)), sp.S.Zero), "fdx")
-    return x
+    for j in reversed(range(n)):
+        s = y[j] - sum((U[(i, j)] * x[i] for i in range(j + 1, n) if (i, j) in U), sp.S.Zero)
+        x[j] = let(r[j] * let(s, "fds"), "fdx", always=True)  # a number r_j must not distribute over s
+    return x, layout
 
 
 def dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
@@ -141,12 +169,12 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     n = dyn.n
     c = dyn.compact
     fd = Program()
-    b = [fd.let(x.tau.symbols[i] - c["bias"][i], "fdb") for i in range(n)]
     # a floating base is the root of the tree, its six coordinates first: eliminating the last
     # coordinate first leaves its 6 x 6 block, dense, for the end and fills nothing else in
     chain = dyn.robot.is_chain and not dyn.robot.floating
     order = list(range(n)) if chain else list(reversed(range(n)))
-    solved = _ldlt_solve(sp.Matrix(c["M"]).extract(order, order), [b[i] for i in order], fd)
+    b = [x.tau.symbols[i] - c["bias"][i] for i in order]
+    solved, layout = ldlt_column_solve(sp.Matrix(c["M"]).extract(order, order), b, fd)
     qdd_out = [solved[order.index(i)] for i in range(n)]
     return [
         FunctionRow(
@@ -156,9 +184,7 @@ def forward_dynamics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (vector_output("qdd", n, _OUTPUT_DOCS["qdd"]),),
             tuple(qdd_out),
             tuple(fd.needed(qdd_out)),
-            # a floating robot's temporaries laid out from the last output back (measured on Talos:
-            # 2400 -> 2330 ns; fixed bases keep their order)
-            visit=tuple(reversed(range(n))) if dyn.robot.floating else None,
+            lead=tuple(dict.fromkeys(layout)),
         )
     ]
 
@@ -297,6 +323,7 @@ def build_functions(
             needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
         steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
         visits = {row.name: row.visit for row in members if row.visit is not None}
+        leads = {row.name: row.lead for row in members if row.lead}
         groups = {row.name: list(row.exprs) for row in members}
-        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits)
+        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits, leads=leads)
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]

@@ -139,6 +139,12 @@ class Program:
             return -self._name(pos, hint)
         return self._name(expr, hint)
 
+    def name(self, expr, hint: str = "t") -> sp.Expr:
+        """Name `expr` even when `let` finds it trivial (a number times a symbol, which every use
+        would multiply again); atoms pass through."""
+        expr = sp.sympify(expr)
+        return expr if expr.is_Atom else self._name(expr, hint)
+
     def _name(self, expr: sp.Expr, hint: str) -> sp.Symbol:
         found = self._by_expr.get(expr)
         if found is not None:

@@ -215,11 +215,14 @@ def _extract(
     prefix: str,
     taken: set[sp.Symbol],
     visit: Sequence[int] | None = None,
+    lead: Sequence[sp.Symbol] = (),
 ) -> Eliminated:
     """The temporaries the outputs need, in order (each output's, depth first, the outputs taken
-    in the order `visit` of their indices, or in their own); fresh names that no input (a
-    parameter called x0) already has, for every function generated from the same robot."""
-    order = _topological(nodes, [outputs[k] for k in visit] if visit is not None else outputs)
+    in the order `visit` of their indices, or in their own; the intermediates of `lead` first,
+    in their order, each after what it uses); fresh names that no input (a parameter called x0)
+    already has, for every function generated from the same robot."""
+    roots = [outputs[k] for k in visit] if visit is not None else list(outputs)
+    order = _topological(nodes, [s for s in lead if s in nodes] + roots)
     fresh = (t for t in (sp.Symbol(f"{prefix}{k}") for k in itertools.count()) if t not in taken)
     rename = {s: next(fresh) for s in order}
     memo: dict = {}
@@ -242,12 +245,15 @@ def eliminate_many(
     prefix: str = "x",
     reserved: Iterable[sp.Symbol] = (),
     visits: dict[str, Sequence[int]] | None = None,
+    leads: dict[str, Sequence[sp.Symbol]] | None = None,
 ) -> dict[str, Eliminated]:
     """`eliminate` for several functions sharing one program: one CSE pass, then each
     group keeps only the temporaries its outputs need (renamed from prefix0 per group,
     skipping the names of inputs and of the `reserved` symbols). `visits` may give, per group,
     the order in which its outputs' temporaries are laid out (the order of the computation: a
-    matrix column by column keeps fewer values alive at once than row by row)."""
+    matrix column by column keeps fewer values alive at once than row by row), and `leads` the
+    intermediates of `assignments` laid out first, in their order (an algorithm's own order of
+    steps, where it keeps fewer values alive than any order of the outputs)."""
     outputs = [sp.sympify(e) for name in groups for e in groups[name]]
     nodes, reduced = _cse_nodes(assignments, outputs)
     taken = _inputs(nodes, reduced) | set(reserved)
@@ -255,6 +261,7 @@ def eliminate_many(
     k = 0
     for name, outs in groups.items():
         visit = (visits or {}).get(name)
-        result[name] = _extract(nodes, reduced[k : k + len(outs)], prefix, taken, visit)
+        lead = (leads or {}).get(name, ())
+        result[name] = _extract(nodes, reduced[k : k + len(outs)], prefix, taken, visit, lead)
         k += len(outs)
     return result
