@@ -170,18 +170,18 @@ void roger_arm_mass_matrix(const double q[], const double p[], double M[])
     roger_arm_sincos(1, angle, sine, cosine);
 #endif
     const double x0 = m2*l2*l2;
-    M[3] = x0;
+    ((volatile double *)M)[3] = x0;
     const double x1 = l2*m2;
     const double x2 = roger_arm_COS(0, q2);
     const double x3 = x1*x2;
     const double x4 = x3*l1;
     const double x5 = x0 + x4;
-    M[1] = x5;
-    M[2] = x5;
+    ((volatile double *)M)[1] = x5;
+    ((volatile double *)M)[2] = x5;
     const double x6 = l1*l1;
     const double x7 = m1*x6;
     const double x8 = x0 + x7 + m2*x6 + 2.0*x4;
-    M[0] = x8;
+    ((volatile double *)M)[0] = x8;
 }
 
 /* C(q, qd) from Christoffel symbols, row-major; C qd = V (32 operations: 21 multiplications, 9 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
@@ -208,7 +208,7 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double x2 = l1*qd1;
     const double x3 = x1*x2;
     const double x4 = x0*x3;
-    C[2] = x4;
+    ((volatile double *)C)[2] = x4;
     const double x5 = roger_arm_COS(0, q2);
     const double x6 = x3*m2;
     const double x7 = 0.5*x6;
@@ -218,14 +218,14 @@ void roger_arm_coriolis_matrix(const double q[], const double qd[], const double
     const double x11 = 0.5*x9 + 0.5*x0*x10;
     const double x12 = x7*x5 - x11*x1;
     const double x13 = x4 + 2.0*x12*l1;
-    C[0] = x13;
+    ((volatile double *)C)[0] = x13;
     const double x14 = x4 - x0*x3;
-    C[3] = x14;
+    ((volatile double *)C)[3] = x14;
     const double x15 = -2.0*x11 + x9;
     const double x16 = 2.0*x7 - x6;
     const double x17 = x15*x1 + x16*x5;
     const double x18 = x14 + x17*l1;
-    C[1] = x18;
+    ((volatile double *)C)[1] = x18;
 }
 
 /* V(q, qd) = C(q, qd) qd (18 operations: 12 multiplications, 4 additions, 0 divisions, 2 trigonometric calls, 0 other calls) */
@@ -406,41 +406,41 @@ void roger_arm_regressor(const double q[], const double qd[], const double qdd[]
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
-    Y[9] = qdd1;
-    Y[10] = qdd1;
-    Y[11] = qd1;
-    Y[49] = qdd2;
-    Y[50] = qd2;
+    ((volatile double *)Y)[9] = qdd1;
+    ((volatile double *)Y)[10] = qdd1;
+    ((volatile double *)Y)[11] = qd1;
+    ((volatile double *)Y)[49] = qdd2;
+    ((volatile double *)Y)[50] = qd2;
     const double x0 = g*roger_arm_SIN(0, q1);
-    Y[1] = x0;
+    ((volatile double *)Y)[1] = x0;
     const double x1 = g*roger_arm_COS(0, q1);
-    Y[2] = x1;
+    ((volatile double *)Y)[2] = x1;
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
-    Y[12] = x2;
+    ((volatile double *)Y)[12] = x2;
     const double x3 = x0 + l1*qdd1;
     const double x4 = roger_arm_SIN(1, q2);
     const double x5 = qd1*qd1;
     const double x6 = -x1 - x5*l1;
     const double x7 = roger_arm_COS(1, q2);
     const double x8 = x3*x4 + x6*x7;
-    Y[41] = -x8;
+    ((volatile double *)Y)[41] = -x8;
     const double x9 = x3*x7 - x4*x6;
-    Y[40] = x9;
+    ((volatile double *)Y)[40] = x9;
     const double x10 = l1*x4;
     const double x11 = l1*x7;
     const double x12 = x10*x8 + x11*x9;
-    Y[13] = x12;
+    ((volatile double *)Y)[13] = x12;
     const double x13 = qd1 + qd2;
     const double x14 = x13*x13;
     const double x15 = qdd1 + qdd2;
-    Y[22] = x15;
-    Y[48] = x15;
+    ((volatile double *)Y)[22] = x15;
+    ((volatile double *)Y)[48] = x15;
     const double x16 = x9 + x11*x15 - x10*x14;
-    Y[14] = x16;
+    ((volatile double *)Y)[14] = x16;
     const double x17 = -x8 - x10*x15 - x11*x14;
-    Y[15] = x17;
+    ((volatile double *)Y)[15] = x17;
     const double x18 = ((double)((qd2 > 0) - (qd2 < 0)));
-    Y[51] = x18;
+    ((volatile double *)Y)[51] = x18;
 }
 
 /* Y_b(q, qd, qdd) with tau = Y_b pi_b, pi_b the base parameters (32 operations: 16 multiplications, 10 additions, 0 divisions, 4 trigonometric calls, 2 other calls) */
@@ -464,46 +464,46 @@ void roger_arm_base_regressor(const double q[], const double qd[], const double 
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
-    Yb[2] = qdd1;
-    Yb[3] = qd1;
-    Yb[8] = 0.0;
-    Yb[9] = 0.0;
-    Yb[10] = 0.0;
-    Yb[11] = 0.0;
-    Yb[12] = 0.0;
-    Yb[13] = 0.0;
-    Yb[14] = 0.0;
-    Yb[15] = 0.0;
-    Yb[19] = qdd2;
-    Yb[20] = qd2;
+    ((volatile double *)Yb)[2] = qdd1;
+    ((volatile double *)Yb)[3] = qd1;
+    ((volatile double *)Yb)[8] = 0.0;
+    ((volatile double *)Yb)[9] = 0.0;
+    ((volatile double *)Yb)[10] = 0.0;
+    ((volatile double *)Yb)[11] = 0.0;
+    ((volatile double *)Yb)[12] = 0.0;
+    ((volatile double *)Yb)[13] = 0.0;
+    ((volatile double *)Yb)[14] = 0.0;
+    ((volatile double *)Yb)[15] = 0.0;
+    ((volatile double *)Yb)[19] = qdd2;
+    ((volatile double *)Yb)[20] = qd2;
     const double x0 = g*roger_arm_SIN(0, q1);
-    Yb[0] = x0;
+    ((volatile double *)Yb)[0] = x0;
     const double x1 = g*roger_arm_COS(0, q1);
-    Yb[1] = x1;
+    ((volatile double *)Yb)[1] = x1;
     const double x2 = ((double)((qd1 > 0) - (qd1 < 0)));
-    Yb[4] = x2;
+    ((volatile double *)Yb)[4] = x2;
     const double x3 = qd1 + qd2;
     const double x4 = x3*x3;
     const double x5 = qdd1 + qdd2;
-    Yb[7] = x5;
-    Yb[18] = x5;
+    ((volatile double *)Yb)[7] = x5;
+    ((volatile double *)Yb)[18] = x5;
     const double x6 = x0 + l1*qdd1;
     const double x7 = roger_arm_SIN(1, q2);
     const double x8 = qd1*qd1;
     const double x9 = -x1 - x8*l1;
     const double x10 = roger_arm_COS(1, q2);
     const double x11 = x6*x10 - x7*x9;
-    Yb[16] = x11;
+    ((volatile double *)Yb)[16] = x11;
     const double x12 = l1*x7;
     const double x13 = l1*x10;
     const double x14 = x11 + x13*x5 - x12*x4;
-    Yb[5] = x14;
+    ((volatile double *)Yb)[5] = x14;
     const double x15 = x6*x7 + x9*x10;
-    Yb[17] = -x15;
+    ((volatile double *)Yb)[17] = -x15;
     const double x16 = -x15 - x12*x5 - x13*x4;
-    Yb[6] = x16;
+    ((volatile double *)Yb)[6] = x16;
     const double x17 = ((double)((qd2 > 0) - (qd2 < 0)));
-    Yb[21] = x17;
+    ((volatile double *)Yb)[21] = x17;
 }
 
 /* dtau/dq and dtau/dqd of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (88 operations: 59 multiplications, 25 additions, 0 divisions, 4 trigonometric calls, 0 other calls) */
@@ -540,13 +540,13 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x7 = x0*x3 - x6;
     const double x8 = x7*m2;
     const double x9 = x8*l2;
-    dtau_dq[2] = x9;
+    ((volatile double *)dtau_dq)[2] = x9;
     const double x10 = x5*x3;
     const double x11 = x0*x4 + x10;
     const double x12 = x11*m2;
     const double x13 = x12*x4 + x8*x3;
     const double x14 = x9 + x2 + x13*l1;
-    dtau_dq[0] = x14;
+    ((volatile double *)dtau_dq)[0] = x14;
     const double x15 = qd1*qd1;
     const double x16 = -x0 - x15*l1;
     const double x17 = x16*x3;
@@ -554,7 +554,7 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x19 = x18*x4 + x17;
     const double x20 = -x19*m2;
     const double x21 = x20*l2;
-    dtau_dq[3] = x21;
+    ((volatile double *)dtau_dq)[3] = x21;
     const double x22 = qd1 + qd2;
     const double x23 = x22*x22;
     const double x24 = -x23*l2;
@@ -568,7 +568,7 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x32 = x29*m2;
     const double x33 = x26*x3 + x32*x4 + x20*x3 - x31*x4;
     const double x34 = x21 + x33*l1;
-    dtau_dq[1] = x34;
+    ((volatile double *)dtau_dq)[1] = x34;
     const double x35 = l2*m2;
     const double x36 = l1*qd1;
     const double x37 = x4*x36;
@@ -581,18 +581,18 @@ void roger_arm_inverse_dynamics_derivatives(const double q[], const double qd[],
     const double x44 = x40*x3 - x43*x4;
     const double x45 = x38 + 2.0*x44*l1;
     const double x46 = 2.0*x45;
-    dtau_dqd[0] = x46;
+    ((volatile double *)dtau_dqd)[0] = x46;
     const double x47 = x38 - x35*x37;
     const double x48 = -2.0*x43 + x42;
     const double x49 = 2.0*x40 - x39;
     const double x50 = x48*x4 + x49*x3;
     const double x51 = x47 + x50*l1;
     const double x52 = 2.0*x51;
-    dtau_dqd[1] = x52;
+    ((volatile double *)dtau_dqd)[1] = x52;
     const double x53 = 2.0*x38;
-    dtau_dqd[2] = x53;
+    ((volatile double *)dtau_dqd)[2] = x53;
     const double x54 = 2.0*x47;
-    dtau_dqd[3] = x54;
+    ((volatile double *)dtau_dqd)[3] = x54;
 }
 
 /* dqdd/dq and dqdd/dqd of qdd = FD(q, qd, tau) = M(q)^-1 (tau - V - G - F), and M(q)^-1 (155 operations: 100 multiplications, 49 additions, 2 divisions, 4 trigonometric calls, 0 other calls) */
@@ -646,14 +646,14 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x24 = x23*x22;
     const double x25 = x19 - x21*x24*x24;
     const double x26 = 1.0/x25;
-    Minv[3] = x26;
+    ((volatile double *)Minv)[3] = x26;
     const double x27 = x24*x26;
-    Minv[1] = -x27;
-    Minv[2] = -x27;
+    ((volatile double *)Minv)[1] = -x27;
+    ((volatile double *)Minv)[2] = -x27;
     const double x28 = x22 + x24*x27;
-    Minv[0] = x28;
+    ((volatile double *)Minv)[0] = x28;
     const double x29 = x27*x7 - x28*x14;
-    dqdd_dq[0] = x29;
+    ((volatile double *)dqdd_dq)[0] = x29;
     const double x30 = qd1*qd1;
     const double x31 = -x4 - x30*l1;
     const double x32 = x31*x0;
@@ -689,11 +689,11 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x62 = x55*x0 + x61*x1 + x52*x0 - x1*x60;
     const double x63 = x53 + x62*l1;
     const double x64 = x53*x27 - x63*x28;
-    dqdd_dq[1] = x64;
+    ((volatile double *)dqdd_dq)[1] = x64;
     const double x65 = x27*x14 - x26*x7;
-    dqdd_dq[2] = x65;
+    ((volatile double *)dqdd_dq)[2] = x65;
     const double x66 = x63*x27 - x53*x26;
-    dqdd_dq[3] = x66;
+    ((volatile double *)dqdd_dq)[3] = x66;
     const double x67 = l1*qd1;
     const double x68 = x1*x67;
     const double x69 = x16*x68;
@@ -707,7 +707,7 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x77 = 2.0*x76;
     const double x78 = 2.0*x69;
     const double x79 = -x77*x28 + x78*x27;
-    dqdd_dqd[0] = x79;
+    ((volatile double *)dqdd_dqd)[0] = x79;
     const double x80 = x69 - x16*x68;
     const double x81 = -2.0*x74 + x73;
     const double x82 = 2.0*x71 - x70;
@@ -716,11 +716,11 @@ void roger_arm_forward_dynamics_derivatives(const double q[], const double qd[],
     const double x85 = 2.0*x84;
     const double x86 = 2.0*x80;
     const double x87 = -x85*x28 + x86*x27;
-    dqdd_dqd[1] = x87;
+    ((volatile double *)dqdd_dqd)[1] = x87;
     const double x88 = -x78*x26 + x77*x27;
-    dqdd_dqd[2] = x88;
+    ((volatile double *)dqdd_dqd)[2] = x88;
     const double x89 = -x86*x26 + x85*x27;
-    dqdd_dqd[3] = x89;
+    ((volatile double *)dqdd_dqd)[3] = x89;
 }
 
 /* M(q)^-1 by the unrolled L D L^T factorisation (23 operations: 14 multiplications, 6 additions, 2 divisions, 1 trigonometric calls, 0 other calls) */
@@ -754,12 +754,12 @@ void roger_arm_mass_matrix_inverse(const double q[], const double p[], double Mi
     const double x10 = x9*x8;
     const double x11 = x5 - x7*x10*x10;
     const double x12 = 1.0/x11;
-    Minv[3] = x12;
+    ((volatile double *)Minv)[3] = x12;
     const double x13 = x10*x12;
-    Minv[1] = -x13;
-    Minv[2] = -x13;
+    ((volatile double *)Minv)[1] = -x13;
+    ((volatile double *)Minv)[2] = -x13;
     const double x14 = x8 + x10*x13;
-    Minv[0] = x14;
+    ((volatile double *)Minv)[0] = x14;
 }
 
 /* xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1] (155 operations: 100 multiplications, 49 additions, 2 divisions, 4 trigonometric calls, 0 other calls) */
@@ -786,18 +786,18 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     double sine[4], cosine[4];
     roger_arm_sincos(2, angle, sine, cosine);
 #endif
-    A[0] = 0.0;
-    A[1] = 0.0;
-    A[2] = 1.0;
-    A[3] = 0.0;
-    A[4] = 0.0;
-    A[5] = 0.0;
-    A[6] = 0.0;
-    A[7] = 1.0;
-    B[0] = 0.0;
-    B[1] = 0.0;
-    B[2] = 0.0;
-    B[3] = 0.0;
+    ((volatile double *)A)[0] = 0.0;
+    ((volatile double *)A)[1] = 0.0;
+    ((volatile double *)A)[2] = 1.0;
+    ((volatile double *)A)[3] = 0.0;
+    ((volatile double *)A)[4] = 0.0;
+    ((volatile double *)A)[5] = 0.0;
+    ((volatile double *)A)[6] = 0.0;
+    ((volatile double *)A)[7] = 1.0;
+    ((volatile double *)B)[0] = 0.0;
+    ((volatile double *)B)[1] = 0.0;
+    ((volatile double *)B)[2] = 0.0;
+    ((volatile double *)B)[3] = 0.0;
     const double x0 = roger_arm_COS(0, q2);
     const double x1 = roger_arm_SIN(0, q2);
     const double x2 = g*roger_arm_SIN(1, q1);
@@ -825,14 +825,14 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x24 = x23*x22;
     const double x25 = x19 - x21*x24*x24;
     const double x26 = 1.0/x25;
-    B[7] = x26;
+    ((volatile double *)B)[7] = x26;
     const double x27 = x24*x26;
-    B[5] = -x27;
-    B[6] = -x27;
+    ((volatile double *)B)[5] = -x27;
+    ((volatile double *)B)[6] = -x27;
     const double x28 = x22 + x24*x27;
-    B[4] = x28;
+    ((volatile double *)B)[4] = x28;
     const double x29 = x27*x7 - x28*x14;
-    A[8] = x29;
+    ((volatile double *)A)[8] = x29;
     const double x30 = qd1*qd1;
     const double x31 = -x4 - x30*l1;
     const double x32 = x31*x0;
@@ -868,7 +868,7 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x62 = x55*x0 + x61*x1 + x52*x0 - x1*x60;
     const double x63 = x53 + x62*l1;
     const double x64 = x53*x27 - x63*x28;
-    A[9] = x64;
+    ((volatile double *)A)[9] = x64;
     const double x65 = l1*qd1;
     const double x66 = x1*x65;
     const double x67 = x16*x66;
@@ -882,7 +882,7 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x75 = 2.0*x74;
     const double x76 = 2.0*x67;
     const double x77 = -x75*x28 + x76*x27;
-    A[10] = x77;
+    ((volatile double *)A)[10] = x77;
     const double x78 = x67 - x16*x66;
     const double x79 = -2.0*x72 + x71;
     const double x80 = 2.0*x69 - x68;
@@ -891,13 +891,13 @@ void roger_arm_linearize(const double q[], const double qd[], const double tau[]
     const double x83 = 2.0*x82;
     const double x84 = 2.0*x78;
     const double x85 = -x83*x28 + x84*x27;
-    A[11] = x85;
+    ((volatile double *)A)[11] = x85;
     const double x86 = x27*x14 - x26*x7;
-    A[12] = x86;
+    ((volatile double *)A)[12] = x86;
     const double x87 = x63*x27 - x53*x26;
-    A[13] = x87;
+    ((volatile double *)A)[13] = x87;
     const double x88 = -x76*x26 + x75*x27;
-    A[14] = x88;
+    ((volatile double *)A)[14] = x88;
     const double x89 = -x84*x26 + x83*x27;
-    A[15] = x89;
+    ((volatile double *)A)[15] = x89;
 }
