@@ -106,7 +106,8 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
 
     Keys: block (the static function's name), inputs (name, size: a state's values), outputs
     (name, size, stores: (index, vector text)), unused, reads ((local, input, index, vector?)),
-    angles (their vector texts, double precision only) and temporaries ((vector?, name, text)).
+    angles (their vector texts, double precision only) and body (_interleaved: the temporaries and,
+    right after each group's last one, the stores of the output groups it completes).
     """
     if spec.ops.total < MIN_OPS_PER_OUTPUT * len(spec.outputs):
         return None
@@ -126,12 +127,12 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
             arrays = (names.sincos["sine"], names.sincos["cosine"])
             calls = {call: f"{arrays[which]}[{k}]" for call, (which, k) in trig.calls.items()}
         printer = VectorPrinter(known, ctx.precision, calls, varying, prefix)
-        body = []
+        lets = []
         for s, e in temporaries:
             vector = printer.varying(e)
             if vector:
                 printer.vary.add(s)
-            body.append((vector, s.name, printer.doprint(e)))
+            lets.append((vector, s.name, printer.doprint(e)))
         outputs = [
             {
                 "name": r.name,
@@ -142,6 +143,7 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
         ]
     except SymdynError:
         return None
+    body = _interleaved(spec, temporaries, lets, outputs, ctx.precision == "double")
     sizes = {inp.name: len(inp.symbols) for inp in spec.inputs}
     return {
         "block": prefix + spec.name,
@@ -150,5 +152,39 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
         "unused": unused,
         "reads": [(local, array, index, array != "p") for local, array, index in reads],
         "angles": angles,
-        "temporaries": body,
+        "body": body,
     }
+
+
+def _interleaved(
+    spec: FunctionSpec, temporaries: list, lets: list, outputs: list[dict], transposed: bool
+) -> list:
+    """The body's statements: ("let", vector?, name, text) for each temporary, and after the last
+    temporary that a group of outputs reads, ("store", {width: [(output, offset, size, texts)]})
+    for the groups of 8 and of 4 consecutive entries that the register transposes write (doubles;
+    the last size mod W entries and floats one by one: width 1). A group stored as soon as it is
+    known needs no register or stack slot to the end of the body (symdyn.codegen.c.target._body)."""
+    position = {sym: k for k, (sym, _) in enumerate(temporaries)}
+    after: dict[int, dict[int, list]] = {}
+    for result, view in zip(spec.results, outputs, strict=True):
+        entries = spec.entries(result)
+        last = [
+            max((position[s] for s in sp.sympify(e).free_symbols if s in position), default=-1)
+            for e in entries
+        ]
+        size = view["size"]
+        for width in (8, 4) if transposed else (1,):
+            full = size - size % width if width > 1 else size
+            for start in range(0, full, width):
+                at = max(last[start : start + width])
+                texts = [t for _, t in view["stores"][start : start + width]]
+                after.setdefault(at, {}).setdefault(width, []).append((view["name"], start, size, texts))
+            for k in range(full, size):
+                group = after.setdefault(last[k], {}).setdefault(-width, [])
+                group.append((view["name"], k, size, [view["stores"][k][1]]))
+    body: list = [("store", after[-1])] if -1 in after else []
+    for k, (vector, name, text) in enumerate(lets):
+        body.append(("let", vector, name, text))
+        if k in after:
+            body.append(("store", after[k]))
+    return body
