@@ -130,7 +130,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
                 # compiler then writes each where the code computes it, instead of gathering values
                 # computed far apart into vector registers to store adjacent entries at once (GCC's
                 # SLP vectorizer at -O2 and -O3: shuffles, values kept alive across the function).
-                # gcc 12, AMD EPYC (Zen 4): Talos' floating M 690 -> 575 ns, the Panda's M 97 -> 83
+                # gcc 12, AMD EPYC (Zen 4): Talos' floating M 690 -> 575 ns, the Panda's M 91 -> 74
                 # ns; vector outputs (tau, qdd) gained nothing and keep plain stores
                 "target": f"((volatile {real} *){result.name})" if result.matrix else result.name,
             }
@@ -166,6 +166,15 @@ def _zero_runs(entries: list) -> list[tuple[int, int]]:
     return [(a, b) for a, b in runs]
 
 
+def last_reads(temporaries: list, entries: list) -> list[int]:
+    """For each output entry, the index of the last of `temporaries` ((symbol, expression), in
+    order) that it reads, or -1 when it reads none: where the entry can be stored."""
+    position = {sym: k for k, (sym, _) in enumerate(temporaries)}
+    return [
+        max((position[s] for s in sp.sympify(e).free_symbols if s in position), default=-1) for e in entries
+    ]
+
+
 def _body(spec: FunctionSpec, temporaries: list, printed: list[tuple[str, str]], outputs: list[dict]) -> list:
     """The statements of a function after its inputs are read: ("let", name, value) for each
     temporary (`printed`: their names and printed values) and ("store", "OUT[k]", value) for each
@@ -173,15 +182,11 @@ def _body(spec: FunctionSpec, temporaries: list, printed: list[tuple[str, str]],
     it reads (or first, when it reads none). A value stored as soon as it is known needs no register
     or stack slot to the end of the function: the stores of a large M at the end made the compiler
     spill hundreds of temporaries to the stack and load them back."""
-    position = {sym: k for k, (sym, _) in enumerate(temporaries)}
     after: dict[int, list] = {}
     for result, view in zip(spec.results, outputs, strict=True):
-        entries = spec.entries(result)
+        last = last_reads(temporaries, spec.entries(result))
         for k, value in view["stores"]:
-            last = max(
-                (position[s] for s in sp.sympify(entries[k]).free_symbols if s in position), default=-1
-            )
-            after.setdefault(last, []).append(("store", f"{view['target']}[{k}]", value))
+            after.setdefault(last[k], []).append(("store", f"{view['target']}[{k}]", value))
     body = list(after.get(-1, []))
     for k, (name, value) in enumerate(printed):
         body.append(("let", name, value))

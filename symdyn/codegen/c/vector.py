@@ -31,7 +31,7 @@ from ..render import RenderContext
 from .config import MATH_CALLS, CNames
 from .printer import ATOM, MUL, CPrinter
 from .sincos import gather
-from .target import function_inputs, symbol_names
+from .target import function_inputs, last_reads, symbol_names
 
 __all__ = ["VectorPrinter", "vector_view", "simd_prefix", "LANE_CALLS", "MIN_OPS_PER_OUTPUT"]
 
@@ -164,17 +164,12 @@ def _interleaved(
     for the groups of 8 and of 4 consecutive entries that the register transposes write (doubles;
     the last size mod W entries and floats one by one: width 1). A group stored as soon as it is
     known needs no register or stack slot to the end of the body (symdyn.codegen.c.target._body)."""
-    position = {sym: k for k, (sym, _) in enumerate(temporaries)}
     after: dict[int, dict[int, list]] = {}
     for result, view in zip(spec.results, outputs, strict=True):
-        entries = spec.entries(result)
-        last = [
-            max((position[s] for s in sp.sympify(e).free_symbols if s in position), default=-1)
-            for e in entries
-        ]
+        last = last_reads(temporaries, spec.entries(result))
         size = view["size"]
         for width in (8, 4) if transposed else (1,):
-            full = size - size % width if width > 1 else size
+            full = size - size % width
             for start in range(0, full, width):
                 at = max(last[start : start + width])
                 texts = [t for _, t in view["stores"][start : start + width]]
