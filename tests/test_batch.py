@@ -6,7 +6,8 @@ twin of NAME_sincos. So a batch must equal the scalar function state by state, b
 compiled with -ffp-contract=off, as symdyn.compile does), for every batch size, a multiple of W or
 not: on the Panda (inverse dynamics, M, forward dynamics, under -march=native and with AVX2 alone)
 and a tree robot with friction (whose sign and step go through the lane helpers), in double and
-float, and with the scalar fallback (no AVX). States include angles the vector sine sends to the
+float, and with the scalar fallback (no AVX); the angles' sines in calls of one, two and three
+angles (Roger's arm). States include angles the vector sine sends to the
 C library (|q| >= 2^19 pi/2), tiny ones and -0. Every build uses the C contract's -Werror flags;
 one runs the batch path under -fsanitize=address,undefined. Through symdyn.compile: no copy of
 C-contiguous float64 arrays, and threads= giving the one-thread result bit for bit.
@@ -137,10 +138,29 @@ def test_panda_batches_equal_the_scalar_functions_bit_for_bit(panda, name):
     rng = np.random.default_rng(26)
     width = panda["libs"][name][2]
     assert width == BUILDS[name][1]
+    assert "panda_simd_sincos3(" in panda["batch"] and "panda_simd_sincos2(" not in panda["batch"]
     for function in ("inverse_dynamics", "mass_matrix", "forward_dynamics"):
         assert f"static void panda_simd_{function}(" in panda["batch"]  # a vector body, not the loop
         for count in _sizes(width):
             _check(panda, name, function, count, rng)
+
+
+@pytest.fixture(scope="module")
+def roger(tmp_path_factory):
+    ctx = context(example("roger_arm_values"), functions=("dynamics",))
+    return _build_all(ctx, tmp_path_factory.mktemp("roger"), [b for b in BUILDS if b != "scalar"])
+
+
+@pytest.mark.parametrize("name", [b for b in BUILDS if b != "scalar"])
+def test_sines_of_one_and_of_two_angles_per_call(roger, name):
+    """Roger's arm: its functions' angles come in calls of NAME_simd_sincosK with K = 1 and 2 (the
+    Panda's six in two calls of three, the tree's in calls of 2 and 3), each bit for bit."""
+    assert "_simd_sincos1(" in roger["batch"] and "_simd_sincos2(" in roger["batch"]
+    rng = np.random.default_rng(7)
+    width = roger["libs"][name][2]
+    for function in roger["table"]:
+        for count in _sizes(width):
+            _check(roger, name, function, count, rng)
 
 
 @pytest.mark.parametrize("name", list(BUILDS))

@@ -94,6 +94,9 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
             lane_calls=[config.math(c) for c in LANE_CALLS],
             pow=config.math("pow"),
             sincos={**names.sincos, "block": BLOCK} if angles else None,
+            sincos_groups=sorted(
+                {len(group) for f in functions if f["vector"] for _, group in f["vector"]["angle_groups"]}
+            ),
             loops=solve_loops_entry(ctx),
         ),
         STEP_SOURCE: env.get_template("c/step.c.j2").render(header_lines=lines, real=config.real),
