@@ -168,6 +168,7 @@ def test_tree_batches_equal_the_scalar_functions_bit_for_bit(tree, name):
     """Every function of the dynamics group, friction's sign and step included; float too
     (W doubled), and the scalar fallback (W = 1) without AVX."""
     _, builds = tree
+    assert "ytree_simd_sincos_lanes(q" in builds["float"]["batch"]  # sinf and cosf in one lane loop
     rng = np.random.default_rng(5)
     for precision, dtype in (("double", np.float64), ("float", np.float32)):
         build_ = builds[precision]

@@ -79,7 +79,7 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
     assert not added & taken, f"a generated function has the name of a batch helper: {added & taken}"
     env = environment()
     lines = header_lines(ctx)
-    angles = any(f["vector"] and f["vector"]["angles"] for f in functions)
+    angles = any(f["vector"] and (f["vector"]["angles"] or f["vector"]["lane_pairs"]) for f in functions)
     return {
         f"{ctx.name}_batch.c": env.get_template("c/batch.c.j2").render(
             header_lines=lines,

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-__all__ = ["BLOCK", "SinCos", "gather"]
+__all__ = ["BLOCK", "SinCos", "gather", "trig_calls"]
 
 #: The helper computes the angles in blocks of this many (one 256-bit vector of doubles):
 #: the arrays are padded with zeros to a multiple of it.
@@ -41,7 +41,7 @@ class SinCos:
         return -(-len(self.angles) // BLOCK) * BLOCK
 
 
-def _trig_calls(exprs: Iterable[sp.Expr]) -> list[sp.Expr]:
+def trig_calls(exprs: Iterable[sp.Expr]) -> list[sp.Expr]:
     """The distinct sin(a) and cos(a) with a non-constant argument, in first-met (preorder) order."""
     found: dict[sp.Expr, None] = {}
     for expr in exprs:
@@ -83,7 +83,7 @@ def gather(temporaries: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[s
 
     index: dict[sp.Expr, int] = {}
     calls: dict[sp.Expr, tuple[int, int]] = {}
-    for call in _trig_calls([e for _, e in temporaries] + list(outputs)):
+    for call in trig_calls([e for _, e in temporaries] + list(outputs)):
         angle = resolve(call.args[0])
         k = index.setdefault(angle, len(index))
         calls[call] = (0 if isinstance(call, sp.sin) else 1, k)

@@ -9,7 +9,11 @@ computes exactly what NAME_f computes for its state; every call that has no vect
 (sqrt, pow, fabs, tan, sign, the step of Coulomb friction) goes through a lane-by-lane helper
 calling the same <math.h> function or comparison as the scalar code, branch-free. The sines and
 cosines of double precision go through the same helper as NAME_f (NAME_sincos,
-symdyn.codegen.c.sincos) on the angles of all W lanes at once.
+symdyn.codegen.c.sincos) on the angles of all W lanes at once. In single precision NAME_f calls
+sinf and cosf, which the compiler merges into one sincosf where both take the same argument; the
+batch asks for both in one lane loop (NAME_simd_sincos_lanes), merged the same way, instead of
+one loop for each: on the Panda in float it took M's batch from 1.15 to 0.80 times the scalar
+loop, the inverse dynamics from 0.79 to 0.54 and the forward dynamics from 0.53 to 0.37.
 
 A function whose code holds anything else gets no vector form (`vector_view` returns None): its
 batch wrapper then calls NAME_f once per state. So does a function with fewer than
@@ -30,7 +34,7 @@ from ..printing import step_comparison
 from ..render import RenderContext
 from .config import MATH_CALLS, CNames
 from .printer import ATOM, MUL, CPrinter
-from .sincos import gather
+from .sincos import gather, trig_calls
 from .target import function_inputs, last_reads, symbol_names
 
 __all__ = [
@@ -121,8 +125,10 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
 
     Keys: block (the static function's name), inputs (name, size: a state's values), outputs
     (name, size, stores: (index, vector text)), unused, reads ((local, input, index, vector?)),
-    angles (their vector texts, double precision only) and body (_interleaved: the temporaries and,
-    right after each group's last one, the stores of the output groups it completes).
+    angles (their vector texts, double precision only), angle_groups (angle_groups), lane_pairs (the
+    angles whose sinf and cosf are computed together, single precision only, _sine_cosine_pairs)
+    and body (_interleaved: the temporaries and, right after each group's last one, the stores of
+    the output groups it completes).
     """
     if spec.ops.total < MIN_OPS_PER_OUTPUT * len(spec.outputs):
         return None
@@ -133,6 +139,7 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
     temporaries = list(spec.temporaries)
     angles: list[str] = []
     calls: dict = {}
+    pairs: list[sp.Expr] = []
     try:
         if ctx.precision == "double":
             trig = gather(spec.temporaries, spec.outputs)
@@ -141,6 +148,12 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
             angles = [plain.vector(a) for a in trig.angles]
             arrays = (names.sincos["sine"], names.sincos["cosine"])
             calls = {call: f"{arrays[which]}[{k}]" for call, (which, k) in trig.calls.items()}
+        else:
+            pairs = _sine_cosine_pairs(spec, varying)
+            arrays = (names.sincos["sine"], names.sincos["cosine"])
+            for k, angle in enumerate(pairs):
+                calls[sp.sin(angle)] = f"{arrays[0]}[{k}]"
+                calls[sp.cos(angle)] = f"{arrays[1]}[{k}]"
         printer = VectorPrinter(known, ctx.precision, calls, varying, prefix)
         lets = []
         for s, e in temporaries:
@@ -168,6 +181,7 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
         "reads": [(local, array, index, array != "p") for local, array, index in reads],
         "angles": angles,
         "angle_groups": angle_groups(angles),
+        "lane_pairs": [VectorPrinter(known, ctx.precision, {}, varying, prefix).doprint(a) for a in pairs],
         "body": body,
     }
 
@@ -175,6 +189,22 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
 def angle_groups(angles: list[str]) -> list[tuple[int, list[str]]]:
     """The angles in calls of NAME_simd_sincosK: (index of the first, its K <= ANGLES_PER_CALL texts)."""
     return [(k, angles[k : k + ANGLES_PER_CALL]) for k in range(0, len(angles), ANGLES_PER_CALL)]
+
+
+def _sine_cosine_pairs(spec: FunctionSpec, varying: set) -> list[sp.Expr]:
+    """The arguments a of a single-precision function that has both sin(a) and cos(a), a over the
+    state's inputs alone (no temporary), in first-met order: NAME_simd_sincos_lanes computes both
+    at the top of the body. (Every example robot's angles are inputs or sums of inputs.)"""
+    calls = trig_calls([e for _, e in spec.temporaries] + list(spec.outputs))
+    temporaries = {s for s, _ in spec.temporaries}
+    sines = {call.args[0] for call in calls if isinstance(call, sp.sin)}
+    cosines = {call.args[0] for call in calls if isinstance(call, sp.cos)}
+    angles = dict.fromkeys(call.args[0] for call in calls)
+    return [
+        a
+        for a in angles
+        if a in sines and a in cosines and a.free_symbols & varying and not a.free_symbols & temporaries
+    ]
 
 
 def _interleaved(
