@@ -12,8 +12,8 @@ cosines of double precision go through the same helper as NAME_f (NAME_sincos,
 symdyn.codegen.c.sincos) on the angles of all W lanes at once. In single precision NAME_f calls
 sinf and cosf, which the compiler merges into one sincosf where both take the same argument; the
 batch asks for both in one lane loop (NAME_simd_sincos_lanes), merged the same way, instead of
-one loop for each: on the Panda in float it took M's batch from 1.15 to 0.80 times the scalar
-loop, the inverse dynamics from 0.79 to 0.54 and the forward dynamics from 0.53 to 0.37.
+one loop for each: on the Panda in float it took M's batch from 1.18 to 0.72 times the scalar
+loop, the inverse dynamics from 0.81 to 0.52 and the forward dynamics from 0.54 to 0.37.
 
 A function whose code holds anything else gets no vector form (`vector_view` returns None): its
 batch wrapper then calls NAME_f once per state. So does a function with fewer than
