@@ -195,6 +195,25 @@ def test_jit_vmap_and_batches(modules):
     _close(jax_mod.gravity_batch(q[0], p), numpy_mod.gravity(q[0], p))
 
 
+def test_batches_compile_without_the_cpu_fusion_emitters(modules, monkeypatch):
+    """f_batch compiles with XLA's CPU fusion emitters off under the pinned jax (the option
+    exists); with an option this XLA does not know (as an older jax), f_batch compiles without
+    options and still equals the NumPy module."""
+    jax_mod, numpy_mod, _ = modules["roger_arm"]
+    assert jax_mod._batch_options() == {"xla_cpu_use_fusion_emitters": False}
+    rng = np.random.default_rng(11)
+    q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 16, 2))
+    p = _params(jax_mod, rng)
+    monkeypatch.setattr(jax_mod, "_BATCH_OPTIONS", {"xla_cpu_no_such_option_of_symdyn": True})
+    jax_mod._batch_options.cache_clear()
+    try:
+        assert jax_mod._batch_options() == {}
+        fresh = jax_mod._batch(jax_mod.inverse_dynamics)
+        _close(fresh(q, qd, qdd, p), numpy_mod.inverse_dynamics(q, qd, qdd, p))
+    finally:
+        jax_mod._batch_options.cache_clear()
+
+
 def test_lax_scan_simulation(modules):
     """A semi-implicit Euler simulation under jax.lax.scan (jitted) follows the same loop
     written with the NumPy module."""
