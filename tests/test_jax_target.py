@@ -68,10 +68,14 @@ def _modules():
 
 
 def _functions(mod) -> list[str]:
+    """The module's one-state functions (not their f_batch twins)."""
     return [
         n
         for n, f in vars(mod).items()
-        if inspect.isfunction(f) and f.__module__ == mod.__name__ and not n.startswith("_")
+        if inspect.isfunction(f)
+        and f.__module__ == mod.__name__
+        and not n.startswith("_")
+        and not n.endswith("_batch")
     ]
 
 
@@ -204,12 +208,15 @@ def test_batches_compile_without_the_cpu_fusion_emitters(modules, monkeypatch):
     rng = np.random.default_rng(11)
     q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 16, 2))
     p = _params(jax_mod, rng)
+    want = numpy_mod.inverse_dynamics(q, qd, qdd, p)
+    _close(jax_mod.inverse_dynamics_batch(q, qd, qdd, p), want)
+    _close(jax.jit(jax_mod.inverse_dynamics_batch)(q, qd, qdd, p), want)  # traced: no options inside
     monkeypatch.setattr(jax_mod, "_BATCH_OPTIONS", {"xla_cpu_no_such_option_of_symdyn": True})
     jax_mod._batch_options.cache_clear()
     try:
         assert jax_mod._batch_options() == {}
         fresh = jax_mod._batch(jax_mod.inverse_dynamics)
-        _close(fresh(q, qd, qdd, p), numpy_mod.inverse_dynamics(q, qd, qdd, p))
+        _close(fresh(q, qd, qdd, p), want)
     finally:
         jax_mod._batch_options.cache_clear()
 

@@ -100,8 +100,9 @@ def _batch_options():
 
 
 def _batch(f):
-    """f over a batch: vmapped over axis 0 of the arguments with two axes or more, jitted (with
-    _batch_options, decided at the first call)."""
+    """f over a batch: vmapped over axis 0 of the arguments with two axes or more, jitted: with
+    _batch_options (decided at the first call) when called on arrays, plainly when traced inside
+    another transformation (jit, grad, vmap), whose own compilation then decides."""
 
     @functools.wraps(f)
     def batched(*args):
@@ -110,14 +111,17 @@ def _batch(f):
             return f(*args)
         return jax.vmap(f, in_axes=axes)(*args)
 
-    jitted = []
+    plain = jax.jit(batched)
+    tuned = []
 
     @functools.wraps(f)
     def call(*args):
-        if not jitted:
+        if any(isinstance(a, jax.core.Tracer) for a in args):
+            return plain(*args)
+        if not tuned:
             options = _batch_options()
-            jitted.append(jax.jit(batched, **({"compiler_options": options} if options else {})))
-        return jitted[0](*args)
+            tuned.append(jax.jit(batched, compiler_options=options) if options else plain)
+        return tuned[0](*args)
 
     return call
 
