@@ -7,8 +7,11 @@ merged into link 7) is generated in double precision for the targets python and 
 (--functions dynamics), and each of inverse dynamics, M and forward dynamics is timed per state:
 * NumPy, one state per call (the generated NumPy module, from Python);
 * NumPy, one call on the whole batch of N states (default 100,000), divided by N;
-* JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit) on the batch, the
-  arrays already on the device, after a first call that compiles (its time is listed);
+* JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit with XLA's CPU fusion
+  emitters off, the module's own compiler option) on the batch, the arrays already on the device,
+  after a first call that compiles (its time is listed); then jax.jit(jax.vmap(f)) of the
+  one-state function with XLA's defaults, as one's own jit gets it, and f_batch again in a
+  process with XLA_FLAGS turning the emitters off for everything;
 * ADAM (adam-robotics, its JAX backend) on the same URDF and the same batch, jax.jit(jax.vmap(..)):
   M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + h, h its
   bias_force plus the URDF's joint damping b qd (ADAM's RNEA takes no accelerations, and it
@@ -144,9 +147,12 @@ def adam_functions(urdf: str, gravity: list[float]):
     }
 
 
-def worker(module_path: str, urdf: str | None, count: int, reps: int, reference: dict, gravity=None) -> dict:
-    """Time the generated JAX module (and ADAM when `urdf` is given) in this interpreter; check both
-    against `reference` (the oracle's values on the first NCHECK states)."""
+def worker(
+    module_path: str, urdf: str | None, count: int, reps: int, reference: dict, gravity=None, own=False
+) -> dict:
+    """Time the generated JAX module (and ADAM when `urdf` is given; jax.jit(jax.vmap(f)) of the
+    one-state functions when `own`) in this interpreter; check each against `reference` (the
+    oracle's values on the first NCHECK states)."""
     import jax
 
     jax.config.update("jax_enable_x64", True)
@@ -158,6 +164,9 @@ def worker(module_path: str, urdf: str | None, count: int, reps: int, reference:
     check = _states(arm.NDOF, NCHECK)  # the states of `reference`
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in FUNCTIONS}}
+    if own:
+        out["own"] = {}
+        routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in FUNCTIONS}
     if urdf is not None:
         from importlib.metadata import version
 
@@ -219,7 +228,8 @@ def _row(cells, widths) -> str:
 def table(results: dict, opts) -> list[str]:
     here, plain, there = results["here"], results["plain"], results.get("there")
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
-    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX (jax {here['jax']})", "same, emitters off"]
+    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
+    head += ["jit(vmap(f))", "f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
     head += ["JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
@@ -227,7 +237,14 @@ def table(results: dict, opts) -> list[str]:
     for f in FUNCTIONS:
         one, batch = results["numpy"][f]
         jx = min(here["symdyn"][f][1], plain["symdyn"][f][1])
-        row = [f, ns(one), ns(batch), ns(here["symdyn"][f][1]), ns(plain["symdyn"][f][1])]
+        row = [
+            f,
+            ns(one),
+            ns(batch),
+            ns(here["symdyn"][f][1]),
+            ns(here["own"][f][1]),
+            ns(plain["symdyn"][f][1]),
+        ]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
         row += [f"{jx / batch:.2f}x"]
@@ -242,11 +259,14 @@ def table(results: dict, opts) -> list[str]:
         _row(["-" * w for w in widths], widths),
         *(_row(r, widths) for r in rows[1:]),
         "",
-        f"JAX/NumPy batch: the faster JAX column; emitters off: XLA_FLAGS={NO_EMITTERS}; "
-        "JAX/ADAM: both under ADAM's jax",
+        "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
+        f"the one-state function under XLA's defaults; XLA_FLAGS: {NO_EMITTERS} for the process; "
+        "JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
         "compile time of the first batch call (s): "
         + ", ".join(f"{f} {here['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
-        + "; emitters off "
+        + "; jit(vmap(f)) "
+        + ", ".join(f"{f} {here['own'][f][0]:.1f}" for f in FUNCTIONS)
+        + "; XLA_FLAGS "
         + ", ".join(f"{f} {plain['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
         + ("; ADAM " + ", ".join(f"{f} {there['adam'][f][0]:.1f}" for f in FUNCTIONS) if there else ""),
         "largest relative error against symdyn.rnea on 8 states: "
@@ -302,7 +322,7 @@ def main(argv=None) -> int:
             assert err < 1e-9, (f, err)
         log("JAX (this Python)")
         args = {"module_path": str(jax_path), "urdf": None, "count": opts.batch, "reps": opts.reps}
-        results["here"] = worker(**args, reference=reference)
+        results["here"] = worker(**args, reference=reference, own=True)
         log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
         flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()
         results["plain"] = _external(sys.executable, {**args, "reference": reference}, tmp, XLA_FLAGS=flags)

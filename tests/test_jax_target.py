@@ -210,7 +210,14 @@ def test_batches_compile_without_the_cpu_fusion_emitters(modules, monkeypatch):
     p = _params(jax_mod, rng)
     want = numpy_mod.inverse_dynamics(q, qd, qdd, p)
     _close(jax_mod.inverse_dynamics_batch(q, qd, qdd, p), want)
-    _close(jax.jit(jax_mod.inverse_dynamics_batch)(q, qd, qdd, p), want)  # traced: no options inside
+    # inside another transformation the twin jits plainly (options are for a top-level jit only):
+    # traced arguments, and constant ones closed over by the outer function
+    _close(jax.jit(jax_mod.inverse_dynamics_batch)(q, qd, qdd, p), want)
+    _close(jax.jit(lambda: jax_mod.inverse_dynamics_batch(q, qd, qdd, p))(), want)
+    scanned = jax.lax.scan(
+        lambda c, _: (c, jax_mod.inverse_dynamics_batch(q, qd, qdd, p)), 0.0, None, length=2
+    )
+    _close(scanned[1][1], want)
     monkeypatch.setattr(jax_mod, "_BATCH_OPTIONS", {"xla_cpu_no_such_option_of_symdyn": True})
     jax_mod._batch_options.cache_clear()
     try:

@@ -26,7 +26,8 @@ argument, so parameters can be fitted by gradient.
 
 Each function f has a batched twin f_batch: f vmapped over the leading axis of
 every argument that has one more axis than for one state (an argument of one
-state's shape is shared by all), and jitted.
+state's shape is shared by all), and jitted; at the top level with XLA's CPU
+fusion emitters off (_BATCH_OPTIONS), which made long bodies far slower.
 
 Double precision: JAX computes in float32 unless its 64-bit mode is on, so this
 module refuses to import (ImportError) until it is enabled, before the import:
@@ -74,15 +75,16 @@ def _params(p):
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
-#: in recent jax (0.10; not in 0.6), compile a long straight-line body into code about a hundred
-#: times slower: the Panda's inverse dynamics vmapped over 10,000 states took 121 us a state with
-#: them and 1 us without. The option concerns the CPU only; other devices ignore it.
+#: in recent jax (0.10; not in 0.6), compile a long straight-line body into far slower code: the
+#: Panda's inverse dynamics vmapped over 100,000 states took 88 us a state with them and 0.6 us
+#: without, its forward dynamics 12 and 1.8 us. The option concerns the CPU; other devices ignore it.
 _BATCH_OPTIONS = {"xla_cpu_use_fusion_emitters": False}
 
 
 @functools.lru_cache(maxsize=None)
 def _batch_options():
-    """_BATCH_OPTIONS if this jax takes compiler options and its XLA knows them, else {}."""
+    """_BATCH_OPTIONS if this jax takes compiler options and its XLA knows them, else {} (for the
+    process: a failure of the probe for any other reason also leaves the batches without them)."""
     try:
         jax.jit(lambda x: x, compiler_options=_BATCH_OPTIONS).lower(0.0).compile()
     except Exception:  # an older jax: no compiler_options argument, or an XLA without the option
@@ -92,8 +94,9 @@ def _batch_options():
 
 def _batch(f):
     """f over a batch: vmapped over axis 0 of the arguments with two axes or more, jitted: with
-    _batch_options (decided at the first call) when called on arrays, plainly when traced inside
-    another transformation (jit, grad, vmap), whose own compilation then decides."""
+    _batch_options (decided at the first call) when called at the top level, plainly inside
+    another transformation (jit, grad, vmap, lax.scan), whose own compilation then decides: jax
+    takes compiler options on a top-level jit only. Not a jax.jit object itself (no .lower)."""
 
     @functools.wraps(f)
     def batched(*args):
@@ -112,7 +115,12 @@ def _batch(f):
         if not tuned:
             options = _batch_options()
             tuned.append(jax.jit(batched, compiler_options=options) if options else plain)
-        return tuned[0](*args)
+        try:
+            return tuned[0](*args)
+        except ValueError as error:  # traced by an outer transformation over constant arguments
+            if tuned[0] is plain or "compiler_options" not in str(error):
+                raise
+            return plain(*args)
 
     return call
 

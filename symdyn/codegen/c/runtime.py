@@ -79,7 +79,7 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
     assert not added & taken, f"a generated function has the name of a batch helper: {added & taken}"
     env = environment()
     lines = header_lines(ctx)
-    angles = any(f["vector"] and (f["vector"]["angles"] or f["vector"]["lane_pairs"]) for f in functions)
+    trig = any(f["vector"] and (f["vector"]["angles"] or f["vector"]["lane_pairs"]) for f in functions)
     return {
         f"{ctx.name}_batch.c": env.get_template("c/batch.c.j2").render(
             header_lines=lines,
@@ -93,7 +93,7 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
             P=prefix,
             lane_calls=[config.math(c) for c in LANE_CALLS],
             pow=config.math("pow"),
-            sincos={**names.sincos, "block": BLOCK} if angles else None,
+            sincos={**names.sincos, "block": BLOCK} if trig else None,
             sincos_groups=sorted(
                 {len(group) for f in functions if f["vector"] for _, group in f["vector"]["angle_groups"]}
             ),

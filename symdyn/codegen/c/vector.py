@@ -40,7 +40,6 @@ from .target import function_inputs, last_reads, symbol_names
 __all__ = [
     "VectorPrinter",
     "vector_view",
-    "angle_groups",
     "simd_prefix",
     "LANE_CALLS",
     "MIN_OPS_PER_OUTPUT",
@@ -125,7 +124,7 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
 
     Keys: block (the static function's name), inputs (name, size: a state's values), outputs
     (name, size, stores: (index, vector text)), unused, reads ((local, input, index, vector?)),
-    angles (their vector texts, double precision only), angle_groups (angle_groups), lane_pairs (the
+    angles (their vector texts, double precision only), angle_groups (_angle_groups), lane_pairs (the
     angles whose sinf and cosf are computed together, single precision only, _sine_cosine_pairs)
     and body (_interleaved: the temporaries and, right after each group's last one, the stores of
     the output groups it completes).
@@ -180,21 +179,22 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
         "unused": unused,
         "reads": [(local, array, index, array != "p") for local, array, index in reads],
         "angles": angles,
-        "angle_groups": angle_groups(angles),
+        "angle_groups": _angle_groups(angles),
         "lane_pairs": [VectorPrinter(known, ctx.precision, {}, varying, prefix).doprint(a) for a in pairs],
         "body": body,
     }
 
 
-def angle_groups(angles: list[str]) -> list[tuple[int, list[str]]]:
+def _angle_groups(angles: list[str]) -> list[tuple[int, list[str]]]:
     """The angles in calls of NAME_simd_sincosK: (index of the first, its K <= ANGLES_PER_CALL texts)."""
     return [(k, angles[k : k + ANGLES_PER_CALL]) for k in range(0, len(angles), ANGLES_PER_CALL)]
 
 
 def _sine_cosine_pairs(spec: FunctionSpec, varying: set) -> list[sp.Expr]:
     """The arguments a of a single-precision function that has both sin(a) and cos(a), a over the
-    state's inputs alone (no temporary), in first-met order: NAME_simd_sincos_lanes computes both
-    at the top of the body. (Every example robot's angles are inputs or sums of inputs.)"""
+    state (not p alone) and reading no temporary, in first-met order: NAME_simd_sincos_lanes
+    computes both at the top of the body. (Every example robot's angles are inputs, sums of inputs
+    or such sums plus parameters; any other keeps one lane loop per call.)"""
     calls = trig_calls([e for _, e in spec.temporaries] + list(spec.outputs))
     temporaries = {s for s, _ in spec.temporaries}
     sines = {call.args[0] for call in calls if isinstance(call, sp.sin)}
