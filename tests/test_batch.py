@@ -89,8 +89,9 @@ def panda(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def tree(tmp_path_factory):
-    """The tree robot's context (derived once: float only prints it otherwise) and its builds."""
-    ctx = context(y_robot(), functions=("dynamics",))
+    """The tree robot's context (derived once: float only prints it otherwise) and its builds: the
+    dynamics and the regressors (vectorised too: 3.7 and 5.5 operations per output value)."""
+    ctx = context(y_robot(), functions=("dynamics", "regressor"))
     builds = {}
     for precision in ("double", "float"):
         ctx_p = dataclasses.replace(ctx, precision=precision)
@@ -184,6 +185,7 @@ def test_tree_batches_equal_the_scalar_functions_bit_for_bit(tree, name):
     (W doubled), and the scalar fallback (W = 1) without AVX."""
     _, builds = tree
     assert "ytree_simd_sincos_lanes(q" in builds["float"]["batch"]  # sinf and cosf in one lane loop
+    assert "static void ytree_simd_base_regressor(" in builds["double"]["batch"]
     rng = np.random.default_rng(5)
     for precision, dtype in (("double", np.float64), ("float", np.float32)):
         build_ = builds[precision]

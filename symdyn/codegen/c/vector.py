@@ -17,10 +17,13 @@ loop, the inverse dynamics from 0.81 to 0.52 and the forward dynamics from 0.54 
 
 A function whose code holds anything else gets no vector form (`vector_view` returns None): its
 batch wrapper then calls NAME_f once per state. So does a function with fewer than
-MIN_OPS_PER_OUTPUT operations per output value (the regressors: the Panda's base regressor has
-434 outputs for 1429 operations): copying its outputs from the W lanes back into the batch's
-layout costs more than the vector arithmetic saves (measured on the Panda: 1.6 times the scalar
-loop's time), while M (8 operations per output) gains.
+MIN_OPS_PER_OUTPUT operations per output value (the friction of a robot without Coulomb
+friction, whose outputs are plain products): there the transposes that carry the outputs from
+the W lanes to the batch's rows are most of the work. The regressors gain: the Panda's base
+regressor (434 outputs, 1429 operations) vectorised takes 0.69 to 0.72 of the scalar loop's
+time over identify's chunk of 4,832 states, its full regressor (637 outputs, 1743 operations)
+0.65 to 0.67 (AVX-512, gcc 12, -O2); they took 1.6 to 1.7 times the scalar loop when each
+group's outputs went through a buffer on the stack and a copy.
 """
 
 from __future__ import annotations
@@ -46,8 +49,9 @@ __all__ = [
     "ANGLES_PER_CALL",
 ]
 
-#: Fewer operations per output value than this: the batch keeps the scalar loop (module docstring).
-MIN_OPS_PER_OUTPUT = 5
+#: Fewer operations per output value than this: the batch keeps the scalar loop (module docstring;
+#: nothing below it was measured to gain, the regressors at 2.7 and 3.3 do).
+MIN_OPS_PER_OUTPUT = 2
 
 #: The angles whose sines and cosines one call of NAME_simd_sincosK computes, their steps
 #: alternating (templates/c/sincos_vector.c.j2). Each angle is a chain of dependent operations;
