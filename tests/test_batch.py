@@ -61,6 +61,7 @@ if {"avx2", "avx512f"} <= CPU:
 #: AVX without AVX2 (W = 4, the C library's sine lane by lane), at -O3 where gcc looks hardest for
 #: values read before they are set; built for Roger's arm only
 AVX_ONLY = {"avx": (("-mavx", "-O3"), 4)} if X86 and "avx" in CPU else {}
+ALL_BUILDS = {**BUILDS, **AVX_ONLY}
 
 
 def _build_all(ctx, folder: Path, names) -> dict:
@@ -70,7 +71,7 @@ def _build_all(ctx, folder: Path, names) -> dict:
     sources = [str(p) for p in paths if p.name.endswith(("_dynamics.c", "_batch.c"))]
     jobs = {}
     for name in names:
-        flags, _ = {**BUILDS, **AVX_ONLY}[name]
+        flags, _ = ALL_BUILDS[name]
         cmd = ["gcc", *STRICT_FLAGS, *BASE, *flags, "-o", str(folder / f"{name}.so"), *sources, "-lm"]
         jobs[name] = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
     table = function_table(ctx)
@@ -171,7 +172,7 @@ def test_sines_of_one_and_of_two_angles_per_call(roger, name):
         f"{HOSTILE_NAME}_simd_sincos1(" in roger["batch"]
         and f"{HOSTILE_NAME}_simd_sincos2(" in roger["batch"]
     )
-    assert roger["libs"][name][2] == {**BUILDS, **AVX_ONLY}[name][1]
+    assert roger["libs"][name][2] == ALL_BUILDS[name][1]
     rng = np.random.default_rng(7)
     width = roger["libs"][name][2]
     for function in roger["table"]:
@@ -181,8 +182,8 @@ def test_sines_of_one_and_of_two_angles_per_call(roger, name):
 
 @pytest.mark.parametrize("name", list(BUILDS))
 def test_tree_batches_equal_the_scalar_functions_bit_for_bit(tree, name):
-    """Every function of the dynamics group, friction's sign and step included; float too
-    (W doubled), and the scalar fallback (W = 1) without AVX."""
+    """Every function of the dynamics and regressor groups, friction's sign and step included;
+    float too (W doubled), and the scalar fallback (W = 1) without AVX."""
     _, builds = tree
     assert "ytree_simd_sincos_lanes(q" in builds["float"]["batch"]  # sinf and cosf in one lane loop
     assert "static void ytree_simd_base_regressor(" in builds["double"]["batch"]

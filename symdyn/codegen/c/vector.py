@@ -142,18 +142,18 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
     temporaries = list(spec.temporaries)
     angles: list[str] = []
     calls: dict = {}
-    pairs: list[sp.Expr] = []
+    lane_pairs: list[str] = []
+    arrays = (names.sincos["sine"], names.sincos["cosine"])
+    plain = VectorPrinter(known, ctx.precision, {}, varying, prefix)
     try:
         if ctx.precision == "double":
             trig = gather(spec.temporaries, spec.outputs)
             temporaries = [(s, e) for s, e in spec.temporaries if s in trig.live]
-            plain = VectorPrinter(known, ctx.precision, {}, varying, prefix)
             angles = [plain.vector(a) for a in trig.angles]
-            arrays = (names.sincos["sine"], names.sincos["cosine"])
             calls = {call: f"{arrays[which]}[{k}]" for call, (which, k) in trig.calls.items()}
         else:
             pairs = _sine_cosine_pairs(spec, varying)
-            arrays = (names.sincos["sine"], names.sincos["cosine"])
+            lane_pairs = [plain.vector(a) for a in pairs]
             for k, angle in enumerate(pairs):
                 calls[sp.sin(angle)] = f"{arrays[0]}[{k}]"
                 calls[sp.cos(angle)] = f"{arrays[1]}[{k}]"
@@ -184,7 +184,7 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
         "reads": [(local, array, index, array != "p") for local, array, index in reads],
         "angles": angles,
         "angle_groups": _angle_groups(angles),
-        "lane_pairs": [VectorPrinter(known, ctx.precision, {}, varying, prefix).doprint(a) for a in pairs],
+        "lane_pairs": lane_pairs,
         "body": body,
     }
 
