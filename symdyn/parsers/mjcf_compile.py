@@ -13,6 +13,9 @@ would print itself, become SymdynWarnings naming the file.
 from __future__ import annotations
 
 import math
+import os
+import signal
+import sys
 import warnings
 from typing import Any
 
@@ -20,6 +23,7 @@ import numpy as np
 
 from ..errors import SymdynError, SymdynWarning
 from ..model.bounded import MAX_MAGNITUDE
+from . import contained
 from .optional import optional_module
 from .safe_xml import parse_xml
 
@@ -32,6 +36,14 @@ _ARRAYS = {
     "site": ("pos", "quat"),
 }
 _DOF_ARRAYS = ("armature", "damping", "frictionloss")
+#: seconds and bytes of address space MuJoCo's compiler may use on one file
+TIMEOUT = contained.TIMEOUT
+MEMORY = contained.MEMORY
+#: the server child that compiles MJCF files in contained children (symdyn.parsers.mjcf_run)
+_SERVER = contained.Server(
+    [sys.executable, "-B", os.path.join(os.path.dirname(__file__), "mjcf_run.py")],
+    env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"},  # one thread: safe to fork
+)
 
 
 def mujoco_module(file: str | None = None) -> Any:
@@ -44,23 +56,34 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
 
     The bytes are first read by symdyn's hardened XML parser (a DOCTYPE, and so any entity, is
     refused) and must have the top element <mujoco>; MuJoCo then compiles the file from its path,
-    so that <include file=...> and asset paths resolve next to it.
+    so that <include file=...> and asset paths resolve next to it, in a contained child process
+    (symdyn.parsers.mjcf_run) of at most MEMORY bytes and TIMEOUT s, which hands the model back
+    as MJB bytes.
     """
     root = parse_xml(raw, file)
     if root.tag != "mujoco":
         raise SymdynError(f"not an MJCF file: its top element is <{root.tag}>, not <mujoco>", file=file)
     mujoco = mujoco_module(file)
-    said: list[str] = []
-    previous = mujoco.get_mju_user_warning()
-    mujoco.set_mju_user_warning(said.append)  # MuJoCo would print its warnings itself
-    try:
-        return mujoco.MjModel.from_xml_path(file)
-    except ValueError as exc:
-        raise SymdynError(f"MuJoCo's compiler refused it: {_one_line(str(exc))}", file=file) from None
-    finally:
-        mujoco.set_mju_user_warning(previous)
-        for text in dict.fromkeys(said):
-            warnings.warn(f"{file}: MuJoCo: {_one_line(text)}", SymdynWarning, stacklevel=4)
+    answer, mjb = _SERVER.request({"file": os.path.abspath(file)}, TIMEOUT, MEMORY)
+    for text in dict.fromkeys(answer.get("warnings", [])):
+        warnings.warn(f"{file}: MuJoCo: {_one_line(text)}", SymdynWarning, stacklevel=4)
+    if "error" in answer and "bad_alloc" not in answer["error"]:
+        raise SymdynError(f"MuJoCo's compiler refused it: {_one_line(answer['error'])}", file=file)
+    if not mjb or answer.get("status"):
+        raise SymdynError(_failure(answer), file=file)
+    return mujoco.MjModel.from_binary_path("model.mjb", {"model.mjb": mjb})
+
+
+def _failure(answer: dict) -> str:
+    """Why the contained compiler gave no model: out of time, out of memory, or a crash."""
+    status = int(answer.get("status", 0))
+    killed = os.WIFSIGNALED(status) and os.WTERMSIG(status) in (signal.SIGXCPU, signal.SIGKILL)
+    if answer.get("timed_out") or killed:
+        return f"MuJoCo's compiler needed more than {TIMEOUT} s"
+    signalled = os.WIFSIGNALED(status) and os.WTERMSIG(status) != signal.SIGXCPU
+    if answer.get("memory") or "bad_alloc" in answer.get("error", "") or not signalled:
+        return f"MuJoCo's compiler needed more than {MEMORY / 2**30:g} GiB of memory"
+    return f"MuJoCo's compiler crashed (signal {os.WTERMSIG(status)})"
 
 
 def _one_line(text: str) -> str:

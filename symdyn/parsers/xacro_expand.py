@@ -5,10 +5,11 @@ A declaration of the xacro namespace alone (xmlns:xacro, which many exported URD
 make one: such a file is read as the plain URDF it is. It is expanded by the `xacro`
 package (the `xacro` extra) in a child process (symdyn.parsers.xacro_run) with the arguments
 NAME:=VALUE given (`xacro_args`) and the package folders given (`package_dirs`, for
-`$(find pkg)` and `package://pkg/` includes; then ROS_PACKAGE_PATH). The child gets at most
-TIMEOUT seconds and MEMORY bytes. An error of xacro (an undefined argument or property, a missing
-package or include) is a SymdynError on one line naming the file, and the line of the xacro
-source where the text it concerns can be found.
+`$(find pkg)` and `package://pkg/` includes; then ROS_PACKAGE_PATH). A xacro file is a program:
+the child is contained (symdyn.parsers.contained) so that it may compute and read files, nothing
+else, for at most TIMEOUT seconds and MEMORY bytes. An error of xacro (an undefined argument or
+property, a missing package or include, an act refused) is a SymdynError on one line naming the
+file, and the line of the xacro source where the text it concerns can be found.
 """
 
 from __future__ import annotations
@@ -17,20 +18,21 @@ import hashlib
 import importlib.util
 import json
 import os
-import subprocess
+import signal
 import sys
 from collections.abc import Mapping
 from pathlib import Path
 
 from ..errors import SymdynError
+from . import contained
 from .safe_xml import Element
 
 __all__ = ["is_xacro", "expand_xacro", "xacro_options", "TIMEOUT", "MEMORY"]
 
 #: seconds the expansion may take
-TIMEOUT = 60
+TIMEOUT = contained.TIMEOUT
 #: bytes of address space the expanding process may use
-MEMORY = 2 * 2**30
+MEMORY = contained.MEMORY
 _RUNNER = Path(__file__).with_name("xacro_run.py")
 
 
@@ -82,22 +84,20 @@ def expand_xacro(
             "pip install 'symdyn[xacro]'",
             file=file,
         )
-    request = {"file": os.path.abspath(file), "args": args, "packages": packages, "memory": MEMORY}
-    try:
-        done = subprocess.run(
-            [sys.executable, str(_RUNNER)],
-            input=json.dumps(request),
-            capture_output=True,
-            text=True,
-            timeout=TIMEOUT,
-            check=False,
-        )
-    except subprocess.TimeoutExpired:
-        raise SymdynError(f"xacro did not finish expanding the file within {TIMEOUT} s", file=file) from None
+    request = {
+        "file": os.path.abspath(file),
+        "args": args,
+        "packages": packages,
+        "memory": MEMORY,
+        "seconds": TIMEOUT,
+    }
+    done = contained.run([sys.executable, "-B", str(_RUNNER)], json.dumps(request).encode(), TIMEOUT)
+    if done.timed_out or done.status in (-signal.SIGXCPU, -signal.SIGKILL):
+        raise SymdynError(f"xacro did not finish expanding the file within {TIMEOUT} s", file=file)
     try:
         answer = json.loads(done.stdout)
     except ValueError:
-        last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        last = (done.stderr.decode("utf-8", "replace").strip().splitlines() or ["no output"])[-1]
         raise SymdynError(f"xacro failed: {last}", file=file) from None
     if "error" in answer:
         where = answer.get("file") or file

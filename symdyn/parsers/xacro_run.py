@@ -1,16 +1,18 @@
 """Expand one xacro file with the `xacro` package, in a child process of symdyn (run as a script).
 
 symdyn.parsers.xacro_expand starts `python xacro_run.py` with a JSON request on stdin:
-{"file": path, "args": {name: value}, "packages": {name: folder}, "memory": bytes}, and reads
-one JSON answer on stdout: {"urdf": text} or {"error": message, "file": path, "line": n}.
-A child process bounds what the expansion may cost (xacro evaluates the ${...} expressions of
-the file in its restricted Python namespace: the parent kills a child that runs too long, and
-the child's address space is capped) and keeps xacro's global state out of symdyn's process.
+{"file": path, "args": {name: value}, "packages": {name: folder}, "memory": bytes, "seconds": s},
+and reads one JSON answer on stdout: {"urdf": text} or {"error": message, "file": path, "line": n}.
+A xacro file is a program (its ${...} are Python expressions, and xacro's restricted namespace
+does not stop one from reaching os.system through Python's object graph), so this child confines
+itself (symdyn.parsers.contained: rlimits, a seccomp filter, an audit hook) before it imports
+xacro: it may compute and read files, nothing else. An act refused is the answer "xacro tried to
+run a process (os.system): a xacro file may only compute", whatever the expression made of it.
 
 `$(find pkg)` and `package://pkg/...` in include file names resolve through the request's
 packages, then the folders of ROS_PACKAGE_PATH (a folder named pkg in one of them, or one of
 them named pkg); an unknown package is an error naming it. This file imports the standard
-library and xacro only, so that it runs without symdyn on the path.
+library, xacro and its sibling contained.py only, so that it runs without symdyn on the path.
 """
 
 from __future__ import annotations
@@ -19,6 +21,11 @@ import json
 import os
 import re
 import sys
+
+#: the modules xacro imports while it works (not when it is imported), imported before confining
+_PRELOAD = ("yaml", "xml.dom.minidom", "xml.dom.expatbuilder", "xml.dom.xmlbuilder", "xml.parsers.expat",
+            "ast", "glob", "copy", "math", "collections", "enum", "textwrap", "optparse", "io")  # fmt: skip
+_MEMORY = "xacro needed more than {:g} GiB of memory"
 
 
 class PackageNotFoundError(Exception):
@@ -66,11 +73,30 @@ def _needles(exc: BaseException) -> list[str]:
     if isinstance(exc, PackageNotFoundError):
         return [f"$(find {exc.name})", f"package://{exc.name}/"]
     text = str(exc)
+    undefined = _undefined_argument(text)
+    if undefined:  # the argument is on the line, the expression around it may be elsewhere too
+        return [f"$(arg {undefined})"]
     out = re.findall(r"when evaluating expression '(.*)'", text)
-    out += [f"$(arg {n})" for n in re.findall(r"^Undefined substitution argument (\S+)", text)]
     out += re.findall(r"name '(\w+)' is not defined", text)
     out += re.findall(r"unknown macro name: (\S+)", text)
     return out
+
+
+def _undefined_argument(text: str) -> str | None:
+    """The name of the argument in xacro's "Undefined substitution argument NAME" message."""
+    found = re.match(r"Undefined substitution argument ([^\s;]+)", text)
+    return found.group(1) if found else None
+
+
+def _memory(exc: BaseException) -> bool:
+    """Whether the error is a MemoryError, or xacro's wrapping of one."""
+    seen = 0
+    while exc is not None and seen < 10:
+        if isinstance(exc, MemoryError):
+            return True
+        exc = getattr(exc, "exc", None) or exc.__cause__ or exc.__context__
+        seen += 1
+    return False
 
 
 def _one_line(text: str) -> str:
@@ -105,27 +131,38 @@ def expand(request: dict) -> dict:
         cause = getattr(exc, "exc", None)
         if isinstance(cause, PackageNotFoundError):
             return {"error": str(cause), "file": current, "line": _line_of(current, _needles(cause))}
+        line = _line_of(current, _needles(exc))
+        if _memory(exc):
+            return {"error": _MEMORY.format(request.get("memory", 0) / 2**30), "file": current, "line": line}
         message = re.sub(r" \[Errno \d+\].*", "", _one_line(str(exc))) or type(exc).__name__
-        undefined = re.match(r"Undefined substitution argument (\S+)", message)
-        if undefined:
-            name = undefined.group(1)
+        name = _undefined_argument(str(exc))
+        if name:
             message = f"undefined argument '{name}': give it with --xacro-arg {name}:=VALUE (xacro_args=)"
-        return {"error": message, "file": current, "line": _line_of(current, _needles(exc))}
+        return {"error": message, "file": current, "line": line}
 
 
 def main() -> None:
     request = json.loads(sys.stdin.read())
-    memory = int(request.get("memory", 0))
-    try:
-        import resource  # POSIX only: elsewhere the time limit alone bounds the expansion
-    except ImportError:
-        resource = None
-    if memory and resource is not None:
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+    import contained  # this file's sibling (the script's folder is on sys.path)
+
+    for name in _PRELOAD:  # what xacro imports on the way, loaded before imports are closed
+        __import__(name)
+    close_imports = contained.confine(int(request["memory"]), float(request["seconds"]), threads=False)
+    import xacro  # noqa: F401 - imported under the audit hook, then imports are closed
+    import xacro.substitution_args  # noqa: F401
+
+    close_imports()
     try:
         answer = expand(request)
     except MemoryError:
-        answer = {"error": "the expansion ran out of memory", "file": request["file"], "line": None}
+        answer = {"error": _MEMORY.format(request["memory"] / 2**30), "file": request["file"], "line": None}
+    tried = contained.refused()
+    if tried:
+        answer = {
+            "error": f"xacro tried {tried}: a xacro file may only compute",
+            "file": answer.get("file", request["file"]),
+            "line": answer.get("line"),
+        }
     sys.stdout.write(json.dumps(answer))
 
 
