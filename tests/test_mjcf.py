@@ -295,3 +295,38 @@ def _joints_by_child(urdf: Path, links: list[str]) -> list[str]:
     """The URDF joint whose child is each of `links`."""
     by_child = {j.find("child").get("link"): j.get("name") for j in ET.parse(urdf).getroot().findall("joint")}
     return [by_child[name] for name in links]
+
+
+#: MuJoCo's compiler allocates what a file asks: four nested <replicate count="100"> make 10^8
+#: bodies; a 10^5 x 10^5 hfield and a 2000^3 flexcomp grid ask for tens of GiB at once
+_BOMBS = {
+    "replicate": '<worldbody><replicate count="100" offset="0.1 0 0"><replicate count="100" offset="0 0.1 0">'
+    '<replicate count="100" offset="0 0 0.1"><replicate count="100" offset="0.1 0.1 0"><body><geom size="0.1"/>'
+    "</body></replicate></replicate></replicate></replicate></worldbody>",
+    "hfield": '<asset><hfield name="h" nrow="100000" ncol="100000" size="1 1 1 1"/></asset>'
+    '<worldbody><geom type="hfield" hfield="h"/><body><joint/><geom size="0.1"/></body></worldbody>',
+    "flexcomp": '<worldbody><flexcomp name="f" type="grid" count="2000 2000 2000" spacing="0.1 0.1 0.1" dim="3">'
+    '<edge equality="false"/></flexcomp><body><joint/><geom size="0.1"/></body></worldbody>',
+}
+
+
+@pytest.mark.parametrize(
+    ("bomb", "limit"),
+    [
+        ("replicate", "more than 3 s"),
+        ("hfield", "more than 1 GiB of memory"),
+        ("flexcomp", "more than 1 GiB"),
+    ],
+)
+def test_the_compiler_is_bounded(capsys, tmp_path, monkeypatch, bomb, limit):
+    """The compiler runs in a contained child (symdyn.parsers.contained) of at most MEMORY bytes
+    and TIMEOUT s: here lowered to 1 GiB and 3 s so that the test takes seconds."""
+    from symdyn.parsers import mjcf_compile
+
+    monkeypatch.setattr(mjcf_compile, "TIMEOUT", 3)
+    monkeypatch.setattr(mjcf_compile, "MEMORY", 2**30)
+    path = tmp_path / f"{bomb}.xml"
+    path.write_text(f"<mujoco>{_BOMBS[bomb]}</mujoco>")
+    line = refused(capsys, "derive", path, seconds=20)
+    assert line.startswith(f"symdyn: error: {path}: MuJoCo's compiler needed {limit}"), line
+    assert symdyn.load_mjcf(DATA / "tree.xml").name  # and the next file compiles as before

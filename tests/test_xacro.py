@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 import sympy as sp
 
 import symdyn
@@ -24,7 +27,7 @@ from symdyn.parsers import xacro_expand
 from symdyn.parsers.safe_xml import parse_xml
 from symdyn.rnea import mass_matrix
 from tests.robots import assert_close, random_state
-from tests.timebound import refused
+from tests.timebound import refused, within
 
 pytest.importorskip("xacro", reason="the test extra installs xacro")
 
@@ -143,3 +146,127 @@ def test_a_missing_xacro_names_the_extra(monkeypatch):
     )
     with pytest.raises(SymdynError, match=r"needs the Python package 'xacro'.*pip install 'symdyn\[xacro\]'"):
         symdyn.load_urdf(ARM, package_dirs=PACKAGES)
+
+
+#: the issue's escape: xacro's own check looks at the outer expression only
+_WRAP = "(lambda: [c for c in ().__class__.__base__.__subclasses__() if c.__name__ == '_wrap_close'][0]"
+
+
+def _hostile(tmp_path: Path, expression: str) -> Path:
+    path = tmp_path / "hostile.urdf"
+    path.write_text(
+        '<robot name="h" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        f'<xacro:property name="x" value="${{{expression}}}"/>\n<link name="a${{x}}"/>\n</robot>\n'
+    )
+    return path
+
+
+@pytest.mark.parametrize(
+    ("escape", "act"),
+    [
+        (".__init__.__globals__['system']('touch {m}'))()", "run a process (os.system)"),
+        (".__init__.__globals__['open']('{m}', 65))()", "write to the file system (open)"),
+        (
+            ".__init__.__globals__['__builtins__']['__import__']('subprocess').run(['touch', '{m}']))()",
+            "run a process (subprocess.Popen)",
+        ),
+        (
+            ".__init__.__globals__['system']('setsid sh -c &quot;sleep 1; touch {m}&quot; &amp;'))()",
+            "run a process (os.system)",
+        ),
+        (
+            ".__init__.__globals__['sys'].modules['ctypes'].CDLL(None).system(b'touch {m}'))()",
+            "load native code",
+        ),
+        (".__init__.__globals__['remove']('{k}'))()", "write to the file system (os.remove)"),
+        (".__init__.__globals__['mkdir']('{m}'))()", "write to the file system (os.mkdir)"),
+    ],
+)
+def test_a_xacro_may_only_compute(capsys, tmp_path, escape, act):
+    marker, kept = tmp_path / "SOMEFILE", tmp_path / "kept"
+    kept.write_text("kept")
+    path = _hostile(tmp_path, _WRAP + escape.format(m=marker, k=kept))
+    line = refused(capsys, "derive", path, seconds=30)
+    assert line.startswith(f"symdyn: error: {path}: xacro: xacro tried to {act}"), line
+    assert line.endswith(": a xacro file may only compute (line 2)"), line
+    time.sleep(1.5)  # a detached child would have touched the file by now
+    assert not marker.exists() and kept.read_text() == "kept"
+
+
+def test_a_route_past_the_audit_hook_meets_the_kernel(capsys, tmp_path):
+    """_posixsubprocess.fork_exec raises no audit event: the seccomp filter refuses the fork."""
+    pytest.importorskip("pyseccomp")
+    marker = tmp_path / "SOMEFILE"
+    g = _WRAP + ".__init__.__globals__"
+    fork = (
+        f"(lambda g, p: g['sys'].modules['_posixsubprocess'].fork_exec([b'/bin/sh', b'-c', b'touch {marker}'], "
+        "(b'/bin/sh',), True, (p[1],), None, None, -1, -1, -1, -1, -1, -1, p[0], p[1], True, True, -1, None, "
+        f"None, None, -1, None, True))({g})(), {g})()['pipe']())"
+    )
+    line = refused(capsys, "derive", _hostile(tmp_path, fork), seconds=30)
+    assert "Operation not permitted" in line or "tried to" in line, line
+    assert not marker.exists()
+
+
+def test_a_xacro_that_asks_for_too_much_memory_is_told_so(capsys, tmp_path):
+    line = refused(capsys, "derive", _hostile(tmp_path, "'a' * (10**10)"), seconds=30)
+    assert (
+        line
+        == f"symdyn: error: {tmp_path / 'hostile.urdf'}: xacro: xacro needed more than 2 GiB of memory (line 2)"
+    )
+
+
+def test_an_undefined_argument_inside_an_expression_is_named_on_its_line(capsys, tmp_path):
+    path = tmp_path / "arm.urdf"
+    path.write_text(
+        '<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        '<xacro:property name="mass" value="3"/>\n<link name="base"/>\n<link name="l1"><inertial>\n'
+        '<mass value="${mass * $(arg scale)}"/>\n'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>\n'
+        '<joint name="j1" type="continuous"><parent link="base"/><child link="l1"/></joint>\n</robot>\n'
+    )
+    line = refused(capsys, "derive", path, seconds=30)
+    assert line == (
+        f"symdyn: error: {path}: xacro: undefined argument 'scale': give it with --xacro-arg scale:=VALUE "
+        "(xacro_args=) (line 5)"
+    )
+
+
+#: pieces of hostile and plain expressions; {m} is the marker file no expression may create
+_PIECES = (
+    "1", "0.5", "-2", "pi", "x", "'a'", "[1, 2]", "(1, 2)", "None", "True",
+    "().__class__.__base__.__subclasses__()", "().__class__.__mro__[-1]", "__import__('os')",
+    "open('{m}', 'w')", "__builtins__", "globals()", "'a' * (10**10)", "[c for c in range(3)]",
+    "(lambda: 1)()", "{{'k': 1}}", "x.__class__", "xacro", "load_yaml('{m}')", "math.sqrt(4)",
+    _WRAP + ".__init__.__globals__['system']('touch {m}'))()",
+    _WRAP + ".__init__.__globals__['open']('{m}', 65))()",
+    "$(arg a)", "$(arg b)", "$(find nopkg)", "$(env HOME)", "$(eval 1 + 1)",
+)  # fmt: skip
+_OPERATORS = (" + ", " * ", " ** ", " / ", "[", ".", "(", " if ", " else ", ", ", " and ", "")
+
+
+@settings(
+    max_examples=24,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(
+    pieces=st.lists(st.sampled_from(_PIECES), min_size=1, max_size=4),
+    operators=st.lists(st.sampled_from(_OPERATORS), min_size=3, max_size=3),
+    argument=st.sampled_from(("1", "0.3", "'", "${x}", "$(arg a)", "a" * 1000, "")),
+)
+def test_fuzzed_xacro_expressions_only_compute(tmp_path, pieces, operators, argument):
+    """Random expressions in ${...} and $(arg ...) never run anything nor leave a file behind:
+    each ends in a load or a one-line SymdynError within the bound."""
+    marker = tmp_path / "SOMEFILE"
+    text = "".join(p + o for p, o in zip(pieces, operators + [""] * 4)).format(m=marker)
+    path = _hostile(tmp_path, text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;"))
+    before = sorted(tmp_path.iterdir())
+    try:
+        with within(25):
+            symdyn.load_urdf(path, xacro_args={"a": argument})
+    except SymdynError as exc:
+        assert "\n" not in str(exc) and str(exc).startswith(str(path)), str(exc)
+    assert sorted(tmp_path.iterdir()) == before and not marker.exists()
+    path.unlink()

@@ -21,6 +21,7 @@ import json
 import os
 import re
 import sys
+from xml.sax.saxutils import escape
 
 #: the modules xacro imports while it works (not when it is imported), imported before confining
 _PRELOAD = ("yaml", "xml.dom.minidom", "xml.dom.expatbuilder", "xml.dom.xmlbuilder", "xml.parsers.expat",
@@ -55,16 +56,20 @@ def find_package(name: str, packages: dict[str, str]) -> str:
 
 
 def _line_of(file: str | None, needles: list[str]) -> int | None:
-    """The first line of `file` that holds one of `needles` (where xacro met the problem)."""
+    """The line of `file` where xacro met the problem: the first line that holds the first of
+    `needles` (the most precise first) found in the file."""
     if not file or not needles:
         return None
     try:
         with open(file, encoding="utf-8", errors="replace") as fh:
-            for number, text in enumerate(fh, start=1):
-                if any(n and n in text for n in needles):
-                    return number
+            lines = fh.read().splitlines()
     except OSError:
         return None
+    for needle in needles:
+        for form in dict.fromkeys((needle, escape(needle, {'"': "&quot;"}))):  # as written in XML too
+            for number, text in enumerate(lines, start=1):
+                if form and form in text:
+                    return number
     return None
 
 
@@ -76,7 +81,8 @@ def _needles(exc: BaseException) -> list[str]:
     undefined = _undefined_argument(text)
     if undefined:  # the argument is on the line, the expression around it may be elsewhere too
         return [f"$(arg {undefined})"]
-    out = re.findall(r"when evaluating expression '(.*)'", text)
+    expressions = re.findall(r"when evaluating expression '(.*)' *$", text, re.M)
+    out = ["${" + e + "}" for e in expressions] + expressions
     out += re.findall(r"name '(\w+)' is not defined", text)
     out += re.findall(r"unknown macro name: (\S+)", text)
     return out
