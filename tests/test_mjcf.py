@@ -300,13 +300,15 @@ def _joints_by_child(urdf: Path, links: list[str]) -> list[str]:
 #: MuJoCo's compiler allocates what a file asks: four nested <replicate count="100"> make 10^8
 #: bodies; a 10^5 x 10^5 hfield and a 2000^3 flexcomp grid ask for tens of GiB at once
 _BOMBS = {
-    "replicate": '<worldbody><replicate count="100" offset="0.1 0 0"><replicate count="100" offset="0 0.1 0">'
-    '<replicate count="100" offset="0 0 0.1"><replicate count="100" offset="0.1 0.1 0"><body><geom size="0.1"/>'
-    "</body></replicate></replicate></replicate></replicate></worldbody>",
+    "replicate": "<worldbody>"
+    + "".join(f'<replicate count="100" offset="{d}">' for d in ("0.1 0 0", "0 0.1 0", "0 0 0.1", "0.1 0.1 0"))
+    + '<body><geom size="0.1"/></body>'
+    + "</replicate>" * 4
+    + "</worldbody>",
     "hfield": '<asset><hfield name="h" nrow="100000" ncol="100000" size="1 1 1 1"/></asset>'
     '<worldbody><geom type="hfield" hfield="h"/><body><joint/><geom size="0.1"/></body></worldbody>',
-    "flexcomp": '<worldbody><flexcomp name="f" type="grid" count="2000 2000 2000" spacing="0.1 0.1 0.1" dim="3">'
-    '<edge equality="false"/></flexcomp><body><joint/><geom size="0.1"/></body></worldbody>',
+    "flexcomp": '<worldbody><flexcomp name="f" type="grid" count="2000 2000 2000" spacing="0.1 0.1 0.1" '
+    'dim="3"><edge equality="false"/></flexcomp><body><joint/><geom size="0.1"/></body></worldbody>',
 }
 
 

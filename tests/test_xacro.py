@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-import sympy as sp
 
 import symdyn
 from symdyn import SymdynError
@@ -199,21 +199,21 @@ def test_a_route_past_the_audit_hook_meets_the_kernel(capsys, tmp_path):
     marker = tmp_path / "SOMEFILE"
     g = _WRAP + ".__init__.__globals__"
     fork = (
-        f"(lambda g, p: g['sys'].modules['_posixsubprocess'].fork_exec([b'/bin/sh', b'-c', b'touch {marker}'], "
-        "(b'/bin/sh',), True, (p[1],), None, None, -1, -1, -1, -1, -1, -1, p[0], p[1], True, True, -1, None, "
-        f"None, None, -1, None, True))({g})(), {g})()['pipe']())"
+        "(lambda g, p: g['sys'].modules['_posixsubprocess'].fork_exec("
+        f"[b'/bin/sh', b'-c', b'touch {marker}'], (b'/bin/sh',), True, (p[1],), None, None, "
+        "-1, -1, -1, -1, -1, -1, p[0], p[1], True, True, -1, None, None, None, -1, None, True))"
+        f"({g})(), {g})()['pipe']())"
     )
     line = refused(capsys, "derive", _hostile(tmp_path, fork), seconds=30)
-    assert "Operation not permitted" in line or "tried to" in line, line
+    sandbox = "xacro tried a system call that symdyn's sandbox refused (EPERM)"
+    assert line.endswith(f"xacro: {sandbox}: a xacro file may only compute (line 2)"), line
     assert not marker.exists()
 
 
 def test_a_xacro_that_asks_for_too_much_memory_is_told_so(capsys, tmp_path):
     line = refused(capsys, "derive", _hostile(tmp_path, "'a' * (10**10)"), seconds=30)
-    assert (
-        line
-        == f"symdyn: error: {tmp_path / 'hostile.urdf'}: xacro: xacro needed more than 2 GiB of memory (line 2)"
-    )
+    path = tmp_path / "hostile.urdf"
+    assert line == f"symdyn: error: {path}: xacro: xacro needed more than 2 GiB of memory (line 2)"
 
 
 def test_an_undefined_argument_inside_an_expression_is_named_on_its_line(capsys, tmp_path):
@@ -260,7 +260,7 @@ def test_fuzzed_xacro_expressions_only_compute(tmp_path, pieces, operators, argu
     """Random expressions in ${...} and $(arg ...) never run anything nor leave a file behind:
     each ends in a load or a one-line SymdynError within the bound."""
     marker = tmp_path / "SOMEFILE"
-    text = "".join(p + o for p, o in zip(pieces, operators + [""] * 4)).format(m=marker)
+    text = "".join(p + o for p, o in zip(pieces, operators + [""] * 4, strict=False)).format(m=marker)
     path = _hostile(tmp_path, text.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;"))
     before = sorted(tmp_path.iterdir())
     try:

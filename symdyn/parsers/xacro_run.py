@@ -17,6 +17,7 @@ library, xacro and its sibling contained.py only, so that it runs without symdyn
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import re
@@ -27,6 +28,7 @@ from xml.sax.saxutils import escape
 _PRELOAD = ("yaml", "xml.dom.minidom", "xml.dom.expatbuilder", "xml.dom.xmlbuilder", "xml.parsers.expat",
             "ast", "glob", "copy", "math", "collections", "enum", "textwrap", "optparse", "io")  # fmt: skip
 _MEMORY = "xacro needed more than {:g} GiB of memory"
+_KERNEL = "xacro tried a system call that symdyn's sandbox refused (EPERM): a xacro file may only compute"
 
 
 class PackageNotFoundError(Exception):
@@ -94,15 +96,13 @@ def _undefined_argument(text: str) -> str | None:
     return found.group(1) if found else None
 
 
-def _memory(exc: BaseException) -> bool:
-    """Whether the error is a MemoryError, or xacro's wrapping of one."""
-    seen = 0
-    while exc is not None and seen < 10:
-        if isinstance(exc, MemoryError):
-            return True
+def _caused_by(exc: BaseException | None, kind: type[BaseException]) -> BaseException | None:
+    """The error of type `kind` in `exc` or what it wraps (xacro's .exc, the cause, the context)."""
+    for _ in range(10):
+        if exc is None or isinstance(exc, kind):
+            return exc
         exc = getattr(exc, "exc", None) or exc.__cause__ or exc.__context__
-        seen += 1
-    return False
+    return None
 
 
 def _one_line(text: str) -> str:
@@ -138,8 +138,11 @@ def expand(request: dict) -> dict:
         if isinstance(cause, PackageNotFoundError):
             return {"error": str(cause), "file": current, "line": _line_of(current, _needles(cause))}
         line = _line_of(current, _needles(exc))
-        if _memory(exc):
+        if _caused_by(exc, MemoryError):
             return {"error": _MEMORY.format(request.get("memory", 0) / 2**30), "file": current, "line": line}
+        denied = _caused_by(exc, PermissionError)
+        if denied is not None and denied.errno == errno.EPERM:  # the kernel's seccomp filter said no
+            return {"error": _KERNEL, "file": current, "line": line}
         message = re.sub(r" \[Errno \d+\].*", "", _one_line(str(exc))) or type(exc).__name__
         name = _undefined_argument(str(exc))
         if name:
