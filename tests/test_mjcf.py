@@ -14,21 +14,25 @@ mj_saveLastXML) are compared with symdyn's URDF loader and Pinocchio on the orig
 
 from __future__ import annotations
 
+import re
 import sys
+import tempfile
 import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import hypothesis
 import numpy as np
 import pytest
 import sympy as sp
+from hypothesis import strategies as st
 
 import symdyn
 from symdyn import SymdynError
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import forward_kinematics, mass_matrix
 from tests.robots import assert_close, ev
-from tests.timebound import refused
+from tests.timebound import refused, within
 
 mujoco = pytest.importorskip("mujoco", reason="the test extra installs mujoco")
 
@@ -514,3 +518,84 @@ def test_spatial_tendons_and_fluid_forces_are_warned_about(tmp_path):
         "the damping of spatial tendon 'cable' is ignored: symdyn does not model it",
         "the fluid force model of <option density=1.2 viscosity=0.01> is ignored: symdyn does not model it",
     ]
+
+
+# ------------------------------------------------------------ a site named like a body
+
+
+def test_a_site_named_like_a_body_is_kept_as_site_name(tmp_path):
+    """MuJoCo keeps body and site names apart (stretch_3, fruitfly): the body keeps its name (a
+    link 'b', a welded body's frame 'w'), the site's frame is 'site:NAME'; poses from MuJoCo."""
+    path = _two(tmp_path, "clash")
+    text = path.read_text().replace(
+        '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/>',
+        '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/><site name="b" pos="0.3 0.1 0" euler="0.3 0 0.2"/>'
+        '<body name="w" pos="0.1 0 0.2"><geom size="0.05" mass="0.1"/><site name="w" pos="0 0.1 0"/></body>',
+    )
+    path.write_text(text)
+    robot = symdyn.load_mjcf(path)
+    assert [link.name for link in robot.links] == ["a", "b"]
+    assert [f.name for f in robot.frames] == ["w", "site:b", "site:w"]
+    model, data = _mujoco(path)
+    for q, _, _ in _states(robot.n):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        poses = forward_kinematics(robot, q)
+        for s, name in enumerate(["site:b", "site:w"]):
+            frame = robot.frame(name)
+            T = poses[frame.link] @ np.array(frame.placement.matrix(), dtype=float)
+            assert_close(T[:3, 3], data.site_xpos[s], TOL, name)
+            assert_close(T[:3, :3].ravel(), data.site_xmat[s], TOL, name)
+
+
+# ------------------------------------------------------------ fuzzing the attributes against MuJoCo
+
+#: (the attribute as written in TWO, with a site) -> mutated; values that broke readers before
+FUZZ_TEXT = TWO.replace("TENDON", "").replace(
+    '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/>',
+    '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/><site name="s" pos="0.3 0.1 0" euler="0.3 0 0.2"/>',
+)
+FUZZ_ATTRIBUTES = [m.start() for m in re.finditer(r'"[-0-9. ]+"', FUZZ_TEXT)]
+FUZZ_HOSTILE = ["nan", "inf", "-inf", "-1", "1e300", "1e400", "1e-300", "0", "abc", "", "1e149"]
+FUZZ_VALUES = FUZZ_HOSTILE + ["2.5", "-0.3", "0.7", "3", "-2", "1e-3", "100", "0.05"]  # and plain ones
+
+
+@hypothesis.settings(
+    max_examples=40,
+    derandomize=True,
+    deadline=None,
+    database=None,
+    suppress_health_check=list(hypothesis.HealthCheck),
+)
+@hypothesis.given(
+    st.lists(
+        st.tuples(st.sampled_from(FUZZ_ATTRIBUTES), st.integers(0, 2), st.sampled_from(FUZZ_VALUES)),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_fuzzed_attributes_load_as_mujoco_reads_them_or_are_refused(mutations):
+    """Numbers of the attributes of a small MJCF replaced by extreme and garbage values: symdyn
+    loads it or refuses it in one line; where it loads, M and tau agree with MuJoCo's."""
+    text = FUZZ_TEXT
+    for start, token, value in sorted(mutations, reverse=True):
+        end = text.index('"', start + 1)
+        words = text[start + 1 : end].split()
+        words[min(token, len(words) - 1)] = value
+        text = text[: start + 1] + " ".join(words) + text[end:]
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "fuzz.xml"
+        path.write_text(text)
+        with within(10), warnings.catch_warnings():
+            warnings.simplefilter("ignore", symdyn.SymdynWarning)
+            try:
+                robot = symdyn.load_mjcf(path)
+            except SymdynError as exc:
+                assert "\n" not in str(exc)
+                return
+        model, data = _mujoco(path)
+    assert robot.n == model.nv
+    for q, qd, qdd in _states(robot.n, 1, seed=len(text)):
+        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
+        assert_close(_without_coulomb(robot, q, qd, qdd), tau, 1e-9, f"tau of\n{text}")
+        assert_close(mass_matrix(robot, q), M, 1e-9, f"M of\n{text}")
