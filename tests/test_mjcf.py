@@ -14,21 +14,25 @@ mj_saveLastXML) are compared with symdyn's URDF loader and Pinocchio on the orig
 
 from __future__ import annotations
 
+import re
 import sys
+import tempfile
 import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import hypothesis
 import numpy as np
 import pytest
 import sympy as sp
+from hypothesis import strategies as st
 
 import symdyn
 from symdyn import SymdynError
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import forward_kinematics, mass_matrix
 from tests.robots import assert_close, ev
-from tests.timebound import refused
+from tests.timebound import refused, within
 
 mujoco = pytest.importorskip("mujoco", reason="the test extra installs mujoco")
 
@@ -211,14 +215,28 @@ def test_ignored_forces_are_warned_about(tmp_path):
 
 
 def test_mujocos_own_warnings_become_symdyn_warnings(tmp_path, capfd):
-    """MuJoCo prints its warnings itself (to the process's stderr): they become SymdynWarnings."""
-    path = tmp_path / "nan.xml"
-    path.write_text((DATA / "bad_number.xml").read_text().replace("1e200", "nan"))
+    """MuJoCo prints its warnings itself (to the process's stderr): they become SymdynWarnings.
+    (A nan never reaches MuJoCo now: symdyn.parsers.mjcf_attributes refuses it first; a negative
+    armature makes MuJoCo warn of a singular M while compiling.)"""
+    path = tmp_path / "negative.xml"
+    path.write_text((DATA / "bad_number.xml").read_text().replace('damping="1e200"', 'armature="-5"'))
     with (
-        pytest.warns(symdyn.SymdynWarning, match=r"nan.xml: MuJoCo: XML contains a 'NaN'"),
-        pytest.raises(SymdynError, match="joint 'j': damping nan is not a finite number"),
+        pytest.warns(
+            symdyn.SymdynWarning, match=r"negative.xml: MuJoCo: Inertia matrix is too close to singular"
+        ),
+        pytest.raises(SymdynError, match=r"field 'joint\(j\).armature': must not be negative \(got -5\)"),
     ):
         symdyn.load_mjcf(path)
+    assert capfd.readouterr() == ("", "")
+
+
+def test_a_nan_is_refused_before_mujoco_reads_it(tmp_path, capfd):
+    path = tmp_path / "nan.xml"
+    path.write_text((DATA / "bad_number.xml").read_text().replace("1e200", "nan"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no warning of MuJoCo's: it never saw the file
+        with pytest.raises(SymdynError, match=r"field 'joint\(j\).damping': line 4: 'nan' is not a finite"):
+            symdyn.load_mjcf(path)
     assert capfd.readouterr() == ("", "")
 
 
@@ -332,3 +350,289 @@ def test_the_compiler_is_bounded(capsys, tmp_path, monkeypatch, bomb, limit):
     line = refused(capsys, "derive", path, seconds=20)
     assert line.startswith(f"symdyn: error: {path}: MuJoCo's compiler needed {limit}"), line
     assert symdyn.load_mjcf(DATA / "tree.xml").name  # and the next file compiles as before
+
+
+# ------------------------------------------------------------ numbers MuJoCo would take or lose
+
+TWO = """<mujoco model="two">
+  <option gravity="0 0 -9.81"/>
+  <worldbody>
+    <body name="a">
+      <joint name="j1" axis="0 1 0" damping="0.2" armature="0.1"/>
+      <geom size="0.05" pos="0.2 0 0" mass="1"/>
+      <body name="b" pos="0.4 0 0">
+        <joint name="j2" axis="0 1 0"/>
+        <geom size="0.05" pos="0.2 0.1 0" mass="0.5"/>
+      </body>
+    </body>
+  </worldbody>
+  TENDON
+</mujoco>
+"""
+
+
+def _two(tmp_path: Path, name: str, tendon: str = "", **replace: str) -> Path:
+    """The two-hinge arm TWO with `tendon` (a <tendon> element) and the text replacements `replace`."""
+    text = TWO.replace("TENDON", tendon)
+    for old, new in replace.items():
+        assert old.replace("_", " ") in text
+        text = text.replace(old.replace("_", " "), new)
+    path = tmp_path / f"{name}.xml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("field", ["armature", "damping", "frictionloss"])
+def test_negative_joint_coefficients_are_refused_as_in_a_urdf(capsys, tmp_path, field):
+    """MuJoCo accepts armature="-1" (its M loses 1 on the diagonal); the URDF loader's message."""
+    # (heavy links: with M[0, 0] - 1 < 0 MuJoCo would warn of a singular M first)
+    text = TWO.replace("TENDON", "").replace(' armature="0.1"', "").replace('mass="1"', 'mass="100"')
+    path = tmp_path / f"{field}.xml"
+    path.write_text(text.replace('damping="0.2"', f'{field}="-1"'))
+    assert getattr(mujoco.MjModel.from_xml_path(str(path)), f"dof_{field}")[0] == -1  # MuJoCo takes it
+    line = refused(capsys, "derive", path)
+    # the words of the URDF loader's <dynamics damping="-1"> (tests/test_urdf.py)
+    assert line == f"symdyn: error: {path}: field 'joint(j1).{field}': must not be negative (got -1)"
+
+
+def test_a_negative_tendon_coefficient_is_refused(capsys, tmp_path):
+    tendon = '<tendon><fixed name="t" damping="-3"><joint joint="j1" coef="1"/></fixed></tendon>'
+    line = refused(capsys, "derive", _two(tmp_path, "t", tendon))
+    assert line.endswith("field 'tendon(t).damping': must not be negative (got -3)"), line
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        # MuJoCo compiles the nan to 0 (with a warning): the compiled model is a valid one
+        ('pos="0.2 0.1 0"', 'pos="nan 0.1 0"', "field 'geom.pos': line 9: 'nan' is not a finite number"),
+        ('pos="0.2 0.1 0"', 'pos="0.2 -inf 0"', "field 'geom.pos': line 9: '-inf' is not a finite number"),
+        # the squared norm overflows: MuJoCo's axis compiles to (0, 0, 0)
+        (
+            'axis="0 1 0" damping',
+            'axis="1e200 1e200 0" damping',
+            "field 'joint(j1).axis': line 5: the direction 1e200 1e200 0 has a squared norm that overflows",
+        ),
+        (
+            '<geom size="0.05" pos="0.2 0 0"',
+            '<site name="s" zaxis="1e300 0 0"/><geom size="0.05" pos="0.2 0 0"',
+            "field 'site(s).zaxis': line 6: the direction 1e300 0 0 has a squared norm that overflows",
+        ),
+    ],
+)
+def test_numbers_mujoco_loses_are_refused(capsys, tmp_path, old, new, message):
+    path = _two(tmp_path, "lost")
+    path.write_text(path.read_text().replace(old, new))
+    line = refused(capsys, "derive", path)
+    assert line.startswith(f"symdyn: error: {path}: {message}"), line
+
+
+def test_what_mujoco_makes_of_the_lost_numbers(tmp_path):
+    """Why the XML is read: MuJoCo turns a nan into 0 and an overflowing axis into zero."""
+    path = _two(tmp_path, "nan")
+    path.write_text(path.read_text().replace('pos="0.2 0.1 0"', 'pos="nan 0.1 0"'))
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert np.isfinite(model.body_ipos).all() and model.body_ipos[2, 1] != 0.1
+    path.write_text(TWO.replace("TENDON", "").replace('axis="0 1 0" damping', 'axis="1e200 1e200 0" damping'))
+    assert mujoco.MjModel.from_xml_path(str(path)).jnt_axis[0].tolist() == [0, 0, 0]
+
+
+def test_a_nan_in_an_included_file_is_refused(capsys, tmp_path):
+    (tmp_path / "arm.xml").write_text(
+        '<mujoco><body name="b"><joint name="j"/><geom size="0.1" pos="0.1 nan 0"/></body></mujoco>'
+    )
+    (tmp_path / "top.xml").write_text('<mujoco><worldbody><include file="arm.xml"/></worldbody></mujoco>')
+    line = refused(capsys, "derive", tmp_path / "top.xml")
+    assert line.startswith(f"symdyn: error: {tmp_path / 'arm.xml'}: field 'geom.pos': line 1: 'nan'"), line
+
+
+def test_names_are_not_numbers(tmp_path):
+    """A body named 'nan' or 'inf' is a name, not a number."""
+    path = _two(tmp_path, "names")
+    path.write_text(path.read_text().replace('name="a"', 'name="nan"').replace('name="b"', 'name="inf"'))
+    assert [link.name for link in symdyn.load_mjcf(path).links] == ["nan", "inf"]
+
+
+# ------------------------------------------------------------ tendons and fluid forces
+
+
+def _mujoco_passive_free(path: Path, flags: str):
+    """MuJoCo's model with its constraints and the passive forces `flags` disabled."""
+    model, data = _mujoco(path)
+    for flag in flags.split():
+        model.opt.disableflags |= int(getattr(mujoco.mjtDisableBit, f"mjDSBL_{flag}"))
+    return model, data
+
+
+def test_a_fixed_tendon_over_one_joint_is_folded_into_it(tmp_path):
+    """armature a, damping d and frictionloss f on L = c q2: a c^2, d c^2, f |c| on joint 2."""
+    tendon = (
+        '<tendon><fixed name="t" armature="0.5" damping="3" frictionloss="0.4">'
+        '<joint joint="j2" coef="-2"/></fixed></tendon>'
+    )
+    path = _two(tmp_path, "one", tendon)
+    robot = symdyn.load_mjcf(path)
+    assert robot.links[1].motor.inertia == 2  # 0.5 * (-2)**2
+    assert robot.links[1].friction.viscous == 12  # 3 * (-2)**2
+    assert robot.links[1].friction.coulomb == sp.Float(0.8)  # 0.4 * |-2|
+    model, data = _mujoco(path)
+    for q, qd, qdd in _states(robot.n):
+        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
+        assert_close(_without_coulomb(robot, q, qd, qdd), tau, TOL, "tau")
+        assert_close(mass_matrix(robot, q), M, TOL, "M")
+
+
+def test_a_coupling_tendons_armature_is_refused(capsys, tmp_path):
+    """The issue's tendon armature="0.5" over j1 - j2: MuJoCo's M[0, 1] gains -0.5, which no
+    diagonal rotor inertia can give."""
+    tendon = (
+        '<tendon><fixed name="t" armature="0.5">'
+        '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
+    )
+    path = _two(tmp_path, "coupled", tendon)
+    line = refused(capsys, "derive", path)
+    assert line.startswith(
+        f"symdyn: error: {path}: field 'tendon(t).armature': fixed tendon 't' (over joints 'j1', 'j2') "
+        "has armature 0.5, which adds a c c^T to M"
+    ), line
+    model, data = _mujoco(path)
+    plain, plain_data = _mujoco(_two(tmp_path, "plain"))
+    q = np.array([0.3, -0.4])
+    with_tendon, without = (
+        _mujoco_dynamics(m, d, q, q, q)[1] for m, d in ((model, data), (plain, plain_data))
+    )
+    assert_close(with_tendon - without, 0.5 * np.array([[1, -1], [-1, 1]]), TOL, "a c c^T")
+
+
+def test_a_coupling_tendons_damping_and_stiffness_are_what_is_left_out(tmp_path):
+    """The issue's <fixed stiffness="20" damping="3"> over j1 - j2: warned about, and MuJoCo's tau
+    exceeds symdyn's by exactly the left-out k (L - L_spring) c + d c c^T qd."""
+    tendon = (
+        '<tendon><fixed name="t" stiffness="20" damping="3" springlength="0.1">'
+        '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
+    )
+    path = _two(tmp_path, "spring", tendon)
+    with pytest.warns(symdyn.SymdynWarning) as said:
+        robot = symdyn.load_mjcf(path)
+    assert [str(w.message) for w in said] == [
+        f"{path}: the stiffness (spring) of fixed tendon 't' (over joints 'j1', 'j2') is ignored: "
+        "symdyn does not model it",
+        f"{path}: the damping of fixed tendon 't' (over joints 'j1', 'j2') is ignored: "
+        "symdyn does not model it",
+    ]
+    c = np.array([1.0, -1.0])
+    model, data = _mujoco(path)
+    for q, qd, qdd in _states(robot.n):
+        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
+        left_out = 20 * (c @ q - 0.1) * c + 3 * c * (c @ qd)
+        assert_close(_without_coulomb(robot, q, qd, qdd) + left_out, tau, TOL, "tau")
+        assert_close(mass_matrix(robot, q), M, TOL, "M")
+
+
+def test_spatial_tendons_and_fluid_forces_are_warned_about(tmp_path):
+    tendon = (
+        '<tendon><spatial name="cable" damping="2"><site site="s1"/><site site="s2"/></spatial>'
+        '<spatial name="limit"><site site="s1"/><site site="s2"/></spatial></tendon>'
+    )
+    path = _two(
+        tmp_path,
+        "spatial",
+        tendon,
+        **{'<option_gravity="0 0 -9.81"/>': '<option density="1.2" viscosity="0.01"/>'},
+    )
+    text = path.read_text().replace(
+        '<geom size="0.05" pos="0.2 0 0"', '<site name="s1"/><geom size="0.05" pos="0.2 0 0"'
+    )
+    path.write_text(
+        text.replace(
+            '<geom size="0.05" pos="0.2 0.1 0"',
+            '<site name="s2" pos="0.1 0 0"/><geom size="0.05" pos="0.2 0.1 0"',
+        )
+    )
+    with pytest.warns(symdyn.SymdynWarning) as said:
+        symdyn.load_mjcf(path)
+    assert [str(w.message).removeprefix(f"{path}: ") for w in said] == [
+        "the damping of spatial tendon 'cable' is ignored: symdyn does not model it",
+        "the fluid force model of <option density=1.2 viscosity=0.01> is ignored: symdyn does not model it",
+    ]
+
+
+# ------------------------------------------------------------ a site named like a body
+
+
+def test_a_site_named_like_a_body_is_kept_as_site_name(tmp_path):
+    """MuJoCo keeps body and site names apart (stretch_3, fruitfly): the body keeps its name (a
+    link 'b', a welded body's frame 'w'), the site's frame is 'site:NAME'; poses from MuJoCo."""
+    path = _two(tmp_path, "clash")
+    text = path.read_text().replace(
+        '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/>',
+        '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/><site name="b" pos="0.3 0.1 0" euler="0.3 0 0.2"/>'
+        '<body name="w" pos="0.1 0 0.2"><geom size="0.05" mass="0.1"/><site name="w" pos="0 0.1 0"/></body>',
+    )
+    path.write_text(text)
+    robot = symdyn.load_mjcf(path)
+    assert [link.name for link in robot.links] == ["a", "b"]
+    assert [f.name for f in robot.frames] == ["w", "site:b", "site:w"]
+    model, data = _mujoco(path)
+    for q, _, _ in _states(robot.n):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        poses = forward_kinematics(robot, q)
+        for s, name in enumerate(["site:b", "site:w"]):
+            frame = robot.frame(name)
+            T = poses[frame.link] @ np.array(frame.placement.matrix(), dtype=float)
+            assert_close(T[:3, 3], data.site_xpos[s], TOL, name)
+            assert_close(T[:3, :3].ravel(), data.site_xmat[s], TOL, name)
+
+
+# ------------------------------------------------------------ fuzzing the attributes against MuJoCo
+
+#: (the attribute as written in TWO, with a site) -> mutated; values that broke readers before
+FUZZ_TEXT = TWO.replace("TENDON", "").replace(
+    '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/>',
+    '<geom size="0.05" pos="0.2 0.1 0" mass="0.5"/><site name="s" pos="0.3 0.1 0" euler="0.3 0 0.2"/>',
+)
+FUZZ_ATTRIBUTES = [m.start() for m in re.finditer(r'"[-0-9. ]+"', FUZZ_TEXT)]
+FUZZ_HOSTILE = ["nan", "inf", "-inf", "-1", "1e300", "1e400", "1e-300", "0", "abc", "", "1e149"]
+FUZZ_VALUES = FUZZ_HOSTILE + ["2.5", "-0.3", "0.7", "3", "-2", "1e-3", "100", "0.05"]  # and plain ones
+
+
+@hypothesis.settings(
+    max_examples=40,
+    derandomize=True,
+    deadline=None,
+    database=None,
+    suppress_health_check=list(hypothesis.HealthCheck),
+)
+@hypothesis.given(
+    st.lists(
+        st.tuples(st.sampled_from(FUZZ_ATTRIBUTES), st.integers(0, 2), st.sampled_from(FUZZ_VALUES)),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_fuzzed_attributes_load_as_mujoco_reads_them_or_are_refused(mutations):
+    """Numbers of the attributes of a small MJCF replaced by extreme and garbage values: symdyn
+    loads it or refuses it in one line; where it loads, M and tau agree with MuJoCo's."""
+    text = FUZZ_TEXT
+    for start, token, value in sorted(mutations, reverse=True):
+        end = text.index('"', start + 1)
+        words = text[start + 1 : end].split()
+        words[min(token, len(words) - 1)] = value
+        text = text[: start + 1] + " ".join(words) + text[end:]
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "fuzz.xml"
+        path.write_text(text)
+        with within(10), warnings.catch_warnings():
+            warnings.simplefilter("ignore", symdyn.SymdynWarning)
+            try:
+                robot = symdyn.load_mjcf(path)
+            except SymdynError as exc:
+                assert "\n" not in str(exc)
+                return
+        model, data = _mujoco(path)
+    assert robot.n == model.nv
+    for q, qd, qdd in _states(robot.n, 1, seed=len(text)):
+        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
+        assert_close(_without_coulomb(robot, q, qd, qdd), tau, 1e-9, f"tau of\n{text}")
+        assert_close(mass_matrix(robot, q), M, 1e-9, f"M of\n{text}")

@@ -15,13 +15,16 @@ walked, body by body (MuJoCo numbers a parent before its children):
 * a body without joints is welded to its parent: it is merged into the parent's link (masses
   add, inertias move to the common centre of mass: symdyn.parsers.urdf_merge) and keeps its
   frame under its name (`Robot.frames`); bodies welded to the world are the ground;
-* sites are frames on the link of their body;
+* sites are frames on the link of their body, named after the site, or 'site:NAME' when a body
+  (or a link named after a joint) has the site's name (MuJoCo keeps the two kinds of names apart);
 * armature becomes the rotor inertia (gear ratio 1: M gains the armature on its diagonal, as in
   MuJoCo), damping the viscous friction and frictionloss the Coulomb friction c sign(qd) (MuJoCo
   enforces it as a constraint instead: the same force while the joint slides);
 * gravity is <option gravity> (zero when the flag gravity is disabled; disabling the damper or
   frictionloss flags drops those terms too); a joint's range is the link's limits when the
-  joint is limited.
+  joint is limited;
+* a fixed tendon over one joint adds its armature, damping and frictionloss to that joint's
+  (symdyn.parsers.mjcf_tendons, which also says what is refused and warned about for others).
 
 A free joint on a root body (a body whose parent is the world) makes the robot floating, always
 (MuJoCo simulates it so; floating=True asks for it and refuses a file without one): that body is
@@ -32,8 +35,12 @@ welded to the world are the scenery and are left out.
 
 Refused, naming the file, body and joint: ball joints; a free joint below the root, or more than
 one; a floating model with joints outside the floating body's tree.
-Warned about and ignored: joint stiffness (springs), gravity compensation and
-equality constraints, which symdyn does not model. Every number is a compiled double
+Refused too: a negative armature, damping or frictionloss (as in a URDF), and a number written
+in the file that is not finite or a direction MuJoCo cannot normalise (symdyn.parsers.mjcf_attributes:
+MuJoCo reads nan as 0, which the compiled model no longer shows).
+Warned about and ignored: joint and tendon stiffness (springs), gravity compensation, equality
+constraints, the damping and frictionloss of tendons over several joints, spatial tendons'
+passive forces and fluid forces, which symdyn does not model. Every number is a compiled double
 (symdyn.parsers.mjcf_values: rotations snapped to exact multiples of pi/2 within 1e-9 rad).
 """
 
@@ -51,7 +58,9 @@ from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import BaseBody, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform, rot_axis
+from .mjcf_attributes import check_attributes
 from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
+from .mjcf_tendons import TendonTerms, tendon_terms
 from .mjcf_values import number, pose, vector
 from .source import read_source
 from .urdf_elements import UrdfInertial, numeric, urdf_robot_name
@@ -79,6 +88,8 @@ class _Walk:
     free_body: int | None = None
     #: the inertials of the floating base's body, in its frame
     base_parts: list[tuple[UrdfInertial, Transform]] = field(default_factory=list)
+    #: what the fixed tendons add to each dof (symdyn.parsers.mjcf_tendons)
+    tendons: TendonTerms = field(default_factory=TendonTerms)
 
 
 def load_mjcf(path: str | os.PathLike, floating: bool = False) -> Robot:
@@ -120,28 +131,31 @@ def _free_body(model: Any, file: str, body_names: list[str], joint_names: list[s
 
 def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) -> Robot:
     """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
+    check_attributes(raw, file)  # before MuJoCo reads a nan as 0, which the compiled model hides
     model = compile_mjcf(raw, file)
     check_numbers(model, file)
     flags = _disabled(model)
     body_names = names(model, "body", model.nbody, "body")
     joint_names = names(model, "jnt", model.njnt, "joint")
     site_names = names(model, "site", model.nsite, "site")
-    _refuse_clashes(file, body_names[1:], site_names)
-    _warn_ignored(file, model, flags, body_names, joint_names)
+    tendons = tendon_terms(model, file, flags)
+    _warn_ignored(file, model, flags, body_names, joint_names, tendons.ignored)
     free = _free_body(model, file, body_names, joint_names)
     if floating and free is None:
         raise SymdynError(
             "no free joint: a floating MJCF robot has a free joint on its root body (<freejoint/>)", file=file
         )
-    walk = _Walk(file, model, owner=[(-1, Transform.identity())], free_body=free)
+    walk = _Walk(file, model, owner=[(-1, Transform.identity())], free_body=free, tendons=tendons)
     for b in range(1, model.nbody):
         _body(walk, b, body_names, joint_names, flags)
+    taken = set(body_names[1:]) | {fields["name"] for fields in walk.links}
     for s in range(model.nsite):
         k, T = walk.owner[int(model.site_bodyid[s])]
         if k == _OUTSIDE:
             continue
         where = {"file": file, "field": f"site({site_names[s]}).quat"}
-        walk.frames.append(Frame(site_names[s], k, T @ pose(model.site_pos[s], model.site_quat[s], **where)))
+        name = _site_frame_name(site_names[s], taken)
+        walk.frames.append(Frame(name, k, T @ pose(model.site_pos[s], model.site_quat[s], **where)))
     if not walk.links and free is None:  # (a free body alone is a floating rigid body)
         raise SymdynError("no hinge or slide joint: the model has nothing that moves", file=file)
     gravity = [sp.S.Zero] * 3 if "gravity" in flags else [number(g) for g in model.opt.gravity]
@@ -184,18 +198,17 @@ def _disabled(model: Any) -> set[str]:
     return out
 
 
-def _refuse_clashes(file: str, bodies: list[str], sites: list[str]) -> None:
-    """Bodies and sites become frames named after them, so a site may not share a body's name."""
-    for name in sorted(set(bodies) & set(sites)):
-        raise SymdynError(
-            f"'{name}' names both a body and a site: symdyn names links and frames after them, "
-            "so rename one of them",
-            file=file,
-        )
+def _site_frame_name(site: str, taken: set[str]) -> str:
+    """The name of a site's frame: the site's name, or 'site:NAME' when a body (or a link named
+    after a joint) has that name (MuJoCo keeps the names of bodies and sites apart)."""
+    return f"site:{site}" if site in taken else site
 
 
-def _warn_ignored(file: str, model: Any, flags: set[str], bodies: list[str], joints: list[str]) -> None:
-    """A SymdynWarning for each kind of force MuJoCo applies that symdyn's model leaves out."""
+def _warn_ignored(
+    file: str, model: Any, flags: set[str], bodies: list[str], joints: list[str], tendons: list[str]
+) -> None:
+    """A SymdynWarning for each kind of force MuJoCo applies that symdyn's model leaves out
+    (`tendons`: what the tendons and fluid leave out, symdyn.parsers.mjcf_tendons)."""
     ignored = []
     stiff = [joints[j] for j in range(model.njnt) if float(model.jnt_stiffness[j]) != 0]
     if stiff and "spring" not in flags:
@@ -205,6 +218,7 @@ def _warn_ignored(file: str, model: Any, flags: set[str], bodies: list[str], joi
         ignored.append(f"the gravity compensation of body {', '.join(repr(n) for n in held)}")
     if model.neq:
         ignored.append(f"{model.neq} equality constraint(s)")
+    ignored += tendons
     for what in ignored:
         warnings.warn(f"{file}: {what} is ignored: symdyn does not model it", SymdynWarning, stacklevel=4)
 
@@ -293,10 +307,12 @@ def _joint(
             "placement": placement,
             "axis": axis,
             "friction": Friction(
-                sp.S.Zero if "damper" in flags else number(model.dof_damping[dof]),
-                sp.S.Zero if "frictionloss" in flags else number(model.dof_frictionloss[dof]),
+                sp.S.Zero if "damper" in flags else _with(model.dof_damping[dof], walk.tendons.damping, dof),
+                sp.S.Zero
+                if "frictionloss" in flags
+                else _with(model.dof_frictionloss[dof], walk.tendons.frictionloss, dof),
             ),
-            "motor": Motor(number(model.dof_armature[dof]), sp.S.One),
+            "motor": Motor(_with(model.dof_armature[dof], walk.tendons.armature, dof), sp.S.One),
             "frame": shift.inverse(),
             "parent": parent,
             "limits": limits,
@@ -305,6 +321,11 @@ def _joint(
     )
     walk.parts.append([])
     return shift.inverse()
+
+
+def _with(value: float, tendon: dict[int, float], dof: int) -> sp.Expr:
+    """A joint's coefficient plus what a fixed tendon over it alone adds (symdyn.parsers.mjcf_tendons)."""
+    return number(float(value) + tendon[dof]) if dof in tendon else number(value)
 
 
 def _link(walk: _Walk, i: int, fields: dict) -> Link:

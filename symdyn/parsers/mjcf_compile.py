@@ -34,6 +34,7 @@ _ARRAYS = {
     "body": ("pos", "quat", "ipos", "iquat", "mass", "inertia"),
     "jnt": ("pos", "axis", "range"),
     "site": ("pos", "quat"),
+    "tendon": ("armature", "damping", "frictionloss", "stiffness"),
 }
 _DOF_ARRAYS = ("armature", "damping", "frictionloss")
 #: seconds and bytes of address space MuJoCo's compiler may use on one file
@@ -44,6 +45,10 @@ _SERVER = contained.Server(
     [sys.executable, "-B", os.path.join(os.path.dirname(__file__), "mjcf_run.py")],
     env={**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"},  # one thread: safe to fork
 )
+#: the fields that are magnitudes (>= 0), as in a URDF's <dynamics> and a robot file's friction
+_NONNEGATIVE = {"jnt": _DOF_ARRAYS, "tendon": _ARRAYS["tendon"]}
+#: the words of messages for each kind of object
+_NOUNS = {"body": "body", "jnt": "joint", "site": "site", "tendon": "tendon"}
 
 
 def mujoco_module(file: str | None = None) -> Any:
@@ -111,22 +116,26 @@ def model_name(model: Any) -> str:
 
 def check_numbers(model: Any, file: str) -> None:
     """Every number symdyn reads from the compiled model is finite and at most MAX_MAGNITUDE =
-    1e150 in absolute value, as in a URDF; SymdynError naming the body, joint or site and the field.
+    1e150 in absolute value, as in a URDF; a joint's or tendon's armature, damping, frictionloss
+    and stiffness are not negative (MuJoCo accepts -1), with the URDF loader's message.
+    SymdynError naming the body, joint, site or tendon and the field.
     """
     labels = {
-        kind: names(model, kind, len(getattr(model, f"{kind}_{_ARRAYS[kind][0]}")), kind) for kind in _ARRAYS
+        kind: names(model, kind, len(getattr(model, f"{kind}_{_ARRAYS[kind][0]}")), _NOUNS[kind])
+        for kind in _ARRAYS
     }
     checks = [
-        (f"{kind} '{labels[kind][i]}'", f, getattr(model, f"{kind}_{f}")[i])
+        (f"{_NOUNS[kind]} '{labels[kind][i]}'", f, getattr(model, f"{kind}_{f}")[i])
         for kind in _ARRAYS
         for f in _ARRAYS[kind]
         for i in range(len(getattr(model, f"{kind}_{f}")))
     ]
-    checks += [
-        (f"joint '{labels['jnt'][int(model.dof_jntid[d])]}'", f, getattr(model, f"dof_{f}")[d])
+    dofs = [
+        ("jnt", labels["jnt"][int(model.dof_jntid[d])], f, getattr(model, f"dof_{f}")[d])
         for f in _DOF_ARRAYS
         for d in range(model.nv)
     ]
+    checks += [(f"joint '{name}'", f, x) for _, name, f, x in dofs]
     checks += [("option", "gravity", model.opt.gravity), ("model", "qpos0", model.qpos0)]
     for what, fld, values in checks:
         for x in np.atleast_1d(values):
@@ -136,3 +145,14 @@ def check_numbers(model: Any, file: str) -> None:
                     "in absolute value",
                     file=file,
                 )
+    tendons = [
+        ("tendon", labels["tendon"][t], f, getattr(model, f"tendon_{f}")[t])
+        for f in _NONNEGATIVE["tendon"]
+        for t in range(model.ntendon)
+    ]
+    for kind, name, fld, x in dofs + tendons:
+        if float(x) < 0:
+            noun = _NOUNS[kind]
+            raise SymdynError(
+                f"must not be negative (got {float(x):g})", file=file, field=f"{noun}({name}).{fld}"
+            )
