@@ -26,7 +26,7 @@ from symdyn.errors import SymdynError
 from symdyn.module_files import load_module
 from symdyn.oracle import closed_loops as oc
 from symdyn.parsers import robot_from_data
-from symdyn.rnea import kinetic_energy, potential_energy, rnea
+from symdyn.rnea import kinetic_energy, mass_matrix, potential_energy, rnea
 
 EXAMPLES = ("fourbar", "fivebar", "delta", "parallelogram_arm")
 LOOPS_DIR = EXAMPLES_DIR / "closed_loops"
@@ -173,6 +173,83 @@ def test_an_actuated_list_that_does_not_match_the_mobility_is_refused(capsys, tm
     assert "field 'actuated': 2 actuated joints (crank, rocker)" in line and "leave 1 degrees" in line
     data["actuated"] = None  # the default: the joints on no loop (none here)
     assert "0 actuated joints (none)" in _refused_generate(capsys, tmp_path, data)
+
+
+# -- symdyn derive
+
+
+def _derived_json(capsys, name: str) -> dict:
+    import json
+
+    from symdyn.cli.main import main
+
+    capsys.readouterr()
+    assert main(["derive", str(LOOPS_DIR / f"{name}.yaml"), "--format", "json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def _matrix(rows, q) -> np.ndarray:
+    import sympy as sp
+
+    subs = {sp.Symbol(f"q{i + 1}"): x for i, x in enumerate(q)}
+    return np.array([[float(sp.sympify(e).evalf(subs=subs)) for e in row] for row in rows])
+
+
+@pytest.mark.parametrize("name", ["fourbar", "fivebar"])
+def test_derive_says_it_prints_the_tree_and_prints_the_closure_that_projects_it(capsys, name):
+    """derive prints the spanning tree's M, says so, and prints phi and K: with them the printed
+    M projects (W = [I; -K_p^-1 K_a], M_a = W^T M W) onto the oracle's actuated mass matrix."""
+    doc = _derived_json(capsys, name)
+    robot = loaded(name)
+    loops = doc["loops"]
+    assert "the equations below are the spanning tree's" in loops["note"][0]
+    assert "M_a = W^T M W" in loops["note"][2] and "actuated_mass_matrix" in loops["note"][3]
+    an = analysis(name)
+    assert loops["rows"] == [f"{robot.loops[0].name}.{r}" for r in "xy"]
+    rng = np.random.default_rng(3)
+    q_any = rng.uniform(-np.pi, np.pi, robot.n)
+    phi_o, K_o, _ = oc.closure(robot, q_any)
+    np.testing.assert_allclose(_matrix([loops["phi"]], q_any)[0], phi_o[list(an.rows)], atol=1e-12)
+    np.testing.assert_allclose(_matrix(loops["K"], q_any), K_o[list(an.rows)], atol=1e-12)
+    act, pas = oc.split(robot)
+    q = oc.solve_loops(robot, np.array(an.assembled[0])[act] + 0.1, an.assembled[0])
+    M, K = _matrix(doc["M"], q), _matrix(loops["K"], q)
+    W = np.zeros((robot.n, len(act)))
+    W[act] = np.eye(len(act))
+    W[pas] = -np.linalg.solve(K[:, pas], K[:, act])
+    np.testing.assert_allclose(W.T @ M @ W, oc.loop_state(robot, q, np.zeros(len(act))).Ma, atol=1e-12)
+    np.testing.assert_allclose(M, mass_matrix(robot, q), atol=1e-12)  # the tree's, as it says
+
+
+def test_derive_text_and_steps_carry_the_header_and_latex_the_closure(capsys):
+    from symdyn.cli.main import main
+
+    path = str(LOOPS_DIR / "fourbar.yaml")
+    for args in ([], ["--steps"], ["--form", "compact"], ["--format", "latex"]):
+        capsys.readouterr()
+        assert main(["derive", path, *args]) == 0
+        out = capsys.readouterr().out
+        mark = "%" if "latex" in args else "#"
+        assert out.startswith(f"{mark} closed loops B (point): the equations below are the spanning tree's")
+        assert (
+            f"{mark} closure phi(q) = 0: rows B.x, B.y (B.z dropped: dependent on the others); 1 degree"
+            in out
+        )
+        assert ("\\phi_{2} &=" if "latex" in args else "phi[2] = ") in out
+
+
+@pytest.mark.parametrize("args", [(), ("--steps",), ("--format", "json")])
+def test_derive_refuses_a_loop_whose_links_are_too_short_as_generate_does(capsys, tmp_path, args):
+    data = _fourbar_data()
+    data["parameters"].update(b=0.05, c=0.1)  # coupler and rocker cannot reach across the ground
+    path = tmp_path / "short.yaml"
+    path.write_text(yaml.safe_dump(data))
+    line = refused(capsys, "derive", path, *args, seconds=30)
+    assert line == (
+        f"symdyn: error: {path}: robot 'fourbar': loop 'B': cannot close: no configuration brings "
+        "its points together from 12 starts (check the lengths and points of field 'loops')"
+    )
+    assert line == _refused_generate(capsys, tmp_path, data).replace("bad.yaml", "short.yaml")
 
 
 # -- the four-bar against its textbook closed forms

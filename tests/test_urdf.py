@@ -194,12 +194,6 @@ def test_limits_of_revolute_and_prismatic_joints(tmp_path):
 @pytest.mark.parametrize(
     ("limit", "field", "fragment"),
     [
-        ('<limit lower="1" upper="-1"/>', "joint(j1).limit", "the lower limit 1 is above the upper limit -1"),
-        (
-            '<limit lower="0.5"/>',
-            "joint(j1).limit",
-            "above the upper limit 0 ('upper' is not given: URDF makes it 0)",
-        ),
         ('<limit lower="-pi" upper="1"/>', "joint(j1).limit.lower", "expected a number, got '-pi'"),
         ('<limit lower="-1" upper="1e999"/>', "joint(j1).limit.upper", "1e999 is not a finite number"),
         (
@@ -217,6 +211,120 @@ def test_malformed_limits_are_refused(tmp_path, limit, field, fragment):
     err = info.value
     assert (err.file, err.link_index, err.link_name, err.field) == (str(path), 2, "l1", field)
     assert fragment in err.reason and "(line 1)" in err.reason
+
+
+# -- files that urdfdom and Pinocchio load although they break a rule: read as they read them
+
+ODD_BODY = (
+    '<inertial><mass value="1.5"/><origin xyz="0.1 0.2 0.3" rpy="0.1 0.2 0.3"/>'
+    '<inertia ixx="0.4" ixy="0.01" ixz="0.02" iyy="0.5" iyz="0.03" izz="0.6"/></inertial>'
+)
+ODD_LIMIT = '<limit lower="-1" upper="1" effort="1" velocity="1"/>'
+
+# case -> (text before the file, type and elements of joint j1, fragments of the one warning)
+ODD_FILES = {
+    "lower above upper": (
+        "",
+        "revolute",
+        '<axis xyz="0 0 1"/>\n<limit lower="1" upper="-1" effort="1" velocity="1"/>',
+        (
+            "l1): field 'joint(j1).limit': the lower limit 1 is above the upper limit -1",
+            "no range",
+            "(line 7)",
+        ),
+    ),
+    "lower only": (
+        "",
+        "prismatic",
+        '<axis xyz="0 1 1"/>\n<limit lower="0.5" effort="1" velocity="1"/>',
+        ("field 'joint(j1).limit'", "above the upper limit 0 ('upper' is not given: URDF makes it 0)"),
+    ),
+    "three axes": (
+        "",
+        "revolute",
+        '<axis xyz="1 0 1"/>\n<axis xyz="0 0 1"/>\n<axis xyz="a"/>' + ODD_LIMIT,
+        (
+            "field 'joint(j1).axis'",
+            "3 <axis> elements: the first is read",
+            "(line 7, 8) are ignored (line 6)",
+        ),
+    ),
+    "blank lines before the declaration": (
+        "\n \t\r\n<?xml version='1.0' encoding='UTF-8'?>\n",
+        "revolute",
+        '<axis xyz="0 0 1"/>' + ODD_LIMIT,
+        ("white space before the XML declaration (line 3) is skipped",),
+    ),
+}
+
+
+def _odd_urdf(before: str, kind: str, elements: str) -> str:
+    """Two links on joints j1 (`kind`, `elements` from line 6 of the robot) and j2 (revolute about y)."""
+    return (
+        f'{before}<robot name="odd">\n<link name="b"/>\n<link name="l1">{ODD_BODY}</link>\n'
+        f'<link name="l2">{ODD_BODY}</link>\n<joint name="j1" type="{kind}"><parent link="b"/>'
+        f'<child link="l1"/><origin xyz="0.1 0 0.2" rpy="0.3 0 0"/>\n{elements}</joint>\n'
+        '<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>'
+        f'<origin xyz="0.5 0 0"/><axis xyz="0 1 0"/>{ODD_LIMIT}</joint>\n</robot>\n'
+    )
+
+
+@pytest.mark.parametrize("case", ODD_FILES)
+def test_files_urdfdom_loads_are_read_as_pinocchio_reads_them_with_a_warning(tmp_path, case, rng):
+    """Bullet's lower > upper ("no limit"), a lower limit alone, several <axis> (urdfdom reads the
+    first) and blank lines before the XML declaration: Pinocchio loads each; symdyn reads the same
+    model (M and tau equal Pinocchio's) and says what it did in one warning naming file and field."""
+    pin = pytest.importorskip("pinocchio")
+    before, kind, elements, fragments = ODD_FILES[case]
+    text = _odd_urdf(before, kind, elements)
+    path = tmp_path / "odd.urdf"
+    path.write_text(text)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        robot = load_urdf(path)
+    (warning,) = [str(w.message) for w in caught]
+    assert warning.startswith(f"{path}: ") and "\n" not in warning
+    for fragment in fragments:
+        assert fragment in warning, warning
+    model = pin.buildModelFromXML(text)
+    data = model.createData()
+    assert [model.names[i] for i in range(1, model.njoints)] == ["j1", "j2"]
+    for _ in range(3):
+        q, qd, qdd = random_state(robot, rng)
+        M = pin.crba(model, data, q)
+        assert_close(mass_matrix(robot, q), np.triu(M) + np.triu(M, 1).T, what="M")
+        assert_close(rnea(robot, q, qd, qdd), pin.rnea(model, data, q, qd, qdd), what="tau")
+    if "limit" in fragments[0]:  # Pinocchio keeps lower > upper as written; symdyn has no range
+        assert model.lowerPositionLimit[0] > model.upperPositionLimit[0]
+        assert robot.links[0].limits is None and robot.joint_ranges()[0] is None
+
+
+def test_lines_after_a_declaration_that_white_space_precedes_keep_their_numbers(tmp_path):
+    path = tmp_path / "odd.urdf"
+    text = _odd_urdf("\n\n<?xml version='1.0'?>\n", "revolute", '<axis xyz="0 0 1"/>' + ODD_LIMIT)
+    path.write_text(text.replace("</joint>\n</robot>", "</joint>\n</robt>"))
+    with pytest.warns(SymdynWarning, match="line 3"), pytest.raises(SymdynError) as info:
+        load_urdf(path)
+    assert str(info.value) == f"{path}: invalid XML at line 11, column 3: mismatched tag"
+
+
+def test_a_file_of_more_links_than_any_robot_is_refused_within_seconds(tmp_path, capsys):
+    """20,000 links fixed to one moving link took 104 s to load; more than MAX_LINKS are refused."""
+    from symdyn.parsers.urdf_elements import MAX_LINKS
+
+    n = MAX_LINKS + 1
+    links = "".join(f'<link name="l{i}"/>' for i in range(n))
+    joints = "".join(
+        f'<joint name="j{i}" type="fixed"><parent link="l0"/><child link="l{i}"/></joint>'
+        for i in range(1, n)
+    )
+    path = tmp_path / "wide.urdf"
+    path.write_text(f'<robot name="wide">{links}{joints}</robot>')
+    line = refused(capsys, "derive", path, seconds=5)
+    assert line.endswith(
+        f"the robot has {n:,} <link> elements, more than symdyn reads ({MAX_LINKS:,}: a robot "
+        "has tens to hundreds, and each costs milliseconds of symbolic work) (line 1)"
+    ), line
 
 
 def test_exact_numbers():

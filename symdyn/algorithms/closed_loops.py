@@ -35,19 +35,29 @@ away from the singular configurations; every step is branch-free).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import sympy as sp
 
-from ..errors import SymdynError
+from ..errors import SymdynError, SymdynWarning
 from ..model.robot import Robot
 from ..symbolic.program import Program
 from .derivatives import ldlt_factor
 from .frame_kinematics import FrameKinematics
 
-__all__ = ["ROW_NAMES", "LoopAnalysis", "closure", "analyse", "solve_columns", "spd_solve", "loop_rows_text"]
+__all__ = [
+    "ROW_NAMES",
+    "LoopAnalysis",
+    "closure",
+    "analyse",
+    "check_loops",
+    "solve_columns",
+    "spd_solve",
+    "loop_rows_text",
+]
 
 #: The names of a closure's rows, in order (a point loop has the first three).
 ROW_NAMES = ("x", "y", "z", "rx", "ry", "rz")
@@ -237,6 +247,15 @@ def analyse(robot: Robot) -> LoopAnalysis:
     return LoopAnalysis(
         tuple(kept), actuated, passive, tuple(notes), tuple(tuple(map(float, x)) for x in configs)
     )
+
+
+def check_loops(robot: Robot) -> LoopAnalysis:
+    """`analyse`, with a SymdynWarning for each note (the closure rows dropped as dependent): the
+    check of the loops that both `symdyn generate` and `symdyn derive` make before they print."""
+    an = analyse(robot)
+    for note in an.notes:
+        warnings.warn(note, SymdynWarning, stacklevel=3)
+    return an
 
 
 def _coordinate_names(robot: Robot, coords: Sequence[int]) -> list[str]:

@@ -93,8 +93,10 @@ def cmd_derive(args: argparse.Namespace) -> int:
     from ..algorithms.configuration_space import READABLE_TERMS
     from ..dynamics import derive
     from . import derive_output as out
+    from .derive_loops import loop_report, with_loops
 
     robot = load_robot_argument(args)
+    loops = loop_report(robot)  # generate's check of the loops, before any derivation
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     dyn = derive(robot, method=args.method, simplify=simplify)
     frames = out.frame_names(dyn, args.frames)
@@ -134,6 +136,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
         text = out.derive_text(dyn, args.form, args.lumped, pruned)
     else:
         text = {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
+    text = with_loops(loops, text, args.format)
     if frames and args.format == "json":
         doc = json.loads(text)
         doc["frames"] = out.frames_json(dyn, frames)

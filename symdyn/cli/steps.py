@@ -9,6 +9,7 @@ from ..apps.steps import derivation_steps
 from ..apps.steps_output import STEP_FORMATS
 from ..errors import SymdynError
 from .common import load_robot_argument
+from .derive_loops import loop_report, with_loops
 
 __all__ = ["parse_at", "cmd_derive_steps"]
 
@@ -46,6 +47,7 @@ def cmd_derive_steps(args: argparse.Namespace) -> int:
         )
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     at = parse_at(args.at) if args.at else None
+    loops = loop_report(robot)  # generate's check of the loops; the steps are the tree's
     steps = derivation_steps(robot, args.method, at=at, simplify=simplify)
-    sys.stdout.write(STEP_FORMATS[args.format](steps))
+    sys.stdout.write(with_loops(loops, STEP_FORMATS[args.format](steps), args.format))
     return 0

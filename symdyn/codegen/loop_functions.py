@@ -23,15 +23,12 @@ is written by each target's template (a fixed maximum of iterations).
 
 from __future__ import annotations
 
-import warnings
-
 import sympy as sp
 
-from ..algorithms.closed_loops import analyse, closure, solve_columns, spd_solve
+from ..algorithms.closed_loops import check_loops, closure, solve_columns, spd_solve
 from ..algorithms.derivatives import substitute
 from ..algorithms.frame_kinematics import FrameKinematics
 from ..dynamics import Dynamics
-from ..errors import SymdynWarning
 from .function_rows import FunctionRow, Input, Inputs, Output, with_steps
 
 __all__ = ["loop_rows", "LOOP_FUNCTION_NAMES", "loop_inputs"]
@@ -69,9 +66,7 @@ def loop_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     robot = dyn.robot
     if not robot.loops:
         return []
-    an = analyse(robot)
-    for note in an.notes:
-        warnings.warn(note, SymdynWarning, stacklevel=4)
+    an = check_loops(robot)
     n, act, pas = dyn.n, list(an.actuated), list(an.passive)
     na, npas = len(act), len(pas)
     qda, qdda, tau_a = loop_inputs(na)

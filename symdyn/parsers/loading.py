@@ -13,7 +13,7 @@ from ..model.robot import Robot
 from ..spatial.transform import Transform
 from .mjcf import mjcf_from_bytes
 from .robot_file import robot_from_bytes
-from .safe_xml import looks_like_xml, parse_xml
+from .safe_xml import declaration_first, looks_like_xml, parse_xml
 from .source import read_source
 from .urdf import urdf_from_root
 
@@ -45,6 +45,7 @@ def load_robot(
         raise TypeError(f"load_robot() got an unexpected keyword argument '{unknown[0]}'")
     file, raw, digest = read_source(path, "robot file")
     if looks_like_xml(raw):
+        raw = declaration_first(raw, file)  # warns once, not again when MuJoCo's reader parses it
         root = parse_xml(raw, file)
         if root.tag == "mujoco":
             _urdf_only(base, tip, xacro, file, "an MJCF file")

@@ -5,16 +5,22 @@ a document type declaration (<!DOCTYPE ...>, which a URDF never needs) is refuse
 so no entity can be declared, expanded or fetched; parameter entities and external
 DTDs are never loaded either. Character data is dropped: a URDF keeps its data in
 attributes. The caller limits the size of the input (symdyn.parsers.source).
+
+White space before the XML declaration (<?xml ...?>), which XML does not allow and expat refuses,
+is skipped with a SymdynWarning naming the file: tinyxml2, the reader of urdfdom, Pinocchio and
+MuJoCo, skips it, and files written by hand or by scripts often start with a blank line. The
+declaration is moved to the start, so the lines after it keep their numbers.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 from xml.parsers import expat
 
-from ..errors import SymdynError
+from ..errors import SymdynError, SymdynWarning
 
-__all__ = ["Element", "looks_like_xml", "parse_xml"]
+__all__ = ["Element", "declaration_first", "looks_like_xml", "parse_xml"]
 
 
 @dataclass
@@ -41,8 +47,34 @@ class _RefusedError(Exception):
     pass
 
 
+_BOM = b"\xef\xbb\xbf"
+_SPACE = b" \t\r\n"
+
+
+def declaration_first(raw: bytes, file: str) -> bytes:
+    """The bytes with an XML declaration that white space precedes moved to the very start (the
+    white space after it), so that expat reads the file and every line after the declaration keeps
+    its number; unchanged otherwise. Warns naming the file and the declaration's line."""
+    bom = _BOM if raw.startswith(_BOM) else b""
+    rest = raw[len(bom) :]
+    text = rest.lstrip(_SPACE)
+    end = text.find(b"?>") + 2
+    if len(text) == len(rest) or not text.startswith(b"<?xml") or end < 2:
+        return raw
+    space = rest[: len(rest) - len(text)]
+    line = space.replace(b"\r\n", b"\n").replace(b"\r", b"\n").count(b"\n") + 1
+    warnings.warn(
+        f"{file}: white space before the XML declaration (line {line}) is skipped, as urdfdom, "
+        "Pinocchio and MuJoCo skip it (XML requires the declaration at the very start)",
+        SymdynWarning,
+        stacklevel=3,
+    )
+    return bom + text[:end] + space + text[end:]
+
+
 def parse_xml(raw: bytes, file: str) -> Element:
     """A tree of elements (tag, attributes, line) from hardened expat; character data is dropped."""
+    raw = declaration_first(raw, file)
     parser = expat.ParserCreate()  # no namespace processing: tags as written (xacro:macro)
     parser.SetParamEntityParsing(expat.XML_PARAM_ENTITY_PARSING_NEVER)
     stack: list[Element] = []

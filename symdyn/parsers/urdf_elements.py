@@ -14,23 +14,26 @@ its sine and cosine are exactly 0 or +-1 (the 1.5707963267948966 of xacro output
 within 1e-3 rad of a nonzero multiple but not 1e-9 (1.5708) it is kept as written
 with a SymdynWarning naming the file, the link, the field and the line, whether or
 not that link ends up in the robot (the whole file is read).
-A joint's <axis xyz> (default 1 0 0) is normalised.
+A joint's <axis xyz> (default 1 0 0) is normalised; of several <axis> elements the first is
+read and the others are ignored, with a SymdynWarning, as urdfdom (and so Pinocchio) reads them.
 The <limit lower= upper=> of a revolute or prismatic joint is its range (lower and upper
 default to 0, as in the URDF specification): lower < upper gives `limits`; lower = upper
 (0 and 0 when neither is written) says nothing about the range, which stays None, as for a
-continuous joint (whose <limit> is not read); lower > upper is refused. Its other
-attributes (effort, velocity) are not read.
+continuous joint (whose <limit> is not read); lower > upper, Bullet's way of writing "no limit",
+which urdfdom and Pinocchio load as written, is no range either, with a SymdynWarning naming the
+file, the joint and the field. Its other attributes (effort, velocity) are not read.
 """
 
 from __future__ import annotations
 
 import math
 import re
+import warnings
 from dataclasses import dataclass
 
 import sympy as sp
 
-from ..errors import SymdynError, link_fields
+from ..errors import SymdynError, SymdynWarning, link_fields, location
 from ..model.angles import snap_angle
 from ..model.bounded import MAX_MAGNITUDE
 from ..model.expressions import C_KEYWORDS
@@ -41,6 +44,7 @@ from .source import did_you_mean
 
 __all__ = [
     "JOINT_TYPES",
+    "MAX_LINKS",
     "MOVABLE",
     "UrdfInertial",
     "UrdfJoint",
@@ -55,6 +59,9 @@ JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "plan
 MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\Z")
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+#: At most this many <link> (and <joint>) elements are read: real robots have tens to hundreds,
+#: and each costs milliseconds of symbolic work (a file of 20,000 took minutes).
+MAX_LINKS = 2000
 
 
 @dataclass
@@ -158,6 +165,11 @@ class UrdfReader:
             raise self.error(f"expected 3 numbers 'x y z', got {text!r}", line=line, **where)
         return [self.number(p, where, line) for p in parts]
 
+    def warn(self, message: str, *, link: UrdfLink | None = None, field: str | None = None, line=None):
+        """A SymdynWarning naming the file, the link, the field and the line, as `error` would."""
+        place = location(self.file, **link_fields(link), field=field)
+        warnings.warn(f"{place}: {message} (line {line})", SymdynWarning, stacklevel=5)
+
     def one(self, el: Element, tag: str, where: dict, required: bool = False) -> Element | None:
         found = el.all(tag)
         if len(found) > 1:
@@ -211,6 +223,14 @@ class UrdfReader:
         links = root.all("link")
         if not links:
             raise self.error("the robot has no <link>", line=root.line)
+        for tag in ("link", "joint"):
+            count = len(root.all(tag))
+            if count > MAX_LINKS:
+                raise self.error(
+                    f"the robot has {count:,} <{tag}> elements, more than symdyn reads ({MAX_LINKS:,}: "
+                    "a robot has tens to hundreds, and each costs milliseconds of symbolic work)",
+                    line=root.line,
+                )
         for i, el in enumerate(links, start=1):
             self._read_link(i, el)
         for el in root.all("joint"):
@@ -294,7 +314,7 @@ class UrdfReader:
         origin = self.origin(el, where, label + ".")
         axis = None
         if kind in MOVABLE:
-            axis_el = self.one(el, "axis", _at(where, label + ".axis"))
+            axis_el = self._first_axis(el, name, _at(where, label + ".axis"))
             axis_where = _at(where, label + ".axis.xyz")
             if axis_el is None:
                 v = [sp.Integer(1), sp.Integer(0), sp.Integer(0)]
@@ -330,6 +350,20 @@ class UrdfReader:
             mimic_el.line if mimic_el is not None else 0, self._limits(el, kind, where, label),
         )  # fmt: skip
 
+    def _first_axis(self, el: Element, joint: str, where: dict) -> Element | None:
+        """The joint's first <axis> (None without one); later ones are ignored with a warning, as
+        urdfdom reads only the first (Pinocchio builds its model from urdfdom's)."""
+        axes = el.all("axis")
+        if len(axes) > 1:
+            lines = ", ".join(str(a.line) for a in axes[1:])
+            self.warn(
+                f"joint '{joint}' has {len(axes)} <axis> elements: the first is read, as urdfdom and "
+                f"Pinocchio read it, and the others (line {lines}) are ignored",
+                line=axes[0].line,
+                **where,
+            )
+        return axes[0] if axes else None
+
     def _limits(self, el: Element, kind: str, where: dict, label: str) -> tuple[sp.Expr, sp.Expr] | None:
         """(lower, upper) of a revolute or prismatic joint's <limit>; None without a range."""
         if kind not in ("revolute", "prismatic"):
@@ -344,11 +378,13 @@ class UrdfReader:
         if lower > upper:
             missing = [k for k in ("lower", "upper") if k not in limit.attrib]
             hint = f" ('{missing[0]}' is not given: URDF makes it 0)" if missing else ""
-            raise self.error(
-                f"the lower limit {float(lower):g} is above the upper limit {float(upper):g}{hint}",
+            self.warn(
+                f"the lower limit {float(lower):g} is above the upper limit {float(upper):g}{hint}: "
+                'read as no range (Bullet\'s "no limit"; urdfdom and Pinocchio load it as written)',
                 line=limit.line,
                 **_at(where, label + ".limit"),
             )
+            return None
         return None if lower == upper else (lower, upper)
 
 

@@ -1,0 +1,156 @@
+"""What `symdyn derive` adds for a robot with closed loops (docs/closed-loops.md).
+
+derive prints closed forms of M, C, G, F, and those are the spanning tree's: the loops cut open,
+every joint free. The closed mechanism's dynamics lives in its actuated coordinates,
+
+    tau_a = W^T tau(q, W qd_a, W qdd_a - [0; K_p^-1 Kdot qd]),   M_a = W^T M W,   W = [I; -K_p^-1 K_a],
+
+on closed configurations only (phi(q) = 0, K = dphi/dq = [K_a K_p]; Khalil and Dombre (2002),
+ch. 14; symdyn.algorithms.closed_loops). K_p^-1 has no closed form worth printing in general (a
+rational function of q, K_p up to 9 x 9 for a Delta), so derive prints no M_a: `symdyn generate`
+writes it as straight-line code (symdyn.codegen.loop_functions). What derive does instead:
+
+- checks the loops with generate's check (symdyn.algorithms.closed_loops.check_loops): a loop
+  that cannot close, an `actuated` list that does not match the mobility, a geometry without
+  numbers are refused in one line, exactly as by `generate`;
+- says so in a header before the equations (comment lines of the text and LaTeX outputs, the
+  key "loops" of JSON): that the equations are the tree's, the formulas above, the closure rows
+  kept, the actuated and passive joints, and where the actuated dynamics is generated;
+- prints the closure phi(q) and its Jacobian K(q), the kept rows, after the equations, in the
+  canonical form of the configuration-space entries (sums of cos and sin of sums of joint angles:
+  symdyn.symbolic.trig_polynomial, printed by symdyn.symbolic.trig_text), so that the projection
+  can be formed from what is printed.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..algorithms.closed_loops import check_loops, closure, loop_rows_text
+from ..algorithms.frame_kinematics import FrameKinematics
+from ..dynamics import state_symbols
+from ..model.robot import Robot
+from ..symbolic.program import Program
+from ..symbolic.trig_polynomial import TrigRing, chop
+from ..symbolic.trig_text import TrigText
+
+__all__ = ["LoopReport", "loop_report", "with_loops"]
+
+#: What the printed equations are, and where the closed mechanism's dynamics is.
+_FORMULAS = (
+    "the closed mechanism's dynamics, in the actuated coordinates and on closed q only: "
+    "tau_a = W^T tau(q, W qd_a, W qdd_a - [0; K_p^-1 Kdot qd]), M_a = W^T M W, "
+    "W = [I; -K_p^-1 K_a], K = dphi/dq = [K_a K_p] (phi and K follow the equations)"
+)
+_WHY = (
+    "no closed form of M_a or tau_a is printed: K_p^-1 has none in general (a rational function "
+    "of q, valid on the closure only); symdyn generate writes them as the functions "
+    "actuated_mass_matrix, actuated_inverse_dynamics, actuated_forward_dynamics and loop_forces, "
+    "K_p^-1 applied by an unrolled L D L^T (docs/closed-loops.md)"
+)
+
+
+_CLOSURE = (
+    "closure rows phi(q) = 0 and their Jacobian K = dphi/dq "
+    "(kept rows, in the axes of `to`; zeros of K left out)"
+)
+
+
+@dataclass(frozen=True)
+class LoopReport:
+    """The header lines (without comment marks), and the kept closure rows: their names, phi(q)
+    and K(q) as canonical closed forms over the joint coordinates q, in SymPy's syntax."""
+
+    header: tuple[str, ...]
+    rows: tuple[str, ...]
+    phi: tuple[str, ...]
+    K: tuple[tuple[str, ...], ...]
+
+
+def _joints(robot: Robot, coords) -> str:
+    own = [link.name for link in robot.links if link.mimic is None]
+    return ", ".join(f"q{j + 1} ({own[j]})" for j in coords)
+
+
+def loop_report(robot: Robot) -> LoopReport | None:
+    """The report of `robot`'s loops (None without loops), after generate's check.
+
+    Raises:
+        SymdynError: whatever `symdyn generate` refuses the loops for (check_loops).
+    """
+    if not robot.loops:
+        return None
+    r = robot.resolved()
+    an = check_loops(r)
+    q = list(state_symbols(r)[0])
+    program = Program()
+    fk = FrameKinematics(r, q, [0] * len(q), program)
+    phi_all, K_all, _ = closure(fk, r, drift=False)
+    kept = [phi_all[i] for i in an.rows] + [e for i in an.rows for e in K_all[i]]
+    ring = TrigRing(q)
+    printer = TrigText(ring)
+    flat = [printer.text(chop(ring.convert(e))) or "0" for e in program.expand(kept)]
+    m = len(an.rows)
+    phi, K = flat[:m], flat[m:]
+    rows = loop_rows_text(r, an.rows)
+    dropped = [i for i in range(len(phi_all)) if i not in an.rows]
+    note = f" ({', '.join(loop_rows_text(r, dropped))} dropped: dependent on the others)" if dropped else ""
+    freedom = f"{an.mobility} degree{'s' if an.mobility > 1 else ''} of freedom"
+    loops = ", ".join(f"{lp.name} ({lp.type})" for lp in r.loops)
+    header = (
+        f"closed loops {loops}: the equations below are the spanning tree's (the loops cut open, "
+        "every joint free), not the closed mechanism's",
+        f"closure phi(q) = 0: rows {', '.join(rows)}{note}; {freedom}: actuated "
+        f"{_joints(r, an.actuated)}; passive {_joints(r, an.passive)}",
+        _FORMULAS,
+        _WHY,
+    )
+    n = len(q)
+    return LoopReport(header, tuple(rows), tuple(phi), tuple(tuple(K[i * n : (i + 1) * n]) for i in range(m)))
+
+
+def _text(report: LoopReport, text: str) -> str:
+    lines = [f"# {h}" for h in report.header] + [text.rstrip("\n"), ""]
+    lines.append(f"# {_CLOSURE}")
+    lines += [
+        f"phi[{i + 1}] = {e}    # {name}"
+        for i, (e, name) in enumerate(zip(report.phi, report.rows, strict=True))
+    ]
+    lines += [
+        f"K[{i + 1},{j + 1}] = {e}" for i, row in enumerate(report.K) for j, e in enumerate(row) if e != "0"
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _latex(report: LoopReport, text: str) -> str:
+    lines = [f"% {h}" for h in report.header] + [text.rstrip("\n"), "", "\\begin{align*}"]
+    entries = [f"\\phi_{{{i + 1}}} &= {sp.latex(sp.sympify(e))}" for i, e in enumerate(report.phi)]
+    entries += [
+        f"K_{{{i + 1},{j + 1}}} &= {sp.latex(sp.sympify(e))}"
+        for i, row in enumerate(report.K)
+        for j, e in enumerate(row)
+        if e != "0"
+    ]
+    return "\n".join(lines) + "\n" + " \\\\\n".join(entries) + "\n\\end{align*}\n"
+
+
+def _json(report: LoopReport, text: str) -> str:
+    doc = json.loads(text)
+    doc["loops"] = {
+        "note": list(report.header),
+        "rows": list(report.rows),
+        "phi": list(report.phi),
+        "K": [list(row) for row in report.K],
+    }
+    return json.dumps(doc, indent=2) + "\n"
+
+
+def with_loops(report: LoopReport | None, text: str, fmt: str) -> str:
+    """derive's output `text` (format `fmt`: text, latex or json) with the loops' header and
+    closure (module docstring); unchanged without loops (`report` None)."""
+    if report is None:
+        return text
+    return {"text": _text, "latex": _latex, "json": _json}[fmt](report, text)
