@@ -14,6 +14,7 @@ from functools import cache
 
 import numpy as np
 import pytest
+import sympy as sp
 import yaml
 from cbuild import compile_shared, write_files
 from robots import EXAMPLES_DIR, pinocchio_model
@@ -21,6 +22,7 @@ from timebound import refused
 
 import symdyn
 from symdyn.algorithms.closed_loops import analyse
+from symdyn.cli.main import main
 from symdyn.codegen import render
 from symdyn.errors import SymdynError
 from symdyn.module_files import load_module
@@ -250,6 +252,29 @@ def test_derive_refuses_a_loop_whose_links_are_too_short_as_generate_does(capsys
         "its points together from 12 starts (check the lengths and points of field 'loops')"
     )
     assert line == _refused_generate(capsys, tmp_path, data).replace("bad.yaml", "short.yaml")
+
+
+def test_derive_of_a_four_bar_in_symbols_prints_its_closure_unchecked(capsys, tmp_path):
+    """A student's four-bar with a symbolic crank: the loops cannot be checked (that needs
+    numbers), so derive says so and prints every closure row; phi is Freudenstein's loop of
+    vectors written by hand in the rocker's axes."""
+    data = _fourbar_data()
+    del data["parameters"]["a"]
+    path = tmp_path / "symbolic.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert main(["derive", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "rows B.x, B.y, B.z, not checked" in out and "free parameters (a)" in out
+    phi = dict(line.split("    # ")[::-1] for line in out.splitlines() if line.startswith("phi["))
+    a, q1, q2, q3 = sp.symbols("a q1 q2 q3")
+    b, c, d = (sp.nsimplify(FOURBAR[k]) for k in "bcd")
+    x = a * sp.cos(q1) + b * sp.cos(q1 + q2) - d - c * sp.cos(q3)
+    y = a * sp.sin(q1) + b * sp.sin(q1 + q2) - c * sp.sin(q3)
+    want = {"B.x": sp.cos(q3) * x + sp.sin(q3) * y, "B.y": -sp.sin(q3) * x + sp.cos(q3) * y}
+    for row, value in want.items():
+        got = sp.nsimplify(sp.sympify(phi[row].split(" = ")[1]))
+        assert sp.simplify(sp.expand_trig(got - value)) == 0, row
+    assert phi["B.z"] == "phi[3] = 0"
 
 
 # -- the four-bar against its textbook closed forms

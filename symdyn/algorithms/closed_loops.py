@@ -128,13 +128,20 @@ def loop_rows_text(robot: Robot, rows: Sequence[int]) -> list[str]:
     return [names[r] for r in rows]
 
 
-def _numeric(robot: Robot):
-    """phi(q) and K(q) of every row as NumPy functions (lambdified over a fresh program)."""
+def geometry_parameters(robot: Robot) -> set[sp.Symbol]:
+    """The free parameters of the geometry the closure depends on (joint placements and axes, the
+    loops' points): the loops are analysed on numbers only when there are none."""
     geometry = set()
     for link in robot.links:
         geometry |= link.placement.matrix().free_symbols | link.axis.free_symbols
     for loop in robot.loops:
         geometry |= loop.point.free_symbols | loop.to_point.free_symbols
+    return geometry
+
+
+def _numeric(robot: Robot):
+    """phi(q) and K(q) of every row as NumPy functions (lambdified over a fresh program)."""
+    geometry = geometry_parameters(robot)
     if geometry:
         names = ", ".join(sorted(str(s) for s in geometry))
         raise SymdynError(

@@ -11,8 +11,10 @@ rational function of q, K_p up to 9 x 9 for a Delta), so derive prints no M_a: `
 writes it as straight-line code (symdyn.codegen.loop_functions). What derive does instead:
 
 - checks the loops with generate's check (symdyn.algorithms.closed_loops.check_loops): a loop
-  that cannot close, an `actuated` list that does not match the mobility, a geometry without
-  numbers are refused in one line, exactly as by `generate`;
+  that cannot close or an `actuated` list that does not match the mobility is refused in one
+  line, exactly as by `generate`; a geometry with free parameters (a student's four-bar in
+  symbols) cannot be checked, which needs numbers: the header says so, and every closure row is
+  printed;
 - says so in a header before the equations (comment lines of the text and LaTeX outputs, the
   key "loops" of JSON): that the equations are the tree's, the formulas above, the closure rows
   kept, the actuated and passive joints, and where the actuated dynamics is generated;
@@ -29,7 +31,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..algorithms.closed_loops import check_loops, closure, loop_rows_text
+from ..algorithms.closed_loops import check_loops, closure, geometry_parameters, loop_rows_text
 from ..algorithms.frame_kinematics import FrameKinematics
 from ..dynamics import state_symbols
 from ..model.robot import Robot
@@ -84,27 +86,39 @@ def loop_report(robot: Robot) -> LoopReport | None:
     if not robot.loops:
         return None
     r = robot.resolved()
-    an = check_loops(r)
+    unchecked = sorted(str(s) for s in geometry_parameters(r))
+    an = None if unchecked else check_loops(r)
     q = list(state_symbols(r)[0])
     program = Program()
     fk = FrameKinematics(r, q, [0] * len(q), program)
     phi_all, K_all, _ = closure(fk, r, drift=False)
-    kept = [phi_all[i] for i in an.rows] + [e for i in an.rows for e in K_all[i]]
+    kept_rows = list(range(len(phi_all))) if an is None else an.rows
+    kept = [phi_all[i] for i in kept_rows] + [e for i in kept_rows for e in K_all[i]]
     ring = TrigRing(q)
     printer = TrigText(ring)
     flat = [printer.text(chop(ring.convert(e))) or "0" for e in program.expand(kept)]
-    m = len(an.rows)
+    m = len(kept_rows)
     phi, K = flat[:m], flat[m:]
-    rows = loop_rows_text(r, an.rows)
-    dropped = [i for i in range(len(phi_all)) if i not in an.rows]
+    rows = loop_rows_text(r, kept_rows)
+    dropped = [i for i in range(len(phi_all)) if i not in kept_rows]
     note = f" ({', '.join(loop_rows_text(r, dropped))} dropped: dependent on the others)" if dropped else ""
-    freedom = f"{an.mobility} degree{'s' if an.mobility > 1 else ''} of freedom"
     loops = ", ".join(f"{lp.name} ({lp.type})" for lp in r.loops)
+    if an is None:
+        analysis = (
+            f"closure phi(q) = 0: rows {', '.join(rows)}, not checked: whether the loops close, "
+            "their independent rows and the mobility are found on numbers, and the geometry has "
+            f"free parameters ({', '.join(unchecked)}); give them values (--params) to check"
+        )
+    else:
+        freedom = f"{an.mobility} degree{'s' if an.mobility > 1 else ''} of freedom"
+        analysis = (
+            f"closure phi(q) = 0: rows {', '.join(rows)}{note}; {freedom}: actuated "
+            f"{_joints(r, an.actuated)}; passive {_joints(r, an.passive)}"
+        )
     header = (
         f"closed loops {loops}: the equations below are the spanning tree's (the loops cut open, "
         "every joint free), not the closed mechanism's",
-        f"closure phi(q) = 0: rows {', '.join(rows)}{note}; {freedom}: actuated "
-        f"{_joints(r, an.actuated)}; passive {_joints(r, an.passive)}",
+        analysis,
         _FORMULAS,
         _WHY,
     )
