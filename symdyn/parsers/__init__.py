@@ -8,7 +8,16 @@ path reads a file's kind that way (symdyn.cli.cache).
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # for type checkers and the API reference, which read the source
+    from .loading import load_robot
+    from .mjcf import load_mjcf
+    from .poe import robot_from_poe
+    from .robot_file import robot_from_data
+    from .urdf import load_urdf
+
+    load = load_robot
 
 __all__ = ["load", "load_mjcf", "load_robot", "load_urdf", "robot_from_data", "robot_from_poe"]
 
