@@ -302,6 +302,9 @@ def test_site_builds_strictly(tmp_path: Path, block_env: dict[str, str]):
     api = (site / "python-api" / "index.html").read_text(encoding="utf-8")
     for name in ("symdyn.derive", "symdyn.Dynamics", "symdyn.generate", "symdyn.SymdynError"):
         assert name in api, f"the API reference lacks {name}"
+    assert re.search(r'<a href="\.\./floating-base/">docs/floating-base\.md</a>', api), (
+        "the API reference's page paths are not links"
+    )
     internal = re.findall(r'id="(symdyn\.[\w.]*NumericModel\.(?:R0|p0|axis))"', api)
     assert not internal, f"the API reference lists internal attributes: {internal}"
     assert offline_problems(site) == []
