@@ -68,9 +68,13 @@ def test_wrong_answers_are_caught(roger, answers, tmp_path, monkeypatch, capsys)
     path.write_text(yaml.safe_dump(wrong))
     assert run_cli(["check", ROGER, path], monkeypatch) == 1
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0] == "M[2,2]: expected l2**2*m2, got l1**2*m2"
-    assert lines[1].startswith("V[2]: expected ") and lines[1].endswith("got -l1*l2*m2*qd1**2*sin(q2)")
-    assert lines[2].startswith("G[1]: expected ") and "cos(q1)" in lines[2]
+    assert lines[0] == "M[2,2]: expected l2**2*m2, got l1**2*m2; answer - symdyn = l1**2*m2 - l2**2*m2"
+    assert lines[1].startswith("V[2]: expected ")
+    assert lines[1].endswith("got -l1*l2*m2*qd1**2*sin(q2); answer - symdyn = -2*l1*l2*m2*qd1**2*sin(q2)")
+    got, diff = lines[2].split("; answer - symdyn = ")
+    assert got.startswith("G[1]: expected ") and "cos(q1)" in got
+    want = sp.sympify("(m1 + m2)*g*l1*(cos(q1) - sin(q1))")
+    assert sp.expand(sp.sympify(diff) - want) == 0
     assert lines[3] == "roger_arm: 3 of 8 entries of M, V, G differ (M[2,2], V[2], G[1])"
     assert len(lines) == 4
 
@@ -192,9 +196,39 @@ def test_one_entry_wrong(roger, tmp_path, capsys):
     assert run_cli(["check", ROGER, answers]) == 1
     out = capsys.readouterr().out
     assert out == (
-        "M[2,2]: expected l2**2*m2, got l2*m2\n"
+        "M[2,2]: expected l2**2*m2, got l2*m2; answer - symdyn = -l2**2*m2 + l2*m2\n"
         "roger_arm: 1 of 4 entries of M checked (the others null); 1 differs (M[2,2])\n"
     )
+
+
+def test_a_differing_entry_is_shown_as_derive_prints_it(roger, tmp_path, capsys):
+    """A new user's case: a uniform bar's M[1,2] answered with l2**2*m2/3 + l1*l2*m2/2*cos(q2) but
+    written wrongly; symdyn's entry is printed as `symdyn derive` prints M[1,2], and the difference
+    is the one worked out by hand."""
+    answers = tmp_path / "bar.yaml"
+    answers.write_text('M[1,2]: "l2**2*m2/3 + l1*l2*m2/2*cos(q2)"\n')
+    assert run_cli(["derive", ROGER]) == 0
+    derived = dict(line.split(" = ", 1) for line in capsys.readouterr().out.splitlines() if " = " in line)
+    assert run_cli(["check", ROGER, answers]) == 1
+    line = capsys.readouterr().out.splitlines()[0]
+    assert line == (
+        f"M[1,2]: expected {derived['M[1,2]']}, got l1*l2*m2*cos(q2)/2 + l2**2*m2/3; "
+        "answer - symdyn = -l1*l2*m2*cos(q2)/2 - 2*l2**2*m2/3"
+    )
+
+
+def test_an_answer_m_that_is_not_symmetric_is_flagged(roger):
+    """M = M^T: an answer whose M[1,2] and M[2,1] differ gets a note with their difference, and a
+    symmetric answer none."""
+    wrong = {"M": [[None, "m2*l2**2 + m2*l1*l2*cos(q2)"], ["m2*l2**2 + m2*l1*l2*sin(q2)", None]]}
+    report = check_answers(roger, wrong)
+    assert report.notes == [
+        "the answer's M is not symmetric: M[1,2] - M[2,1] = -l1*l2*m2*sin(q2) + l1*l2*m2*cos(q2) "
+        "(every M is symmetric: M = M^T)"
+    ]
+    assert "note: the answer's M is not symmetric" in report.text()
+    wrong["M"][1][0] = wrong["M"][0][1]
+    assert check_answers(roger, wrong).notes == []
 
 
 def test_no_entry_at_all(roger, tmp_path, capsys):

@@ -304,13 +304,28 @@ def test_two_processes_building_one_entry(temporary_cache):
     assert count == 1 and not list((root / "v1").glob(".build-*"))
 
 
-def test_a_warm_simulate_imports_no_sympy(tmp_path, temporary_cache):
-    """The warm command-line path (cached library) runs without importing SymPy (docs/speed.md)."""
+def _urdf_declaring_xacro(folder: Path) -> Path:
+    """The two-link URDF as exported URDFs are: declaring the xacro namespace, needing no expansion."""
+    text = (Path(__file__).parent / "data" / "urdf" / "two_link.urdf").read_text()
+    path = folder / "exported.urdf"
+    path.write_text(
+        text.replace(
+            '<robot name="two_link">', '<robot name="two_link" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        )
+    )
+    return path
+
+
+@pytest.mark.parametrize("kind", ["robot file", "URDF declaring xacro"])
+def test_a_warm_simulate_imports_no_sympy(tmp_path, temporary_cache, kind):
+    """The warm command-line path (cached library) runs without importing SymPy (docs/speed.md),
+    for a URDF too when it only declares the xacro namespace (every example-robot-data URDF does)."""
     import subprocess
     import sys
 
     out = tmp_path / "a.csv"
-    argv = ["simulate", str(PLANAR), "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
+    robot = PLANAR if kind == "robot file" else _urdf_declaring_xacro(tmp_path)
+    argv = ["simulate", str(robot), "--duration", "0.1", "--dt", "1e-2", "--out", str(out)]
     assert main(argv) == 0  # builds the entry
     code = (
         "import sys; from symdyn.cli.main import main; "
@@ -319,6 +334,37 @@ def test_a_warm_simulate_imports_no_sympy(tmp_path, temporary_cache):
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert run.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_the_cached_plant_is_keyed_by_the_floating_base(tmp_path, monkeypatch):
+    """--floating changes the robot, so it is part of the key (a floating run once found the fixed
+    robot's entry); a xacro file, an MJCF file and --xacro-arg go to the uncached route."""
+    import argparse
+
+    import symdyn.apps.compile as compiled
+    from symdyn.cli import cache as cli_cache
+
+    keys, uncached = [], []
+    monkeypatch.setattr(compiled, "cached_dynamics", lambda key, make: keys.append(key))
+    monkeypatch.setattr(cli_cache, "_uncached", lambda make: uncached.append(make))
+    plain = _urdf_declaring_xacro(tmp_path)
+    xacro = tmp_path / "arm.urdf"
+    xacro.write_text(plain.read_text().replace("</robot>", '<xacro:property name="a" value="1"/></robot>'))
+    mjcf = tmp_path / "arm.xml"
+    mjcf.write_text("<mujoco/>")
+    for robot, floating, xacro_arg in [
+        (plain, False, None),
+        (plain, True, None),
+        (plain, False, ["a:=1"]),
+        (xacro, False, None),
+        (mjcf, False, None),
+    ]:
+        args = argparse.Namespace(
+            robot=str(robot), base=None, tip=None, floating=floating, xacro_arg=xacro_arg, package_dir=None
+        )
+        cli_cache.cached_plant(args, lambda: None)
+    assert [k["floating"] for k in keys] == [False, True] and keys[0]["file"] == keys[1]["file"]
+    assert len(uncached) == 3
 
 
 def test_a_missing_or_unknown_parameter_is_named():

@@ -302,9 +302,13 @@ def test_site_builds_strictly(tmp_path: Path, block_env: dict[str, str]):
     api = (site / "python-api" / "index.html").read_text(encoding="utf-8")
     for name in ("symdyn.derive", "symdyn.Dynamics", "symdyn.generate", "symdyn.SymdynError"):
         assert name in api, f"the API reference lacks {name}"
+    assert re.search(r'<a href="\.\./floating-base/">docs/floating-base\.md</a>', api), (
+        "the API reference's page paths are not links"
+    )
     internal = re.findall(r'id="(symdyn\.[\w.]*NumericModel\.(?:R0|p0|axis))"', api)
     assert not internal, f"the API reference lists internal attributes: {internal}"
     assert offline_problems(site) == []
+    assert unrendered_math(site) == []
     for page in MATH_PAGES:
         html = (site / page.removesuffix(".md").removesuffix("index") / "index.html").read_text(
             encoding="utf-8"
@@ -356,6 +360,37 @@ def offline_problems(site: Path) -> list[str]:
     fonts = re.findall(r"url\((fonts/[^)]+\.woff2)\)", css.read_text(encoding="utf-8"))
     problems += [f"assets/katex/{f} is missing" for f in fonts if not (css.parent / f).is_file()]
     return problems + ([] if fonts else ["katex.min.css names no woff2 font"])
+
+
+#: What arithmatex leaves as it is, and so the reader sees raw: a display or inline delimiter
+#: outside the elements arithmatex made, code and scripts (a display indented wrongly in a list).
+RAW_MATH = re.compile(r"\$\$|\\\(|\\\[")
+NOT_PROSE = re.compile(
+    r"<(pre|code|script|style)\b.*?</\1>|<(div|span) class=\"arithmatex\">.*?</\2>", re.S | re.I
+)
+
+
+def unrendered_math(site: Path) -> list[str]:
+    """Every place of the built site's pages where LaTeX math is shown raw instead of typeset."""
+    problems = []
+    for path in sorted(site.rglob("*.html")):
+        text = NOT_PROSE.sub("", path.read_text(encoding="utf-8"))
+        problems += [
+            f"{path.relative_to(site)}: {text[max(0, m.start() - 60) : m.end() + 40]!r}"
+            for m in RAW_MATH.finditer(text)
+        ]
+    return problems
+
+
+def test_the_raw_math_check_finds_what_it_looks_for(tmp_path: Path):
+    """unrendered_math itself: a display left in a paragraph and a raw inline formula are found,
+    typeset math and code are not."""
+    (tmp_path / "a.html").write_text(
+        '<p>$$\n\\kappa = 1\n$$</p><div class="arithmatex">\\[x\\]</div>'
+        '<span class="arithmatex">\\(y\\)</span><code>$$ \\(z\\)</code><p>and \\(w\\)</p>'
+    )
+    found = unrendered_math(tmp_path)
+    assert len(found) == 3 and all(f.startswith("a.html: ") for f in found)
 
 
 def test_the_offline_check_finds_what_it_looks_for(tmp_path: Path):

@@ -23,7 +23,9 @@ largest number, then `sympy.simplify` of it, must be 0), and when that is
 inconclusive numerically at random points (joint values in [-pi, pi],
 velocities and accelerations in [-2, 2], free parameters in [0.5, 2]). An entry
 that differs at any point differs; one that agrees everywhere but resists
-simplification counts as matching numerically.
+simplification counts as matching numerically. A differing entry's line gives symdyn's entry in
+the form `symdyn derive` prints it and the difference answer - symdyn, simplified; an answer M
+that is not symmetric gets a note (symdyn.apps.check_explain).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from ..errors import SymdynError
 from ..model.expressions import parse_expression
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
+from .check_explain import SIMPLIFY_MAX_OPS, asymmetry_notes, chop, derive_form, difference_text
 from .check_state import AT_KEY, TOLERANCE_KEY, compare_at_state
 from .check_steps import check_steps
 
@@ -64,7 +67,6 @@ QUANTITIES = ("M", "C", "V", "G", "F", "tau")
 MATRICES = ("M", "C")
 SAMPLES = 16
 RTOL = 1e-9
-SIMPLIFY_MAX_OPS = 400  # larger differences are judged numerically only
 #: the key of answers for the derivation's intermediate steps (symdyn.apps.check_steps)
 STEPS_KEY = "steps"
 #: a key giving one entry on its own: M[2,2], G[1]
@@ -229,6 +231,8 @@ class EntryResult:
     expected: sp.Expr
     got: sp.Expr
     status: str
+    #: symdyn's entry as `symdyn derive` prints it ('' for the plain text of `expected`)
+    shown: str = ""
 
     @property
     def label(self) -> str:
@@ -239,7 +243,12 @@ class EntryResult:
         return self.status != "differs"
 
     def line(self) -> str:
-        return f"{self.label}: expected {sp.sstr(self.expected)}, got {sp.sstr(self.got)}"
+        """label: expected E, got A; answer - symdyn = A - E (simplified)."""
+        expected = self.shown or sp.sstr(self.expected)
+        return (
+            f"{self.label}: expected {expected}, got {sp.sstr(self.got)}; "
+            f"answer - symdyn = {difference_text(self.expected, self.got)}"
+        )
 
 
 @dataclass
@@ -255,6 +264,8 @@ class CheckReport:
     #: the quantities the answers give (M, G, ...) and how many steps, checked or not
     given: tuple[str, ...] = ()
     steps_given: int = 0
+    #: what else is wrong with the answers (an M that is not symmetric)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -298,6 +309,7 @@ class CheckReport:
                 lines.append(f"{r.label}: matches ({r.status})")
         if self.first_step:
             lines.append(f"first differing step: {self.first_step}")
+        lines += [f"note: {note}" for note in self.notes]
         lines.append(self.summary())
         return "\n".join(lines) + "\n"
 
@@ -310,15 +322,6 @@ def _numeric_zero(diff: sp.Expr, scale: sp.Expr, symbols: list[sp.Symbol], point
     if not np.all(np.isfinite(d)):
         return False
     return bool(np.all(np.abs(d) <= RTOL * (1.0 + np.abs(s))))
-
-
-def _chop(diff: sp.Expr, *exprs: sp.Expr) -> sp.Expr:
-    """diff without the floating-point rounding noise of numeric parameter values."""
-    floats = [abs(f) for x in exprs for f in x.atoms(sp.Float)]
-    if not floats:
-        return diff
-    tiny = 1e-12 * max(1.0, float(max(floats)))
-    return diff.xreplace({f: sp.S.Zero for f in diff.atoms(sp.Float) if abs(f) <= tiny})
 
 
 def _symbolic_zero(diff: sp.Expr) -> bool:
@@ -334,7 +337,7 @@ def _symbolic_zero(diff: sp.Expr) -> bool:
 
 def compare_entry(expected: sp.Expr, got: sp.Expr, symbols: list[sp.Symbol], points: np.ndarray) -> str:
     """ "symbolic", "numeric" or "differs" (module docstring) for one answer entry."""
-    diff = _chop(sp.expand(got - expected), expected, got)
+    diff = chop(sp.expand(got - expected), expected, got)
     if diff == 0:
         return "symbolic"
     if not _numeric_zero(diff, sp.Abs(expected) + sp.Abs(got), symbols, points):
@@ -393,11 +396,17 @@ def check_answers(
         report.results = [EntryResult(*s) for s in steps]
         report.entries += sum(sizes)
         report.steps_given = len(sizes)
+    show = derive_form(dyn)
     for name, got in parsed.items():
         expected = dyn.closed_form(name)
         for index, g in got.items():
             e = expected[index[0] - 1, index[1] - 1] if name in MATRICES else expected[index[0] - 1]
-            report.results.append(EntryResult(name, index, e, g, compare_entry(e, g, symbols, points)))
+            status = compare_entry(e, g, symbols, points)
+            shown = show(name, index, e) if status == "differs" else ""
+            report.results.append(EntryResult(name, index, e, g, status, shown))
+    report.notes = asymmetry_notes(
+        parsed.get("M", {}), lambda a, b: compare_entry(a, b, symbols, points) == "differs"
+    )
     if not report.results:
         raise SymdynError(_NOTHING_GIVEN, file=file)
     return report

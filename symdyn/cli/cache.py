@@ -1,11 +1,13 @@
 """`symdyn cache`: where the cache is and how big (or --clear); and the applications' cached robot.
 
 The applications (simulate, analyze) key their cache entry by the robot file's bytes and
-the options that change the robot (--base, --tip, --params), so a second run of an unchanged
-file finds its compiled library without parsing the file, deriving or importing SymPy
-(symdyn.apps.compile.cached_dynamics). MJCF and xacro files, whose robot depends on the files
-they include (and on --xacro-arg), are loaded every time and compiled through symdyn.compile's
-cache, keyed by the loaded robot.
+the options that change the robot (--base, --tip, --floating, --params), so a second run of an
+unchanged file finds its compiled library without parsing the file, deriving or importing SymPy
+(symdyn.apps.compile.cached_dynamics). A URDF is read this way too when it needs no expansion:
+the loader's own test (symdyn.parsers.xacro_expand.is_xacro) decides, so the xacro namespace that
+exported URDFs declare does not count. MJCF and xacro files, whose robot depends on the files they
+include (and on --xacro-arg), are loaded every time and compiled through symdyn.compile's cache,
+keyed by the loaded robot.
 """
 
 from __future__ import annotations
@@ -29,11 +31,29 @@ def cached_plant(args: argparse.Namespace, make_robot, **options):
             raw = fh.read()
     except OSError:
         return _uncached(make_robot)
-    if b"<mujoco" in raw or b"xacro" in raw:  # MJCF and xacro read other files too (includes)
+    if _reads_other_files(raw, args.robot) or args.xacro_arg or args.package_dir:
         return _uncached(make_robot)
     digest = hashlib.sha256(raw).hexdigest()
-    key = {"file": digest, "base": args.base, "tip": args.tip, **options}
+    floating = bool(getattr(args, "floating", False))
+    key = {"file": digest, "base": args.base, "tip": args.tip, "floating": floating, **options}
     return cached_dynamics(key, make_robot)
+
+
+def _reads_other_files(raw: bytes, file: str) -> bool:
+    """Whether the robot of these bytes depends on other files: an MJCF file (its includes and
+    assets) or a URDF that xacro must expand, by the loader's own tests; a file that is not even
+    well-formed XML goes to the loader too, for its message."""
+    from ..errors import SymdynError
+    from ..parsers.safe_xml import looks_like_xml, parse_xml
+    from ..parsers.xacro_expand import is_xacro
+
+    if not looks_like_xml(raw):
+        return False
+    try:
+        root = parse_xml(raw, file)
+    except SymdynError:
+        return True
+    return root.tag != "robot" or is_xacro(file, root)
 
 
 def _uncached(make_robot):
