@@ -16,12 +16,12 @@ One set of rules for every file symdyn writes (`generate --out`, `simulate --out
 - a folder, a block device (a disk), a socket, an empty path, a path through a file and a name
   longer than the file system allows (255 bytes) are refused in one line.
 
-`make_folder` creates the missing folders of an output folder, but never one that a path only
-passes through ("a/../out" when "a" does not exist is refused, not created); `folder_lock` holds an
-exclusive lock (flock) on a folder while a run writes into it, so concurrent runs write one after the
-other. A path symdyn refuses is a SymdynError; a write that fails (no space, no permission, a reader that
-went away) an OSError naming the output path (not a temporary) and saying why; either way the
-temporary is removed and the old file is left as it was.
+`check_folder` refuses an output folder early and `make_folder` creates its missing folders, but
+never one that a path only passes through ("a/../out" when "a" does not exist is refused, not
+created); `folder_lock` holds an exclusive lock (flock) on a folder while a run writes into it, so
+concurrent runs write one after the other. A path symdyn refuses is a SymdynError; a write that
+fails (no space, no permission, a reader that went away) an OSError naming the output path (not a
+temporary) and saying why; either way the temporary is removed and the old file is left as it was.
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ __all__ = [
     "stage",
     "commit",
     "sweep",
+    "check_folder",
     "make_folder",
     "remove_folders",
     "folder_lock",
@@ -281,25 +282,35 @@ def sweep(folder: Path, names: Iterable[str]) -> None:
             remove(path)
 
 
-def make_folder(out: Path) -> list[Path]:
-    """Create the missing folders of `out`; the ones created, outermost first.
-
-    A missing part of the path that goes up ("..") is refused rather than created to resolve it.
-    """
+def check_folder(out: str | os.PathLike) -> tuple[Path, list[str]]:
+    """Refuse an output folder symdyn would not write into (before any work is done): '', a path
+    that exists and is no folder, one through a file, one whose missing part goes up (".."); the
+    deepest folder of `out` that exists and the names below it to create."""
+    if os.fspath(out) == "":
+        raise SymdynError("'': the output folder is empty")
+    out = Path(out)
     missing: list[str] = []
     probe = out
-    while not os.path.lexists(probe) and probe != probe.parent:
-        missing.append(probe.name)
-        probe = probe.parent
+    try:
+        while not os.path.lexists(probe) and probe != probe.parent:
+            missing.append(probe.name)
+            probe = probe.parent
+    except ValueError:  # a NUL character
+        raise _fail(repr(os.fspath(out)), "an output path cannot hold a NUL character") from None
     if not probe.is_dir():
-        raise _fail(str(out), f"{probe} is not a folder")
+        raise _fail(str(out), "exists and is not a folder" if not missing else f"{probe} is not a folder")
     if ".." in missing:
-        first = probe / missing[-1]
         raise _fail(
             str(out),
-            f"the path goes up ('..') from {first}, which does not exist (symdyn creates no "
-            "folder only to pass through it)",
+            f"the path goes up ('..') from {probe / missing[-1]}, which does not exist (symdyn "
+            "creates no folder only to pass through it)",
         )
+    return probe, missing
+
+
+def make_folder(out: str | os.PathLike) -> list[Path]:
+    """Create the missing folders of `out` (check_folder's rules); the ones created, outermost first."""
+    probe, missing = check_folder(out)
     created: list[Path] = []
     try:
         for name in reversed(missing):

@@ -80,11 +80,7 @@ def write_files(
     dangling link) is refused, --force or not; a link to a regular file is written through.
     """
     out = Path(out_dir)
-    if os.fspath(out_dir) == "":
-        raise SymdynError("the output folder is empty")
-    if os.path.lexists(out) and not out.is_dir():
-        raise SymdynError(f"{out}: output path exists and is not a folder")
-    created = make_folder(out)
+    created = make_folder(out_dir)
     try:
         with folder_lock(out):
             return _write_locked(out, files, force)
