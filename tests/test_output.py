@@ -16,9 +16,12 @@ import re
 import stat
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from robots import EXAMPLES_DIR, dead_pid
 from timebound import refused, within
 
@@ -246,7 +249,9 @@ def test_a_path_through_a_missing_folder_creates_nothing(tmp_path, capsys, monke
         write_files(tmp_path / "b" / "c", {"arm.h": "h"})
     assert list(tmp_path.iterdir()) == []
     monkeypatch.undo()
-    assert write_files(tmp_path / "a" / ".." / "b" / "c", {"arm.h": "h"}) == [tmp_path / "b" / "c" / "arm.h"]
+    (tmp_path / "a").mkdir()  # now the path only passes through folders that exist
+    assert write_files(tmp_path / "a" / ".." / "b" / "c", {"arm.h": "h"}) == [tmp_path / "a/../b/c/arm.h"]
+    assert (tmp_path / "b" / "c" / "arm.h").read_text() == "h"
 
 
 def test_generate_refuses_a_special_file_in_its_folder(tmp_path):
@@ -328,3 +333,93 @@ def test_concurrent_generate_runs_leave_one_robots_files(tmp_path):
     spec.loader.exec_module(numpy_module)
     q = np.array([0.3, -0.7])  # the module computes that robot's M (m1 differs between the six)
     assert np.allclose(numpy_module.mass_matrix(q), rnea_module.mass_matrix(robot, q), atol=1e-12)
+
+
+# --------------------------------------------------------------------------- fuzz (issue 34, item 11)
+# Output paths built from odd names, special files, links, folders and files passed through, ''
+# and names over 255 bytes, in a sandbox four folders deep (so that '..' never climbs out of it):
+# every case writes the content or fails with SymdynError or an OSError naming the path, within
+# 5 s; no special file is replaced and no temporary file is left, for write_atomic and write_files.
+
+FUZZ_EXAMPLES = int(os.environ.get("SYMDYN_FUZZ_EXAMPLES", "120"))
+SPECIAL = ("fifo", "null", "full", "disk", "dangling", "loop", "devlink")
+COMPONENTS = [
+    *SPECIAL,
+    *("file", "folder", "link", "dirlink", "new.csv", "..", ".", "", " ", "-", "--out", "é.csv"),
+    *("a\nb", "\x1b[2J", "*", ".hidden", "x" * 255, "x" * 256, "é" * 128, ".file.1.abcdefgh.tmp"),
+]
+PATHS = st.one_of(st.just(""), st.lists(st.sampled_from(COMPONENTS), min_size=1, max_size=3).map("/".join))
+
+
+def _sandbox(root) -> object:
+    """root/a/b/c/box with a regular file (0600), a folder, a FIFO, links and device nodes (root)."""
+    box = root / "a" / "b" / "c" / "box"
+    (box / "folder").mkdir(parents=True)
+    (box / "folder" / "inner").write_text("inner")
+    (box / "file").write_text("old")
+    os.chmod(box / "file", 0o600)
+    os.mkfifo(box / "fifo")
+    if os.geteuid() == 0:
+        os.mknod(box / "null", stat.S_IFCHR | 0o666, os.makedev(1, 3))
+        os.mknod(box / "full", stat.S_IFCHR | 0o666, os.makedev(1, 7))
+        os.mknod(box / "disk", stat.S_IFBLK | 0o666, os.makedev(7, 0))
+    for name, to in [("link", "file"), ("dirlink", "folder"), ("dangling", "gone/x"), ("loop", "loop")]:
+        (box / name).symlink_to(to)
+    (box / "devlink").symlink_to("null")
+    return box
+
+
+def _specials(root) -> dict:
+    """(kind, device) of every entry under `root` that is not a regular file or folder."""
+    found = {}
+    for folder, dirs, names in os.walk(root):
+        for name in dirs + names:
+            st_ = os.lstat(os.path.join(folder, name))
+            if not (stat.S_ISREG(st_.st_mode) or stat.S_ISDIR(st_.st_mode)):
+                found[os.path.join(folder, name)] = (stat.S_IFMT(st_.st_mode), st_.st_rdev)
+    return found
+
+
+def _attempt(write, target) -> bool:
+    """Whether write() succeeded; else it failed as the command line reports in one line."""
+    try:
+        with within(5):
+            write()
+        return True
+    except SymdynError as exc:
+        assert str(exc) and str(target) in str(exc) or "empty" in str(exc), exc
+    except OSError as exc:
+        assert exc.filename is not None and exc.strerror, repr(exc)
+    return False
+
+
+@settings(
+    max_examples=FUZZ_EXAMPLES,
+    derandomize=True,
+    deadline=None,
+    database=None,
+    suppress_health_check=list(HealthCheck),
+)
+@given(relative=PATHS, generated=st.booleans())
+def test_fuzz_output_paths(relative, generated):
+    import tempfile
+    from unittest import mock
+
+    with tempfile.TemporaryDirectory() as tmp, mock.patch.object(destination, "FIFO_WAIT", 0.05):
+        root = Path(tmp)
+        box = _sandbox(root)
+        target = box / relative if relative else ""
+        specials = _specials(root)
+        data = f"content of {relative!r}\n"
+        if generated:
+            wrote = _attempt(lambda: write_files(target, {"arm.h": data}), target)
+            written = Path(target) / "arm.h"
+        else:
+            wrote = _attempt(lambda: write_atomic(target, data), target)
+            written = Path(target)
+        if wrote and written.is_file():
+            assert written.read_text() == data
+        assert _specials(root) == specials  # nothing special was replaced, none was made
+        leftovers = [os.path.join(f, n) for f, _, names in os.walk(root) for n in names if n.endswith(".tmp")]
+        assert leftovers in ([], [str(box / ".file.1.abcdefgh.tmp")]), leftovers
+        assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
