@@ -227,6 +227,8 @@ def test_a_link_is_written_through_and_a_dangling_one_refused(tmp_path):
     (tmp_path / "dangling.csv").symlink_to("missing/x.csv")
     with pytest.raises(SymdynError, match=r"dangling.csv: a dangling symbolic link \(to missing/x.csv\)"):
         write_atomic(tmp_path / "dangling.csv", "x")
+    with pytest.raises(SymdynError, match="names a folder .it ends with a slash., which does not exist"):
+        write_atomic(f"{tmp_path}/new.csv/", "x")  # open() would not make the file new.csv either
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dangling.csv", "data.csv", "link.csv"]
 
 

@@ -111,6 +111,8 @@ def destination(path: str | os.PathLike) -> Destination:
     try:
         st = os.lstat(text)
     except FileNotFoundError:
+        if text.endswith(("/", os.sep)):
+            raise _fail(text, "names a folder (it ends with a slash), which does not exist") from None
         return _new(text, Path(text))
     except OSError as exc:
         raise _fail(text, _reason(exc)) from None
@@ -184,7 +186,7 @@ def stage(dest: Destination, content: bytes) -> Path:
     try:
         try:
             _write_all(fd, content)
-            if dest.like is not None:
+            if dest.like is not None and hasattr(os, "fchmod"):  # POSIX (Windows has no modes to keep)
                 with contextlib.suppress(OSError):  # another user's file: the owner cannot be kept
                     os.fchown(fd, dest.like.st_uid, dest.like.st_gid)
                 os.fchmod(fd, stat.S_IMODE(dest.like.st_mode) & 0o777)
