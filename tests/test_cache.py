@@ -119,3 +119,78 @@ def test_a_read_only_cache_is_a_symdyn_error(tmp_path, monkeypatch):
             cache.get_or_build(cache.entry_key(test="ro"), _write)
     finally:
         os.chmod(root / "v1", 0o700)
+
+
+# Issue 34, item 9: a build killed by SIGKILL left $TMPDIR/symdyn-build-* that no later run removed.
+# Issue 34, item 8: a relative SYMDYN_CACHE_DIR broke every compile (the compiler runs in another
+# folder, where the library's relative path pointed elsewhere).
+
+DOUBLE = {"double.c": "double twice(double x) { return 2.0 * x; }\n"}
+
+
+def _compiler():
+    from symdyn.apps.build import find_compiler
+
+    compiler = find_compiler()
+    if compiler is None:
+        pytest.skip("no C compiler")
+    return compiler
+
+
+def _twice(library: Path) -> float:
+    import ctypes
+
+    lib = ctypes.CDLL(str(library))
+    lib.twice.restype, lib.twice.argtypes = ctypes.c_double, [ctypes.c_double]
+    return lib.twice(1.25)
+
+
+def test_a_killed_compilers_folder_is_removed_by_the_next_build(tmp_path, monkeypatch):
+    import signal
+    import tempfile
+
+    from symdyn.apps.build import BUILD_PREFIX, compile_library
+
+    compiler = _compiler()
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    code = (
+        "import os, sys, tempfile\n"
+        "from symdyn.apps import build\n"
+        "def stop(*args, **kwargs):\n"  # the compiler started: die as by kill -9, mid-build
+        "    os.kill(os.getpid(), 9)\n"
+        "build._compile_objects = stop\n"
+        "build.compile_library(sys.argv[1:], {'a.c': 'int x;'}, 'lib.so')\n"
+    )
+    env = {**os.environ, "TMPDIR": str(tmp_path / "tmp"), "PYTHONPATH": str(ROOT)}
+    killed = subprocess.run([sys.executable, "-c", code, *compiler], env=env, timeout=60)
+    assert killed.returncode == -signal.SIGKILL
+    left = list((tmp_path / "tmp").iterdir())
+    assert len(left) == 1 and left[0].name.startswith(BUILD_PREFIX) and (left[0] / "a.c").is_file()
+    live = tmp_path / "tmp" / f"{BUILD_PREFIX}{os.getpid()}-livebild"  # a build under way: kept
+    old = tmp_path / "tmp" / f"{BUILD_PREFIX}oldstyle"  # an earlier version's, an hour old: removed
+    young = tmp_path / "tmp" / f"{BUILD_PREFIX}youngone"  # the same, recent: kept
+    for folder in (live, old, young):
+        folder.mkdir()
+    past = time.time() - STALE_SECONDS - 60
+    os.utime(old, (past, past))
+    library = compile_library(compiler, DOUBLE, tmp_path / "double.so")
+    assert _twice(library) == 2.5
+    assert sorted((tmp_path / "tmp").iterdir()) == sorted([live, young])
+
+
+def test_a_relative_cache_folder_is_taken_from_the_current_folder(tmp_path, monkeypatch):
+    from symdyn.apps.build import compile_library
+
+    compiler = _compiler()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(cache.CACHE_ENV, "relative/cache")
+    assert cache.cache_dir() == tmp_path / "relative" / "cache"
+
+    def build(folder: Path) -> dict:
+        compile_library(compiler, DOUBLE, folder / "double.so")
+        return {}
+
+    entry = cache.get_or_build(cache.entry_key(test="relative"), build)
+    assert entry.path.is_absolute() and entry.path.parent == tmp_path / "relative" / "cache" / "v1"
+    assert _twice(entry.file("double.so")) == 2.5

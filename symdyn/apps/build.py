@@ -28,6 +28,7 @@ from ..errors import SymdynError
 
 __all__ = [
     "COMPILE_FLAGS",
+    "BUILD_PREFIX",
     "ARCH_ENV",
     "arch_flags",
     "machine_fingerprint",
@@ -35,6 +36,9 @@ __all__ = [
     "compile_library",
     "library_suffix",
 ]
+
+#: The start of the name of the temporary folder the compiler runs in ($TMPDIR/symdyn-build-PID-XXXXXXXX).
+BUILD_PREFIX = "symdyn-build-"
 
 COMPILE_FLAGS = ("-std=c99", "-O2", "-fPIC", "-ffp-contract=off", "-shared")
 
@@ -97,13 +101,17 @@ def compile_library(
     """Compile the C `sources` (file name -> text; headers included) into the library `target`,
     with COMPILE_FLAGS and `arch` (arch_flags()); without -march=native when the compiler refuses it.
     Each .c file compiles in a process of its own, all at once (the large generated files dominate),
-    then they are linked.
+    then they are linked, in $TMPDIR/symdyn-build-PID-XXXXXXXX; the folders that builds killed
+    mid-way left there are removed first, once stale (symdyn.leftovers).
 
     Raises SymdynError with the compiler's messages when it fails.
     """
     import tempfile
 
-    with tempfile.TemporaryDirectory(prefix="symdyn-build-") as tmp:
+    from ..leftovers import sweep_folders
+
+    sweep_folders(Path(tempfile.gettempdir()), BUILD_PREFIX)  # the folders of builds killed mid-way
+    with tempfile.TemporaryDirectory(prefix=f"{BUILD_PREFIX}{os.getpid()}-") as tmp:
         for name, text in sources.items():
             Path(tmp, name).write_text(text, encoding="utf-8")
         c_files = sorted(name for name in sources if name.endswith(".c"))

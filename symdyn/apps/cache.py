@@ -1,6 +1,7 @@
 """The cache of derived and generated artefacts: one folder per entry, verified before it is trusted.
 
-Where: $SYMDYN_CACHE_DIR when set, else the user's cache folder for "symdyn"
+Where: $SYMDYN_CACHE_DIR when set (a relative path is taken from the current folder when read),
+else the user's cache folder for "symdyn"
 (platformdirs: ~/.cache/symdyn on Linux, honouring $XDG_CACHE_HOME;
 ~/Library/Caches/symdyn on macOS; %LOCALAPPDATA%\\symdyn\\Cache on Windows).
 Layout: <root>/v1/<key>/ holds the entry's files and manifest.json, which records
@@ -38,7 +39,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..errors import SymdynError
-from ..leftovers import is_stale, remove
+from ..leftovers import sweep_folders
 
 __all__ = [
     "CACHE_ENV",
@@ -64,8 +65,8 @@ _STAGING = ".build-"
 def cache_dir() -> Path:
     """The cache's root folder ($SYMDYN_CACHE_DIR, else the user's cache folder for symdyn)."""
     env = os.environ.get(CACHE_ENV, "").strip()
-    if env:
-        return Path(env).expanduser()
+    if env:  # absolute now: the compiler runs in another folder, and a relative root would move with it
+        return Path(os.path.abspath(os.path.expanduser(env)))
     try:
         import platformdirs
     except ImportError:  # the XDG rule, which platformdirs follows on Linux
@@ -219,12 +220,6 @@ def get_or_build(key: str, build: Callable[[Path], dict]) -> Entry:
         ) from None
 
 
-def _staging_pid(name: str) -> int | None:
-    """The process that made the staging folder `name` (.build-PID-XXXXXXXX), None when not said."""
-    head = name[len(_STAGING) :].split("-", 1)[0]
-    return int(head) if head.isdigit() and "-" in name[len(_STAGING) :] else None
-
-
 def _staging_folders(layout: Path) -> list[Path]:
     try:
         return [p for p in layout.iterdir() if p.name.startswith(_STAGING) and p.is_dir()]
@@ -232,19 +227,12 @@ def _staging_folders(layout: Path) -> list[Path]:
         return []
 
 
-def _sweep(layout: Path) -> None:
-    """Remove the stale staging folders of killed builds (a live build's folder is kept)."""
-    for folder in _staging_folders(layout):
-        if is_stale(folder, _staging_pid(folder.name)):
-            remove(folder)
-
-
 def _build_entry(key: str, build: Callable[[Path], dict]) -> Entry:
     import tempfile
 
     layout = cache_dir() / _LAYOUT
     layout.mkdir(parents=True, exist_ok=True)
-    _sweep(layout)
+    sweep_folders(layout, _STAGING)
     staging = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{os.getpid()}-", dir=layout))
     try:
         meta = build(staging)

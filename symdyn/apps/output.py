@@ -1,4 +1,5 @@
-"""Writing results: files written all at once, and Matplotlib figures rendered to bytes.
+"""Writing results: files written all at once (or streamed into a device or FIFO, never replacing
+one: symdyn.codegen.destination), and Matplotlib figures rendered to bytes.
 
 Shared by the applications that write files (symdyn.apps.trajectory, analysis_plots
 and the command line). Figures use the Agg canvas directly, never pyplot, so no
@@ -9,35 +10,37 @@ from __future__ import annotations
 
 import io
 import os
-import tempfile
 from pathlib import Path
 
+from ..codegen.destination import destination, sweep, write_to
 from ..errors import SymdynError
 
-__all__ = ["write_atomic", "figure", "figure_bytes", "plot_format", "PLOT_FORMATS"]
+__all__ = ["write_atomic", "check_output", "figure", "figure_bytes", "plot_format", "PLOT_FORMATS"]
 
 #: The image formats of --plot, by file suffix.
 PLOT_FORMATS = ("png", "pdf", "svg")
 
 
-def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
-    """Write a file all at once: a temporary file beside it, then os.replace."""
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    if not folder.is_dir():
-        raise SymdynError(f"{target}: folder {folder} does not exist")
-    if target.is_dir():
-        raise SymdynError(f"{target}: is a folder")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=folder)
+def check_output(path: str | os.PathLike | None, option: str = "") -> None:
+    """Refuse, before any work is done, an output path that write_atomic would refuse (the message
+    starts with `option`, the flag that gave it); None passes."""
+    if path is None:
+        return
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(content.encode() if isinstance(content, str) else content)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return target
+        destination(path)
+    except SymdynError as exc:
+        raise SymdynError(f"{option} {exc}".strip()) from None
+
+
+def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
+    """Write a file all at once by symdyn.codegen.destination's rules: a regular file (new, or
+    existing: its mode and owner kept; a link's target) through a temporary beside it and one
+    rename; a character device, a FIFO or /dev/stdout streamed in place; anything else refused."""
+    dest = destination(path)
+    if dest.kind in ("new", "file"):
+        sweep(dest.real.parent, [dest.real.name])
+    write_to(dest, content)
+    return Path(path)
 
 
 def figure(rows: int, width: float = 8.0, height_per_row: float = 2.6):

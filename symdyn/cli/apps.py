@@ -22,7 +22,6 @@ from __future__ import annotations
 import argparse
 import re
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -119,23 +118,12 @@ def _with_params(robot, params: dict[str, float], option: str = "--params"):
     return robot
 
 
-def _check_out_path(path: str | None, option: str) -> None:
-    """Refuse an output path whose folder is missing (before any work is done)."""
-    if path is None:
-        return
-    target = Path(path)
-    if target.is_dir():
-        raise SymdynError(f"{option} {path}: is a folder")
-    if not (target.parent if str(target.parent) else Path(".")).is_dir():
-        raise SymdynError(f"{option} {path}: folder {target.parent} does not exist")
-
-
 def _check_plot_path(path: str | None) -> None:
     if path is None:
         return
-    from ..apps.output import plot_format
+    from ..apps.output import check_output, plot_format
 
-    _check_out_path(path, "--plot")
+    check_output(path, "--plot")
     plot_format(path)
     try:
         import matplotlib  # noqa: F401
@@ -168,11 +156,11 @@ def _torques(items, n: int):
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     from ..apps.floating_stepping import floating_sizes, initial_configuration
-    from ..apps.output import write_atomic
+    from ..apps.output import check_output, write_atomic
     from ..apps.simulate import simulate
     from ..apps.trajectory import plot_trajectory
 
-    _check_out_path(args.out, "--out")
+    check_output(args.out, "--out")
     _check_plot_path(args.plot)
     params = _assignments(args.params, "--params")
     if args.track is not None and args.tau is not None:

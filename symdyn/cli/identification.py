@@ -69,8 +69,10 @@ def _per_joint(items, n: int, what: str):
 def cmd_identify(args: argparse.Namespace) -> int:
     from ..apps.identify import identify, plot_identification
     from ..apps.measurements import read_measurements
+    from ..apps.output import check_output
     from ..dynamics import derive
 
+    check_output(args.plot, "--plot")
     robot = _robot(args)
     data = read_measurements(args.data, robot.n, floating=robot.floating)
     result = identify(robot, data, derive(robot, simplify=False).base_parameters, predict=bool(args.plot))
@@ -92,7 +94,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 def cmd_excite(args: argparse.Namespace) -> int:
     from ..apps.excite import excite
+    from ..apps.output import check_output
 
+    check_output(args.out, "--out")
     robot = _robot(args)
     n = robot.n
     if not args.dt > 0:

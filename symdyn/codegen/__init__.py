@@ -23,6 +23,7 @@ from ..dynamics import SINGULAR_M, derive
 from ..errors import SymdynError, SymdynWarning
 from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
+from .destination import check_folder
 from .frame_functions import choose_frames
 from .functions import FRAME_GROUPS, FUNCTION_NAMES, GROUPS, build_functions
 from .output import write_files
@@ -164,6 +165,7 @@ def generate(
     for operational_space, the rows `task_axes` ("x,y,z"; None: all six), docs/generated-code.md.
     `prune`: from the significance-pruned model, symdyn.codegen.pruned.
     """
+    check_folder(out_dir)  # before the work: '', a file, a path through a missing folder
     if not isinstance(robot, Robot):
         from ..parsers import load
 
