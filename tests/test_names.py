@@ -24,6 +24,7 @@ import pytest
 from cbuild import STRICT_FLAGS, compilers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from texbuild import ESCAPES, commands
 from timebound import within
 
 from symdyn.codegen import render
@@ -125,10 +126,6 @@ NAMES = st.one_of(
 )
 
 
-def _commands(tex: str) -> set[str]:
-    return set(re.findall(r"\\(?:[A-Za-z]+|.)", tex))
-
-
 _PLAIN_COMMANDS: set[str] = set()
 
 
@@ -137,7 +134,7 @@ def _plain_commands() -> set[str]:
     if not _PLAIN_COMMANDS:
         robot = urdf_from_bytes(_urdf(["tool", "camera"]), "plain.urdf", "-", None, None)
         tex = render(robot, targets=("latex",), functions=("kinematics",))["fuzz_dynamics.tex"]
-        _PLAIN_COMMANDS.update(_commands(tex) | {"\\_", "\\#", "\\%", "\\&", "\\{", "\\}", "\\$"})
+        _PLAIN_COMMANDS.update(commands(tex) | ESCAPES)
     return _PLAIN_COMMANDS
 
 
@@ -151,7 +148,7 @@ def _check_files(files: dict, folder: str) -> None:
     built = namespace["functions"]()
     assert all(isinstance(f, casadi.Function) for f in built.values())
     compile(files["fuzz_numpy.py"], "fuzz_numpy.py", "exec")
-    assert _commands(files["fuzz_dynamics.tex"]) <= _plain_commands()
+    assert commands(files["fuzz_dynamics.tex"]) <= _plain_commands()
     if compilers():
         for name in ("fuzz_dynamics.h", "fuzz_dynamics.c"):
             with open(os.path.join(folder, name), "w", encoding="utf-8") as f:
