@@ -24,12 +24,14 @@ import pytest
 from cbuild import STRICT_FLAGS, compilers
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from robots import raw_example
 from texbuild import ESCAPES, commands
 from timebound import within
 
-from symdyn.codegen import render
+from symdyn.codegen import generate, render
 from symdyn.errors import SymdynError
 from symdyn.model.names import MAX_IDENTIFIER, comment_text, identifier, identifiers, latex_text, short_name
+from symdyn.parsers import robot_from_data
 from symdyn.parsers.urdf import urdf_from_bytes
 
 #: CasADi's rule for a function name (casadi/core/function_internal.cpp)
@@ -90,6 +92,19 @@ def test_latex_and_comment_text_run_nothing(name):
     assert not re.search(r"(?<!\\)[#%&{}$^~]", tex), tex
     text = comment_text(name)
     assert text.isascii() and not re.search(r"[\n\\'\"%*]", text), text
+
+
+def test_a_robot_name_of_250_characters_makes_files_the_file_system_takes(tmp_path):
+    """The robot's name is cut (with its hash) in code and file names, and the header says so."""
+    name = "r" * 250
+    robot = robot_from_data(raw_example("roger_arm_values") | {"name": name})
+    with within(60):
+        paths = generate(
+            robot, ("c", "casadi", "python", "jax", "latex"), tmp_path, functions=("kinematics",)
+        )
+    assert paths and all(len(p.name.encode()) <= 200 and p.name.startswith(short_name(name)) for p in paths)
+    header = (tmp_path / f"{short_name(name)}_dynamics.h").read_text()
+    assert f"Robot '{name}' is {short_name(name)} in code and file names." in header
 
 
 # --------------------------------------------------------------------------- fuzz
