@@ -35,7 +35,6 @@ and 6.2; Spong, Hutchinson, Vidyasagar, Robot Modeling and Control (2006), sec. 
 
 from __future__ import annotations
 
-import re
 import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -63,6 +62,7 @@ from .algorithms.singular import SingularJoint, describe_singular, singular_join
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
 from .model.free_flyer import NQ_BASE, NV_BASE, base_symbols
+from .model.names import latex_text
 from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
@@ -546,7 +546,7 @@ class Dynamics:
     def _repr_latex_(self) -> str:
         """tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (slide 16) for notebooks, with the closed
         forms of M, V and G for robots of up to AUTO_SIMPLIFY_MAX_JOINTS joints."""
-        n, name = self.n, re.sub(r"([_#%&{}$])", r"\\\1", self.robot.name)
+        n, name = self.n, latex_text(self.robot.name)
         q = ", ".join(f"q_{{{i}}}" for i in (range(1, n + 1) if n <= 3 else (1, "\\dots", n)))
         lines = [
             f"\\text{{{name}}}:\\ \\tau = M(q)\\,\\ddot{{q}} + V(q, \\dot{{q}}) + G(q) + F(\\dot{{q}})",

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import importlib
 import re
-import shutil
-import subprocess
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -30,6 +28,7 @@ from robots import (
     roger_eye_lecture,
 )
 from sympy.printing.latex import LatexPrinter
+from texbuild import TEX, typeset
 
 from symdyn.codegen import latex as latex_backend
 from symdyn.codegen import render as render_targets
@@ -369,22 +368,10 @@ def test_parameter_names_like_the_notation_are_spelled_out():
     assert nt.latex(nt.prepare(s1 * sp.sin(q1))) == r"\mathrm{s1} s_{1}"
 
 
-@pytest.mark.skipif(not (shutil.which("pdflatex") or shutil.which("latexmk")), reason="no pdflatex/latexmk")
+@pytest.mark.skipif(TEX is None, reason="no pdflatex/latexmk")
 @pytest.mark.parametrize("name", ["roger_arm", "planar_3r", "puma560"])
 def test_fragment_compiles(name, tmp_path):
-    files = {f"{name}_dynamics.tex": latex_backend.dynamics_latex(_dynamics(name))}
-    for file, text in files.items():
-        (tmp_path / file).write_text(text)
-    doc = tmp_path / "doc.tex"
-    doc.write_text(
-        "\\documentclass{article}\n\\usepackage{amsmath}\n\\begin{document}\n"
-        f"\\input{{{name}_dynamics.tex}}\n\\end{{document}}\n"
-    )
-    if shutil.which("pdflatex"):
-        cmd = ["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "doc.tex"]
-    else:
-        cmd = ["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "doc.tex"]
-    proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    proc = typeset(tmp_path, {f"{name}_dynamics.tex": latex_backend.dynamics_latex(_dynamics(name))})
     assert proc.returncode == 0, proc.stdout[-3000:]
     assert (tmp_path / "doc.pdf").stat().st_size > 0
     assert "Undefined control sequence" not in proc.stdout

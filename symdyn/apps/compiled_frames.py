@@ -4,7 +4,8 @@ generated kinematics and operational_space functions (symdyn.codegen.frame_funct
 
 Each frame (and choice of task axes) has a compiled library of its own, built on first use
 and cached like the robot's (CompiledDynamics.frame_functions); the methods here only pick
-the generated function: frame F's functions are named after identifier(F).
+the generated function: frame F's functions are named after its identifier
+(symdyn.codegen.frame_functions.frame_identifiers of F alone, as its library is built).
 """
 
 from __future__ import annotations
@@ -24,10 +25,11 @@ class FrameMethods:
         raise NotImplementedError  # CompiledDynamics defines it
 
     def _function(self, frame: str, suffix: str, axes=None):
-        from ..codegen.frame_functions import identifier  # not at import: a warm run loads no SymPy
+        from ..codegen.frame_functions import frame_identifiers  # not at import: a warm run loads no SymPy
 
         group = "operational_space" if suffix.startswith("operational") else "kinematics"
-        return self.frame_functions(frame, group, axes).function(f"{identifier(frame)}_{suffix}")
+        ident = frame_identifiers([frame])[frame]
+        return self.frame_functions(frame, group, axes).function(f"{ident}_{suffix}")
 
     def frame_pose(self, frame: str, q):
         """world_T_F, 4 x 4."""

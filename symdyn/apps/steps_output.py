@@ -6,6 +6,7 @@ import json
 
 import sympy as sp
 
+from ..model.names import comment_text
 from .steps import Step, Steps
 
 __all__ = ["steps_text", "steps_latex", "steps_json", "STEP_FORMATS", "STEP_LABELS"]
@@ -83,10 +84,10 @@ def steps_latex(steps: Steps) -> str:
     for k in range(1, steps.robot.n + 1):
         names.update({sp.Symbol(f"q{k}"): f"q_{{{k}}}", sp.Symbol(f"qd{k}"): f"\\dot{{q}}_{{{k}}}"})
         names[sp.Symbol(f"qdd{k}")] = f"\\ddot{{q}}_{{{k}}}"
-    out = [f"% {_title(steps)}"]
+    out = [f"% {comment_text(_title(steps))}"]
     for phase, i, group in _groups(steps):
         frame = f" (frame {group[0].frame})" if group[0].frame else ""
-        out.append(f"% {_HEADINGS[phase].format(i=i)}{frame}")
+        out.append(f"% {comment_text(_HEADINGS[phase].format(i=i) + frame)}")
         out.append("\\begin{align*}")
         rows = []
         for s in group:

@@ -26,6 +26,7 @@ from ..algorithms.configuration_space import pair_columns
 from ..dynamics import Dynamics
 from ..errors import SymdynError
 from ..lumped import lumped_constants
+from ..model.names import comment_text, identifiers, latex_text
 from ..symbolic.simplify import count_ops, eliminate
 from ..symbolic.trig_text import number_text
 
@@ -40,6 +41,7 @@ __all__ = [
     "lumped_lines",
     "lumped_json",
     "lumped_latex",
+    "latex_notes",
     "latex_align",
     "prune_summary",
     "frame_names",
@@ -311,10 +313,11 @@ def _latex_label(name: str, label: str) -> str:
 
 
 def _latex_name(name: str) -> str:
-    """I12 -> I_{12}, Izz1R -> \\mathrm{Izz}_{1R}: letters, then the rest as a subscript."""
+    """I12 -> I_{12}, Izz1R -> \\mathrm{Izz}_{1R}: letters, then the rest as a subscript
+    (every other name upright, as latex_text spells it)."""
     m = re.fullmatch(r"([A-Za-z]+)(\d\w*)", name)
     if m is None:
-        return f"\\mathrm{{{name}}}"
+        return f"\\mathrm{{{latex_text(name)}}}"
     head = m[1] if len(m[1]) == 1 else f"\\mathrm{{{m[1]}}}"
     return f"{head}_{{{m[2]}}}"
 
@@ -326,6 +329,11 @@ def latex_align(nt, items, expand: bool = True) -> str:
         lines = nt.lines(nt.prepare(e), expand=expand)
         rows.append(f"{head} &= {lines[0]}" + "".join(f" \\\\\n  &\\quad {ln}" for ln in lines[1:]))
     return "\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}"
+
+
+def latex_notes(constants) -> list[str]:
+    """The lumped constants' notes (none without them) as LaTeX comment lines, each one line."""
+    return [f"% note: {comment_text(note)}" for note in (constants.notes() if constants is not None else [])]
 
 
 def lumped_latex(nt, constants) -> list[str]:
@@ -351,7 +359,7 @@ def derive_latex_configuration(dyn: Dynamics, lumped: bool = False) -> str:
         "% tau = M(q) qdd + B(q) [qd qd] + Csq(q) [qd^2] + G(q) + F(qd)  (needs \\usepackage{amsmath})",
     ]
     definitions = lumped_latex(nt, constants) if constants is not None else []
-    out += [f"% note: {note}" for note in (constants.notes() if constants is not None else [])]
+    out += latex_notes(constants)
     for name, items in entries.items():
         if items:
             out.append(latex_align(nt, [(_latex_label(name, label), e) for label, e in items]))
@@ -414,24 +422,26 @@ def frames_json(dyn: Dynamics, names: list[str]) -> dict:
 
 
 def frames_latex(dyn: Dynamics, names: list[str]) -> str:
-    """One align* per frame: the entries of T (world_T_F) and J (world-aligned), in LaTeX."""
+    """One align* per frame: the entries of T (world_T_F) and J (world-aligned), in LaTeX, each
+    frame labelled by its identifier (symdyn.model.names.identifiers: distinct, LaTeX-safe) and
+    named in a comment above its block."""
     symbols = {}
     for head, v in (("q", dyn.q), ("\\dot{q}", dyn.qd)):
         symbols.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})
+    labels = identifiers(names)
     out = []
     for name in names:
-        tex = re.sub(r"([_#%&{}$])", r"\\\1", name)
         rows = []
         for label, m in (("T", dyn.frame_pose(name)), ("J", dyn.frame_jacobian(name))):
-            head = f"{label}^{{\\mathrm{{{tex}}}}}"
+            head = f"{label}^{{\\mathrm{{{latex_text(labels[name])}}}}}"
             rows += [
                 f"{head}_{{{i + 1},{j + 1}}} &= {sp.latex(m[i, j], symbol_names=symbols)}"
                 for i in range(m.rows)
                 for j in range(m.cols)
             ]
+        spelled = "" if labels[name] == name else f" (labelled {labels[name]})"
         out.append(
-            f"% frame {name}: pose world_T_F and world-aligned Jacobian\n\\begin{{align*}}\n"
-            + " \\\\\n".join(rows)
-            + "\n\\end{align*}"
+            f"% frame {comment_text(name)}{spelled}: pose world_T_F and world-aligned Jacobian\n"
+            "\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}"
         )
     return "\n".join(out) + "\n"

@@ -29,7 +29,15 @@ from ..algorithms.product_form import ProductForm
 from ..dynamics import Dynamics
 from ..lumped import LumpedConstants, lumped_product_form
 from ..symbolic.horner import product_text as text
-from .derive_output import header, json_header, latex_align, lumped_json, lumped_latex, lumped_lines
+from .derive_output import (
+    header,
+    json_header,
+    latex_align,
+    latex_notes,
+    lumped_json,
+    lumped_latex,
+    lumped_lines,
+)
 
 __all__ = ["product_text", "product_json", "product_json_text", "product_latex"]
 
@@ -125,7 +133,7 @@ def product_latex(dyn: Dynamics, lumped: bool = False) -> str:
     parts = [f"% {_EQUATION}  (needs \\usepackage{{amsmath}})"]
     atoms = [f"{nt.names[s]} &= {sp.latex(e, symbol_names=qnames)}" for s, e in pf.atoms]
     parts.append("\\begin{align*}\n" + " \\\\\n".join(atoms) + "\n\\end{align*}")
-    parts += [f"% note: {note}" for note in (lc.notes() if lc is not None else [])] + definitions
+    parts += latex_notes(lc) + definitions
     if pf.shared:
         parts.append(rows([(nt.names[s], e) for s, e in pf.shared]))
     for name, items in pf.entries.items():

@@ -1,6 +1,7 @@
 """The generated frame functions (docs/generated-code.md): kinematics and operational space.
 
-For each chosen frame F (`FrameChoice`), with F's name made an identifier ID (`identifier`):
+For each chosen frame F (`FrameChoice`), with F's name made an identifier ID valid in every
+target (`frame_identifiers`: symdyn.model.names.identifiers, distinct, never `com`):
 
     ID_pose(q, p, T)                            T = world_T_F, 4 x 4
     ID_jacobian(q, p, J)                        6 x n, world-aligned at F's origin
@@ -26,7 +27,6 @@ end_effector), each once.
 
 from __future__ import annotations
 
-import re
 import warnings
 from collections.abc import Sequence
 
@@ -38,6 +38,7 @@ from ..algorithms.operational_space import operational_space, task_rows
 from ..dynamics import Dynamics
 from ..errors import SymdynError, SymdynWarning
 from ..model.free_flyer import NQ_BASE, NV_BASE
+from ..model.names import comment_text, identifier, identifiers
 from ..model.robot import Robot
 from .centroidal_functions import centroidal_of, com_row, floating_inputs
 from .function_rows import FrameChoice, FunctionRow, Inputs, Output, with_steps
@@ -46,6 +47,7 @@ __all__ = [
     "FrameChoice",
     "choose_frames",
     "identifier",
+    "frame_identifiers",
     "comment_text",
     "default_frames",
     "kinematics_rows",
@@ -75,18 +77,11 @@ def frame_function_names(frames: tuple[tuple[str, str, str], ...]) -> set[str]:
     return {f"{ident}_{s}" for _, ident, _ in frames for s in FRAME_SUFFIXES} | set(COM_FUNCTIONS)
 
 
-def identifier(name: str) -> str:
-    """A frame name as a C identifier: characters outside [A-Za-z0-9_] become `_`, and a name
-    that then starts with a digit gets a leading `_` (so that it names a Python function too)."""
-    ident = re.sub(r"[^A-Za-z0-9_]", "_", name)
-    return "_" + ident if ident[:1].isdigit() or not ident else ident
-
-
-def comment_text(name: str) -> str:
-    """A name safe inside any target's comments and docstrings: every character but letters,
-    digits, spaces and ``_.:+()#@=,;<>[]|~!?^&/-`` becomes `?` (no newline, `*/`, `%`, quote or
-    backslash survives)."""
-    return re.sub(r"[^A-Za-z0-9_ .:+()#@=,;<>\[\]|~!?^&/-]", "?", name)
+def frame_identifiers(names: Sequence[str]) -> dict[str, str]:
+    """{frame: identifier} of the chosen frames: distinct identifiers valid in every target
+    (symdyn.model.names.identifiers), none of them `com`, whose functions would be the centre
+    of mass's."""
+    return identifiers(names, reserved=("com",))
 
 
 def default_frames(robot: Robot) -> list[str]:
@@ -105,9 +100,10 @@ def choose_frames(robot: Robot, frames: Sequence[str] | str | None = None, task_
     """The FrameChoice of `frames` (names, or "F1,F2"; None: the default frames) and `task_axes`
     ("x,y,z", names of TASK_AXES, or None: all six).
 
+    Each frame's identifier is frame_identifiers': two frames never share one.
+
     Raises:
-        SymdynError: an unknown frame (naming the near matches), no frame, two frames with one
-            identifier, a frame whose identifier is `com`, or an unknown task axis.
+        SymdynError: an unknown frame (naming the near matches), no frame, or an unknown task axis.
     """
     rows = task_rows(task_axes, "--task-axes")
     if isinstance(frames, str):
@@ -115,22 +111,9 @@ def choose_frames(robot: Robot, frames: Sequence[str] | str | None = None, task_
     names = list(dict.fromkeys(default_frames(robot) if frames is None else frames))
     if not names:
         raise SymdynError(f"--frames: robot '{robot.name}': no frame given")
-    table, seen = [], {}
-    for name in names:
-        link = robot.frame(name, "--frames").link
-        ident = identifier(name)
-        if ident in seen:
-            raise SymdynError(
-                f"--frames: robot '{robot.name}': frames {seen[ident]!r} and {name!r} both become the "
-                f"identifier '{ident}' in generated code; choose one of them"
-            )
-        if ident == "com":
-            raise SymdynError(
-                f"--frames: robot '{robot.name}': frame {name!r} would become the identifier 'com', "
-                "whose functions are the centre of mass's; leave it out of --frames"
-            )
-        seen[ident] = name
-        table.append((name, ident, _link_text(robot, link)))
+    links = [robot.frame(name, "--frames").link for name in names]
+    idents = frame_identifiers(names)
+    table = [(name, idents[name], _link_text(robot, link)) for name, link in zip(names, links, strict=True)]
     return FrameChoice(tuple(table), rows)
 
 

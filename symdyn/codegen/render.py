@@ -16,6 +16,8 @@ import jinja2
 from .. import __version__
 from ..dynamics import Dynamics
 from ..errors import SymdynError
+from ..model.names import comment_text as name_text
+from ..model.names import short_name
 from ..model.robot import Robot
 from .functions import FunctionSpec
 
@@ -23,6 +25,7 @@ __all__ = [
     "RenderContext",
     "environment",
     "header_lines",
+    "renamed_lines",
     "comment_text",
     "GENERATED_MARKER",
     "PRECISIONS",
@@ -47,7 +50,9 @@ class RenderContext:
 
     @property
     def name(self) -> str:
-        return self.robot.name
+        """The robot's name as generated code and file names spell it: whole, or cut with a hash
+        when longer than symdyn.model.names.MAX_IDENTIFIER characters (`short_name`)."""
+        return short_name(self.robot.name)
 
     def function(self, name: str) -> FunctionSpec:
         return next(f for f in self.functions if f.name == name)
@@ -73,9 +78,20 @@ def comment_text(text: str) -> str:
     return "".join(out)
 
 
+def renamed_lines(ctx: RenderContext) -> list[str]:
+    """The names spelled differently in code than in the robot's file (none for most robots):
+    the robot's, cut when too long, and each frame's whose identifier differs from its name (as
+    symdyn.model.names.comment_text spells it: `?` for a character outside printable ASCII)."""
+    robot = ctx.robot.name
+    lines = [f"Robot '{robot}' is {ctx.name} in code and file names."] * (ctx.name != robot)
+    renamed = [(name, ident) for name, ident, _ in ctx.frames if ident != name]
+    return lines + [f"Frame '{name_text(name)}' is {ident} in function names." for name, ident in renamed]
+
+
 def header_lines(ctx: RenderContext) -> list[str]:
     """The header every generated text file starts with (without comment markers), every line
-    passed through comment_text."""
+    passed through comment_text; the names spelled differently in code follow the operation
+    counts (`renamed_lines`)."""
     source = Path(ctx.robot.source).name if ctx.robot.source else "(in-memory robot)"
     sha = ctx.robot.source_sha256 or "-"
     lines = [
@@ -92,7 +108,7 @@ def header_lines(ctx: RenderContext) -> list[str]:
             f"  {f.name:<{width}}  {o.total:5d} ops: {o.mul} mul, {o.add} add, {o.div} div, "
             f"{o.trig} trig, {o.other} other"
         )
-    return [comment_text(line) for line in lines + list(ctx.notes)]
+    return [comment_text(line) for line in lines + renamed_lines(ctx) + list(ctx.notes)]
 
 
 def _template_root() -> Path:

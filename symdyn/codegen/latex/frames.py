@@ -8,23 +8,13 @@ joint symbols and the free parameters under their names.
 
 from __future__ import annotations
 
-import re
-
 import sympy as sp
 
-from ..frame_functions import comment_text, frame_function_names
+from ...model.names import comment_text, latex_text
+from ..frame_functions import frame_function_names
 from ..render import RenderContext, environment
 
-__all__ = ["frames_latex", "function_blocks", "tex_text"]
-
-
-def _tex(text: str) -> str:
-    """Text for LaTeX's text mode: a comment-safe name (comment_text) with `^`, `~` as `?`, and
-    `_ # & { } $` escaped."""
-    return re.sub(r"([_#%&{}$])", r"\\\1", re.sub(r"[\^~\\]", "?", comment_text(text)))
-
-
-tex_text = _tex
+__all__ = ["frames_latex", "function_blocks"]
 
 
 def frames_latex(ctx: RenderContext) -> str:
@@ -34,7 +24,7 @@ def frames_latex(ctx: RenderContext) -> str:
     if not names:
         return ""
     blocks = function_blocks(ctx, names)
-    frames = [(_tex(n), _tex(i), comment_text(link)) for n, i, link in ctx.frames]
+    frames = [(latex_text(n), latex_text(i), latex_text(link)) for n, i, link in ctx.frames]
     return environment().get_template("latex/frames.tex.j2").render(blocks=blocks, frames=frames)
 
 
@@ -52,10 +42,10 @@ def function_blocks(ctx: RenderContext, names: list[str]) -> list[dict]:
         local.update({s: f"x_{{{k + 1}}}" for k, (s, _) in enumerate(spec.temporaries)})
         rows = [f"{local[s]} &= {sp.latex(e, symbol_names=local)}" for s, e in spec.temporaries]
         for r in spec.results:
-            label = _tex(r.name)
+            label = latex_text(r.name)
             for k, e in enumerate(spec.entries(r)):
                 i, j = divmod(k, r.cols)
                 index = f"{i + 1},{j + 1}" if r.matrix else f"{i + 1}"
                 rows.append(f"{label}_{{{index}}} &= {sp.latex(sp.sympify(e), symbol_names=local)}")
-        blocks.append({"name": _tex(name), "doc": comment_text(spec.doc), "rows": rows})
+        blocks.append({"name": latex_text(name), "doc": comment_text(spec.doc), "rows": rows})
     return blocks

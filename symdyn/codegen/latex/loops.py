@@ -5,9 +5,10 @@ the projection of the dynamics (Khalil and Dombre (2002), ch. 14)."""
 
 from __future__ import annotations
 
+from ...model.names import latex_text
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment
-from .frames import function_blocks, tex_text
+from .frames import function_blocks
 
 __all__ = ["loops_latex"]
 
@@ -20,9 +21,9 @@ def loops_latex(ctx: RenderContext) -> str:
     robot = ctx.robot
     loops = [
         (
-            tex_text(lp.name),
-            tex_text(robot.links[lp.link].name),
-            "the base" if lp.to < 0 else tex_text(robot.links[lp.to].name),
+            latex_text(lp.name),
+            latex_text(robot.links[lp.link].name),
+            "the base" if lp.to < 0 else latex_text(robot.links[lp.to].name),
             lp.type,
         )
         for lp in robot.loops

@@ -21,10 +21,11 @@ import sympy as sp
 from sympy.printing.latex import LatexPrinter
 
 from ...dynamics import Dynamics
+from ...model.names import latex_text
 from ...symbolic.simplify import chop_float_noise
 from ..printing import step_comparison
 
-__all__ = ["DynamicsLatexPrinter", "Notation", "escape_text", "width", "LINE_WIDTH", "MATRIX_WIDTH"]
+__all__ = ["DynamicsLatexPrinter", "Notation", "width", "LINE_WIDTH", "MATRIX_WIDTH"]
 
 #: Estimated visible width (characters) of one displayed line and of a bmatrix row.
 LINE_WIDTH = 56
@@ -32,10 +33,6 @@ MATRIX_WIDTH = 60
 
 # LaTeX spellings reserved for the notation; a parameter printing like one is spelled out.
 _RESERVED_LATEX = re.compile(r"(q|s|c|x|\\tau)(_\{.*\})?\Z|\\dot|\\ddot")
-
-
-def escape_text(s: str) -> str:
-    return s.replace("_", r"\_")
 
 
 class DynamicsLatexPrinter(LatexPrinter):
@@ -108,7 +105,7 @@ class Notation:
         for s in dyn.params:
             tex = plain.doprint(s)
             if _RESERVED_LATEX.match(tex):
-                tex = f"\\mathrm{{{escape_text(s.name)}}}"
+                tex = f"\\mathrm{{{latex_text(s.name)}}}"
             names[s] = tex
         self.params = [names[s] for s in dyn.params]
         self.names = names

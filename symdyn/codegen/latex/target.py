@@ -30,12 +30,13 @@ import sympy as sp
 
 from ...algorithms.configuration_space import pair_columns
 from ...dynamics import AUTO_SIMPLIFY_MAX_JOINTS, Dynamics
+from ...model.names import comment_text, latex_text
 from ...symbolic.simplify import eliminate
 from ..render import RenderContext, environment, header_lines
 from .base_parameters import base_parameters_latex
 from .frames import frames_latex
 from .loops import loops_latex
-from .notation import MATRIX_WIDTH, Notation, escape_text, width
+from .notation import MATRIX_WIDTH, Notation, width
 from .product import product_blocks, product_choice
 
 __all__ = ["render", "latex_document_body", "dynamics_latex", "file_name", "AMSMATH_NOTE", "TOOLS"]
@@ -150,8 +151,8 @@ def latex_document_body(dyn: Dynamics, form: str = "auto") -> str:
         environment()
         .get_template("latex/body.tex.j2")
         .render(
-            name=robot.name,
-            tex_name=escape_text(robot.name),
+            name=comment_text(robot.name),
+            tex_name=latex_text(robot.name),
             n=n,
             joints=[str(i) for i in range(1, n + 1)] if n <= 3 else ["1", "\\dots", str(n)],
             method=dyn.method,

@@ -56,6 +56,14 @@ class MatlabNames:
     locals: dict[sp.Symbol, str]  # input symbol -> local variable name
 
 
+def _frame_hint(ctx: RenderContext, function: str) -> str:
+    """The end of the message when `function` is one of frame F's functions: shorten F's name."""
+    for name, ident, _ in ctx.frames:
+        if function.startswith(f"{ctx.name}_{ident}_"):
+            return f" or frame {name!r}'s (or leave out --target matlab)"
+    return ""
+
+
 def matlab_names(ctx: RenderContext) -> MatlabNames:
     """Function and local names for one robot (deterministic, collision-free).
 
@@ -74,7 +82,7 @@ def matlab_names(ctx: RenderContext) -> MatlabNames:
     if len(longest) > NAME_LENGTH_MAX:
         raise SymdynError(
             f"robot '{name}': the MATLAB function name '{longest}' is longer than {NAME_LENGTH_MAX} "
-            "characters (namelengthmax); shorten the robot name"
+            f"characters (namelengthmax); shorten the robot's name{_frame_hint(ctx, longest)}"
         )
     arguments = {r.name for f in ctx.functions for r in f.results} | {
         i.name for f in ctx.functions for i in f.inputs
