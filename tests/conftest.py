@@ -7,6 +7,8 @@
   vector bodies double a library's compile time). tests/test_batch.py compiles and checks the
   vector path, and symdyn.compile's default -march=native, itself. A SYMDYN_MARCH set by the
   caller is kept.
+- Progress reports are off (SYMDYN_QUIET=1, symdyn.progress), in this process and the commands it
+  starts.
 - Under CI (the environment variable CI set to true, as .ci/run is run), a skipped test is a
   failure: CI installs every tool the tests use (a C compiler, pdflatex, the test extra), so a
   skip there would only hide a missing install step. Locally, tests of absent tools still skip.
@@ -25,6 +27,10 @@ if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
+# no progress reports (symdyn.progress): a command that runs for a second would add lines to the
+# standard error the tests compare; tests/test_progress.py turns them on where it tests them, and
+# the commands of the pages run (tests/test_docs.py) inherit the variable
+os.environ["SYMDYN_QUIET"] = "1"
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -18,11 +18,13 @@ def load_robot_argument(args: argparse.Namespace):
     """A robot from a robot file, an MJCF file, or a URDF file with --base/--tip (a xacro file with
     --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.loading), whatever
     its name."""
+    from .. import progress
     from ..errors import SymdynError
     from ..parsers import load
 
     floating = getattr(args, "floating", False)
-    robot = load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
+    with progress.stage(f"loading {args.robot}"):
+        robot = load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
     command = getattr(args, "command", None)
     if robot.floating and command not in FLOATING_COMMANDS:
         raise SymdynError(
@@ -79,4 +81,10 @@ def add_robot_argument(parser: argparse.ArgumentParser) -> None:
         metavar="NAME=DIR",
         help="xacro: the folder of package NAME, for $(find NAME) and package://NAME (repeatable; "
         "else ROS_PACKAGE_PATH)",
+    )
+    parser.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress reports on stderr (a command that runs for a second or more reports its "
+        "stages and their time)",
     )

@@ -13,7 +13,7 @@ import sys
 import warnings
 from collections.abc import Callable, Sequence
 
-from .. import __version__
+from .. import __version__, progress
 from ..errors import SymdynError, SymdynWarning
 from .apps import COMMANDS as APPLICATIONS
 from .common import METHODS, add_robot_argument, load_robot_argument
@@ -24,6 +24,8 @@ __all__ = ["main", "build_parser", "COMMANDS"]
 EXIT_BAD_INPUT = 1
 EXIT_INTERNAL = 3
 PRINTED = ("M", "C", "V", "G", "F")
+#: generate notes the size of its C, and how long a build takes, from this many bytes
+BIG_C = 200_000
 
 
 def _entry_name(name: str, shape: tuple[int, int], k: int) -> str:
@@ -98,7 +100,8 @@ def cmd_derive(args: argparse.Namespace) -> int:
     robot = load_robot_argument(args)
     loops = loop_report(robot)  # generate's check of the loops, before any derivation
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
-    dyn = derive(robot, method=args.method, simplify=simplify)
+    with progress.stage(f"deriving '{robot.name}' ({robot.n} joints, {args.method})"):
+        dyn = derive(robot, method=args.method, simplify=simplify)
     frames = out.frame_names(dyn, args.frames)
     if robot.floating:  # trigonometric polynomials in the joint angles: not with a quaternion
         if args.form not in (None, "compact") or args.lumped or args.prune is not None:
@@ -109,7 +112,9 @@ def cmd_derive(args: argparse.Namespace) -> int:
         args.form = "compact"
     if args.form is None:
         args.form = "configuration"
-        if not dyn.configuration_space.readable:
+        with progress.stage("the configuration-space form (M, Christoffel symbols, G)"):
+            readable = dyn.configuration_space.readable
+        if not readable:
             args.form = "compact"
             print(
                 f"symdyn: note: the configuration-space form of '{robot.name}' has "
@@ -117,34 +122,42 @@ def cmd_derive(args: argparse.Namespace) -> int:
                 "--form compact (ask for --form configuration to print it all the same)",
                 file=sys.stderr,
             )
-    if args.form == "product":
-        from . import derive_product as prod
-
-        if args.prune is not None:
-            raise SymdynError("derive: --prune applies to --form configuration, not --form product")
-        writer = {"text": prod.product_text, "json": prod.product_json_text, "latex": prod.product_latex}
-        text = writer[args.format](dyn, lumped=args.lumped)
-    elif args.format == "latex":
-        configuration = args.form == "configuration"
-        text = out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
-    elif args.prune is not None:
-        from ..algorithms.pruning import prune_robot
-
-        if args.format != "text" or args.form != "configuration":
-            raise SymdynError("derive: --prune prints the configuration form as text only")
-        pruned = prune_robot(dyn.configuration_space, robot, args.prune)
-        text = out.derive_text(dyn, args.form, args.lumped, pruned)
-    else:
-        text = {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
+    with progress.stage(f"the {args.form} form as {args.format}"):
+        text = _derive_output(args, dyn, robot)
     text = with_loops(loops, text, args.format)
     if frames and args.format == "json":
         doc = json.loads(text)
         doc["frames"] = out.frames_json(dyn, frames)
         text = json.dumps(doc, indent=2) + "\n"
     elif frames:
-        text += (out.frames_latex if args.format == "latex" else out.frames_text)(dyn, frames)
+        with progress.stage(f"the frames {', '.join(frames)}"):
+            text += (out.frames_latex if args.format == "latex" else out.frames_text)(dyn, frames)
     sys.stdout.write(text)
     return 0
+
+
+def _derive_output(args: argparse.Namespace, dyn, robot) -> str:
+    """The text of `symdyn derive` in the form and format asked for."""
+    from . import derive_output as out
+
+    if args.form == "product":
+        from . import derive_product as prod
+
+        if args.prune is not None:
+            raise SymdynError("derive: --prune applies to --form configuration, not --form product")
+        writer = {"text": prod.product_text, "json": prod.product_json_text, "latex": prod.product_latex}
+        return writer[args.format](dyn, lumped=args.lumped)
+    if args.format == "latex":
+        configuration = args.form == "configuration"
+        return out.derive_latex_configuration(dyn, args.lumped) if configuration else _derive_latex(dyn)
+    if args.prune is not None:
+        from ..algorithms.pruning import prune_robot
+
+        if args.format != "text" or args.form != "configuration":
+            raise SymdynError("derive: --prune prints the configuration form as text only")
+        pruned = prune_robot(dyn.configuration_space, robot, args.prune)
+        return out.derive_text(dyn, args.form, args.lumped, pruned)
+    return {"text": out.derive_text, "json": out.derive_json}[args.format](dyn, args.form, args.lumped)
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
@@ -166,6 +179,16 @@ def cmd_generate(args: argparse.Namespace) -> int:
     )
     for p in paths:
         print(p)
+    c_files = [p for p in paths if p.suffix == ".c"]
+    size = sum(p.stat().st_size for p in c_files if p.is_file())
+    if size >= BIG_C:
+        from ..apps.build import compile_estimate
+
+        progress.note(
+            f"{size / 1000:.0f} KB of C in {len(c_files)} file{'s' * (len(c_files) != 1)}: a build takes "
+            f"{compile_estimate(size)} (more on a smaller or busy machine; each .c file compiles on "
+            "its own core)"
+        )
     return 0
 
 
@@ -319,11 +342,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `symdyn` command; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(_named_command(argv)).parse_args(argv)
+    progress.restart()
+    progress.quiet(bool(getattr(args, "quiet", False)))
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         warnings.showwarning = _show_warning
         try:
-            return args.func(args)
+            status = args.func(args)
+            progress.finish()
+            return status
         except SymdynError as exc:
             print(f"symdyn: error: {_one_line(exc)}", file=sys.stderr)
             return EXIT_BAD_INPUT

@@ -19,6 +19,7 @@ import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
+from .. import progress
 from ..dynamics import SINGULAR_M, derive
 from ..errors import SymdynError, SymdynWarning
 from ..model.expressions import is_c_identifier
@@ -97,7 +98,10 @@ def context(
             "--frames and --task-axes choose the frames of the kinematics and operational_space "
             "function groups: name them in --functions"
         )
-    with warnings.catch_warnings():  # build_functions says it again, with the functions left out
+    with (
+        warnings.catch_warnings(),  # build_functions says it again, with the functions left out
+        progress.stage(f"deriving '{robot.name}' ({robot.n} joints, {method})"),
+    ):
         warnings.filterwarnings("ignore", f"robot '.*': {re.escape(SINGULAR_M)}", SymdynWarning)
         dyn = derive(robot, method=method, simplify=False)
     notes: tuple[str, ...] = ()
@@ -138,8 +142,9 @@ def render(
     modules = [_target_module(t) for t in dict.fromkeys(targets)]
     ctx = context(robot, precision, method, prune, functions, frames, task_axes)
     files: dict[str, str | bytes] = {}
-    for module in modules:
-        files.update(module.render(ctx))
+    for target, module in zip(dict.fromkeys(targets), modules, strict=True):
+        with progress.stage(f"rendering {target} ({len(ctx.functions)} functions)"):
+            files.update(module.render(ctx))
     return files
 
 

@@ -42,6 +42,7 @@ from collections.abc import Callable, Sequence
 
 import sympy as sp
 
+from .. import progress
 from ..dynamics import QUANTITIES, Dynamics, singular_message
 from ..errors import SymdynWarning
 from ..symbolic.program import Program
@@ -310,20 +311,31 @@ def build_functions(
     x = Inputs.of(dyn, frames)
     families = [family for family in FAMILIES if family in chosen]
     _warn_singular(dyn, families)
-    rows = [row for family in families for row in family(dyn, x)]
+    rows = []
+    with progress.stage("building the functions", total=len(families), unit="family") as advance:
+        for family in families:
+            rows += family(dyn, x)
+            advance()
     shared = [row for row in rows if row.name in SHARED_FUNCTIONS]
     rows = [row for row in rows if row.name not in SHARED_FUNCTIONS or row is _first(shared, row.name)]
     names = [row.name for row in rows]
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
     code = {}
-    for group in dict.fromkeys(row.cse for row in rows):
-        members = [row for row in rows if row.cse == group]
-        needs = [e for row in members for e in row.exprs] + [e for row in members for _, e in row.steps]
-        if not group:
-            needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
-        steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
-        visits = {row.name: row.visit for row in members if row.visit is not None}
-        leads = {row.name: row.lead for row in members if row.lead}
-        groups = {row.name: list(row.exprs) for row in members}
-        code |= eliminate_many(steps, groups, reserved=x.symbols, visits=visits, leads=leads)
+    passes = list(dict.fromkeys(row.cse for row in rows))
+    with progress.stage("common subexpressions", total=len(passes), unit="pass") as advance:
+        for group in passes:
+            code |= _eliminate(dyn, x, [row for row in rows if row.cse == group], group)
+            advance()
     return [FunctionSpec(row.name, row.doc, row.inputs, row.results, code[row.name]) for row in rows]
+
+
+def _eliminate(dyn: Dynamics, x, members: list, group) -> dict:
+    """One CSE pass over the rows `members` (of cse group `group`: '' is the shared pass)."""
+    needs = [e for row in members for e in row.exprs] + [e for row in members for _, e in row.steps]
+    if not group:
+        needs += [e for name in QUANTITIES for e in dyn.compact[name]] + list(dyn.compact["bias"])
+    steps = dyn.program.needed(needs) + [s for row in members for s in row.steps]
+    visits = {row.name: row.visit for row in members if row.visit is not None}
+    leads = {row.name: row.lead for row in members if row.lead}
+    groups = {row.name: list(row.exprs) for row in members}
+    return eliminate_many(steps, groups, reserved=x.symbols, visits=visits, leads=leads)
