@@ -207,3 +207,26 @@ def test_frames_do_not_combine_with_steps(capsys, tmp_path):
     assert main(["derive", str(path), "--frames", "tool", "--steps"]) == 1
     out, err = capsys.readouterr()
     assert out == "" and "--frames" in err and "--steps" in err
+
+
+HOSTILE_LINK = "a&#10;M[1] = 0&#10;#"
+
+
+def test_a_name_with_newlines_stays_inside_its_comment_and_label(tmp_path, capsys):
+    """A URDF link (and so frame) whose name holds newlines and an entry's text: derive's text
+    output keeps every line of its own shape (a comment, a blank, or LABEL[i,j] = expr), and the
+    robot's M[1,1] is the one line that says M[1,1] (the pendulum's m l^2 + Izz = 1*0.25 + 0.1)."""
+    urdf = tmp_path / "hostile.urdf"
+    urdf.write_text(
+        f"""<robot name="arm"><link name="base"/>
+<link name="{HOSTILE_LINK}"><inertial><mass value="1"/><origin xyz="0.5 0 0"/>
+<inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="j1" type="revolute"><parent link="base"/><child link="{HOSTILE_LINK}"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"""
+    )
+    assert main(["derive", str(urdf), "--frames", "a\nM[1] = 0\n#"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    shape = re.compile(r"#.*|\w+(\[[\d,() ]+\])? = .+|")
+    assert all(shape.fullmatch(line) for line in lines), [x for x in lines if not shape.fullmatch(x)]
+    assert [line for line in lines if line.startswith("M[1")] == ["M[1,1] = 0.35"]
+    assert "T_a_M_1_0[1,1] = cos(q1)" in lines

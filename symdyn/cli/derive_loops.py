@@ -34,6 +34,7 @@ import sympy as sp
 from ..algorithms.closed_loops import check_loops, closure, geometry_parameters, loop_rows_text
 from ..algorithms.frame_kinematics import FrameKinematics
 from ..dynamics import state_symbols
+from ..model.names import comment_text
 from ..model.robot import Robot
 from ..symbolic.program import Program
 from ..symbolic.trig_polynomial import TrigRing, chop
@@ -63,18 +64,21 @@ _CLOSURE = (
 
 @dataclass(frozen=True)
 class LoopReport:
-    """The header lines (without comment marks), and the kept closure rows: their names, phi(q)
-    and K(q) as canonical closed forms over the joint coordinates q, in SymPy's syntax."""
+    """The header lines (without comment marks; the robot's names in them spelled by
+    symdyn.model.names.comment_text, so each stays one line), and the kept closure rows: their
+    names, phi(q) and K(q) as canonical closed forms over the joint coordinates q, in SymPy's
+    syntax, and the same as expressions (`exprs`: phi's entries, then K's row by row)."""
 
     header: tuple[str, ...]
     rows: tuple[str, ...]
     phi: tuple[str, ...]
     K: tuple[tuple[str, ...], ...]
+    exprs: tuple[sp.Expr, ...]
 
 
 def _joints(robot: Robot, coords) -> str:
     own = [link.name for link in robot.links if link.mimic is None]
-    return ", ".join(f"q{j + 1} ({own[j]})" for j in coords)
+    return ", ".join(f"q{j + 1} ({comment_text(own[j])})" for j in coords)
 
 
 def loop_report(robot: Robot) -> LoopReport | None:
@@ -96,13 +100,15 @@ def loop_report(robot: Robot) -> LoopReport | None:
     kept = [phi_all[i] for i in kept_rows] + [e for i in kept_rows for e in K_all[i]]
     ring = TrigRing(q)
     printer = TrigText(ring)
-    flat = [printer.text(chop(ring.convert(e))) or "0" for e in program.expand(kept)]
+    polys = [chop(ring.convert(e)) for e in program.expand(kept)]
+    flat = [printer.text(p) or "0" for p in polys]
     m = len(kept_rows)
     phi, K = flat[:m], flat[m:]
-    rows = loop_rows_text(r, kept_rows)
+    rows = [comment_text(row) for row in loop_rows_text(r, kept_rows)]
     dropped = [i for i in range(len(phi_all)) if i not in kept_rows]
-    note = f" ({', '.join(loop_rows_text(r, dropped))} dropped: dependent on the others)" if dropped else ""
-    loops = ", ".join(f"{lp.name} ({lp.type})" for lp in r.loops)
+    dropped_rows = comment_text(", ".join(loop_rows_text(r, dropped)))
+    note = f" ({dropped_rows} dropped: dependent on the others)" if dropped else ""
+    loops = ", ".join(f"{comment_text(lp.name)} ({lp.type})" for lp in r.loops)
     if an is None:
         analysis = (
             f"closure phi(q) = 0: rows {', '.join(rows)}, not checked: whether the loops close, "
@@ -123,7 +129,8 @@ def loop_report(robot: Robot) -> LoopReport | None:
         _WHY,
     )
     n = len(q)
-    return LoopReport(header, tuple(rows), tuple(phi), tuple(tuple(K[i * n : (i + 1) * n]) for i in range(m)))
+    K_rows = tuple(tuple(K[i * n : (i + 1) * n]) for i in range(m))
+    return LoopReport(header, tuple(rows), tuple(phi), K_rows, tuple(ring.to_sympy(p) for p in polys))
 
 
 def _text(report: LoopReport, text: str) -> str:
@@ -141,9 +148,10 @@ def _text(report: LoopReport, text: str) -> str:
 
 def _latex(report: LoopReport, text: str) -> str:
     lines = [f"% {h}" for h in report.header] + [text.rstrip("\n"), "", "\\begin{align*}"]
-    entries = [f"\\phi_{{{i + 1}}} &= {sp.latex(sp.sympify(e))}" for i, e in enumerate(report.phi)]
+    m, n = len(report.phi), len(report.K[0]) if report.K else 0
+    entries = [f"\\phi_{{{i + 1}}} &= {sp.latex(report.exprs[i])}" for i in range(m)]
     entries += [
-        f"K_{{{i + 1},{j + 1}}} &= {sp.latex(sp.sympify(e))}"
+        f"K_{{{i + 1},{j + 1}}} &= {sp.latex(report.exprs[m + i * n + j])}"
         for i, row in enumerate(report.K)
         for j, e in enumerate(row)
         if e != "0"

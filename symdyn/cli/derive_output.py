@@ -61,7 +61,7 @@ def floating_note(dyn: Dynamics) -> str:
 
 def header(dyn: Dynamics, equation: str) -> list[str]:
     return [
-        f"# {dyn.robot.name}: {dyn.robot.n} joints{floating_note(dyn)}, method {dyn.method}",
+        f"# {comment_text(dyn.robot.name)}: {dyn.robot.n} joints{floating_note(dyn)}, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
         + (", ".join(map(str, dyn.params)) or "none"),
         f"# {equation}",
@@ -387,22 +387,24 @@ def frame_names(dyn: Dynamics, text: str | None) -> list[str]:
 
 def _frame_link(dyn: Dynamics, name: str) -> str:
     k = dyn.robot.frame(name).link
-    return "the base" if k < 0 else f"link {k + 1} ({dyn.robot.links[k].name})"
+    return "the base" if k < 0 else f"link {k + 1} ({comment_text(dyn.robot.links[k].name)})"
 
 
 def frames_text(dyn: Dynamics, names: list[str]) -> str:
     """Each frame's pose world_T_F (T[i,j], 4 x 4) and world-aligned Jacobian (J[i,j], 6 x n,
-    rows v_x v_y v_z w_x w_y w_z), closed forms, one entry per line as M is printed."""
+    rows v_x v_y v_z w_x w_y w_z), closed forms, one entry per line as M is printed; a frame's
+    entries are labelled by its identifier (symdyn.model.names), its comment line names it."""
     lines = []
+    ids = identifiers(names)
     for name in names:
         lines += [
             "",
-            f"# frame {name} on {_frame_link(dyn, name)}: pose world_T_F, Jacobian J world-aligned at "
-            "F's origin (rows v_x v_y v_z w_x w_y w_z)",
+            f"# frame {comment_text(name)} on {_frame_link(dyn, name)}: pose world_T_F, Jacobian J "
+            "world-aligned at F's origin (rows v_x v_y v_z w_x w_y w_z)",
         ]
         for label, m in (("T", dyn.frame_pose(name)), ("J", dyn.frame_jacobian(name))):
             lines += [
-                f"{label}_{name}[{i + 1},{j + 1}] = {sp.sstr(m[i, j])}"
+                f"{label}_{ids[name]}[{i + 1},{j + 1}] = {sp.sstr(m[i, j])}"
                 for i in range(m.rows)
                 for j in range(m.cols)
             ]

@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 
 from .. import __version__, progress
 from ..errors import SymdynError, SymdynWarning
+from ..model.names import comment_text
 from .apps import COMMANDS as APPLICATIONS
 from .common import METHODS, add_robot_argument, load_robot_argument
 from .identification import COMMANDS as IDENTIFICATION
@@ -40,7 +41,7 @@ def _derive_text(dyn) -> str:
     from .derive_output import floating_note as _floating_note
 
     lines = [
-        f"# {dyn.robot.name}: {dyn.robot.n} joints{_floating_note(dyn)}, method {dyn.method}",
+        f"# {comment_text(dyn.robot.name)}: {dyn.robot.n} joints{_floating_note(dyn)}, method {dyn.method}",
         f"# joints: q = ({', '.join(map(str, dyn.q))}); free parameters: "
         + (", ".join(map(str, dyn.params)) or "none"),
         "# tau = M(q) qdd + V(q, qd) + G(q) + F(qd),  V = C(q, qd) qd",
