@@ -26,8 +26,8 @@ from collections.abc import Mapping, Sequence
 from functools import lru_cache
 from pathlib import Path
 
-from .. import progress
 from ..errors import SymdynError
+from ..progress import stage as progress_stage
 
 __all__ = [
     "COMPILE_FLAGS",
@@ -132,7 +132,7 @@ def compile_library(
     label = f"compiling {Path(target).name}: {size / 1000:.0f} KB of C in {count} files"
     label += f" ({compile_estimate(size)})"
     with (
-        progress.stage(label),
+        progress_stage(label),
         tempfile.TemporaryDirectory(prefix=f"{BUILD_PREFIX}{os.getpid()}-") as tmp,
     ):
         for name, text in sources.items():

@@ -18,12 +18,12 @@ def load_robot_argument(args: argparse.Namespace):
     """A robot from a robot file, an MJCF file, or a URDF file with --base/--tip (a xacro file with
     --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.loading), whatever
     its name."""
-    from .. import progress
     from ..errors import SymdynError
     from ..parsers import load
+    from ..progress import stage as progress_stage
 
     floating = getattr(args, "floating", False)
-    with progress.stage(f"loading {args.robot}"):
+    with progress_stage(f"loading {args.robot}"):
         robot = load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
     command = getattr(args, "command", None)
     if robot.floating and command not in FLOATING_COMMANDS:

@@ -13,9 +13,14 @@ import sys
 import warnings
 from collections.abc import Callable, Sequence
 
-from .. import __version__, progress
+from .. import __version__
 from ..errors import SymdynError, SymdynWarning
 from ..model.names import comment_text
+from ..progress import finish as progress_finish
+from ..progress import note as progress_note
+from ..progress import quiet as progress_quiet
+from ..progress import restart as progress_restart
+from ..progress import stage as progress_stage
 from .apps import COMMANDS as APPLICATIONS
 from .common import METHODS, add_robot_argument, load_robot_argument
 from .identification import COMMANDS as IDENTIFICATION
@@ -101,7 +106,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
     robot = load_robot_argument(args)
     loops = loop_report(robot)  # generate's check of the loops, before any derivation
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
-    with progress.stage(f"deriving '{robot.name}' ({robot.n} joints, {args.method})"):
+    with progress_stage(f"deriving '{robot.name}' ({robot.n} joints, {args.method})"):
         dyn = derive(robot, method=args.method, simplify=simplify)
     frames = out.frame_names(dyn, args.frames)
     if robot.floating:  # trigonometric polynomials in the joint angles: not with a quaternion
@@ -113,7 +118,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
         args.form = "compact"
     if args.form is None:
         args.form = "configuration"
-        with progress.stage("the configuration-space form (M, Christoffel symbols, G)"):
+        with progress_stage("the configuration-space form (M, Christoffel symbols, G)"):
             readable = dyn.configuration_space.readable
         if not readable:
             args.form = "compact"
@@ -123,7 +128,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
                 "--form compact (ask for --form configuration to print it all the same)",
                 file=sys.stderr,
             )
-    with progress.stage(f"the {args.form} form as {args.format}"):
+    with progress_stage(f"the {args.form} form as {args.format}"):
         text = _derive_output(args, dyn, robot)
     text = with_loops(loops, text, args.format)
     if frames and args.format == "json":
@@ -131,7 +136,7 @@ def cmd_derive(args: argparse.Namespace) -> int:
         doc["frames"] = out.frames_json(dyn, frames)
         text = json.dumps(doc, indent=2) + "\n"
     elif frames:
-        with progress.stage(f"the frames {', '.join(frames)}"):
+        with progress_stage(f"the frames {', '.join(frames)}"):
             text += (out.frames_latex if args.format == "latex" else out.frames_text)(dyn, frames)
     sys.stdout.write(text)
     return 0
@@ -185,7 +190,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     if size >= BIG_C:
         from ..apps.build import compile_estimate
 
-        progress.note(
+        progress_note(
             f"{size / 1000:.0f} KB of C in {len(c_files)} file{'s' * (len(c_files) != 1)}: a build takes "
             f"{compile_estimate(size)} (more on a smaller or busy machine; each .c file compiles on "
             "its own core)"
@@ -343,14 +348,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `symdyn` command; returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(_named_command(argv)).parse_args(argv)
-    progress.restart()
-    progress.quiet(bool(getattr(args, "quiet", False)))
+    progress_restart()
+    progress_quiet(bool(getattr(args, "quiet", False)))
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         warnings.showwarning = _show_warning
         try:
             status = args.func(args)
-            progress.finish()
+            progress_finish()
             return status
         except SymdynError as exc:
             print(f"symdyn: error: {_one_line(exc)}", file=sys.stderr)

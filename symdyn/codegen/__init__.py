@@ -19,11 +19,11 @@ import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
-from .. import progress
 from ..dynamics import SINGULAR_M, derive
 from ..errors import SymdynError, SymdynWarning
 from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
+from ..progress import stage as progress_stage
 from .destination import check_folder
 from .frame_functions import choose_frames
 from .functions import FRAME_GROUPS, FUNCTION_NAMES, GROUPS, build_functions
@@ -100,7 +100,7 @@ def context(
         )
     with (
         warnings.catch_warnings(),  # build_functions says it again, with the functions left out
-        progress.stage(f"deriving '{robot.name}' ({robot.n} joints, {method})"),
+        progress_stage(f"deriving '{robot.name}' ({robot.n} joints, {method})"),
     ):
         warnings.filterwarnings("ignore", f"robot '.*': {re.escape(SINGULAR_M)}", SymdynWarning)
         dyn = derive(robot, method=method, simplify=False)
@@ -143,7 +143,7 @@ def render(
     ctx = context(robot, precision, method, prune, functions, frames, task_axes)
     files: dict[str, str | bytes] = {}
     for target, module in zip(dict.fromkeys(targets), modules, strict=True):
-        with progress.stage(f"rendering {target} ({len(ctx.functions)} functions)"):
+        with progress_stage(f"rendering {target} ({len(ctx.functions)} functions)"):
             files.update(module.render(ctx))
     return files
 

@@ -42,9 +42,9 @@ from collections.abc import Callable, Sequence
 
 import sympy as sp
 
-from .. import progress
 from ..dynamics import QUANTITIES, Dynamics, singular_message
 from ..errors import SymdynWarning
+from ..progress import stage as progress_stage
 from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .centroidal_functions import centroidal_rows
@@ -312,7 +312,7 @@ def build_functions(
     families = [family for family in FAMILIES if family in chosen]
     _warn_singular(dyn, families)
     rows = []
-    with progress.stage("building the functions", total=len(families), unit="family") as advance:
+    with progress_stage("building the functions", total=len(families), unit="family") as advance:
         for family in families:
             rows += family(dyn, x)
             advance()
@@ -322,7 +322,7 @@ def build_functions(
     assert len(set(names)) == len(names), f"duplicate generated function names: {names}"
     code = {}
     passes = list(dict.fromkeys(row.cse for row in rows))
-    with progress.stage("common subexpressions", total=len(passes), unit="pass") as advance:
+    with progress_stage("common subexpressions", total=len(passes), unit="pass") as advance:
         for group in passes:
             code |= _eliminate(dyn, x, [row for row in rows if row.cse == group], group)
             advance()
