@@ -67,6 +67,7 @@ from .model.free_flyer import NQ_BASE, NV_BASE, base_symbols
 from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
+from .model.tendons import refuse_tendons
 from .symbolic.program import Program
 from .symbolic.simplify import chop_float_noise
 
@@ -294,6 +295,12 @@ class Dynamics:
         """The regressor Y (n x 13 nb) over the intermediates of `program`, tau = Y pi with pi the
         standard parameters (symdyn.standard_parameters; symdyn.algorithms.regressor)."""
         if "Y" not in self._linear:
+            refuse_tendons(
+                self.robot,
+                "the regressor (and the base parameters and identification built on it)",
+                "their terms are not linear in the inertial parameters; derive M, G, F and tau, "
+                "or identify the robot without them",
+            )
             self._linear["Y"] = regressor_matrix(self.robot, self.q, self.qd, self.qdd, self.program)
         return self._linear["Y"]  # type: ignore[return-value]
 
