@@ -23,8 +23,10 @@ walked, body by body (MuJoCo numbers a parent before its children):
 * gravity is <option gravity> (zero when the flag gravity is disabled; disabling the damper or
   frictionloss flags drops those terms too); a joint's range is the link's limits when the
   joint is limited;
-* a fixed tendon over one joint adds its armature, damping and frictionloss to that joint's
-  (symdyn.parsers.mjcf_tendons, which also says what is refused and warned about for others).
+* a fixed tendon over one joint adds its armature, damping and frictionloss to that joint's; a
+  fixed tendon over several joints, a tendon's spring and a joint's spring (stiffness about
+  springref) become `Robot.tendons` (symdyn.parsers.mjcf_tendons, which also says what is
+  refused and warned about).
 
 A free joint on a root body (a body whose parent is the world) makes the robot floating, always
 (MuJoCo simulates it so; floating=True asks for it and refuses a file without one): that body is
@@ -38,10 +40,10 @@ one; a floating model with joints outside the floating body's tree.
 Refused too: a negative armature, damping or frictionloss (as in a URDF), and a number written
 in the file that is not finite or a direction MuJoCo cannot normalise (symdyn.parsers.mjcf_attributes:
 MuJoCo reads nan as 0, which the compiled model no longer shows).
-Warned about and ignored: joint and tendon stiffness (springs), gravity compensation, equality
-constraints, the damping and frictionloss of tendons over several joints, spatial tendons'
-passive forces and fluid forces, which symdyn does not model. Every number is a compiled double
-(symdyn.parsers.mjcf_values: rotations snapped to exact multiples of pi/2 within 1e-9 rad).
+Warned about and ignored: gravity compensation, equality constraints, spatial tendons' passive
+forces, fluid forces, and tendons and springs on a floating base, which symdyn does not model.
+Every number is a compiled double (symdyn.parsers.mjcf_values: rotations snapped to exact
+multiples of pi/2 within 1e-9 rad).
 """
 
 from __future__ import annotations
