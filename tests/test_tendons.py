@@ -19,6 +19,7 @@ import symdyn
 from symdyn import SymdynError
 from symdyn.rnea import gravity_torque, mass_matrix, potential_energy
 from tests.robots import assert_close
+from tests.test_mjcf import _mujoco, _mujoco_dynamics, _two
 from tests.timebound import refused, within
 
 mujoco = pytest.importorskip("mujoco", reason="the test extra installs mujoco")
@@ -59,42 +60,11 @@ THREE = """<mujoco model="three">
 </mujoco>
 """
 
-#: the issue's two hinges, with TENDON in place of a <tendon> element
-TWO = """<mujoco model="two">
-  <worldbody>
-    <body name="a">
-      <joint name="j1" axis="0 1 0" damping="0.2" armature="0.1"/>
-      <geom size="0.05" pos="0.2 0 0" mass="1"/>
-      <body name="b" pos="0.4 0 0">
-        <joint name="j2" axis="0 1 0"/>
-        <geom size="0.05" pos="0.2 0.1 0" mass="0.5"/>
-      </body>
-    </body>
-  </worldbody>
-  TENDON
-</mujoco>
-"""
-
 
 def _file(tmp_path: Path, name: str, text: str) -> Path:
     path = tmp_path / f"{name}.xml"
     path.write_text(text)
     return path
-
-
-def _mujoco(path: Path):
-    model = mujoco.MjModel.from_xml_path(str(path))
-    model.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
-    return model, mujoco.MjData(model)
-
-
-def _mujoco_dynamics(model, data, q, qd, qdd) -> tuple[np.ndarray, np.ndarray]:
-    """(qfrc_inverse, M) of MuJoCo at one state."""
-    data.qpos[:], data.qvel[:], data.qacc[:] = q, qd, qdd
-    mujoco.mj_inverse(model, data)
-    M = np.zeros((model.nv, model.nv))
-    mujoco.mj_fullM(model, data, M)
-    return data.qfrc_inverse.copy(), M
 
 
 def _states(n: int, count: int = 4, seed: int = 3):
@@ -182,7 +152,7 @@ def test_the_issues_coupling_stiffness_and_damping_enter_tau(tmp_path):
         '<tendon><fixed name="t" stiffness="20" damping="3" springlength="0.1">'
         '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
     )
-    path = _file(tmp_path, "spring", TWO.replace("TENDON", tendon))
+    path = _two(tmp_path, "spring", tendon)
     robot = symdyn.load_mjcf(path)
     model, data = _mujoco(path)
     for q, qd, qdd in _states(robot.n):
@@ -197,12 +167,12 @@ def test_the_issues_coupling_armature_enters_m(tmp_path):
         '<tendon><fixed name="t" armature="0.5">'
         '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
     )
-    path = _file(tmp_path, "coupled", TWO.replace("TENDON", tendon))
+    path = _two(tmp_path, "coupled", tendon)
     robot = symdyn.load_mjcf(path)
     model, data = _mujoco(path)
     q = np.array([0.3, -0.4])
     M = _mujoco_dynamics(model, data, q, q, q)[1]
-    plain = _mujoco(_file(tmp_path, "plain", TWO.replace("TENDON", "")))
+    plain = _mujoco(_two(tmp_path, "plain"))
     assert M[0, 1] - _mujoco_dynamics(*plain, q, q, q)[1][0, 1] == pytest.approx(-0.5, abs=1e-12)
     assert_close(mass_matrix(robot, q), M, TOL, "M")
     assert_close(symdyn.derive(robot).evaluate("M", q), M, TOL, "M")
@@ -213,7 +183,7 @@ def test_a_dead_band_spring_is_refused(capsys, tmp_path):
         '<tendon><fixed name="t" stiffness="20" springlength="0.1 0.3">'
         '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
     )
-    path = _file(tmp_path, "band", TWO.replace("TENDON", tendon))
+    path = _two(tmp_path, "band", tendon)
     line = refused(capsys, "derive", path)
     assert line.startswith(
         f"symdyn: error: {path}: field 'tendon(t).springlength': fixed tendon 't' has a spring with a "
