@@ -59,6 +59,7 @@ from .algorithms.operational_space import operational_space, task_rows
 from .algorithms.product_form import ProductForm, product_form
 from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.singular import SingularJoint, describe_singular, singular_joints
+from .algorithms.tendons import tendon_terms
 from .algorithms.tip_wrench import tip_wrench_torque
 from .errors import SymdynError, SymdynWarning
 from .model.free_flyer import NQ_BASE, NV_BASE, base_symbols
@@ -66,6 +67,7 @@ from .model.names import latex_text
 from .model.parameters import standard_parameters
 from .model.robot import Robot
 from .model.symbols import joint_symbols
+from .model.tendons import refuse_tendons
 from .symbolic.program import Program
 from .symbolic.simplify import chop_float_noise
 
@@ -293,6 +295,12 @@ class Dynamics:
         """The regressor Y (n x 13 nb) over the intermediates of `program`, tau = Y pi with pi the
         standard parameters (symdyn.standard_parameters; symdyn.algorithms.regressor)."""
         if "Y" not in self._linear:
+            refuse_tendons(
+                self.robot,
+                "the regressor (and the base parameters and identification built on it)",
+                "their terms are not linear in the inertial parameters; derive M, G, F and tau, "
+                "or identify the robot without them",
+            )
             self._linear["Y"] = regressor_matrix(self.robot, self.q, self.qd, self.qdd, self.program)
         return self._linear["Y"]  # type: ignore[return-value]
 
@@ -672,6 +680,12 @@ def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = N
         F = friction_vector(r, qd[6:, :] if r.floating else qd)
         if r.floating:
             F = sp.Matrix([*[sp.S.Zero] * 6, *F])  # (a list: F of no joints is 0 x 0)
+        if r.tendons:  # fixed tendons and joint springs, for both routes (symdyn.algorithms.tendons)
+            extra = tendon_terms(r, q, qd)
+            terms["M"], terms["G"], F = terms["M"] + extra.M, terms["G"] + extra.G, F + extra.F
+            if method == "newton-euler":
+                terms["tau"] = terms["tau"] + extra.M * qdd + extra.G
+                terms["bias"] = terms["bias"] + extra.G
         terms["F"] = F
         if method == "lagrange" and not r.floating:
             terms["tau"] = terms["M"] * qdd + terms["V"] + terms["G"] + F

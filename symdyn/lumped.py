@@ -48,6 +48,7 @@ from .dynamics import Dynamics, derive
 from .errors import SymdynError
 from .model.parameters import PER_BODY, standard_parameters
 from .model.robot import Friction, Motor, Robot
+from .model.tendons import refuse_tendons
 from .symbolic.lumping import Lumper, split_sign
 from .symbolic.trig_polynomial import TrigRing, scale, to_sympy_number
 
@@ -275,6 +276,11 @@ def lumped_constants(dyn: Dynamics, cs: ConfigurationSpace | None = None) -> Lum
     given as met), then `lc.definitions()`, `lc.base_definitions()` and
     `lc.standard_definitions()`.
     """
+    refuse_tendons(
+        dyn.robot,
+        "derive --lumped",
+        "their springs are not trigonometric polynomials; derive without --lumped",
+    )
     cs = cs or dyn.configuration_space
     q = list(dyn.q)
     names, values = standard_parameters(dyn.robot)

@@ -205,12 +205,12 @@ def test_bad_files_are_one_line_errors(capsys, name, message):
 
 
 def test_ignored_forces_are_warned_about(tmp_path):
-    path = tmp_path / "spring.xml"
+    path = tmp_path / "gravcomp.xml"
     path.write_text(
-        '<mujoco><worldbody><body name="b"><joint name="j" stiffness="3"/>'
+        '<mujoco><worldbody><body name="b" gravcomp="1"><joint name="j"/>'
         '<geom size="0.1" pos="0.1 0 0"/></body></worldbody></mujoco>'
     )
-    with pytest.warns(symdyn.SymdynWarning, match="the stiffness .spring. of joint 'j' is ignored"):
+    with pytest.warns(symdyn.SymdynWarning, match="the gravity compensation of body 'b' is ignored"):
         symdyn.load_mjcf(path)
 
 
@@ -482,51 +482,7 @@ def test_a_fixed_tendon_over_one_joint_is_folded_into_it(tmp_path):
         assert_close(mass_matrix(robot, q), M, TOL, "M")
 
 
-def test_a_coupling_tendons_armature_is_refused(capsys, tmp_path):
-    """The issue's tendon armature="0.5" over j1 - j2: MuJoCo's M[0, 1] gains -0.5, which no
-    diagonal rotor inertia can give."""
-    tendon = (
-        '<tendon><fixed name="t" armature="0.5">'
-        '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
-    )
-    path = _two(tmp_path, "coupled", tendon)
-    line = refused(capsys, "derive", path)
-    assert line.startswith(
-        f"symdyn: error: {path}: field 'tendon(t).armature': fixed tendon 't' (over joints 'j1', 'j2') "
-        "has armature 0.5, which adds a c c^T to M"
-    ), line
-    model, data = _mujoco(path)
-    plain, plain_data = _mujoco(_two(tmp_path, "plain"))
-    q = np.array([0.3, -0.4])
-    with_tendon, without = (
-        _mujoco_dynamics(m, d, q, q, q)[1] for m, d in ((model, data), (plain, plain_data))
-    )
-    assert_close(with_tendon - without, 0.5 * np.array([[1, -1], [-1, 1]]), TOL, "a c c^T")
-
-
-def test_a_coupling_tendons_damping_and_stiffness_are_what_is_left_out(tmp_path):
-    """The issue's <fixed stiffness="20" damping="3"> over j1 - j2: warned about, and MuJoCo's tau
-    exceeds symdyn's by exactly the left-out k (L - L_spring) c + d c c^T qd."""
-    tendon = (
-        '<tendon><fixed name="t" stiffness="20" damping="3" springlength="0.1">'
-        '<joint joint="j1" coef="1"/><joint joint="j2" coef="-1"/></fixed></tendon>'
-    )
-    path = _two(tmp_path, "spring", tendon)
-    with pytest.warns(symdyn.SymdynWarning) as said:
-        robot = symdyn.load_mjcf(path)
-    assert [str(w.message) for w in said] == [
-        f"{path}: the stiffness (spring) of fixed tendon 't' (over joints 'j1', 'j2') is ignored: "
-        "symdyn does not model it",
-        f"{path}: the damping of fixed tendon 't' (over joints 'j1', 'j2') is ignored: "
-        "symdyn does not model it",
-    ]
-    c = np.array([1.0, -1.0])
-    model, data = _mujoco(path)
-    for q, qd, qdd in _states(robot.n):
-        tau, M = _mujoco_dynamics(model, data, q, qd, qdd)
-        left_out = 20 * (c @ q - 0.1) * c + 3 * c * (c @ qd)
-        assert_close(_without_coulomb(robot, q, qd, qdd) + left_out, tau, TOL, "tau")
-        assert_close(mass_matrix(robot, q), M, TOL, "M")
+# (fixed tendons over several joints and springs are modelled: tests/test_tendons.py)
 
 
 def test_spatial_tendons_and_fluid_forces_are_warned_about(tmp_path):

@@ -40,6 +40,7 @@ from ..dynamics import AUTO_SIMPLIFY_MAX_JOINTS, friction_vector, simplify_entry
 from ..errors import SymdynError
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
+from ..model.tendons import refuse_tendons
 from ..model.topology import children
 
 __all__ = [
@@ -224,6 +225,7 @@ def derivation_steps(
     r = robot.resolved()
     if r.n != r.nb:
         raise SymdynError(f"robot '{r.name}': the steps are shown for robots without mimic joints")
+    refuse_tendons(r, "derive --steps", "the steps show the rigid bodies' recursion; derive without --steps")
     q, qd, qdd, values = _state(r, at)
     steps = (_newton_euler if method == "newton-euler" else _lagrange)(r, q, qd, qdd)
     if simplify is None:

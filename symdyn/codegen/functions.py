@@ -303,6 +303,8 @@ def build_functions(
     """
     if dyn.robot.floating and groups is None:
         groups = FLOATING_DEFAULT
+    if dyn.robot.tendons and groups is None:  # the regressor takes no tendons (Dynamics.regressor_compact)
+        groups = [g for g in GROUPS if g not in (*NAMED_ONLY, "regressor")]
     per_frame = {b for g in FRAME_GROUPS for b in GROUPS[g]}
     named_only = {b for g in NAMED_ONLY for b in GROUPS[g]}
     chosen = set(FAMILIES) - named_only if groups is None else {b for g in groups for b in GROUPS[g]}

@@ -42,6 +42,7 @@ from .limits import check_limits
 from .loops import Loop, check_loops, loop_path
 from .parameter_names import parameter_names_problem, parameter_number
 from .table import robot_table
+from .tendons import Tendon
 from .topology import Coordinate, Mimic, check_parents, idle_joints, is_chain
 
 __all__ = [
@@ -52,6 +53,7 @@ __all__ = [
     "Mimic",
     "Frame",
     "BaseBody",
+    "Tendon",
     "JOINT_TYPES",
     "DEFAULT_GRAVITY",
 ]
@@ -177,6 +179,8 @@ class Robot:
     actuated: tuple[int, ...] | None = None
     #: the body the free flyer moves (its mass and inertia): used only when `floating`
     base_body: BaseBody = field(default_factory=BaseBody)
+    #: fixed tendons and joint springs (symdyn.model.tendons): couplings with constant coefficients
+    tendons: tuple[Tendon, ...] = ()
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
@@ -196,6 +200,7 @@ class Robot:
                 f"robot '{self.name}': a floating base has no fixed placement in the world (its "
                 "position and orientation are coordinates): give 'base: floating' without a placement"
             )
+        self._check_tendons()
         for i, link in enumerate(self.links):
             m = link.mimic
             if m is None:
@@ -208,6 +213,23 @@ class Robot:
                     f"robot '{self.name}': link {i + 1} ({link.name}) mimics {other}, which is a mimic "
                     "joint itself (mimic the joint that it follows instead)"
                 )
+
+    def _check_tendons(self) -> None:
+        """One coefficient per link in every tendon, and none on a floating base."""
+        for t in self.tendons:
+            if len(t.coefficients) != len(self.links):
+                raise SymdynError(
+                    f"robot '{self.name}': tendon '{t.name}' has {len(t.coefficients)} coefficients, "
+                    f"expected {len(self.links)} (one per link)",
+                    file=self.source,
+                )
+        if self.floating and self.tendons:
+            raise SymdynError(
+                f"robot '{self.name}': fixed tendons and joint springs ('{self.tendons[0].name}') on a "
+                "floating base are not handled yet: fix the base, or remove the tendon's armature, "
+                "damping, frictionloss and stiffness",
+                file=self.source,
+            )
 
     def __repr__(self) -> str:
         """A header line and one row per link (symdyn.model.table), instead of every matrix."""
@@ -450,5 +472,6 @@ class Robot:
             base=self.base.subs(mapping),
             loops=tuple(loop.subs(mapping) for loop in self.loops),
             base_body=self.base_body.subs(mapping),
+            tendons=tuple(t.subs(mapping) for t in self.tendons),
             **changes,
         )

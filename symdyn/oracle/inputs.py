@@ -50,7 +50,9 @@ class NumericModel:
     qd_b = S qd; `own` (n,) int, per coordinate the link whose joint it is (not a mimic);
     `names` the links' names and `name` the robot's, for messages. `floating`: the base floats
     (Robot.floating), `base_inertia` (6,6) the spatial inertia of its body about the base origin
-    (zero on a fixed base).
+    (zero on a fixed base). `tendon_coef` (nt, nb) the fixed tendons' coefficients over the bodies'
+    joint positions and `tendon_armature`, `tendon_damping`, `tendon_friction`,
+    `tendon_stiffness`, `tendon_length` (nt,) their passive properties (symdyn.model.tendons).
     """
 
     revolute: np.ndarray
@@ -83,6 +85,12 @@ class NumericModel:
     name: str
     floating: bool
     base_inertia: np.ndarray
+    tendon_coef: np.ndarray
+    tendon_armature: np.ndarray
+    tendon_damping: np.ndarray
+    tendon_friction: np.ndarray
+    tendon_stiffness: np.ndarray
+    tendon_length: np.ndarray
 
     def __post_init__(self) -> None:
         for value in vars(self).values():  # cached and shared: make every array read-only
@@ -183,6 +191,12 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
     ]
     frame_R = np.array([_floats(T.R, (3, 3), f"frame {name}") for _, name, T in frames]).reshape(-1, 3, 3)
     frame_p = np.array([_floats(T.p, (3,), f"frame {name}") for _, name, T in frames]).reshape(-1, 3)
+    tendons = np.array(
+        [
+            [_floats(x, (), f"tendon {t.name}") for x in (*t.coefficients, *_tendon_properties(t))]
+            for t in r.tendons
+        ]
+    ).reshape(len(r.tendons), n + 5)
     return NumericModel(
         revolute=np.array([lk.joint == "revolute" for lk in links], dtype=bool),
         R0=R0, p0=p0, axis=axis, mass=mass, com=com, inertia=inertia,
@@ -196,7 +210,15 @@ def _numeric_model(robot, values: tuple[float, ...]) -> NumericModel:
         selection=selection, own=np.array([i for i, lk in enumerate(links) if lk.mimic is None], dtype=int),
         names=tuple(lk.name for lk in links), name=r.name,
         floating=bool(r.floating), base_inertia=base_inertia,
+        tendon_coef=tendons[:, :n], tendon_armature=tendons[:, n], tendon_damping=tendons[:, n + 1],
+        tendon_friction=tendons[:, n + 2], tendon_stiffness=tendons[:, n + 3],
+        tendon_length=tendons[:, n + 4],
     )  # fmt: skip
+
+
+def _tendon_properties(t) -> tuple:
+    """A tendon's armature, damping, frictionloss, stiffness and spring length, in that order."""
+    return (t.armature, t.damping, t.frictionloss, t.stiffness, t.springlength)
 
 
 def _spatial_inertias(mass: np.ndarray, com: np.ndarray, inertia: np.ndarray) -> np.ndarray:

@@ -46,6 +46,7 @@ from .inputs import (
 from .recursions import body_crba, body_rnea, joint_friction
 from .singular import check_invertible
 from .spatial import joint_poses, motion_transforms, mv, subspaces
+from .tendons import tendon_efforts, tendon_kinetic, tendon_mass, tendon_potential
 
 __all__ = [
     "NumericModel",
@@ -88,6 +89,8 @@ def _rnea(mdl, q, qd, qdd, g_on: bool, f_on: bool) -> np.ndarray:
     tau = body_rnea(mdl, q_b, qd_b, qdd_b, np.zeros((len(q), 6)), base_a)[0] + mdl.reflected * qdd_b
     if f_on:
         tau += joint_friction(mdl, qd_b)
+    if len(mdl.tendon_coef):  # fixed tendons and joint springs (symdyn.oracle.tendons)
+        tau += tendon_efforts(mdl, q_b, qd_b, qdd_b, g_on, f_on)
     return project(mdl, tau)
 
 
@@ -127,7 +130,7 @@ def rnea(robot, q, qd, qdd, params=None, *, gravity=True, friction=True) -> np.n
 
 def _mass_matrix(mdl: NumericModel, q: np.ndarray) -> np.ndarray:
     """M for a batch of independent q (N, n) -> (N, n, n); see `mass_matrix`."""
-    M = body_crba(mdl, body_positions(mdl, q))[0] + np.diag(mdl.reflected)
+    M = body_crba(mdl, body_positions(mdl, q))[0] + np.diag(mdl.reflected) + tendon_mass(mdl)
     return mdl.selection.T @ M @ mdl.selection
 
 
@@ -214,7 +217,10 @@ def friction_torque(robot, qd, params=None) -> np.ndarray:
         return _out(np.concatenate([np.zeros((len(v), 6)), F], 1), single)
     mdl, (qd,), single = checked_inputs("friction_torque", robot, params, ("qd", qd))
     qd_b = body_rates(mdl, qd)
-    return _out(project(mdl, joint_friction(mdl, qd_b)), single)
+    F = joint_friction(mdl, qd_b)
+    if len(mdl.tendon_coef):
+        F = F + tendon_efforts(mdl, np.zeros_like(qd_b), qd_b, np.zeros_like(qd_b), False, True)
+    return _out(project(mdl, F), single)
 
 
 def forward_dynamics(robot, q, qd, tau, params=None) -> np.ndarray:
@@ -272,7 +278,7 @@ def kinetic_energy(robot, q, qd, params=None) -> float | np.ndarray:
     X = motion_transforms(joint_poses(mdl, body_positions(mdl, q)))
     S = subspaces(mdl)
     qd_b = body_rates(mdl, qd)
-    T = 0.5 * (mdl.reflected * qd_b**2).sum(axis=1)
+    T = 0.5 * (mdl.reflected * qd_b**2).sum(axis=1) + tendon_kinetic(mdl, qd_b)
     vs: list[np.ndarray] = []
     for i in range(mdl.nb):
         p = mdl.parent[i]
@@ -347,4 +353,5 @@ def potential_energy(robot, q, params=None) -> float | np.ndarray:
     _fixed_only(robot, "potential_energy")
     mdl, (q,), single = checked_inputs("potential_energy", robot, params, ("q", q))
     U = -np.einsum("i,nij,j->n", mdl.mass, _com_positions(mdl, q), mdl.gravity)
+    U = U + tendon_potential(mdl, body_positions(mdl, q))
     return float(U[0]) if single else U

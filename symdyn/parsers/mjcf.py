@@ -23,8 +23,10 @@ walked, body by body (MuJoCo numbers a parent before its children):
 * gravity is <option gravity> (zero when the flag gravity is disabled; disabling the damper or
   frictionloss flags drops those terms too); a joint's range is the link's limits when the
   joint is limited;
-* a fixed tendon over one joint adds its armature, damping and frictionloss to that joint's
-  (symdyn.parsers.mjcf_tendons, which also says what is refused and warned about for others).
+* a fixed tendon over one joint adds its armature, damping and frictionloss to that joint's; a
+  fixed tendon over several joints, a tendon's spring and a joint's spring (stiffness about
+  springref) become `Robot.tendons` (symdyn.parsers.mjcf_tendons, which also says what is
+  refused and warned about).
 
 A free joint on a root body (a body whose parent is the world) makes the robot floating, always
 (MuJoCo simulates it so; floating=True asks for it and refuses a file without one): that body is
@@ -38,10 +40,10 @@ one; a floating model with joints outside the floating body's tree.
 Refused too: a negative armature, damping or frictionloss (as in a URDF), and a number written
 in the file that is not finite or a direction MuJoCo cannot normalise (symdyn.parsers.mjcf_attributes:
 MuJoCo reads nan as 0, which the compiled model no longer shows).
-Warned about and ignored: joint and tendon stiffness (springs), gravity compensation, equality
-constraints, the damping and frictionloss of tendons over several joints, spatial tendons'
-passive forces and fluid forces, which symdyn does not model. Every number is a compiled double
-(symdyn.parsers.mjcf_values: rotations snapped to exact multiples of pi/2 within 1e-9 rad).
+Warned about and ignored: gravity compensation, equality constraints, spatial tendons' passive
+forces, fluid forces, and tendons and springs on a floating base, which symdyn does not model.
+Every number is a compiled double (symdyn.parsers.mjcf_values: rotations snapped to exact
+multiples of pi/2 within 1e-9 rad).
 """
 
 from __future__ import annotations
@@ -57,10 +59,11 @@ from ..errors import SymdynError, SymdynWarning
 from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import BaseBody, Friction, Link, Motor, Robot
+from ..model.tendons import Tendon
 from ..spatial.transform import Transform, rot_axis
 from .mjcf_attributes import check_attributes
 from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
-from .mjcf_tendons import TendonTerms, tendon_terms
+from .mjcf_tendons import Coupling, TendonTerms, tendon_terms
 from .mjcf_values import number, pose, vector
 from .source import read_source
 from .urdf_elements import UrdfInertial, numeric, urdf_robot_name
@@ -90,6 +93,8 @@ class _Walk:
     base_parts: list[tuple[UrdfInertial, Transform]] = field(default_factory=list)
     #: what the fixed tendons add to each dof (symdyn.parsers.mjcf_tendons)
     tendons: TendonTerms = field(default_factory=TendonTerms)
+    #: the link of each dof (MuJoCo's dof index -> index into links)
+    dof_link: dict[int, int] = field(default_factory=dict)
 
 
 def load_mjcf(path: str | os.PathLike, floating: bool = False) -> Robot:
@@ -138,9 +143,9 @@ def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) 
     body_names = names(model, "body", model.nbody, "body")
     joint_names = names(model, "jnt", model.njnt, "joint")
     site_names = names(model, "site", model.nsite, "site")
-    tendons = tendon_terms(model, file, flags)
-    _warn_ignored(file, model, flags, body_names, joint_names, tendons.ignored)
     free = _free_body(model, file, body_names, joint_names)
+    tendons = tendon_terms(model, file, flags, floating=free is not None)
+    _warn_ignored(file, model, flags, body_names, joint_names, tendons.ignored)
     if floating and free is None:
         raise SymdynError(
             "no free joint: a floating MJCF robot has a free joint on its root body (<freejoint/>)", file=file
@@ -169,6 +174,19 @@ def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) 
         frames=tuple(walk.frames),
         floating=free is not None,
         base_body=BaseBody() if free is None else _base_body(walk, body_names[free]),
+        tendons=tuple(_tendon(walk, c) for c in tendons.couplings),
+    )
+
+
+def _tendon(walk: _Walk, c: Coupling) -> Tendon:
+    """A coupling over MuJoCo's dofs as a Tendon over the links (symdyn.model.tendons)."""
+    coefficients = [sp.S.Zero] * len(walk.links)
+    for dof, value in c.coefficients.items():
+        coefficients[walk.dof_link[dof]] = number(value)
+    return Tendon(
+        c.name,
+        tuple(coefficients),
+        *(number(v) for v in (c.armature, c.damping, c.frictionloss, c.stiffness, c.springlength)),
     )
 
 
@@ -210,9 +228,6 @@ def _warn_ignored(
     """A SymdynWarning for each kind of force MuJoCo applies that symdyn's model leaves out
     (`tendons`: what the tendons and fluid leave out, symdyn.parsers.mjcf_tendons)."""
     ignored = []
-    stiff = [joints[j] for j in range(model.njnt) if float(model.jnt_stiffness[j]) != 0]
-    if stiff and "spring" not in flags:
-        ignored.append(f"the stiffness (spring) of joint {', '.join(repr(n) for n in stiff)}")
     held = [bodies[b] for b in range(model.nbody) if float(model.body_gravcomp[b]) != 0]
     if held:
         ignored.append(f"the gravity compensation of body {', '.join(repr(n) for n in held)}")
@@ -300,6 +315,7 @@ def _joint(
     if bool(model.jnt_limited[j]):
         lower, upper = (number(x) for x in model.jnt_range[j])
         limits = (lower, upper) if lower < upper else None
+    walk.dof_link[dof] = len(walk.links)
     walk.links.append(
         {
             "name": name,
