@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived, derived_robot, example
+from timebound import refused
 
 import symdyn
 from symdyn.apps.excite import excite
@@ -314,3 +315,35 @@ def test_simulated_floating_log_is_identified(tmp_path, capsys):
     data = read_measurements(out, 1, floating=True)
     assert np.all(data.tau[:, :6] == 0)
     assert max(report["residual_rms"]) <= 1e-9 * np.abs(data.tau).max()
+
+
+def test_values_that_overflow_the_least_squares_are_one_line(tmp_path, capsys):
+    """Before: a CSV with a 1e308 acceleration ended in LAPACK's "DLASCL had an illegal value" and
+    an internal LinAlgError; now a regressor entry or a torque beyond 1e150 (the bound of a robot
+    file's numbers) is refused naming the sample and its time, and 1e140 still identifies."""
+    rng = np.random.default_rng(5)
+    N = 60
+    columns = ["t", *(f"{h}{i}" for h in ("q", "qd", "qdd", "tau") for i in range(1, 5))]
+    rows = np.column_stack([np.arange(N) * 0.01, rng.normal(size=(N, 16))])
+
+    def write(k: int, column: str, value: float) -> Path:
+        values = rows.copy()
+        values[k, columns.index(column)] = value
+        path = tmp_path / f"{column}.csv"
+        path.write_text(
+            ",".join(columns) + "\n" + "".join(",".join(f"{x:.17g}" for x in r) + "\n" for r in values)
+        )
+        return path
+
+    robot = str(EXAMPLES_DIR / f"{ROBOT}.yaml")
+    line = refused(capsys, "identify", robot, write(5, "qdd3", 1e308), seconds=60)
+    assert line.startswith("symdyn: error: identify: the base regressor's row 3 at sample 5 (t = 0.05 s) is ")
+    assert line.endswith(
+        "more than 1e+150 in absolute value (the least squares would overflow): give the log in SI units"
+    )
+    line = refused(capsys, "identify", robot, write(7, "tau2", -1e200), seconds=60)
+    assert line.startswith(
+        "symdyn: error: identify: the torque tau2 at sample 7 (t = 0.07 s) is -1e+200, more than"
+    )
+    assert main(["identify", robot, str(write(7, "tau2", 1e140)), "--format", "json"]) == 0
+    assert np.all(np.isfinite(json.loads(capsys.readouterr().out)["residual_rms"]))
