@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import sympy as sp
 from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived, derived_robot, example
-from timebound import refused
+from timebound import refused, within
 
 import symdyn
 from symdyn.apps.excite import excite
@@ -347,3 +347,48 @@ def test_values_that_overflow_the_least_squares_are_one_line(tmp_path, capsys):
     )
     assert main(["identify", robot, str(write(7, "tau2", 1e140)), "--format", "json"]) == 0
     assert np.all(np.isfinite(json.loads(capsys.readouterr().out)["residual_rms"]))
+
+
+@pytest.mark.parametrize(
+    "options,message",
+    [
+        (["--period", "1e-300"], "--period 1e-300: must be from 1e-06 to 1e+06 s"),  # before: TypeError
+        (["--period", "inf"], "--period inf: must be from 1e-06 to 1e+06 s"),  # before: ZeroDivisionError
+        (["--period", "nan"], "--period nan: must be from 1e-06 to 1e+06 s"),
+        (["--samples", "1e9"], "--samples 1000000000: must be from 2 to 10,000"),  # before: MemoryError
+        (["--samples", "-5"], "--samples -5: must be from 2 to 10,000"),
+        (["--harmonics", "100000"], "--harmonics 100000: must be from 1 to 100"),  # before: 2.6 TiB
+        (["--evaluations", "0"], "--evaluations 0: must be at least 1"),
+        (["--seed", "-1"], "--seed -1: must be at least 0"),  # before: numpy's ValueError
+        (["--dt", "nan"], "--dt nan: must be positive and at most the period (10 s)"),
+        (["--dt", "20"], "--dt 20: must be positive and at most the period (10 s)"),
+        (
+            ["--dt", "1e-300"],  # before: numpy's "Maximum allowed size exceeded"
+            "excite: a period of 10 s every 1e-300 s is 1e+301 samples, more than the CSV may hold "
+            "(MAX_ROWS = 1,000,000); increase dt",
+        ),
+        (["--qd-max", "inf"], "--qd-max: 'inf' is not a finite number"),
+        (["--qd-max", "0"], "excite: qd_max must be positive and finite"),
+    ],
+)
+def test_excite_options_out_of_range_are_one_line(tmp_path, capsys, options, message):
+    """Each is refused before the optimisation runs, within seconds, and writes nothing."""
+    out = tmp_path / "e.csv"
+    line = refused(capsys, "excite", EXAMPLES_DIR / f"{ROBOT}.yaml", "--out", out, *options, seconds=20)
+    assert line == f"symdyn: error: {message}" and not out.exists()
+
+
+def test_excite_limits_too_small_for_double_precision_are_one_line():
+    """Before: qd_max = 1e-300 left no trial with a finite condition number, and excite failed with
+    an internal TypeError; the API refuses a period or counts out of range as the command does."""
+    robot = example(ROBOT)
+    with within(30), pytest.raises(SymdynError, match="excite: no trial gives a finite condition number"):
+        excite(robot, qd_max=1e-300, evaluations=8, harmonics=2, samples=20)
+    for settings, match in (
+        ({"period": 1e-300}, r"the period must be from 1e-06 to 1e\+06 s, got 1e-300"),
+        ({"samples": 10**9}, "samples must be a whole number from 2 to 10,000, got 1000000000"),
+        ({"harmonics": 2.5}, "harmonics must be a whole number from 1 to 100, got 2.5"),
+        ({"seed": -1}, "seed must be a whole number at least 0, got -1"),
+    ):
+        with within(5), pytest.raises(SymdynError, match=match):
+            excite(robot, **settings)
