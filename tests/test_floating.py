@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cbuild import compile_shared, header_macros, write_files
+from robots import FLYER
 from timebound import refused, within
 
 import symdyn
@@ -320,16 +321,6 @@ def test_float_bound_holds_in_the_generated_float_code(tmp_path):
         assert not np.allclose(
             gravity(_scaled_quaternion(q, 1e-21, pair=True)), gravity(_scaled_quaternion(q, 1.0, pair=True))
         )
-
-
-#: a base body with one link: its libraries compile in a second or two
-FLYER = """name: flyer2
-base: {floating: true, mass: 3, com: [0.02, -0.01, 0.05],
-       inertia: {ixx: 0.05, iyy: 0.06, izz: 0.07, ixy: 0.004}}
-links:
-  - {joint: revolute, a: 0.4, alpha: 0.7, d: 0.1, theta: 0, mass: 1, com: [-0.2, 0.01, 0.02],
-     inertia: {ixx: 0.002, iyy: 0.01, izz: 0.01}}
-"""
 
 
 def test_quaternion_norms_outside_the_bound_are_refused(tmp_path, capsys):

@@ -18,7 +18,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
-from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived, derived_robot, example
+from robots import (
+    ASYMMETRIC_PARAMS,
+    EXAMPLES_DIR,
+    FLYER,
+    asymmetric_friction,
+    derived,
+    derived_robot,
+    example,
+)
 from timebound import refused, within
 
 import symdyn
@@ -284,16 +292,6 @@ def test_floating_robot_identified_from_a_csv_log_and_an_npz_log(tmp_path):
         f"{tmp_path / 'fixed.csv'}: line 2: missing column(s) x_b"
     )
     assert "NQ = 10 position columns, NV = 9 for qd, qdd and tau" in message
-
-
-#: a body with one link (small: its libraries compile in a second or two)
-FLYER = """name: flyer1
-base: {floating: true, mass: 3, com: [0.02, -0.01, 0.05],
-       inertia: {ixx: 0.05, iyy: 0.06, izz: 0.07, ixy: 0.004}}
-links:
-  - {joint: revolute, a: 0.4, alpha: 0.7, d: 0.1, theta: 0, mass: 1, com: [-0.2, 0.01, 0.02],
-     inertia: {ixx: 0.002, iyy: 0.01, izz: 0.01}}
-"""
 
 
 def test_simulated_floating_log_is_identified(tmp_path, capsys):
