@@ -318,7 +318,14 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     q = _vector(args.q, n, "--q")
     qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
     limits = _numbers(args.torque_limits, "--torque-limits")
-    result = analyze(plant, q, qd, torque_limits=limits, axes=axes, frame=args.frame)
+    with np.errstate(all="ignore"):  # an overflow is reported below, in one line
+        result = analyze(plant, q, qd, torque_limits=limits, axes=axes, frame=args.frame)
+    computed = (result.V, result.G, result.F, result.v_vel, result.v_grav, result.manipulability.matrix)
+    if not all(np.isfinite(x).all() for x in (*computed, result.polytope.vertices)):
+        raise SymdynError(
+            "analyze: the velocity terms, the ellipsoid or the polytope are not finite at this state: "
+            "--qd or --torque-limits so large that their products overflow double precision"
+        )
     image = None
     if args.plot:
         if len(result.axes) != 2:
