@@ -705,3 +705,13 @@ def floating_solo12():
         return None
     path = folder / "solo_description/robots/solo12.urdf"
     return path, derive(load_urdf(path, floating=True), simplify=False)
+
+
+#: a floating base body with one link (small: its libraries compile in a second or two)
+FLYER = """name: flyer1
+base: {floating: true, mass: 3, com: [0.02, -0.01, 0.05],
+       inertia: {ixx: 0.05, iyy: 0.06, izz: 0.07, ixy: 0.004}}
+links:
+  - {joint: revolute, a: 0.4, alpha: 0.7, d: 0.1, theta: 0, mass: 1, com: [-0.2, 0.01, 0.02],
+     inertia: {ixx: 0.002, iyy: 0.01, izz: 0.01}}
+"""

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from timebound import refused
 
 from symdyn import cli
 from symdyn.algorithms.kinematics import numeric_jacobian, numeric_pose
@@ -326,3 +327,14 @@ def test_frame_option_uses_that_frames_jacobian(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert err.startswith("symdyn: error: ") and "unknown frame 'tol'" in err and "'tool'" in err
     assert err.count("\n") == 1
+
+
+def test_overflowing_options_are_one_line(capsys):
+    """Before: `analyze --torque-limits 1e308` and `--qd 1e200,0,0` printed a polytope of NaN
+    vertices and exited 0; now one line saying the products overflow."""
+    robot = str(EXAMPLES / "planar_3r.yaml")
+    for options in (["--torque-limits", "1e308"], ["--qd", "1e200,0,0", "--torque-limits", "1"]):
+        line = refused(capsys, "analyze", robot, "--q", "0,0,0", *options, seconds=60)
+        assert line.startswith(
+            "symdyn: error: analyze: the velocity terms, the ellipsoid or the polytope are not"
+        )

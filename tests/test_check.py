@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 import sympy as sp
 import yaml
+from timebound import refused, within
 
 import symdyn.apps.check as check_module
 from symdyn import cli
@@ -273,3 +274,15 @@ def test_one_entry_at_a_state(roger):
         == "roger_arm: 1 of 4 entries of M checked (the others null); it matches (at the given state)"
     )
     assert not check_answers(roger, {"at": at, "M[2,2]": 0.25}).ok
+
+
+def test_samples_out_of_range_are_one_line(capsys):
+    """Before: `check --samples 1e9` was refused by argparse as a spelling (and 1000000000 ended in an
+    internal MemoryError); now any whole number is read and one out of 1..MAX_SAMPLES is refused
+    before the robot is derived."""
+    robot, answers = EXAMPLES / "roger_arm.yaml", EXAMPLES / "answers" / "roger_arm_answers.yaml"
+    for samples in ("1e9", "1000000000", "0", "-3"):
+        line = refused(capsys, "check", robot, answers, "--samples", samples, seconds=5)
+        assert line == f"symdyn: error: --samples {int(float(samples))}: must be from 1 to 100,000"
+    with within(5), pytest.raises(SymdynError, match="samples must be a whole number from 1 to 100,000"):
+        check_answers(load_robot(robot), answers, samples=10**9)

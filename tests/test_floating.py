@@ -13,12 +13,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 from cbuild import compile_shared, header_macros, write_files
+from robots import FLYER
+from timebound import refused, within
 
 import symdyn
+import symdyn.apps.simulate
 from symdyn import SymdynError
 from symdyn.cli.main import main
 from symdyn.codegen import render
 from symdyn.codegen.functions import build_functions
+from symdyn.model.quaternion_norm import QUATERNION_NORM
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import bias_torque, friction_torque, gravity_torque, mass_matrix
 
@@ -98,7 +102,8 @@ def test_solo_against_pinocchio(solo):
 
 def test_non_unit_quaternion_reads_its_normalised_orientation(arm):
     """Every function reads q / |q|: a quaternion of norm 2.5 gives the unit one's values; the
-    zero quaternion has no orientation (the values are not finite)."""
+    zero quaternion has no orientation (the derivation's values are not finite; the oracle refuses
+    it, as every norm outside QUATERNION_NORM: test_quaternion_norms_outside_the_bound_are_refused)."""
     robot, dyn = arm
     rng = np.random.default_rng(2)
     q, v, a = _state(robot, rng)
@@ -111,7 +116,10 @@ def test_non_unit_quaternion_reads_its_normalised_orientation(arm):
     zero[3:7] = 0
     with np.errstate(all="ignore"):
         assert not np.isfinite(dyn.evaluate("G", zero)).all()
-        assert not np.isfinite(gravity_torque(robot, zero)).all()
+    with pytest.raises(
+        SymdynError, match=r"gravity_torque: q: the base quaternion \(entries 4 to 7\) has norm 0,"
+    ):
+        gravity_torque(robot, zero)
 
 
 def test_mass_matrix_depends_on_the_joints_only(arm):
@@ -253,3 +261,110 @@ def test_command_line(tmp_path, capsys):
         assert main(argv) == 1
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and message in err, err
+
+
+def _scaled_quaternion(q: np.ndarray, norm: float, pair: bool = False) -> np.ndarray:
+    """q with its quaternion scaled to `norm` (pair: (x, 0, 0, x) of that norm, a quarter turn
+    about x: gravity turns with it, and its entries are those of the issue's (0, 0, x, x))."""
+    out = q.copy()
+    out[3:7] = (
+        [norm / np.sqrt(2), 0.0, 0.0, norm / np.sqrt(2)] if pair else q[3:7] / np.linalg.norm(q[3:7]) * norm
+    )
+    return out
+
+
+def test_generated_code_holds_the_quaternion_norms_of_its_bound(generated):
+    """QUATERNION_NORM (docs/floating-base.md) is the generated C's own bound: at norms 1e-150 and
+    1e150 (and between) it gives the unit quaternion's values; beyond, at 1e-160 and 1e160, |q|^2
+    leaves the doubles and the values are NaN or wrong: without the run-time check,
+    (0, 0, 1e-200, 1e-200) gave NaN, and 1e200 NaN (reported as a singular M) or R = 1."""
+    robot, _, c = generated
+    low, high = QUATERNION_NORM["double"]
+    assert (low, high) == (1e-150, 1e150)
+    q, v, a = _state(robot, np.random.default_rng(31))
+    want = {
+        name: c(name, q, *(v, a)[: len(SIGNATURES[name][0]) - 1]) for name in ("gravity", "inverse_dynamics")
+    }
+    for norm in (low, 1e-100, 1e-20, 1e20, 1e100, high):
+        for name, expected in want.items():
+            got = c(name, _scaled_quaternion(q, norm), *(v, a)[: len(SIGNATURES[name][0]) - 1])
+            np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    with np.errstate(all="ignore"):
+        assert not np.isfinite(c("gravity", _scaled_quaternion(q, 1e-160, pair=True))).all()
+        far = c("gravity", _scaled_quaternion(q, 1e160, pair=True))
+        assert not np.allclose(far, c("gravity", _scaled_quaternion(q, 1.0, pair=True)))
+
+
+def test_float_bound_holds_in_the_generated_float_code(tmp_path):
+    """QUATERNION_NORM["float"] = [1e-18, 1e18] for --precision float: gravity at those norms equals
+    the unit quaternion's to float rounding, and at 1e-21 (|q|^2 below FLT_MIN) it does not."""
+    robot = symdyn.load_robot(ARM)
+    files = render(robot, targets=("c",), functions=["dynamics"], precision="float")
+    write_files({k: v for k, v in files.items() if k.startswith("floating_arm_dynamics.")}, tmp_path)
+    lib = ctypes.CDLL(str(compile_shared([tmp_path / "floating_arm_dynamics.c"], tmp_path / "libf.so")))
+    ptr = ctypes.POINTER(ctypes.c_float)
+    lib.floating_arm_gravity.argtypes = [ptr, ptr, ptr]
+
+    def gravity(q):
+        out, q32 = np.full(robot.nv, np.nan, dtype=np.float32), np.ascontiguousarray(q, dtype=np.float32)
+        lib.floating_arm_gravity(q32.ctypes.data_as(ptr), None, out.ctypes.data_as(ptr))
+        return out.astype(float)
+
+    q = _state(robot, np.random.default_rng(32))[0]
+    want = gravity(q)
+    low, high = QUATERNION_NORM["float"]
+    for norm in (low, 1e-9, 1e9, high):
+        np.testing.assert_allclose(
+            gravity(_scaled_quaternion(q, norm)), want, rtol=1e-5, atol=1e-5 * np.abs(want).max()
+        )
+    with np.errstate(all="ignore"):
+        assert not np.allclose(
+            gravity(_scaled_quaternion(q, 1e-21, pair=True)), gravity(_scaled_quaternion(q, 1.0, pair=True))
+        )
+
+
+def test_quaternion_norms_outside_the_bound_are_refused(tmp_path, capsys):
+    """Before: simulate's q0 of norm 1e200 was reported as "singular M", 1e-200 as "zero", and the
+    compiled functions and the oracle returned NaN or wrong values; now every run-time entry point
+    refuses a finite quaternion outside QUATERNION_NORM in one line naming the function, the
+    argument and the state, and takes any norm inside it (q0 normalised)."""
+    (tmp_path / "flyer.yaml").write_text(FLYER)
+    robot = symdyn.load_robot(tmp_path / "flyer.yaml")
+    compiled = symdyn.compile(robot)
+    q, v, a = _state(robot, np.random.default_rng(33))
+    tiny, huge = _scaled_quaternion(q, 2e-200, pair=True), _scaled_quaternion(q, 2e200, pair=True)
+    for bad, norm in ((tiny, "2e-200"), (huge, "2e+200"), (_scaled_quaternion(q, 0.0), "0")):
+        outside = (
+            f"has norm {norm}, outside [1e-150, 1e+150], the norms whose square the generated code forms"
+        )
+        with within(10):
+            for call, where in (
+                (lambda bad=bad: compiled.forward_dynamics(bad, v, a), "forward_dynamics: q: "),
+                (
+                    lambda bad=bad: compiled.gravity(np.stack([q, bad])),
+                    "gravity: q: the base quaternion (entries 4 to 7) of state 1 ",
+                ),
+                (lambda bad=bad: compiled.difference(q, bad), "difference: q_next: "),
+                (lambda bad=bad: symdyn.rnea(robot, bad, v, a), "rnea: q: "),
+                (lambda bad=bad: symdyn.apps.simulate.simulate(compiled, bad, duration=0.1, dt=0.01), "q0: "),
+            ):
+                with pytest.raises(SymdynError) as info:
+                    call()
+                assert str(info.value).startswith(where) and outside in str(info.value), str(info.value)
+    q0, out = "--q0=" + ",".join(f"{x:.17g}" for x in huge), tmp_path / "s.csv"
+    line = refused(
+        capsys, "simulate", tmp_path / "flyer.yaml", q0, "--duration", "0.05", "--dt", "0.01", "--out", out
+    )
+    assert line.startswith("symdyn: error: q0: the base quaternion (entries 4 to 7) has norm 2e+200, outside")
+    assert not out.exists()
+    inside = _scaled_quaternion(q, 1e-120)
+    want = compiled.forward_dynamics(q, v, v)
+    np.testing.assert_allclose(compiled.forward_dynamics(inside, v, v), want, rtol=1e-10)
+    np.testing.assert_allclose(
+        symdyn.rnea(robot, inside, v, a), symdyn.rnea(robot, q, v, a), rtol=1e-10, atol=1e-12
+    )
+    run = symdyn.apps.simulate.simulate(compiled, inside, duration=0.02, dt=0.01)
+    unit = symdyn.apps.simulate.simulate(compiled, q, duration=0.02, dt=0.01)
+    assert np.allclose(np.linalg.norm(run.q[0, 3:7]), 1.0) and np.allclose(
+        run.q, unit.q, rtol=1e-12, atol=1e-14
+    )

@@ -18,7 +18,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sympy as sp
-from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction, derived, derived_robot, example
+from robots import (
+    ASYMMETRIC_PARAMS,
+    EXAMPLES_DIR,
+    FLYER,
+    asymmetric_friction,
+    derived,
+    derived_robot,
+    example,
+)
+from timebound import refused, within
 
 import symdyn
 from symdyn.apps.excite import excite
@@ -285,16 +294,6 @@ def test_floating_robot_identified_from_a_csv_log_and_an_npz_log(tmp_path):
     assert "NQ = 10 position columns, NV = 9 for qd, qdd and tau" in message
 
 
-#: a body with one link (small: its libraries compile in a second or two)
-FLYER = """name: flyer1
-base: {floating: true, mass: 3, com: [0.02, -0.01, 0.05],
-       inertia: {ixx: 0.05, iyy: 0.06, izz: 0.07, ixy: 0.004}}
-links:
-  - {joint: revolute, a: 0.4, alpha: 0.7, d: 0.1, theta: 0, mass: 1, com: [-0.2, 0.01, 0.02],
-     inertia: {ixx: 0.002, iyy: 0.01, izz: 0.01}}
-"""
-
-
 def test_simulated_floating_log_is_identified(tmp_path, capsys):
     """`symdyn simulate` on a floating robot writes t, q (NQ), qd, qdd, tau (NV) (its qdd the forward
     dynamics at each sample), which `symdyn identify` reads as it is: its predictions are the
@@ -314,3 +313,80 @@ def test_simulated_floating_log_is_identified(tmp_path, capsys):
     data = read_measurements(out, 1, floating=True)
     assert np.all(data.tau[:, :6] == 0)
     assert max(report["residual_rms"]) <= 1e-9 * np.abs(data.tau).max()
+
+
+def test_values_that_overflow_the_least_squares_are_one_line(tmp_path, capsys):
+    """Before: a CSV with a 1e308 acceleration ended in LAPACK's "DLASCL had an illegal value" and
+    an internal LinAlgError; now a regressor entry or a torque beyond 1e150 (the bound of a robot
+    file's numbers) is refused naming the sample and its time, and 1e140 still identifies."""
+    rng = np.random.default_rng(5)
+    N = 60
+    columns = ["t", *(f"{h}{i}" for h in ("q", "qd", "qdd", "tau") for i in range(1, 5))]
+    rows = np.column_stack([np.arange(N) * 0.01, rng.normal(size=(N, 16))])
+
+    def write(k: int, column: str, value: float) -> Path:
+        values = rows.copy()
+        values[k, columns.index(column)] = value
+        path = tmp_path / f"{column}.csv"
+        path.write_text(
+            ",".join(columns) + "\n" + "".join(",".join(f"{x:.17g}" for x in r) + "\n" for r in values)
+        )
+        return path
+
+    robot = str(EXAMPLES_DIR / f"{ROBOT}.yaml")
+    line = refused(capsys, "identify", robot, write(5, "qdd3", 1e308), seconds=60)
+    assert line.startswith("symdyn: error: identify: the base regressor's row 3 at sample 5 (t = 0.05 s) is ")
+    assert line.endswith(
+        "more than 1e+150 in absolute value (the least squares would overflow): give the log in SI units"
+    )
+    line = refused(capsys, "identify", robot, write(7, "tau2", -1e200), seconds=60)
+    assert line.startswith(
+        "symdyn: error: identify: the torque tau2 at sample 7 (t = 0.07 s) is -1e+200, more than"
+    )
+    assert main(["identify", robot, str(write(7, "tau2", 1e140)), "--format", "json"]) == 0
+    assert np.all(np.isfinite(json.loads(capsys.readouterr().out)["residual_rms"]))
+
+
+@pytest.mark.parametrize(
+    "options,message",
+    [
+        (["--period", "1e-300"], "--period 1e-300: must be from 1e-06 to 1e+06 s"),  # before: TypeError
+        (["--period", "inf"], "--period inf: must be from 1e-06 to 1e+06 s"),  # before: ZeroDivisionError
+        (["--period", "nan"], "--period nan: must be from 1e-06 to 1e+06 s"),
+        (["--samples", "1e9"], "--samples 1000000000: must be from 2 to 10,000"),  # before: MemoryError
+        (["--samples", "-5"], "--samples -5: must be from 2 to 10,000"),
+        (["--harmonics", "100000"], "--harmonics 100000: must be from 1 to 100"),  # before: 2.6 TiB
+        (["--evaluations", "0"], "--evaluations 0: must be at least 1"),
+        (["--seed", "-1"], "--seed -1: must be at least 0"),  # before: numpy's ValueError
+        (["--dt", "nan"], "--dt nan: must be positive and at most the period (10 s)"),
+        (["--dt", "20"], "--dt 20: must be positive and at most the period (10 s)"),
+        (
+            ["--dt", "1e-300"],  # before: numpy's "Maximum allowed size exceeded"
+            "excite: a period of 10 s every 1e-300 s is 1e+301 samples, more than the CSV may hold "
+            "(MAX_ROWS = 1,000,000); increase dt",
+        ),
+        (["--qd-max", "inf"], "--qd-max: 'inf' is not a finite number"),
+        (["--qd-max", "0"], "excite: qd_max must be positive and finite"),
+    ],
+)
+def test_excite_options_out_of_range_are_one_line(tmp_path, capsys, options, message):
+    """Each is refused before the optimisation runs, within seconds, and writes nothing."""
+    out = tmp_path / "e.csv"
+    line = refused(capsys, "excite", EXAMPLES_DIR / f"{ROBOT}.yaml", "--out", out, *options, seconds=20)
+    assert line == f"symdyn: error: {message}" and not out.exists()
+
+
+def test_excite_limits_too_small_for_double_precision_are_one_line():
+    """Before: qd_max = 1e-300 left no trial with a finite condition number, and excite failed with
+    an internal TypeError; the API refuses a period or counts out of range as the command does."""
+    robot = example(ROBOT)
+    with within(30), pytest.raises(SymdynError, match="excite: no trial gives a finite condition number"):
+        excite(robot, qd_max=1e-300, evaluations=8, harmonics=2, samples=20)
+    for settings, match in (
+        ({"period": 1e-300}, r"the period must be from 1e-06 to 1e\+06 s, got 1e-300"),
+        ({"samples": 10**9}, "samples must be a whole number from 2 to 10,000, got 1000000000"),
+        ({"harmonics": 2.5}, "harmonics must be a whole number from 1 to 100, got 2.5"),
+        ({"seed": -1}, "seed must be a whole number at least 0, got -1"),
+    ):
+        with within(5), pytest.raises(SymdynError, match=match):
+            excite(robot, **settings)

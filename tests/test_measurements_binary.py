@@ -1,11 +1,17 @@
 """Logs in NumPy's binary formats (symdyn.apps.measurements_binary through read_measurements):
 a .npz of t, q, qd, qdd, tau and a structured .npy give the values of the same CSV log exactly;
-a wrong array is one line naming the file and the array, and a pickle is never loaded."""
+a wrong array is one line naming the file and the array, and a pickle is never loaded; sizes are
+read from the arrays' headers before anything is allocated (MAX_LOG_BYTES)."""
 
 from __future__ import annotations
 
+import io
+import zipfile
+
 import numpy as np
 import pytest
+from robots import EXAMPLES_DIR
+from timebound import refused, within
 
 from symdyn.apps.measurements import read_measurements
 from symdyn.errors import SymdynError
@@ -54,5 +60,52 @@ def test_a_plain_or_pickled_npy_is_refused(tmp_path):
     with pytest.raises(SymdynError, match=r"plain\.npy: a \.npy log is one structured array"):
         read_measurements(tmp_path / "plain.npy", 2)
     np.save(tmp_path / "objects.npy", np.array([{"t": 1}], dtype=object), allow_pickle=True)
-    with pytest.raises(SymdynError, match=r"objects\.npy: cannot read as a NumPy file"):
+    objects = r"objects\.npy: the file holds Python objects \(dtype object\), which symdyn never loads"
+    with pytest.raises(SymdynError, match=objects):
         read_measurements(tmp_path / "objects.npy", 2)
+
+
+def _header_only(shape: tuple, descr="<f8") -> bytes:
+    """The .npy header of an array of `shape`, without its data."""
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": descr, "fortran_order": False, "shape": shape})
+    return buf.getvalue()
+
+
+def test_sizes_are_read_from_the_headers_before_anything_is_loaded(tmp_path, capsys):
+    """Before: a .npy whose header says (1e11, 9) failed with an internal MemoryError (6.55 TiB),
+    a .npz asking for 3 GiB was decompressed; now both are refused from their headers, in a
+    second, naming the limit (MAX_LOG_BYTES, 2 GiB)."""
+    record = np.dtype(
+        [(name, "<f8") for name in ("t", "q1", "q2", "qd1", "qd2", "qdd1", "qdd2", "tau1", "tau2")]
+    )
+    (tmp_path / "huge.npy").write_bytes(_header_only((10**11,), record.descr))
+    scara = str(EXAMPLES_DIR / "scara.yaml")
+    line = refused(capsys, "identify", scara, tmp_path / "huge.npy", seconds=5)
+    assert line.endswith(
+        "huge.npy: 100000000000 records take 6.55 TiB, more than a log may hold "
+        "(2 GiB: symdyn.apps.measurements.MAX_LOG_BYTES)"
+    )
+    with zipfile.ZipFile(tmp_path / "big.npz", "w") as z:
+        z.writestr("t.npy", _header_only((3 * 2**30 // 8,)))
+    line = refused(capsys, "identify", scara, tmp_path / "big.npz", seconds=5)
+    assert line.endswith("big.npz: its arrays t, q, qd, qdd, tau take 3 GiB, more than a log may hold "
+                         "(2 GiB: symdyn.apps.measurements.MAX_LOG_BYTES)")  # fmt: skip
+
+
+def test_truncated_and_object_arrays_are_one_line_and_other_arrays_are_not_read(tmp_path, capsys):
+    """A header promising more data than the file holds; an .npz with an object array (before: an
+    internal ValueError of np.load); an array other than t, q, qd, qdd, tau is never loaded, even
+    one whose header claims a terabyte."""
+    (tmp_path / "short.npy").write_bytes(_header_only((100,), [("t", "<f8")]) + bytes(80))
+    with within(5), pytest.raises(SymdynError, match=r"the file: its header promises 800 B .* holds 80 B"):
+        read_measurements(tmp_path / "short.npy", 2)
+    np.savez(tmp_path / "obj.npz", t=np.array([1, "a"], dtype=object), q=np.zeros((2, 2)))
+    line = refused(capsys, "identify", EXAMPLES_DIR / "scara.yaml", tmp_path / "obj.npz", seconds=5)
+    assert "obj.npz: array t holds Python objects (dtype object), which symdyn never loads" in line
+    arrays = _arrays()
+    np.savez(tmp_path / "extra.npz", **arrays)
+    with zipfile.ZipFile(tmp_path / "extra.npz", "a") as z:
+        z.writestr("junk.npy", _header_only((2**40,)))
+    got = read_measurements(tmp_path / "extra.npz", 2)
+    assert np.array_equal(got.tau, arrays["tau"]) and np.array_equal(got.t, arrays["t"])

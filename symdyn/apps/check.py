@@ -61,11 +61,14 @@ __all__ = [
     "entry_count",
     "compare_entry",
     "check_answers",
+    "MAX_SAMPLES",
 ]
 
 QUANTITIES = ("M", "C", "V", "G", "F", "tau")
 MATRICES = ("M", "C")
 SAMPLES = 16
+#: the most random points of the numeric comparison (each entry is evaluated at all of them at once)
+MAX_SAMPLES = 100_000
 RTOL = 1e-9
 #: the key of answers for the derivation's intermediate steps (symdyn.apps.check_steps)
 STEPS_KEY = "steps"
@@ -359,6 +362,12 @@ def check_answers(
     """
     if method not in METHODS:
         raise SymdynError(f"unknown method '{method}' (use {' or '.join(METHODS)})")
+    if (
+        isinstance(samples, bool)
+        or not isinstance(samples, (int, np.integer))
+        or not 1 <= samples <= MAX_SAMPLES
+    ):
+        raise SymdynError(f"check: samples must be a whole number from 1 to {MAX_SAMPLES:,}, got {samples!r}")
     file = None if isinstance(answers, Mapping) else str(Path(answers))
     data = answers if isinstance(answers, Mapping) else read_answers(answers)
     parsed = parse_answers(data, robot, file)

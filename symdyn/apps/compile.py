@@ -42,6 +42,7 @@ from ..module_files import load_module
 from . import cache
 from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
+from .configuration_check import quaternion_checked
 from .robot_key import robot_digest
 from .singular import INVERTING, NotGeneratedError, guarded
 
@@ -287,7 +288,8 @@ class CompiledDynamics(FrameMethods):
         if self._library is None:
             _warn_fallback()
             for f in meta["functions"]:
-                setattr(self, f["name"], guarded(self, f["name"], _numpy_method(self, f["name"])))
+                method = quaternion_checked(f, _numpy_method(self, f["name"]), self.n)
+                setattr(self, f["name"], guarded(self, f["name"], method))
         return self
 
     def __getattr__(self, name: str):
@@ -300,7 +302,8 @@ class CompiledDynamics(FrameMethods):
         ffi, lib, _ = self._loaded()
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
-            setattr(self, f["name"], guarded(self, f["name"], c_method(ffi, lib, f, p_ptr, self)))
+            method = quaternion_checked(f, c_method(ffi, lib, f, p_ptr, self), self.n)
+            setattr(self, f["name"], guarded(self, f["name"], method))
         return self.__dict__[name]
 
     def _loaded(self) -> tuple:

@@ -21,6 +21,7 @@ on the direction of (a, b) only.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,7 +34,27 @@ from .identify import base_regressor_samples
 from .measurements import needs_scipy
 from .output import write_atomic
 
-__all__ = ["FourierTrajectory", "excite", "DEFAULTS"]
+__all__ = [
+    "FourierTrajectory",
+    "excite",
+    "csv_samples",
+    "DEFAULTS",
+    "MAX_SAMPLES",
+    "MAX_HARMONICS",
+    "PERIOD_RANGE",
+    "MAX_ROWS",
+]
+
+#: the most samples per period for the condition number: each evaluation holds their base
+#: regressor (samples x n x nbase doubles: 35 MB for the Panda at the limit)
+MAX_SAMPLES = 10_000
+#: the most harmonics per joint (Powell's method keeps a square matrix of 2 n L directions)
+MAX_HARMONICS = 100
+#: the periods (s) `excite` accepts: beyond them the Fourier series' amplitudes (a / (w l) and
+#: a w l) leave what a robot's limits and double precision can express together
+PERIOD_RANGE = (1e-6, 1e6)
+#: the most samples of the CSV `write_csv` writes (period / dt + 1): about 600 MB of text for the Panda
+MAX_ROWS = 1_000_000
 
 #: period T (s), harmonics L, samples per period for the condition number, optimiser evaluations,
 #: random starts, and the limits (revolute rad, rad/s, rad/s^2; prismatic m, m/s, m/s^2)
@@ -87,9 +108,10 @@ class FourierTrajectory:
 
     def csv_text(self, robot: Robot, dt: float) -> str:
         """t, q, qd, qdd and tau (the robot file's inverse dynamics) over one period every dt:
-        the columns `symdyn identify` reads."""
+        the columns `symdyn identify` reads (at most MAX_ROWS samples: `csv_samples`)."""
         from .compiled import compiled_dynamics
 
+        csv_samples(self.period, dt)
         t = np.arange(0.0, self.period + 0.5 * dt, dt)
         q, qd, qdd = self(t)
         tau = compiled_dynamics(robot).inverse_dynamics(q, qd, qdd)
@@ -102,6 +124,20 @@ class FourierTrajectory:
         return write_atomic(path, self.csv_text(robot, dt))
 
 
+def csv_samples(period: float, dt: float) -> int:
+    """The samples of one period every dt (the CSV's rows); SymdynError unless dt is a positive
+    number at most the period and there are at most MAX_ROWS samples."""
+    if not (isinstance(dt, (int, float)) and math.isfinite(dt) and 0 < dt <= period):
+        raise SymdynError(f"excite: dt must be a positive number at most the period {period:g} s, got {dt!r}")
+    rows = period / dt + 1
+    if not rows <= MAX_ROWS:
+        raise SymdynError(
+            f"excite: a period of {period:g} s every {dt:g} s is {rows:.3g} samples, more than the CSV "
+            f"may hold (MAX_ROWS = {MAX_ROWS:,}); increase dt"
+        )
+    return int(math.floor(period / dt + 0.5)) + 1
+
+
 class _BudgetSpentError(Exception):
     """The optimiser has used its evaluations."""
 
@@ -112,8 +148,8 @@ def _limits(robot: Robot, given, key: str) -> np.ndarray:
     if given is None:
         return np.array([DEFAULTS[key][k] for k in kinds])
     values = np.broadcast_to(np.asarray(given, dtype=float), (robot.n,)).copy()
-    if not np.all(values > 0):
-        raise SymdynError(f"excite: {key} must be positive")
+    if not np.all((values > 0) & np.isfinite(values)):
+        raise SymdynError(f"excite: {key} must be positive and finite")
     return values
 
 
@@ -124,6 +160,23 @@ def _scaled(a, b, omega, t, limits) -> tuple[np.ndarray, np.ndarray]:
     ratios = [np.max(np.abs(x), axis=0) / lim for x, lim in zip((q, qd, qdd), limits, strict=True)]
     s = 1.0 / max(float(np.max(r)) for r in ratios)
     return a * s, b * s
+
+
+def _check_settings(period, harmonics, samples, evaluations, seed) -> None:
+    """SymdynError naming the first setting of `excite` out of its range."""
+    low, high = PERIOD_RANGE
+    if not (isinstance(period, (int, float)) and low <= period <= high):
+        raise SymdynError(f"excite: the period must be from {low:g} to {high:g} s, got {period!r}")
+    for name, value, low, high in (
+        ("harmonics", harmonics, 1, MAX_HARMONICS),
+        ("samples", samples, 2, MAX_SAMPLES),
+        ("evaluations", evaluations, 1, None),
+        ("seed", seed, 0, None),
+    ):
+        whole = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+        if not whole or value < low or (high is not None and value > high):
+            bound = f"from {low} to {high:,}" if high is not None else f"at least {low}"
+            raise SymdynError(f"excite: {name} must be a whole number {bound}, got {value!r}")
 
 
 def excite(
@@ -144,8 +197,7 @@ def excite(
         SymdynError: bad limits or settings, or a robot with free parameters.
     """
     minimize = needs_scipy("optimize").minimize
-    if not (period > 0 and harmonics >= 1 and samples >= 2 and evaluations >= 1):
-        raise SymdynError("excite: period, harmonics, samples and evaluations must be positive")
+    _check_settings(period, harmonics, samples, evaluations, seed)
     n = robot.n
     q0 = np.zeros(n) if q0 is None else np.broadcast_to(np.asarray(q0, dtype=float), (n,)).copy()
     limits = tuple(
@@ -167,7 +219,8 @@ def excite(
         if best["count"] >= evaluations:
             raise _BudgetSpentError
         best["count"] += 1
-        f = cost(x)
+        with np.errstate(all="ignore"):  # a trial whose condition number is not finite is never kept
+            f = cost(x)
         if f < best["f"]:
             best.update(f=f, x=np.array(x))
         return f
@@ -180,5 +233,11 @@ def excite(
     except _BudgetSpentError:
         pass
     f, x = best["f"], best["x"]
+    if x is None:
+        raise SymdynError(
+            f"excite: no trial gives a finite condition number of the base regressor over {samples} "
+            "samples (limits or a period so small or large that the motion does not excite every base "
+            "parameter in double precision)"
+        )
     a, b = _scaled(x[: n * harmonics].reshape(shape), x[n * harmonics :].reshape(shape), omega, t, limits)
     return FourierTrajectory(q0, a, b, period, condition_number=float(np.exp(f)))

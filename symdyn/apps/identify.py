@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SymdynError
+from ..model.parameter_names import MAX_MAGNITUDE
 from ..model.robot import Robot
 from .least_squares import Triangular, combine, one_blas_thread
 from .measurements import SG_ORDER, SG_WINDOW, Measurements, differentiate, needs_scipy, read_measurements
@@ -201,10 +202,12 @@ def identify(
     step = chunk_samples(n, nb) if chunk is None else max(1, int(chunk))
     chunks = [slice(s, min(s + step, N)) for s in range(0, N, step)]
     joints = [Triangular(nb) for _ in range(n)]  # [W_j | y_j]: the rows of joint j
+    _check_bounded(data.tau, data.t, "the torque tau{}")
     with one_blas_thread():
         for s in chunks:
             W3 = regressor(data.q[s], data.qd[s], data.qdd[s])
             assert W3.shape[2] == nb, (W3.shape, nb)
+            _check_bounded(W3, data.t[s], "the base regressor's row {}", s.start)
             for j, part in enumerate(joints):
                 part.add(W3[:, j, :], data.tau[s, j])
     plain = combine(joints, np.ones(n))
@@ -231,6 +234,23 @@ def identify(
         residual_rms=np.array([part.residual_norm(x) for part in joints]) / np.sqrt(N),
         samples=N,
         predicted=predicted,
+    )
+
+
+def _check_bounded(values: np.ndarray, t: np.ndarray, what: str, start: int = 0) -> None:
+    """SymdynError unless every entry of `values` (samples first; the second axis the row of a
+    sample) is at most MAX_MAGNITUDE in absolute value (so that the QR's products stay finite):
+    names the first sample, its time and the row (`what` formatted with it, 1-based)."""
+    if not values.size or (values.min() >= -MAX_MAGNITUDE and values.max() <= MAX_MAGNITUDE):
+        return
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(values) <= MAX_MAGNITUDE)  # NaN too
+    k, j = np.argwhere(bad)[0][:2]
+    x = np.asarray(values[k, j]).flat[np.flatnonzero(bad[k, j])[0]]
+    why = f"more than {MAX_MAGNITUDE:g} in absolute value" if np.isfinite(x) else "not finite"
+    raise SymdynError(
+        f"identify: {what.format(j + 1)} at sample {start + k} (t = {t[k]:g} s) is {x:g}, {why} (the "
+        "least squares would overflow): give the log in SI units"
     )
 
 

@@ -23,14 +23,21 @@ whose value and first two derivatives at the window's centre replace q, qd and q
 log without accelerations gets qdd as the filter's derivative of qd (v lives in a vector space,
 the base's part in the base frame; q and qd stay as measured). The samples must then be evenly
 spaced in t.
+
+Limits, checked before anything large is allocated: a log is a regular file (a device such as
+/dev/zero, a FIFO or a socket is refused: it may never end); its values (N samples x columns, 8
+bytes each) take at most MAX_LOG_BYTES, which a binary log's headers tell before it is loaded and
+a CSV's count of lines before it is parsed (counted only when the file exceeds MAX_LOG_BYTES / 4
+bytes, since a value takes at least two characters, "0,").
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import os
+import stat
 import warnings
+from array import array
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,11 +60,17 @@ __all__ = [
     "needs_scipy",
     "SG_WINDOW",
     "SG_ORDER",
+    "MAX_LOG_BYTES",
 ]
 
 #: Savitzky-Golay window (samples, odd) and polynomial degree for qd and qdd from q
 SG_WINDOW = 21
 SG_ORDER = 4
+#: the most bytes a log's values may take (N samples x columns x 8): 2 GiB, e.g. 9 million samples
+#: of the Panda's 29 columns
+MAX_LOG_BYTES = 2 * 2**30
+#: the longest line before the header (blank lines) or of the header itself (bytes)
+MAX_LINE = 2**20
 
 
 @dataclass
@@ -130,13 +143,17 @@ def read_measurements(
     """
     where = str(path)
     suffix = Path(path).suffix.lower()
+    size = _regular_file(path, where)
     if suffix in (".npz", ".npy"):
         from .measurements_binary import read_binary
 
-        header, data = read_binary(path, log_columns(n, floating))
+        header, data = read_binary(path, log_columns(n, floating), MAX_LOG_BYTES)
         cols = _columns(header, n, where, torques, floating)
     else:
-        header, data, line = _read_csv(path, where)
+        try:
+            header, data, line = _read_csv(path, where, size)
+        except MemoryError:
+            raise SymdynError(f"{where}: not enough memory to read it (MemoryError)") from None
         cols = _columns(header, n, f"{where}: line {line}", torques, floating)
     if len(data) < 2:
         raise SymdynError(f"{where}: too few samples ({len(data)})")
@@ -151,18 +168,38 @@ def read_measurements(
     return Measurements(t, q, qd, qdd, tau, differentiated=True)
 
 
-def _read_csv(path: str | os.PathLike, where: str) -> tuple[list[str], np.ndarray, int]:
-    """(header, values (N, columns), the header's line number) of a CSV log: pandas' parser, else
-    numpy.loadtxt, else Python."""
+def _regular_file(path: str | os.PathLike, where: str) -> int:
+    """The size of the log at `path`, a regular file (symbolic links followed); else SymdynError."""
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise SymdynError(f"{where}: cannot read ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise SymdynError(f"{where}: is a folder, not a log file")
+    if not stat.S_ISREG(info.st_mode):
+        raise SymdynError(
+            f"{where}: not a regular file (a device, FIFO or socket, which may never end): "
+            "symdyn reads a log from a file"
+        )
+    return info.st_size
+
+
+def _read_csv(path: str | os.PathLike, where: str, size: int) -> tuple[list[str], np.ndarray, int]:
+    """(header, values (N, columns), the header's line number) of a CSV log of `size` bytes:
+    pandas' parser, else numpy.loadtxt, else Python."""
     header, skip = None, 0
     try:
         with open(path, "rb") as f:
-            for line in f:
+            for line in iter(lambda: f.readline(MAX_LINE), b""):
                 skip += 1
+                if len(line) == MAX_LINE and not line.endswith(b"\n"):
+                    raise SymdynError(f"{where}: line {skip} is longer than {MAX_LINE} bytes: not a CSV log")
                 try:
                     row = next(csv.reader([line.decode()]), [])
                 except UnicodeDecodeError as exc:
                     raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
+                except csv.Error as exc:
+                    raise SymdynError(f"{where}: line {skip}: {exc}") from None
                 if row and any(c.strip() for c in row):
                     header = row
                     break
@@ -170,12 +207,33 @@ def _read_csv(path: str | os.PathLike, where: str) -> tuple[list[str], np.ndarra
         raise SymdynError(f"{where}: cannot read ({exc.strerror or exc})") from None
     if header is None:
         raise SymdynError(f"{where}: empty file (expected a header t,q1..,tau1..)")
+    _check_rows(path, where, len(header), size)
     data = parse_rows(path, skip, len(header))
     if data is None:
         data = _loadtxt(path, skip, len(header))
     if data is None or not np.all(np.isfinite(data)):
         data = _read_slowly(path, header, skip)
     return header, data, skip
+
+
+def _check_rows(path: str | os.PathLike, where: str, width: int, size: int) -> None:
+    """SymdynError when the CSV's lines of `width` values would take more than MAX_LOG_BYTES.
+
+    A value takes at least two characters ("0,"), so a file of at most MAX_LOG_BYTES / 4 bytes
+    cannot; a larger one has its lines counted first (a read at disk speed, no parsing)."""
+    if size <= MAX_LOG_BYTES // 4:
+        return
+    lines = 1
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(2**24), b""):
+            lines += block.count(b"\n")
+    if 8 * width * lines > MAX_LOG_BYTES:
+        from .measurements_binary import size_text
+
+        raise SymdynError(
+            f"{where}: {lines} lines of {width} values take {size_text(8 * width * lines)}, more than a "
+            f"log may hold ({size_text(MAX_LOG_BYTES)}: symdyn.apps.measurements.MAX_LOG_BYTES)"
+        )
 
 
 def _loadtxt(path: str | os.PathLike, skip: int, width: int) -> np.ndarray | None:
@@ -193,14 +251,20 @@ def _loadtxt(path: str | os.PathLike, skip: int, width: int) -> np.ndarray | Non
 def _read_slowly(path: str | os.PathLike, header: list[str], skip: int) -> np.ndarray:
     """The values after the header (its line is number `skip`) by Python's csv and float; a
     SymdynError naming the line and column of the first wrong value."""
-    where, width = str(path), len(header)
+    where = str(path)
+    with open(path, newline="") as f:
+        try:
+            return _parse_slowly(where, csv.reader(f), header, skip)
+        except UnicodeDecodeError as exc:
+            raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
+
+
+def _parse_slowly(where: str, rows, header: list[str], skip: int) -> np.ndarray:
+    """The values of the csv.reader `rows` after line `skip` (see `_read_slowly`)."""
+    width = len(header)
     names = [h.strip() for h in header]
-    try:
-        text = Path(path).read_text()
-    except UnicodeDecodeError as exc:
-        raise SymdynError(f"{where}: not a text file ({exc.reason})") from None
-    values = []
-    for k, row in enumerate(csv.reader(io.StringIO(text)), start=1):
+    values = array("d")  # 8 bytes a value, as the array it becomes
+    for k, row in _numbered(where, rows):
         if k <= skip or not row or not any(c.strip() for c in row):
             continue
         if len(row) != width:
@@ -213,7 +277,22 @@ def _read_slowly(path: str | os.PathLike, header: list[str], skip: int) -> np.nd
             if not np.isfinite(x):
                 raise SymdynError(f"{where}: line {k}: column {name} is {c.strip()}, not a finite number")
             values.append(x)
-    return np.array(values, dtype=np.float64).reshape(-1, width)
+    return np.frombuffer(values, dtype=np.float64).reshape(-1, width).copy()
+
+
+def _numbered(where: str, rows):
+    """(line number, row) of a csv.reader; a row it refuses (a field past csv's size limit) is a
+    SymdynError naming its line."""
+    k = 0
+    while True:
+        k += 1
+        try:
+            row = next(rows)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            raise SymdynError(f"{where}: line {k}: {exc}") from None
+        yield k, row
 
 
 def needs_scipy(module: str):
@@ -242,4 +321,14 @@ def differentiate(
     if not (np.all(dt > 0) and np.ptp(dt) <= 1e-6 * np.mean(dt)):
         raise SymdynError(f"{where}: without qd and qdd columns the times t must be evenly spaced")
     h = float(np.mean(dt))
-    return tuple(savgol_filter(q, window, SG_ORDER, deriv=d, delta=h, axis=0) for d in orders)
+    with np.errstate(all="ignore"):
+        try:
+            out = tuple(savgol_filter(q, window, SG_ORDER, deriv=d, delta=h, axis=0) for d in orders)
+        except (ZeroDivisionError, OverflowError):  # delta ** 2 underflows to 0 for tiny steps
+            out = (np.array(np.inf),)
+    if not all(np.isfinite(x).all() for x in out):
+        raise SymdynError(
+            f"{where}: the Savitzky-Golay derivatives overflow (samples {h:g} s apart): give qd and qdd "
+            "columns, or times in seconds"
+        )
+    return out

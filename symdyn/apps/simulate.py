@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import SymdynError
+from ..model.quaternion_norm import check_quaternions, quaternion_norms
 from . import stepping
 from .compiled import CompiledDynamics, compiled_dynamics, with_parameters
 from .floating_stepping import floating_sizes, run_floating
@@ -338,9 +339,8 @@ def _floating(plant, sizes, q0, v0, duration, dt, tau, integrator) -> Trajectory
     v = np.zeros(nv) if v0 is None else _state(v0, nv, "qd0")
     if q.ndim != 1 or v.ndim != 1:
         raise SymdynError(f"robot '{plant.robot.name}' has a floating base: give one initial state")
-    if np.linalg.norm(q[3:7]) == 0:
-        raise SymdynError("q0: the base quaternion (entries 4 to 7) is zero")
-    q[3:7] /= np.linalg.norm(q[3:7])
+    check_quaternions(q, "q0")  # then a unit quaternion: the one the run's integrate keeps
+    q[3:7] /= quaternion_norms(q)
     t, h = sample_times(duration, dt)
     table = _torque_table(tau, nv, torque_rows(t, h))
     torque = torque_function(tau, nv) if table is None else None

@@ -32,7 +32,7 @@ from .common import METHODS, add_robot_argument, load_robot_argument
 #: A plain decimal number, read with float() instead of the expression parser (no SymPy needed).
 _PLAIN = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
-__all__ = ["COMMANDS", "cmd_simulate", "cmd_analyze", "cmd_check"]
+__all__ = ["COMMANDS", "cmd_simulate", "cmd_analyze", "cmd_check", "whole_number"]
 
 
 # --------------------------------------------------------------------------- argument helpers
@@ -306,7 +306,14 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     q = _vector(args.q, n, "--q")
     qd = _vector(args.qd, n, "--qd", default=np.zeros(n))
     limits = _numbers(args.torque_limits, "--torque-limits")
-    result = analyze(plant, q, qd, torque_limits=limits, axes=axes, frame=args.frame)
+    with np.errstate(all="ignore"):  # an overflow is reported below, in one line
+        result = analyze(plant, q, qd, torque_limits=limits, axes=axes, frame=args.frame)
+    computed = (result.V, result.G, result.F, result.v_vel, result.v_grav, result.manipulability.matrix)
+    if not all(np.isfinite(x).all() for x in (*computed, result.polytope.vertices)):
+        raise SymdynError(
+            "analyze: the velocity terms, the ellipsoid or the polytope are not finite at this state: "
+            "--qd or --torque-limits so large that their products overflow double precision"
+        )
     image = None
     if args.plot:
         if len(result.axes) != 2:
@@ -332,10 +339,10 @@ def cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from ..apps.check import check_answers
+    from ..apps.check import MAX_SAMPLES, check_answers
 
-    if args.samples < 1:
-        raise SymdynError("--samples must be at least 1")
+    if not 1 <= args.samples <= MAX_SAMPLES:
+        raise SymdynError(f"--samples {args.samples}: must be from 1 to {MAX_SAMPLES:,}")
     robot = load_robot_argument(args)
     report = check_answers(robot, args.answers, method=args.method, samples=args.samples)
     sys.stdout.write(report.text(verbose=args.verbose))
@@ -353,6 +360,22 @@ def _positive(text: str) -> float:
     if not np.isfinite(v) or v <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive number, got '{text}'")
     return v
+
+
+def whole_number(text: str) -> int:
+    """An integer option's value: a whole number, also written as a float ("1e6", "100.0"), so
+    that its range is checked (and named) by the command rather than refused as a spelling."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
+    if not (np.isfinite(v) and v == int(v)):
+        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'")
+    return int(v)
 
 
 #: The options of a vector: values separated by spaces (or commas, split by _words).
@@ -454,7 +477,9 @@ def _check_arguments(c: argparse.ArgumentParser) -> None:
     add_robot_argument(c)
     c.add_argument("answers", help="answers file (YAML)")
     c.add_argument("--method", choices=METHODS, default="newton-euler")
-    c.add_argument("--samples", type=int, default=16, help="random points for the numeric comparison")
+    c.add_argument(
+        "--samples", type=whole_number, default=16, help="random points for the numeric comparison"
+    )
     c.add_argument("--verbose", action="store_true", help="also list the entries that match")
     c.set_defaults(func=cmd_check)
 

@@ -19,6 +19,7 @@ import sys
 import numpy as np
 
 from ..errors import SymdynError
+from .apps import whole_number
 from .common import add_robot_argument, load_robot_argument
 
 __all__ = ["COMMANDS", "cmd_identify", "cmd_excite"]
@@ -99,8 +100,7 @@ def cmd_excite(args: argparse.Namespace) -> int:
     check_output(args.out, "--out")
     robot = _robot(args)
     n = robot.n
-    if not args.dt > 0:
-        raise SymdynError("--dt must be positive")
+    _check_excite_options(args)
     traj = excite(
         robot,
         q0=_per_joint(args.q0, n, "--q0"),
@@ -121,6 +121,27 @@ def cmd_excite(args: argparse.Namespace) -> int:
     )
     print("or, exactly: symdyn simulate ROBOT --track " + ",".join(traj.expressions()))
     return 0
+
+
+def _check_excite_options(args: argparse.Namespace) -> None:
+    """The options of `excite` in range, before the optimisation runs (excite checks them again)."""
+    from ..apps.excite import MAX_HARMONICS, MAX_SAMPLES, PERIOD_RANGE, csv_samples
+
+    for option, value, low, high in (
+        ("--harmonics", args.harmonics, 1, MAX_HARMONICS),
+        ("--samples", args.samples, 2, MAX_SAMPLES),
+        ("--evaluations", args.evaluations, 1, None),
+        ("--seed", args.seed, 0, None),
+    ):
+        if value < low or (high is not None and value > high):
+            bound = f"from {low} to {high:,}" if high is not None else f"at least {low}"
+            raise SymdynError(f"{option} {value}: must be {bound}")
+    low, high = PERIOD_RANGE
+    if not low <= args.period <= high:
+        raise SymdynError(f"--period {args.period:g}: must be from {low:g} to {high:g} s")
+    if not (np.isfinite(args.dt) and 0 < args.dt <= args.period):
+        raise SymdynError(f"--dt {args.dt:g}: must be positive and at most the period ({args.period:g} s)")
+    csv_samples(args.period, args.dt)
 
 
 def _identify_arguments(i: argparse.ArgumentParser) -> None:
@@ -145,11 +166,15 @@ def _excite_arguments(e: argparse.ArgumentParser) -> None:
     e.add_argument("--qd-max", **vec, help="largest |qd| per joint (default 1.5 rad/s, 0.3 m/s)")
     e.add_argument("--qdd-max", **vec, help="largest |qdd| per joint (default 3 rad/s^2, 1 m/s^2)")
     e.add_argument("--period", type=float, default=10.0, help="period T in s (default 10)")
-    e.add_argument("--harmonics", type=int, default=5, help="harmonics per joint (default 5)")
-    e.add_argument("--samples", type=int, default=100, help="samples per period for the condition number")
-    e.add_argument("--evaluations", type=int, default=1000, help="optimiser evaluations (default 1000)")
+    e.add_argument("--harmonics", type=whole_number, default=5, help="harmonics per joint (default 5)")
+    e.add_argument(
+        "--samples", type=whole_number, default=100, help="samples per period for the condition number"
+    )
+    e.add_argument(
+        "--evaluations", type=whole_number, default=1000, help="optimiser evaluations (default 1000)"
+    )
     e.add_argument("--dt", type=float, default=0.01, help="CSV sample spacing in s (default 0.01)")
-    e.add_argument("--seed", type=int, default=0, help="random starts (default 0)")
+    e.add_argument("--seed", type=whole_number, default=0, help="random starts (default 0)")
     e.add_argument("--params", nargs="+", help="values of free parameters (NAME=VALUE)")
     e.set_defaults(func=cmd_excite)
 

@@ -28,6 +28,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import SymdynError
+from ..model.quaternion_norm import check_quaternions
 from .frames import frame_state
 from .inputs import body_positions, body_rates, numeric_model, skew
 from .rnea import mass_matrix
@@ -171,6 +172,8 @@ def centroidal(robot, q, v=None, params=None) -> CentroidalState:
     v = np.zeros(robot.nv) if v is None else _vector(robot, v, robot.nv, "v")
     if robot.floating and np.linalg.norm(q[3:7]) == 0:
         raise SymdynError(f"centroidal: robot '{robot.name}': the base quaternion q[3:7] is zero")
+    if robot.floating:
+        check_quaternions(q, f"centroidal: robot '{robot.name}': q")
     bodies = _Bodies(robot, q, params)
     Ag = bodies.momentum(robot, np.eye(robot.nv))[0]
     drift = bodies.momentum(robot, v[:, None])[1][:, 0]

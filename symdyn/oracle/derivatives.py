@@ -40,6 +40,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..errors import SymdynError
+from ..model.quaternion_norm import check_quaternions
 from .floating import base_rotation
 from .inputs import skew
 from .rnea import mass_matrix, rnea
@@ -100,6 +101,7 @@ def integrate(robot, q, dq) -> np.ndarray:
     norm = np.linalg.norm(quat, axis=1)
     if np.any(norm == 0):
         raise SymdynError(f"integrate: robot '{robot.name}': the base quaternion q[3:7] is zero")
+    check_quaternions(Q, f"integrate: robot '{robot.name}': q")
     quat = quat / norm[:, None]
     u, w = D[:, :3], D[:, 3:6]
     t = np.linalg.norm(w, axis=1)
@@ -135,6 +137,8 @@ def rnea_derivatives(robot, q, v, a, params=None, *, gravity: bool = True) -> Rn
         raise SymdynError(f"rnea_derivatives: robot '{robot.name}': give one state (q, v, a), not a batch")
     if robot.floating and not np.any(q[0, 3:7]):
         raise SymdynError(f"rnea_derivatives: robot '{robot.name}': the base quaternion q[3:7] is zero")
+    if robot.floating:
+        check_quaternions(q[0], f"rnea_derivatives: robot '{robot.name}': q")
     nv = robot.nv
     E = np.eye(nv)
     steps = np.concatenate([E * STEP, -E * STEP, E * 2 * STEP, -E * 2 * STEP])

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SymdynError
+from ..model.quaternion_norm import check_quaternions
 from .inputs import NumericModel, body_positions, body_rates, checked_inputs, project
 from .recursions import body_crba, body_rnea, joint_friction
 from .spatial import crm, mv
@@ -41,7 +42,11 @@ def floating_inputs(where: str, robot, params, *named: tuple[str, object, str]):
     with kind "q" (NQ entries) or "v" (NV entries, for v, a and tau); as in checked_inputs."""
     mdl, _, _ = checked_inputs(where, robot, params)
     sizes = {"q": mdl.n + 7, "v": mdl.n + 6}
-    return checked_inputs(where, robot, params, *((n, x, sizes[k], _WHAT[k]) for n, x, k in named))
+    out = checked_inputs(where, robot, params, *((n, x, sizes[k], _WHAT[k]) for n, x, k in named))
+    for (name, _, kind), array in zip(named, out[1], strict=True):
+        if kind == "q":  # the norms whose square the generated code holds (symdyn.model.quaternion_norm)
+            check_quaternions(array[0] if out[2] else array, f"{where}: {name}")
+    return out
 
 
 def base_rotation(quat: np.ndarray) -> np.ndarray:
