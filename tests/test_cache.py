@@ -119,3 +119,12 @@ def test_a_read_only_cache_is_a_symdyn_error(tmp_path, monkeypatch):
             cache.get_or_build(cache.entry_key(test="ro"), _write)
     finally:
         os.chmod(root / "v1", 0o700)
+
+
+def test_a_manifest_of_deeply_nested_brackets_is_a_stale_entry(temporary_cache):
+    """json's reader raised RecursionError on 100,000 nested brackets; the entry is removed and rebuilt."""
+    key = cache.entry_key(test="nested")
+    folder = cache.cache_dir() / "v1" / key
+    folder.mkdir(parents=True)
+    (folder / "manifest.json").write_text("[" * 100_000 + "]" * 100_000)
+    assert cache.lookup(key) is None and not folder.exists()
