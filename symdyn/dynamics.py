@@ -56,7 +56,7 @@ from .algorithms.frames import joint_frames
 from .algorithms.lagrange import lagrange
 from .algorithms.newton_euler import newton_euler
 from .algorithms.operational_space import operational_space, task_rows
-from .algorithms.product_form import ProductForm, product_form
+from .algorithms.product_form import ProductForm, check_product_size, product_form
 from .algorithms.regressor import regressor as regressor_matrix
 from .algorithms.singular import SingularJoint, describe_singular, singular_joints
 from .algorithms.tendons import tendon_terms
@@ -239,6 +239,7 @@ class Dynamics:
 
     @cached_property
     def _product(self) -> ProductForm:
+        check_product_size(self.robot)  # before the configuration form is built
         return product_form(self.robot, self.configuration_space, self.closed_form("F"))
 
     def product_form(self) -> ProductForm:

@@ -194,3 +194,12 @@ def test_a_relative_cache_folder_is_taken_from_the_current_folder(tmp_path, monk
     entry = cache.get_or_build(cache.entry_key(test="relative"), build)
     assert entry.path.is_absolute() and entry.path.parent == tmp_path / "relative" / "cache" / "v1"
     assert _twice(entry.file("double.so")) == 2.5
+
+
+def test_a_manifest_of_deeply_nested_brackets_is_a_stale_entry(temporary_cache):
+    """json's reader raised RecursionError on 100,000 nested brackets; the entry is removed and rebuilt."""
+    key = cache.entry_key(test="nested")
+    folder = cache.cache_dir() / "v1" / key
+    folder.mkdir(parents=True)
+    (folder / "manifest.json").write_text("[" * 100_000 + "]" * 100_000)
+    assert cache.lookup(key) is None and not folder.exists()

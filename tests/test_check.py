@@ -286,3 +286,54 @@ def test_samples_out_of_range_are_one_line(capsys):
         assert line == f"symdyn: error: --samples {int(float(samples))}: must be from 1 to 100,000"
     with within(5), pytest.raises(SymdynError, match="samples must be a whole number from 1 to 100,000"):
         check_answers(load_robot(robot), answers, samples=10**9)
+
+
+# -- issue 34: answers bounded like robot files ---------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "entry, message",
+    [
+        # each exponent within 64, the product 65 * 65 * 47,905 terms once expanded: it hung
+        (
+            "sin(q1)**64*cos(q2)**64*(q1+q2+m1+m2)**64",
+            "would expand to 47,905 terms, more than the limit of 1,000",
+        ),
+        ("**".join(["q1"] * 99), "calls and powers are nested more than 20 deep"),  # RecursionError
+        ("(q1+q2+m1+m2+l1+l2)**-64", "would expand to 11,238,513 terms"),  # SymPy expands denominators
+    ],
+)
+def test_answers_that_would_expand_or_recurse_without_bound_are_refused(tmp_path, capsys, entry, message):
+    from timebound import refused
+
+    path = tmp_path / "answers.yaml"
+    path.write_text(yaml.safe_dump({"G[1]": entry}))
+    line = refused(capsys, "check", ROGER, path, seconds=10)
+    assert line.startswith(f"symdyn: error: {path}: field 'G[1]': ") and message in line
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("M: " + "[" * 100_000 + "]" * 100_000 + "\n", "invalid YAML: nested too deeply"),
+        ("G: &a [x]\nM: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n" + "".join(
+            f"k{i}: &c{i} [{', '.join([f'*c{i - 1}' if i else '*b'] * 9)}]\n" for i in range(8)
+        ), "the document expands to more than 100,000 nodes"),
+        ("G[1]: 1\nG[1]: 2\n", "duplicate key 'G[1]'"),
+    ],
+)  # fmt: skip
+def test_answer_files_are_read_as_robot_files_are(tmp_path, capsys, text, message):
+    """The answers file went to yaml.safe_load: deep nesting was a RecursionError, aliases unbounded."""
+    from timebound import refused
+
+    path = tmp_path / "answers.yaml"
+    path.write_text(text)
+    assert message in refused(capsys, "check", ROGER, path, seconds=10)
+
+
+def test_a_long_answer_within_the_bound_is_still_checked(roger):
+    """The lecture's G[1] plus a sum of 150 terms written out (refused before as nested 150 levels deep)."""
+    g1 = "(m1 + m2)*g*l1*sin(q1) + m2*g*l2*sin(q1 + q2)"
+    padding = " + ".join(f"{i}*m1 - {i}*m1" for i in range(75))
+    report = check_answers(roger, {"G": [f"{g1} + {padding}", None]})
+    assert report.ok and [r.status for r in report.results] == ["symbolic"]

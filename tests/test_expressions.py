@@ -274,3 +274,106 @@ def test_parameter_names(name, reason):
 def test_valid_parameter_names(name):
     assert check_parameter_name(name) == name
     assert parse_expression(name) == sp.Symbol(name)
+
+
+# -- issue 34: the size of what gets expanded, nesting, hostile literals --------------------------
+
+from timebound import refused, within  # noqa: E402
+
+from symdyn.model.bounded import MAX_ANSWER_TERMS, MAX_EXPANDED_TERMS, expanded_terms  # noqa: E402
+
+
+def _sympy_terms(text: str) -> int:
+    """The terms of the expression expanded by SymPy, sines and cosines of sums as exponentials."""
+    e = parse_expression(text, max_terms=10**6).rewrite(sp.exp)
+    return len(sp.Add.make_args(sp.expand(e)))
+
+
+@pytest.mark.parametrize(
+    "text", ["(a+b+c)**3", "(a+b)**2*(c+d)", "(a+b+c+d)**5", "(x+y)**-3", "sin(x)**6", "(a+b)*(a-b)"]
+)
+def test_the_expansion_estimate_bounds_what_sympy_expands(text):
+    """An upper bound, and the multinomial count where no terms cancel: C(t + k - 1, k) for (a+b+c)**3."""
+    assert expanded_terms(parse_expression(text), 10**6, SymdynError) >= _sympy_terms(text)
+    for exact in ("(a+b+c)**3", "(a+b+c+d)**5"):
+        assert expanded_terms(parse_expression(exact), 100, SymdynError) == _sympy_terms(exact)
+    assert _sympy_terms("(a+b+c)**3") == 10
+
+
+def test_a_product_of_capped_powers_is_refused_naming_the_field_and_the_limit():
+    """Each exponent is within 64, but the product would expand to 47,905**2 terms (it hung)."""
+    with within(3), pytest.raises(SymdynError) as info:
+        parse_expression("(a+b+c+d)**64*(e+f+g+h)**64", file="f.yaml", field="com.x")
+    message = str(info.value)
+    assert message.startswith("f.yaml: field 'com.x': '(a + b + c + d)**64' would expand to 47,905 terms")
+    assert f"limit of {MAX_EXPANDED_TERMS}" in message
+    with within(3), pytest.raises(SymdynError, match=f"limit of {MAX_ANSWER_TERMS:,}"):
+        parse_expression(
+            "sin(q1)**64*cos(q2)**64*(q1+q2+m1+m2)**64", allow_joint_symbols=True, max_terms=MAX_ANSWER_TERMS
+        )
+
+
+def test_a_robot_file_with_a_product_of_capped_powers_is_refused_in_one_line(tmp_path, capsys):
+    text = (Path(__file__).resolve().parents[1] / "examples" / "roger_arm.yaml").read_text()
+    path = tmp_path / "com.yaml"
+    path.write_text(text.replace("com: [0, 0, 0]", "com: ['(a+b+c+d)**64*(e+f+g+h)**64', 0, 0]", 1))
+    line = refused(capsys, "derive", path, seconds=10)
+    assert f"{path}: link 1 (upper_arm): field 'com.x': " in line and "limit of 100" in line
+
+
+def test_a_parameter_value_that_completes_a_large_expansion_is_refused():
+    """x: a+b+c+d and mass: x**64 pass each on its own; substituted they are (a+b+c+d)**64."""
+    data = {
+        "name": "t",
+        "parameters": {"x": "a+b+c+d"},
+        "links": [
+            {"name": "l", "joint": "revolute", "a": 1, "alpha": 0, "d": 0, "theta": 0, "mass": "x**64",
+             "com": [0, 0, 0], "inertia": {"ixx": 0, "iyy": 0, "izz": 0, "ixy": 0, "ixz": 0, "iyz": 0}}
+        ],
+    }  # fmt: skip
+    from symdyn.parsers.robot_file import robot_from_data
+
+    with within(5), pytest.raises(SymdynError, match=r"field 'mass'.*47,905 terms.*after substituting"):
+        robot_from_data(data, "f.yaml")
+
+
+def test_a_long_sum_is_one_level_of_nesting():
+    """150 terms written out were refused as nested 150 levels deep; a chain is one level."""
+    names = sp.symbols("v0:150")
+    assert parse_expression(" + ".join(map(str, names))) == sp.Add(*names)
+    assert parse_expression(" * ".join(map(str, names[:40])) + " / v149") == sp.Mul(*names[:40]) / names[149]
+    assert parse_expression("v1 - v2 + v3 - v4") == names[1] - names[2] + names[3] - names[4]
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "**".join(["x"] * 99),  # x**x**...: SymPy's recursion broke `check` after 21 s
+        "sin(" * 99 + "x" + ")" * 99,
+        "tan(" * 30 + "x" + ")" * 30,
+        "sqrt(" * 25 + "x" + ")" * 25,
+        "(" * 30 + "x" + "**y)" * 30,
+    ],
+)
+def test_calls_and_powers_nested_deeply_are_refused(text):
+    with within(2), pytest.raises(SymdynError, match="calls and powers are nested more than 20 deep"):
+        parse_expression(text, field="mass")
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("x+" * 500_000 + "x", "longer than 2000 characters"),
+        ("١٢٣", r"invalid character '١' \(U\+0661\)"),
+        ("x²", "invalid character"),
+        ("1e400", "not finite"),
+        ("0**-1", "division by zero"),
+        ("10**10**10", "exponent 10000000000"),
+        ("x/(y-y)", "division by zero"),
+    ],
+)
+def test_hostile_literals_are_refused_quickly(text, message):
+    """The same parser reads robot files and check's answers (allow_joint_symbols)."""
+    for answer in (False, True):
+        with within(2), pytest.raises(SymdynError, match=message):
+            parse_expression(text, field="mass", allow_joint_symbols=answer)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 import pytest
+import sympy as sp
 import yaml
 from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction
 
@@ -125,3 +126,27 @@ def test_compile_checks_its_values_before_building(roger, tmp_path, monkeypatch)
     with pytest.raises(SymdynError, match="symdyn.compile: parameter m2 must be finite"):
         symdyn.compile(roger, {**GOOD, "m2": math.inf})
     assert not any(tmp_path.iterdir())  # refused before anything was built
+
+
+def test_a_run_time_value_that_divides_by_zero_says_so(tmp_path):
+    """mass: x/y with y = 0 was reported as "mass zoo is not a real number"; com too."""
+    text = (EXAMPLES_DIR / "roger_arm.yaml").read_text()
+    robot = symdyn.load_robot(_write(tmp_path / "xy.yaml", text.replace("mass: m2", "mass: x/y")))
+    with pytest.raises(SymdynError) as info:
+        with_parameters(robot, {"x": 1, "y": 0})
+    assert str(info.value) == (
+        "parameter y = 0: link 2 (forearm): field 'mass': division by zero: "
+        "the values make mass = x/y infinite"
+    )
+    fine = with_parameters(robot, {"x": 1, "y": 4})
+    assert float(sp.sympify(fine.links[1].mass).xreplace(fine.value_map)) == 0.25
+    com = text.replace("com: [0, 0, 0]", "com: [x/y, 0, 0]")
+    robot = symdyn.load_robot(_write(tmp_path / "com.yaml", com))
+    where = r"parameter y = 0: link 1 \(upper_arm\): field 'com': division by zero"
+    with pytest.raises(SymdynError, match=where):
+        with_parameters(robot, {"x": 1, "y": 0})
+
+
+def _write(path, text: str):
+    path.write_text(text)
+    return path

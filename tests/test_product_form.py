@@ -289,3 +289,48 @@ def test_puma_latex_compiles(tmp_path):
     proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stdout[-3000:]
     assert "Undefined control sequence" not in proc.stdout
+
+
+def _dh_chain(n: int) -> dict:
+    """A numeric standard-DH chain of n revolute joints, every other twist pi/2."""
+    link = {"joint": "revolute", "a": 0.3, "d": 0.1, "theta": 0, "mass": 1.0, "com": [0.1, 0.02, 0.01],
+            "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.015, "ixy": 0, "ixz": 0, "iyz": 0}}  # fmt: skip
+    links = [{**link, "name": f"l{i + 1}", "alpha": "pi/2" if i % 2 == 0 else 0} for i in range(n)]
+    return {"name": f"arm{n}", "convention": "standard", "gravity": [0, 0, -9.81], "links": links}
+
+
+def test_a_12_joint_arm_is_refused_within_seconds_pointing_to_compact(tmp_path, capsys):
+    """It ended in an internal MemoryError after 131 s; the limit is checked before anything is built."""
+    import yaml
+    from timebound import refused, within
+
+    from symdyn.algorithms.product_form import MAX_PRODUCT_JOINTS
+    from symdyn.errors import SymdynError
+    from symdyn.parsers.robot_file import robot_from_data
+
+    path = tmp_path / "arm12.yaml"
+    path.write_text(yaml.safe_dump(_dh_chain(12)))
+    for extra in ([], ["--lumped", "--format", "json"], ["--format", "latex"]):
+        line = refused(capsys, "derive", path, "--form", "product", *extra, seconds=10)
+        assert line == (
+            f"symdyn: error: the product form is limited to chains of {MAX_PRODUCT_JOINTS} joints and "
+            "robot 'arm12' has one of 12 (it grows about threefold with each joint); use --form compact "
+            "(the dynamics as named intermediates)"
+        )
+    dyn = derive(robot_from_data(_dh_chain(12), "arm12.yaml"))
+    with within(5), pytest.raises(SymdynError, match="limited to chains of 10 joints"):
+        dyn.product_form()
+
+
+def test_a_configuration_form_beyond_the_terms_bound_is_refused(monkeypatch):
+    """Under the joint limit, a form larger than MAX_PRODUCT_TERMS is refused once its size is known."""
+    from symdyn.algorithms import product_form as module
+    from symdyn.errors import SymdynError
+
+    dyn = derived("puma560", "newton-euler")
+    terms = dyn.configuration_space.terms
+    assert terms == 1198  # docs/speed.md; the bound is checked against it
+    module.check_product_size(dyn.robot, dyn.configuration_space)
+    monkeypatch.setattr(module, "MAX_PRODUCT_TERMS", terms - 1)
+    with pytest.raises(SymdynError, match=f"limited to configuration forms of {terms - 1:,} terms"):
+        module.product_form(dyn.robot, dyn.configuration_space, dyn.closed_form("F"))

@@ -85,3 +85,21 @@ def test_integers_with_thousands_of_digits_are_refused_in_one_line(text, message
     """Python's int() refuses more than 4300 digits with a ValueError (an internal error before)."""
     with within(5), pytest.raises(SymdynError, match=message):
         parse_text(text, "f.yaml")
+
+
+def test_a_plain_file_larger_than_the_bound_is_no_alias_bomb():
+    """21,000 frames written out plainly are 105,000 nodes, more than the bound, and no alias
+    adds any: read as written (a file of 30,000 frames was refused as an alias bomb)."""
+    frames = [{"name": f"f{i}", "link": "forearm"} for i in range(21_000)]
+    text = "frames:\n" + "".join(f"  - {{name: {f['name']}, link: {f['link']}}}\n" for f in frames)
+    assert 5 * len(frames) > MAX_EXPANDED_NODES
+    with within(60):
+        assert parse_text(text, "f.yaml") == {"frames": frames}
+
+
+def test_an_alias_bomb_inside_a_large_plain_file_is_still_refused():
+    """The plain nodes around it do not pay for what the aliases add."""
+    plain = "".join(f"p{i}: [{i}, {i}, {i}]\n" for i in range(5_000))
+    match = "expands to more than 100,000 nodes beyond those written"
+    with within(20), pytest.raises(SymdynError, match=match):
+        parse_text(plain + alias_bomb(6), "f.yaml")

@@ -10,6 +10,13 @@ factored Horner-like and with equal or opposite pieces shared under names x1, x2
 (symdyn.algorithms.configuration_space), only written differently: `check` substitutes the
 atoms and shared quantities back and compares.
 
+Its size is bounded (`check_product_size`): at most MAX_PRODUCT_JOINTS = 10 joints in a chain
+(from the base to a leaf: the branches of a tree, the legs of a quadruped, hardly couple), refused
+before anything is derived, and a configuration form of at most MAX_PRODUCT_TERMS = 250,000 terms
+(the Panda's is 228,647 and takes about 20 s). A chain's form grows about threefold with each
+joint: a 12-joint arm ran out of memory after minutes. Beyond, `derive --form compact` prints
+the dynamics as named intermediates.
+
 References: Armstrong, Khatib, Burdick, "The explicit dynamic model and inertial
 parameters of the PUMA 560 arm", Proc. IEEE ICRA 1986 (the PUMA 560 in 1,165 operations over
 c_i, s_i, c_23, s_23 and named constants); Craig, Introduction to Robotics (3rd ed., 2005),
@@ -22,16 +29,49 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from ..errors import SymdynError
 from ..model.robot import Robot
 from ..symbolic.atom_polynomial import Atoms
 from ..symbolic.horner import Factoring
 from ..symbolic.trig_polynomial import TrigRing, chop, largest
 from .configuration_space import ConfigurationSpace, pair_columns
 
-__all__ = ["ProductForm", "product_form", "parallel_groups", "MATRICES"]
+__all__ = [
+    "ProductForm",
+    "product_form",
+    "parallel_groups",
+    "check_product_size",
+    "MATRICES",
+    "MAX_PRODUCT_JOINTS",
+    "MAX_PRODUCT_TERMS",
+]
 
 #: the quantities of the product form, in printed order
 MATRICES = ("M", "B", "Csq", "G", "F")
+#: the most joints of a chain (base to leaf) a product form is built for, checked before anything is derived
+MAX_PRODUCT_JOINTS = 10
+#: the most terms of the configuration form a product form is built from (the Panda: 228,647)
+MAX_PRODUCT_TERMS = 250_000
+_INSTEAD = "use --form compact (the dynamics as named intermediates)"
+
+
+def check_product_size(robot: Robot, cs: ConfigurationSpace | None = None) -> None:
+    """Refuse a product form beyond MAX_PRODUCT_JOINTS joints in a chain or, given the configuration
+    form `cs`, beyond MAX_PRODUCT_TERMS of its terms: building it would take minutes and gigabytes."""
+    depth: list[int] = []
+    for parent in robot.parents:  # a parent comes before its children
+        depth.append(1 + (depth[parent] if parent >= 0 else 0))
+    longest = max(depth, default=0)
+    if longest > MAX_PRODUCT_JOINTS:
+        raise SymdynError(
+            f"the product form is limited to chains of {MAX_PRODUCT_JOINTS} joints and robot "
+            f"'{robot.name}' has one of {longest} (it grows about threefold with each joint); {_INSTEAD}"
+        )
+    if cs is not None and cs.terms > MAX_PRODUCT_TERMS:
+        raise SymdynError(
+            f"the product form is limited to configuration forms of {MAX_PRODUCT_TERMS:,} terms and "
+            f"robot '{robot.name}' has {cs.terms:,} (factoring them would take minutes); {_INSTEAD}"
+        )
 
 
 def _parallel(robot: Robot, child: int, parent: int) -> bool:
@@ -149,7 +189,11 @@ def product_form(robot: Robot, cs: ConfigurationSpace, F) -> ProductForm:
     Returns:
         The `ProductForm`: atoms used (c before s, single joints by index, then blocks),
         shared quantities, and the entries factored and shared.
+
+    Raises:
+        SymdynError: beyond the size `check_product_size` allows.
     """
+    check_product_size(robot, cs)
     groups = parallel_groups(robot)
     taken = {sp.sstr(g) for g in cs.ring.gens} | {str(s) for s in robot.params}
     atoms = Atoms(cs.ring, groups, taken)

@@ -176,8 +176,8 @@ def _verified(folder: Path, key: str, load: Callable[[dict], Iterable[str]] | No
             return None
         entry.checked.update(names)
         return entry
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        return None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
+        return None  # RecursionError: json's reader on a manifest of deeply nested brackets
 
 
 def _remove(folder: Path) -> None:

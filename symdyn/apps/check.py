@@ -38,13 +38,14 @@ from pathlib import Path
 
 import numpy as np
 import sympy as sp
-import yaml
 
 from ..dynamics import METHODS, derive
 from ..errors import SymdynError
+from ..model.bounded import MAX_ANSWER_TERMS
 from ..model.expressions import parse_expression
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
+from ..parsers.yaml_text import parse_text
 from .check_explain import SIMPLIFY_MAX_OPS, asymmetry_notes, chop, derive_form, difference_text
 from .check_state import AT_KEY, TOLERANCE_KEY, compare_at_state
 from .check_steps import check_steps
@@ -84,8 +85,11 @@ def _entry_label(name: str, index: tuple[int, ...]) -> str:
 
 
 def _parse_entry(value: object, file: str | None, label: str) -> sp.Expr:
-    """Parse one answer entry, letting the joint symbols q<k>, qd<k>, qdd<k> through."""
-    return parse_expression(value, file=file, field=label, allow_joint_symbols=True)
+    """Parse one answer entry, letting the joint symbols q<k>, qd<k>, qdd<k> through, and
+    refusing one that would expand to more than MAX_ANSWER_TERMS terms."""
+    return parse_expression(
+        value, file=file, field=label, allow_joint_symbols=True, max_terms=MAX_ANSWER_TERMS
+    )
 
 
 def _entry_key(key: object) -> tuple[str, tuple[int, ...]] | None:
@@ -200,19 +204,14 @@ def answer_entry(value: object, robot: Robot, file: str | None, label: str) -> s
 
 
 def read_answers(path: str | os.PathLike) -> object:
-    """The data of an answers file (YAML, safe loader)."""
+    """The data of an answers file: YAML read as robot files are (symdyn.parsers.yaml_text: safe
+    loader, repeated keys, deep nesting and aliases that expand too far refused in one line)."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
         raise SymdynError(f"not a UTF-8 text file: {exc.reason}", file=str(p)) from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or "invalid YAML"
-        raise SymdynError(f"invalid YAML{where}: {problem}", file=str(p)) from None
+    return parse_text(text, str(p))
 
 
 def load_answers(path: str | os.PathLike, robot: Robot) -> dict[str, dict[tuple[int, ...], sp.Expr]]:

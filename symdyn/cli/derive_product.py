@@ -12,6 +12,9 @@ entries of B and Csq, G and F over them.
 JSON: keys `atoms` and `shared` (name -> expression, in the order defined), `M` (rows), `B`,
 `Csq` (rows), `G`, `F` (lists), every string read by sympy.sympify.
 
+Beyond MAX_PRODUCT_JOINTS joints (or MAX_PRODUCT_TERMS terms of the configuration form) it is
+refused, pointing to --form compact (symdyn.algorithms.product_form.check_product_size).
+
 With `lumped` (`derive --form product --lumped`) the coefficients are the lumped constants of
 `derive --lumped` (symdyn.lumped.lumped_product_form: named by value, or over the base
 parameters when the inertial data is symbolic), defined after the atoms as `derive --lumped`
@@ -25,7 +28,7 @@ import json
 import sympy as sp
 
 from ..algorithms.configuration_space import pair_columns
-from ..algorithms.product_form import ProductForm
+from ..algorithms.product_form import ProductForm, check_product_size
 from ..dynamics import Dynamics
 from ..lumped import LumpedConstants, lumped_product_form
 from ..symbolic.horner import product_text as text
@@ -51,6 +54,7 @@ def _groups_note(dyn: Dynamics, pf: ProductForm) -> str:
 
 
 def _form(dyn: Dynamics, lumped: bool) -> tuple[ProductForm, LumpedConstants | None]:
+    check_product_size(dyn.robot)  # within seconds: before the configuration form is built
     return lumped_product_form(dyn) if lumped else (dyn.product_form(), None)
 
 

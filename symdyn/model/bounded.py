@@ -13,7 +13,12 @@ the expression node by node and checks each power before SymPy evaluates it):
   = 4096 bits (MAX_ROOT_BITS = 256 for a root: exact roots of huge integers make SymPy factorise);
 * every rational number has a numerator and a denominator of at most MAX_NUMBER_BITS = 8192 bits;
 * every number is at most MAX_MAGNITUDE = 1e150 in absolute value (a robot has no quantity near
-  it, and products of two such numbers stay finite as doubles), and floats are finite.
+  it, and products of two such numbers stay finite as doubles), and floats are finite;
+* the expression, and every part of it, expands to at most MAX_EXPANDED_TERMS = 100 terms, or
+  to as many as it has nodes when it is written out longer (`expanded_terms`, an upper bound
+  computed from the factors' term counts and the exponents before anything is expanded: each
+  exponent is capped, but (a+b+c+d)**64*(e+f+g+h)**64 would expand to 2.3e9 terms); answers of
+  `symdyn check` are allowed MAX_ANSWER_TERMS = 1000.
 
 A violation is one SymdynError naming the file, the link and the field (through `fail`).
 """
@@ -34,8 +39,12 @@ __all__ = [
     "MAX_ROOT_BITS",
     "MAX_NUMBER_BITS",
     "MAX_MAGNITUDE",
+    "MAX_EXPANDED_TERMS",
+    "MAX_ANSWER_TERMS",
     "check_power",
     "check_bounded",
+    "check_expansion",
+    "expanded_terms",
     "bounded_subs",
 ]
 
@@ -44,6 +53,12 @@ MAX_POWER_BITS = 4096
 MAX_ROOT_BITS = 256
 MAX_NUMBER_BITS = 8192
 _MAX_MAGNITUDE_INT = 10**150
+#: Most terms a robot-file expression (or any part of it) may expand to: a derivation multiplies
+#: the fields of a link together, so a field of 100 terms already gives entries of 10,000.
+MAX_EXPANDED_TERMS = 100
+#: Most terms an answer of `symdyn check` may expand to (the expanded difference is compiled with
+#: sympy.lambdify, whose sums of 3000 terms break Python's compiler).
+MAX_ANSWER_TERMS = 1000
 
 Fail = Callable[[str], SymdynError]
 
@@ -104,9 +119,64 @@ def check_bounded(expr: sp.Expr, fail: Fail) -> None:
             raise fail(problem)
 
 
+def _count(n: int) -> str:
+    return f"{n:,}" if n < 10**12 else f"about 10**{len(str(n)) - 1}"
+
+
+def expanded_terms(expr: sp.Expr, limit: int, fail: Fail) -> int:
+    """An upper bound on the terms of `expr` expanded, or `fail` once `expr` or a part of it exceeds `limit`.
+
+    Counted bottom-up without expanding: a sum has the terms of its summands, a product the
+    product of its factors' counts, base**k (k an integer, or the integer part of a rational
+    exponent, in absolute value: SymPy expands denominators too) at most C(t + k - 1, k) for a
+    base of t terms (the monomials of degree k in t variables), a sine or cosine two (the
+    exponentials e^(ix), e^(-ix): sin(x)**64 expands to 65 terms over angles k x); numbers,
+    symbols, other functions and powers with a symbolic exponent one.
+    """
+    memo: dict[sp.Basic, int] = {}
+
+    def terms(node: sp.Basic) -> int:
+        done = memo.get(node)
+        if done is not None:
+            return done
+        counts = [terms(a) for a in node.args]
+        if node.is_Add:
+            n = sum(counts)
+        elif node.is_Mul:
+            n = 1
+            for c in counts:
+                n *= c
+                if n > limit:
+                    break
+        elif node.is_Pow and node.exp.is_Rational:
+            k = abs(int(node.exp))
+            n = math.comb(counts[0] + k - 1, k) if k else 1
+        elif isinstance(node, (sp.sin, sp.cos)):
+            n = 2
+        else:
+            n = 1
+        if n > limit:
+            raise fail(
+                f"'{_short(str(node))}' would expand to {_count(n)} terms, more than the limit of "
+                f"{limit:,} (counted from its factors' terms and exponents)"
+            )
+        memo[node] = n
+        return n
+
+    return terms(expr)
+
+
+def check_expansion(expr: sp.Expr, fail: Fail, limit: int = MAX_EXPANDED_TERMS) -> None:
+    """Refuse `expr` if it or a part of it would expand to more than `limit` terms (`expanded_terms`),
+    or than its own nodes when it has more (a sum written out term by term is no expansion)."""
+    size = sum(1 for _ in sp.preorder_traversal(expr))
+    expanded_terms(expr, max(limit, size), fail)
+
+
 def bounded_subs(expr: sp.Expr, mapping: Mapping[sp.Basic, sp.Expr], fail: Fail) -> sp.Expr:
-    """expr.xreplace(mapping), every power checked (`check_power`) before SymPy evaluates it and
-    every rebuilt node checked against the bounds of this module."""
+    """expr.xreplace(mapping), every power checked (`check_power`) before SymPy evaluates it,
+    every rebuilt node checked against the bounds of this module and the result's expansion
+    (`check_expansion`)."""
     if not mapping:
         return expr
     memo: dict[sp.Basic, sp.Expr] = {}
@@ -133,6 +203,9 @@ def bounded_subs(expr: sp.Expr, mapping: Mapping[sp.Basic, sp.Expr], fail: Fail)
         return out
 
     try:
-        return walk(expr)
+        out = walk(expr)
     except RecursionError:
         raise fail("expression is nested too deeply after substituting parameters") from None
+    if out is not expr:
+        check_expansion(out, lambda message: fail(f"{message}, after substituting parameters"))
+    return out

@@ -10,11 +10,13 @@ ever passed to ``eval``, ``exec`` or ``sympify``, so loading a file never
 executes code from it.
 
 Limits that keep a hostile file from hanging the loader: text at most
-2000 characters, nesting depth at most 100, integer literals at most 30
+2000 characters, nesting depth at most 100 (a chain such as a + b - c + ... or a*b/c*... counts
+as one level, however long), calls and powers nested at most 20 deep inside each other
+(SymPy recurses several frames per level of sin(sin(...)) or x**x**...), integer literals at most 30
 digits, and the bounds of `symdyn.model.bounded` on the result (exponents at most 64 in
 absolute value once SymPy has merged powers of powers, numeric powers of at most 4096 bits,
-256 bits under a root, numbers at most 1e150 in absolute value). Division by zero,
-non-finite and non-real results are errors.
+256 bits under a root, numbers at most 1e150 in absolute value, at most 100 terms once expanded,
+1000 for an answer of `symdyn check`). Division by zero, non-finite and non-real results are errors.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from collections.abc import Callable
 import sympy as sp
 
 from ..errors import SymdynError
-from .bounded import MAX_EXPONENT, check_bounded, check_power
+from .bounded import MAX_EXPANDED_TERMS, MAX_EXPONENT, check_bounded, check_expansion, check_power
 
 __all__ = [
     "parse_expression",
@@ -39,12 +41,14 @@ __all__ = [
     "RESERVED_NAMES",
     "MAX_TEXT_LENGTH",
     "MAX_DEPTH",
+    "MAX_CALL_DEPTH",
     "MAX_EXPONENT",
     "MAX_INT_DIGITS",
 ]
 
 MAX_TEXT_LENGTH = 2000
 MAX_DEPTH = 100
+MAX_CALL_DEPTH = 20
 MAX_INT_DIGITS = 30
 
 _FUNCTIONS: dict[str, Callable[[sp.Expr], sp.Expr]] = {
@@ -82,6 +86,8 @@ _BINOPS = {
     ast.Div: "/",
     ast.Pow: "**",
 }
+#: the operators whose left-nested chains (a + b - c + ...) are built in one loop, as one level
+_CHAINS = {"+": ("+", "-"), "-": ("+", "-"), "*": ("*", "/"), "/": ("*", "/")}
 
 _DESCRIBE = {
     ast.Attribute: "attribute access",
@@ -178,24 +184,27 @@ class _Builder:
             "+ - * / **, parentheses, sin, cos, tan, sqrt and pi"
         )
 
-    def build(self, node: ast.AST, depth: int = 0) -> sp.Expr:
+    def build(self, node: ast.AST, depth: int = 0, calls: int = 0) -> sp.Expr:
+        """The SymPy object of `node`, `depth` levels and `calls` calls or powers deep."""
         if depth > MAX_DEPTH:
             raise self.fail(f"expression is nested more than {MAX_DEPTH} levels deep")
+        if calls > MAX_CALL_DEPTH:
+            raise self.fail(f"calls and powers are nested more than {MAX_CALL_DEPTH} deep inside each other")
         if isinstance(node, ast.Constant):
             return self._constant(node)
         if isinstance(node, ast.Name):
             return self._name(node)
         if isinstance(node, ast.UnaryOp):
             if isinstance(node.op, ast.USub):
-                return -self.build(node.operand, depth + 1)
+                return -self.build(node.operand, depth + 1, calls)
             if isinstance(node.op, ast.UAdd):
-                return self.build(node.operand, depth + 1)
+                return self.build(node.operand, depth + 1, calls)
             op = {ast.Not: "'not'", ast.Invert: "'~'"}.get(type(node.op), "unary operator")
             raise self._refuse(node, f"operator {op}")
         if isinstance(node, ast.BinOp):
-            return self._binop(node, depth)
+            return self._binop(node, depth, calls)
         if isinstance(node, ast.Call):
-            return self._call(node, depth)
+            return self._call(node, depth, calls)
         raise self._refuse(node)
 
     def _constant(self, node: ast.Constant) -> sp.Expr:
@@ -220,7 +229,8 @@ class _Builder:
         self.names.append(name)
         return sp.Symbol(name)
 
-    def _binop(self, node: ast.BinOp, depth: int) -> sp.Expr:
+    def _operator(self, node: ast.BinOp) -> str:
+        """The operator of `node` (+ - * / **), or refuse it."""
         op = _BINOPS.get(type(node.op))
         if op is None:
             sym = {
@@ -234,25 +244,39 @@ class _Builder:
                 ast.BitOr: "'|'",
             }.get(type(node.op), "binary operator")
             raise self._refuse(node, f"operator {sym}")
-        left = self.build(node.left, depth + 1)
-        right = self.build(node.right, depth + 1)
+        return op
+
+    def _binop(self, node: ast.BinOp, depth: int, calls: int) -> sp.Expr:
+        op = self._operator(node)
+        if op == "**":
+            left = self.build(node.left, depth + 1, calls + 1)
+            return self._power(node, left, self.build(node.right, depth + 1, calls + 1))
+        # a left-nested chain a + b - c + ... (or a * b / c ...) is one level, built in a loop
+        chain = [node]
+        while isinstance(chain[-1].left, ast.BinOp) and self._operator(chain[-1].left) in _CHAINS[op]:
+            chain.append(chain[-1].left)
+        out = self.build(chain[-1].left, depth + 1, calls)
+        for link in reversed(chain):
+            right = self.build(link.right, depth + 1, calls)
+            out = self._apply(link, self._operator(link), out, right)
+        return out
+
+    def _apply(self, node: ast.BinOp, op: str, left: sp.Expr, right: sp.Expr) -> sp.Expr:
         if op == "+":
             return left + right
         if op == "-":
             return left - right
         if op == "*":
             return left * right
-        if op == "/":
-            if right.is_zero:
-                raise self.fail(f"division by zero in '{self._segment(node)}'")
-            return left / right
-        return self._power(node, left, right)
+        if right.is_zero:
+            raise self.fail(f"division by zero in '{self._segment(node)}'")
+        return left / right
 
     def _power(self, node: ast.AST, base: sp.Expr, exponent: sp.Expr) -> sp.Expr:
         check_power(base, exponent, self.fail, self._segment(node))
         return base**exponent
 
-    def _call(self, node: ast.Call, depth: int) -> sp.Expr:
+    def _call(self, node: ast.Call, depth: int, calls: int) -> sp.Expr:
         func = node.func
         if not isinstance(func, ast.Name) or func.id not in _FUNCTIONS:
             name = self._segment(func) or type(func).__name__
@@ -262,7 +286,7 @@ class _Builder:
         if len(node.args) != 1 or isinstance(node.args[0], ast.Starred):
             seg = self._segment(node)
             raise self.fail(f"'{func.id}' takes exactly one positional argument (in '{seg}')")
-        arg = self.build(node.args[0], depth + 1)
+        arg = self.build(node.args[0], depth + 1, calls + 1)
         if func.id == "sqrt":
             return self._power(node, arg, sp.S.Half)
         return _FUNCTIONS[func.id](arg)
@@ -298,6 +322,7 @@ def parse_expression_names(
     link_name: str | None = None,
     field: str | None = None,
     allow_joint_symbols: bool = False,
+    max_terms: int = MAX_EXPANDED_TERMS,
 ) -> tuple[sp.Expr, tuple[str, ...]]:
     """Parse like `parse_expression`; also return the parameter names in textual order.
 
@@ -305,6 +330,7 @@ def parse_expression_names(
     without repeats), even if they cancel in the result ("x - x").
     With allow_joint_symbols=True the joint symbols q<k>, qd<k>, qdd<k> (k >= 1) are
     accepted as names too (answer files of `symdyn check`); robot files never pass it.
+    max_terms: the most terms the expression may expand to (symdyn.model.bounded.expanded_terms).
     """
     fail = _fail_factory(file, link_index, link_name, field)
     if isinstance(value, bool):
@@ -331,6 +357,7 @@ def parse_expression_names(
     builder = _Builder(text, fail, allow_joint_symbols)
     expr = builder.build(tree.body)
     check_bounded(expr, fail)
+    check_expansion(expr, fail, max_terms)
     if expr.has(sp.zoo, sp.oo, -sp.oo, sp.nan):
         raise fail(f"expression '{_short(text)}' is not finite ({expr})")
     if expr.has(sp.I):
@@ -346,6 +373,7 @@ def parse_expression(
     link_name: str | None = None,
     field: str | None = None,
     allow_joint_symbols: bool = False,
+    max_terms: int = MAX_EXPANDED_TERMS,
 ) -> sp.Expr:
     """Parse a number (int/float from YAML) or an expression string into a SymPy expression.
 
@@ -360,6 +388,7 @@ def parse_expression(
         link_name=link_name,
         field=field,
         allow_joint_symbols=allow_joint_symbols,
+        max_terms=max_terms,
     )
     return expr
 

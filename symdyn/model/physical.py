@@ -88,6 +88,7 @@ def check_values(robot: Robot, values: Mapping[sp.Symbol, float], where: str = "
         if not used:
             continue
         try:
+            _check_finite(link, mapping, i + 1)
             check_link_numbers(
                 _plain(sp.sympify(link.mass).xreplace(mapping)),
                 link.inertia.xreplace(mapping),
@@ -105,10 +106,29 @@ def check_values(robot: Robot, values: Mapping[sp.Symbol, float], where: str = "
             )
         except SymdynError as e:
             culprits = _closure(_symbols(link, e.field), depends) & set(numbers)
+            if e.reason.startswith(_DIVISION):  # name the parameters that are zero
+                culprits = {p for p in culprits if float(values[p]) == 0} or culprits
             used = culprits or used
             given = ", ".join(f"{p} = {float(values[p]):g}" for p in sorted(used, key=str))
             noun = "parameters" if len(used) > 1 else "parameter"
             raise SymdynError(f"{prefix}{noun} {given}: {e}") from None
+
+
+_DIVISION = "division by zero"
+
+
+def _check_finite(link, mapping: Mapping[sp.Symbol, sp.Expr], index: int) -> None:
+    """Refuse a field of the link that the values make infinite (x/y with y = 0 is SymPy's zoo)."""
+    for field, value in _fields(link).items():
+        v = sp.sympify(value)
+        if v.free_symbols & set(mapping) and v.xreplace(mapping).has(sp.zoo, sp.oo, -sp.oo, sp.nan):
+            written = value if not isinstance(value, sp.MatrixBase) else list(value)
+            raise SymdynError(
+                f"{_DIVISION}: the values make {field} = {written} infinite",
+                field=field,
+                link_index=index,
+                link_name=link.name,
+            )
 
 
 def _plain(x: sp.Expr):
@@ -127,17 +147,25 @@ def _closure(symbols: set, depends: Mapping[sp.Symbol, set]) -> set:
     return out
 
 
-def _symbols(link, field: str | None = None) -> set:
-    """The free symbols of the link's physical numbers (mass, inertia, friction, motor), or of
-    the one `field` (as SymdynError.field names it) when given and known."""
-    fields = {
+def _fields(link) -> dict[str, object]:
+    """The link's numbers by field: its physical ones (mass, inertia, friction, motor), then its
+    centre of mass and its placement in the parent (the DH or URDF geometry, as a transform)."""
+    return {
         "mass": link.mass,
         "inertia": link.inertia,
         "friction.viscous": link.friction.viscous,
         **coulomb_fields(link.friction.coulomb, link.friction.coulomb_minus),
         "motor.inertia": link.motor.inertia,
         "motor.gear_ratio": link.motor.gear_ratio,
+        "com": link.com,
+        "placement": sp.Matrix.hstack(link.placement.R, link.placement.p),
     }
+
+
+def _symbols(link, field: str | None = None) -> set:
+    """The free symbols of the link's numbers (`_fields`), or of the one `field` (as
+    SymdynError.field names it) when given and known."""
+    fields = _fields(link)
     values = [fields[field]] if field in fields else list(fields.values())
     out: set = set()
     for value in values:

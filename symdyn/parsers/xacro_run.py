@@ -18,6 +18,7 @@ library, xacro and its sibling contained.py only, so that it runs without symdyn
 from __future__ import annotations
 
 import errno
+import importlib
 import json
 import os
 import re
@@ -155,7 +156,7 @@ def main() -> None:
     import contained  # this file's sibling (the script's folder is on sys.path)
 
     for name in _PRELOAD:  # what xacro imports on the way, loaded before imports are closed
-        __import__(name)
+        importlib.import_module(name)
     close_imports = contained.confine(int(request["memory"]), float(request["seconds"]), threads=False)
     import xacro  # noqa: F401 - imported under the audit hook, then imports are closed
     import xacro.substitution_args  # noqa: F401
