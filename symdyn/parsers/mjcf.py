@@ -53,7 +53,7 @@ from ..model.robot import BaseBody, Friction, Link, Motor, Robot
 from ..spatial.transform import Transform, rot_axis
 from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
 from .mjcf_values import number, pose, vector
-from .source import read_source
+from .source import check_link_count, read_source
 from .urdf_elements import UrdfInertial, numeric, urdf_robot_name
 from .urdf_merge import merge_inertials
 
@@ -121,6 +121,7 @@ def _free_body(model: Any, file: str, body_names: list[str], joint_names: list[s
 def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) -> Robot:
     """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
     model = compile_mjcf(raw, file)
+    check_link_count(model.nbody - 1, "bodies once compiled", file)  # <replicate> and <include> add some
     check_numbers(model, file)
     flags = _disabled(model)
     body_names = names(model, "body", model.nbody, "body")

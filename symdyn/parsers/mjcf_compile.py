@@ -21,7 +21,8 @@ import numpy as np
 from ..errors import SymdynError, SymdynWarning
 from ..model.bounded import MAX_MAGNITUDE
 from .optional import optional_module
-from .safe_xml import parse_xml
+from .safe_xml import Element, parse_xml
+from .source import check_link_count
 
 __all__ = ["check_numbers", "compile_mjcf", "model_name", "mujoco_module", "names"]
 
@@ -49,6 +50,7 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
     root = parse_xml(raw, file)
     if root.tag != "mujoco":
         raise SymdynError(f"not an MJCF file: its top element is <{root.tag}>, not <mujoco>", file=file)
+    check_link_count(_count_tags(root, "body"), "<body> elements", file)  # before MuJoCo compiles them
     mujoco = mujoco_module(file)
     said: list[str] = []
     previous = mujoco.get_mju_user_warning()
@@ -61,6 +63,16 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
         mujoco.set_mju_user_warning(previous)
         for text in dict.fromkeys(said):
             warnings.warn(f"{file}: MuJoCo: {_one_line(text)}", SymdynWarning, stacklevel=4)
+
+
+def _count_tags(root: Element, tag: str) -> int:
+    """How many elements below `root` have the tag `tag` (iterative: bodies nest deeply)."""
+    count, stack = 0, [root]
+    while stack:
+        el = stack.pop()
+        count += el.tag == tag
+        stack.extend(el.children)
+    return count
 
 
 def _one_line(text: str) -> str:

@@ -37,7 +37,7 @@ from ..model.expressions import C_KEYWORDS
 from ..model.inertia import tensor_from_components
 from ..spatial.transform import Transform, rpy_matrix
 from .safe_xml import Element
-from .source import did_you_mean
+from .source import check_link_count, did_you_mean
 
 __all__ = [
     "JOINT_TYPES",
@@ -211,6 +211,7 @@ class UrdfReader:
         links = root.all("link")
         if not links:
             raise self.error("the robot has no <link>", line=root.line)
+        check_link_count(len(links), "<link> elements", self.file)
         for i, el in enumerate(links, start=1):
             self._read_link(i, el)
         for el in root.all("joint"):
