@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
+from functools import cache
 
 import numpy as np
 import pytest
@@ -17,14 +18,16 @@ from robots import (
     random_params,
     random_state,
     solo_robot,
+    tree_robot,
     y_robot,
 )
 from test_mimic import CASES as MIMIC_CASES
 
 from symdyn import rnea
-from symdyn.algorithms.configuration_space import pair_columns
+from symdyn.algorithms.configuration_space import pair_column, pair_columns
 from symdyn.dynamics import derive
 from symdyn.symbolic.simplify import count_ops
+from symdyn.symbolic.trig_polynomial import add_into, chop, largest
 
 NAMES = ("M", "B", "Csq", "G")
 
@@ -73,11 +76,26 @@ def test_routes_agree_float_data(name):
     _assert_same_terms(a, b, exact=False, what=name)
 
 
+def forest_robot():
+    """Four independent double pendulums (every other link on the base): a wide tree whose M is
+    block diagonal, so most of its n^3 / 2 Christoffel symbols are structurally zero."""
+    parents = tuple(p for k in range(4) for p in (-1, 2 * k))
+    return tree_robot("forest", parents, ("revolute",) * len(parents), seed=34)
+
+
 TREES = {
     "ytree": y_robot,
     "solo": solo_robot,
     **{f"mimic_{k}": (lambda v=v: v[0]) for k, v in MIMIC_CASES.items()},
 }
+#: trees checked against the oracle and the dense Christoffel sum only (not both routes)
+ROBOTS = {**TREES, "forest": forest_robot}
+
+
+@cache
+def _derived(name: str):
+    """The Newton-Euler derivation of an example or of a robot of ROBOTS (cached)."""
+    return derive(ROBOTS[name](), simplify=False) if name in ROBOTS else derived(name, "newton-euler")
 
 
 @pytest.mark.parametrize("case", sorted(TREES))
@@ -101,9 +119,9 @@ def _value(dyn, name: str, q, values) -> np.ndarray:
     return np.array(out, dtype=float).reshape(rows, cols)
 
 
-@pytest.mark.parametrize("name", [*EXAMPLE_NAMES, "ytree", "mimic_chain"])
+@pytest.mark.parametrize("name", [*EXAMPLE_NAMES, "ytree", "forest", "mimic_chain"])
 def test_values_equal_the_oracle(name):
-    dyn = derive(TREES[name](), simplify=False) if name in TREES else derived(name, "newton-euler")
+    dyn = _derived(name)
     small = dyn.configuration_space.readable  # the Panda: V and C would be the recursion expanded
     if small:
         args = [list(dyn.q), list(dyn.qd), list(dyn.params)]
@@ -176,3 +194,46 @@ def test_puma_velocity_terms_are_compact():
     assert len(dyn.christoffel) == 84
     assert count_ops([], list(dyn.V)).total <= 2 * gamma
     assert all(isinstance(c, Fraction) for p in dyn.configuration_space.gamma.values() for c in p.values())
+
+
+def _dense_christoffel(cs) -> dict:
+    """Gamma^k_ij = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k) summed for every k and i <= j
+    (all n^3 / 2 of them, as configuration_space did before it skipped the (k, i, j) that no
+    nonzero derivative of M enters), zeros and float residues dropped as it drops them."""
+    ring, M, n = cs.ring, cs.M, cs.n
+    big = largest(M[i][j] for i in range(n) for j in range(i, n))
+    half = Fraction(1, 2)
+    gamma = {}
+    for k in range(n):
+        for i in range(n):
+            for j in range(i, n):
+                acc: dict = {}
+                for (a, b, x), f in (((k, j, i), half), ((k, i, j), half), ((i, j, k), -half)):
+                    add_into(acc, ring.diff(M[min(a, b)][max(a, b)], x), f)
+                acc = chop(acc, big)
+                if acc:
+                    gamma[(k, i, j)] = acc
+    return gamma
+
+
+@pytest.mark.parametrize("name", ["puma560", "stanford", "ytree", "solo", "forest"])
+def test_sparse_christoffel_symbols_equal_the_dense_sum(name):
+    """The Christoffel symbols summed only where a derivative of M enters are the full sum's,
+    coefficient for coefficient and in the same order (so `derive` prints the same bytes); B's
+    and Csq's nonzero entries (`ConfigurationSpace.nonzero`) are those whose polynomial is not
+    zero, in row-major order."""
+    dyn = _derived(name)
+    cs = dyn.configuration_space
+    assert list(cs.gamma.items()) == list(_dense_christoffel(cs).items())
+    for which in ("B", "Csq"):
+        rows, cols = cs.shape(which)
+        every = [(k, c) for k in range(rows) for c in range(cols) if cs.poly(which, k, c)]
+        assert list(cs.nonzero(which)) == every, which
+    if name == "forest":  # the pendulums do not couple: no symbol joins two of them
+        assert all(k // 2 == i // 2 == j // 2 for k, i, j in cs.gamma)
+
+
+def test_pair_column_inverts_pair_columns():
+    for n in (2, 3, 7, 40):
+        assert [pair_column(n, i, j) for i, j in pair_columns(n)] == list(range(n * (n - 1) // 2))
+    assert pair_columns(0) == pair_columns(1) == ()

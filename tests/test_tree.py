@@ -32,7 +32,10 @@ from robots import (
     tree_robot,
     y_robot,
 )
+from timebound import refused, within
 
+import symdyn
+from symdyn.cli.main import main
 from symdyn.codegen import render
 from symdyn.codegen.derivative_functions import DERIVATIVE_FUNCTION_NAMES
 from symdyn.codegen.functions import FUNCTION_NAMES, build_functions
@@ -195,6 +198,124 @@ def test_solo_derives_in_seconds():
         start = time.perf_counter()
         derive(robot, method=method)
         assert time.perf_counter() - start < 60, method
+
+
+def pendulums_file(path, count: int) -> None:
+    """A robot file of `count` independent pendulums: every link hangs from the base."""
+    lines = ["name: pendulums", "convention: modified", "links:"]
+    for i in range(count):
+        lines += [f"  - name: p{i}", "    parent: null", "    joint: revolute", "    alpha: pi/2"]
+        lines += [f"    a: {0.1 * (i % 7 + 1):.1f}", "    mass: 1.5", "    com: [0.3, 0, 0]"]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_hundred_independent_pendulums_derive_in_seconds(tmp_path, capsys):
+    """Issue 34 item 5: `derive` of 100 pendulums gave no answer in 120 s (every B entry rebuilt
+    the n(n-1)/2 pair columns, n^5 in all); now about 2 s of CPU. Each pendulum's M and G are its
+    own (the oracle's), and no Christoffel symbol couples two of them: B and Csq are zero."""
+    path = tmp_path / "pendulums.yaml"
+    pendulums_file(path, 100)
+    capsys.readouterr()
+    with within(60):
+        assert main(["derive", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "# B = 0" in out and "# Csq = 0" in out
+    entries = dict(line.split(" = ", 1) for line in out.splitlines() if line[:2] in ("M[", "G["))
+    robot = symdyn.load_robot(path)
+    q = np.random.default_rng(5).uniform(-np.pi, np.pi, 100)
+    M, G = np.zeros((100, 100)), np.zeros(100)
+    for label, text in entries.items():
+        e = sp.sympify(text)
+        value = float(e.subs({s: q[int(str(s)[1:]) - 1] for s in e.free_symbols}))
+        if label[0] == "G":
+            G[int(label[2:-1]) - 1] = value
+        else:
+            i, j = (int(k) - 1 for k in label[2:-1].split(","))
+            M[i, j] = M[j, i] = value
+    np.testing.assert_allclose(M, mass_matrix(robot, q), atol=1e-12)
+    np.testing.assert_allclose(G, gravity_torque(robot, q), atol=1e-12)
+
+
+# --------------------------------------------------------------------------- size limits
+
+
+def chain_urdf(path, joints: int) -> None:
+    """A URDF chain of `joints` revolute joints."""
+    parts = ['<robot name="chain">', '<link name="l0"/>']
+    for i in range(1, joints + 1):
+        inertial = (
+            '<inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>'
+        )
+        parts.append(f'<link name="l{i}">{inertial}</link>')
+        parts.append(
+            f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+            '<origin xyz="0.1 0 0"/><axis xyz="0 0 1"/></joint>'
+        )
+    path.write_text("\n".join([*parts, "</robot>"]))
+
+
+def mjcf_bodies(path, bodies: int, nested: bool) -> None:
+    """An MJCF file of `bodies` hinged bodies, side by side or each inside the one before."""
+    one = '<body name="b{i}" pos="0.1 0 0"><joint name="j{i}" axis="0 1 0"/><geom size="0.01" mass="1"/>'
+    if nested:
+        tree = "".join(one.format(i=i) for i in range(bodies)) + "</body>" * bodies
+    else:
+        tree = "".join(one.format(i=i) + "</body>" for i in range(bodies))
+    path.write_text(f'<mujoco model="many"><worldbody>{tree}</worldbody></mujoco>')
+
+
+LIMIT = "symdyn reads models of at most 1,000 links (MAX_LINKS)"
+
+
+def test_ten_thousand_links_are_refused_when_loaded(tmp_path, capsys):
+    """Issue 34 item 5: a 10,000-joint URDF chain loaded in 20 s of CPU (and could never be
+    derived); an MJCF file of 10,000 bodies side by side took 7 s in MuJoCo's compiler and 24 s
+    in all. Now one line at load time, in about a second, before any link is read. (10,000
+    bodies nested MuJoCo refuses itself: its XML reader's depth limit.)"""
+    urdf = tmp_path / "chain.urdf"
+    chain_urdf(urdf, 10_000)
+    assert refused(capsys, "derive", urdf, seconds=30) == (
+        f"symdyn: error: {urdf}: 10,001 <link> elements: {LIMIT}"
+    )
+    pytest.importorskip("mujoco")
+    for nested in (False, True):
+        mjcf = tmp_path / f"bodies{nested}.xml"
+        mjcf_bodies(mjcf, 10_000, nested)
+        assert refused(capsys, "derive", mjcf, seconds=30) == (
+            f"symdyn: error: {mjcf}: 10,000 <body> elements: {LIMIT}"
+        )
+
+
+def test_more_than_max_links_are_refused_in_every_format(tmp_path, capsys):
+    """MAX_LINKS + 1 links: a robot file's, and an MJCF body that <replicate> makes 1,001 bodies
+    (counted once MuJoCo has compiled it)."""
+    path = tmp_path / "pendulums.yaml"
+    pendulums_file(path, 1001)
+    assert refused(capsys, "derive", path, seconds=30) == f"symdyn: error: {path}: 1,001 links: {LIMIT}"
+    pytest.importorskip("mujoco")
+    mjcf = tmp_path / "replicated.xml"
+    body = '<body name="b"><joint name="j" axis="0 1 0"/><geom size="0.01" mass="1"/></body>'
+    mjcf.write_text(
+        f'<mujoco><worldbody><replicate count="1001" offset="0.1 0 0">{body}</replicate></worldbody></mujoco>'
+    )
+    assert refused(capsys, "derive", mjcf, seconds=30) == (
+        f"symdyn: error: {mjcf}: 1,001 bodies once compiled: {LIMIT}"
+    )
+
+
+def test_the_limit_lets_max_links_through(tmp_path, monkeypatch):
+    """At most MAX_LINKS links load (here the limit lowered to 3, so the files stay small)."""
+    monkeypatch.setattr("symdyn.parsers.source.MAX_LINKS", 3)
+    for count, ok in ((3, True), (4, False)):
+        yaml_path, urdf = tmp_path / f"p{count}.yaml", tmp_path / f"c{count}.urdf"
+        pendulums_file(yaml_path, count)
+        chain_urdf(urdf, count - 1)  # count <link> elements
+        for path in (yaml_path, urdf):
+            if ok:
+                assert symdyn.load_robot(path).nb == (count if path == yaml_path else count - 1)
+            else:
+                with pytest.raises(SymdynError, match="at most 3 links"):
+                    symdyn.load_robot(path)
 
 
 # --------------------------------------------------------------------------- random trees

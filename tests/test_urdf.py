@@ -308,25 +308,6 @@ def test_lines_after_a_declaration_that_white_space_precedes_keep_their_numbers(
     assert str(info.value) == f"{path}: invalid XML at line 11, column 3: mismatched tag"
 
 
-def test_a_file_of_more_links_than_any_robot_is_refused_within_seconds(tmp_path, capsys):
-    """20,000 links fixed to one moving link took 104 s to load; more than MAX_LINKS are refused."""
-    from symdyn.parsers.urdf_elements import MAX_LINKS
-
-    n = MAX_LINKS + 1
-    links = "".join(f'<link name="l{i}"/>' for i in range(n))
-    joints = "".join(
-        f'<joint name="j{i}" type="fixed"><parent link="l0"/><child link="l{i}"/></joint>'
-        for i in range(1, n)
-    )
-    path = tmp_path / "wide.urdf"
-    path.write_text(f'<robot name="wide">{links}{joints}</robot>')
-    line = refused(capsys, "derive", path, seconds=5)
-    assert line.endswith(
-        f"the robot has {n:,} <link> elements, more than symdyn reads ({MAX_LINKS:,}: a robot "
-        "has tens to hundreds, and each costs milliseconds of symbolic work) (line 1)"
-    ), line
-
-
 def test_exact_numbers():
     robot = load("rpy_chain.urdf")
     a, b, c = robot.links

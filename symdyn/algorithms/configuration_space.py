@@ -25,9 +25,10 @@ parameters of the PUMA 560 arm", Proc. IEEE ICRA 1986; Craig, Introduction to Ro
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
+from functools import lru_cache
 
 import sympy as sp
 
@@ -35,7 +36,13 @@ from ..symbolic.program import Program
 from ..symbolic.trig_polynomial import TrigPoly, TrigRing, add_into, chop, largest, scale
 from ..symbolic.trig_text import TrigText
 
-__all__ = ["ConfigurationSpace", "configuration_space", "pair_columns", "christoffel_name"]
+__all__ = [
+    "ConfigurationSpace",
+    "configuration_space",
+    "pair_columns",
+    "pair_column",
+    "christoffel_name",
+]
 
 _HALF = Fraction(1, 2)
 
@@ -47,9 +54,17 @@ _HALF = Fraction(1, 2)
 READABLE_TERMS = 100_000
 
 
-def pair_columns(n: int) -> list[tuple[int, int]]:
-    """The columns of B: (i, j), i < j, in the order (0, 1), (0, 2), ..., (n-2, n-1) (0-based)."""
-    return [(i, j) for i in range(n) for j in range(i + 1, n)]
+@lru_cache(maxsize=4)
+def pair_columns(n: int) -> tuple[tuple[int, int], ...]:
+    """The columns of B: (i, j), i < j, in the order (0, 1), (0, 2), ..., (n-2, n-1) (0-based);
+    built once per n (a B entry's lookup must not cost n^2)."""
+    return tuple((i, j) for i in range(n) for j in range(i + 1, n))
+
+
+def pair_column(n: int, i: int, j: int) -> int:
+    """The column of B holding (i, j), i < j (0-based): the inverse of `pair_columns(n)`."""
+    assert 0 <= i < j < n, (n, i, j)
+    return i * n - i * (i + 1) // 2 + j - i - 1
 
 
 def christoffel_name(k: int, i: int, j: int) -> str:
@@ -102,6 +117,16 @@ class ConfigurationSpace:
             g = self.gamma.get((k, i, j))
             return scale(g, Fraction(2)) if g else {}
         raise KeyError(name)
+
+    def nonzero(self, name: str) -> Iterator[tuple[int, int]]:
+        """(k, c) of the nonzero entries of B or Csq in row-major order, read off the nonzero
+        Christoffel symbols: work in proportion to them, not to the n^3 / 2 entries of B."""
+        n = self.n
+        for k, i, j in sorted(self.gamma):
+            if name == "B" and i < j:
+                yield k, pair_column(n, i, j)
+            elif name == "Csq" and i == j:
+                yield k, i
 
     def shape(self, name: str) -> tuple[int, int]:
         n = self.n
@@ -181,10 +206,36 @@ class ConfigurationSpace:
         return [sp.Add(*[self.expr("M", k, j) * qdd[j] for j in range(n)], bias[k]) for k in range(n)]
 
 
+def joints_of(p: TrigPoly, n: int) -> set[int]:
+    """The joints j < n whose angle or coordinate q_j a polynomial depends on (dp/dq_j may be
+    nonzero only for these)."""
+    out: set[int] = set()
+    for mono, k, _kind in p:
+        out.update(j for j in range(n) if k[j])
+        out.update(g for g, _e in mono if g < n)
+    return out
+
+
+def _christoffel_keys(M: list[list[TrigPoly]], n: int) -> list[tuple[int, int, int]]:
+    """The (k, i, j), i <= j, whose Gamma^k_ij has a nonzero term, in (k, i, j) order: each
+    nonzero dM_ab/dq_x (a <= b) enters Gamma^a_xb, Gamma^b_xa and Gamma^x_ab, indices sorted.
+    On a tree that is the entries within the ancestry of each other, not all n^3 / 2."""
+    keys = set()
+    for a in range(n):
+        for b in range(a, n):
+            if not M[a][b]:
+                continue
+            for x in joints_of(M[a][b], n):
+                keys.add((a, min(x, b), max(x, b)))
+                keys.add((b, min(x, a), max(x, a)))
+                keys.add((x, a, b))
+    return sorted(keys)
+
+
 def _christoffel(ring: TrigRing, M: list[list[TrigPoly]], big: float) -> dict[tuple[int, int, int], TrigPoly]:
     """Gamma^k_ij = 1/2 (dM_kj/dq_i + dM_ki/dq_j - dM_ij/dq_k), i <= j, nonzero ones (float
-    residues below CHOP * big dropped)."""
-    n = ring.n
+    residues below CHOP * big dropped); only the (k, i, j) some nonzero derivative of M enters
+    (_christoffel_keys) are summed, each as the full sum in the same order of terms."""
     dM: dict[tuple[int, int, int], TrigPoly] = {}
 
     def d(a: int, b: int, x: int) -> TrigPoly:
@@ -195,16 +246,14 @@ def _christoffel(ring: TrigRing, M: list[list[TrigPoly]], big: float) -> dict[tu
         return hit
 
     gamma = {}
-    for k in range(n):
-        for i in range(n):
-            for j in range(i, n):
-                acc: TrigPoly = {}
-                add_into(acc, d(k, j, i), _HALF)
-                add_into(acc, d(k, i, j), _HALF)
-                add_into(acc, d(i, j, k), -_HALF)
-                acc = chop(acc, big)
-                if acc:
-                    gamma[(k, i, j)] = acc
+    for k, i, j in _christoffel_keys(M, ring.n):
+        acc: TrigPoly = {}
+        add_into(acc, d(k, j, i), _HALF)
+        add_into(acc, d(k, i, j), _HALF)
+        add_into(acc, d(i, j, k), -_HALF)
+        acc = chop(acc, big)
+        if acc:
+            gamma[(k, i, j)] = acc
     return gamma
 
 

@@ -75,21 +75,26 @@ class SingularJoint:
 
 def _zero_pivots(M: sp.Matrix, order: Sequence[int]) -> list[int]:
     """The coordinates whose pivot D_j of M (eliminated in `order`) is exactly zero. Such a
-    pivot's column of L is zero too (M positive semi-definite), so the factorisation goes on."""
-    A = M.extract(list(order), list(order))
-    n = A.rows
+    pivot's column of L is zero too (M positive semi-definite), so the factorisation goes on.
+    The sums run over the nonzero entries of L only (the same sums: the others add exact
+    zeros), so a tree, eliminated without fill-in, costs its ancestries, not n^3."""
+    n = M.rows
+    A = M.extract(list(order), list(order)).tolist()
     program = Program()  # a scratch program: the pivots only need to be compared with zero
-    L = sp.zeros(n, n)
+    L: list[dict[int, sp.Expr]] = [{} for _ in range(n)]  # row i: k -> L_ik, nonzero ones
     D: list[sp.Expr] = [sp.S.Zero] * n
     zero = []
     for j in range(n):
-        D[j] = program.let(A[j, j] - sum((L[j, k] ** 2 * D[k] for k in range(j)), sp.S.Zero), "D")
+        row = L[j]
+        D[j] = program.let(A[j][j] - sum((v**2 * D[k] for k, v in row.items()), sp.S.Zero), "D")
         if D[j] == 0:
             zero.append(order[j])
             continue
         for i in range(j + 1, n):
-            s = A[i, j] - sum((L[i, k] * L[j, k] * D[k] for k in range(j)), sp.S.Zero)
-            L[i, j] = program.let(s / D[j], "L") if s != 0 else sp.S.Zero
+            other = L[i]
+            s = A[i][j] - sum((other[k] * v * D[k] for k, v in row.items() if k in other), sp.S.Zero)
+            if s != 0:
+                other[j] = program.let(s / D[j], "L")
     return sorted(zero)
 
 

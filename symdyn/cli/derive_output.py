@@ -93,17 +93,9 @@ def configuration_entries(dyn: Dynamics, lumped: bool = False, cs=None, text: bo
     out = {
         "M": [(f"M[{i + 1},{j + 1}]", get("M", i, j)) for i in range(n) for j in range(i, n)],
         "B": [
-            (f"B[{k + 1},({i + 1},{j + 1})]", get("B", k, c))
-            for k in range(n)
-            for c, (i, j) in enumerate(pairs)
-            if cs.poly("B", k, c)
+            (f"B[{k + 1},({pairs[c][0] + 1},{pairs[c][1] + 1})]", get("B", k, c)) for k, c in cs.nonzero("B")
         ],
-        "Csq": [
-            (f"Csq[{k + 1},{i + 1}]", get("Csq", k, i))
-            for k in range(n)
-            for i in range(n)
-            if cs.poly("Csq", k, i)
-        ],
+        "Csq": [(f"Csq[{k + 1},{i + 1}]", get("Csq", k, i)) for k, i in cs.nonzero("Csq")],
         "G": [(f"G[{k + 1}]", get("G", k, 0)) for k in range(n)],
         "F": [(f"F[{k + 1}]", sp.sstr(e) if text else e) for k, e in enumerate(F)],
     }

@@ -65,7 +65,7 @@ from .mjcf_attributes import check_attributes
 from .mjcf_compile import check_numbers, compile_mjcf, model_name, mujoco_module, names
 from .mjcf_tendons import Coupling, TendonTerms, tendon_terms
 from .mjcf_values import number, pose, vector
-from .source import read_source
+from .source import check_link_count, read_source
 from .urdf_elements import UrdfInertial, numeric, urdf_robot_name
 from .urdf_merge import merge_inertials
 
@@ -138,6 +138,7 @@ def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) 
     """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
     check_attributes(raw, file)  # before MuJoCo reads a nan as 0, which the compiled model hides
     model = compile_mjcf(raw, file)
+    check_link_count(model.nbody - 1, "bodies once compiled", file)  # <replicate> and <include> add some
     check_numbers(model, file)
     flags = _disabled(model)
     body_names = names(model, "body", model.nbody, "body")

@@ -25,7 +25,8 @@ from ..errors import SymdynError, SymdynWarning
 from ..model.bounded import MAX_MAGNITUDE
 from . import contained
 from .optional import optional_module
-from .safe_xml import parse_xml
+from .safe_xml import Element, parse_xml
+from .source import check_link_count
 
 __all__ = ["check_numbers", "compile_mjcf", "model_name", "mujoco_module", "names"]
 
@@ -68,6 +69,7 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
     root = parse_xml(raw, file)
     if root.tag != "mujoco":
         raise SymdynError(f"not an MJCF file: its top element is <{root.tag}>, not <mujoco>", file=file)
+    check_link_count(_count_tags(root, "body"), "<body> elements", file)  # before MuJoCo compiles them
     mujoco = mujoco_module(file)
     answer, mjb = _SERVER.request({"file": os.path.abspath(file)}, TIMEOUT, MEMORY)
     for text in dict.fromkeys(answer.get("warnings", [])):
@@ -89,6 +91,16 @@ def _failure(answer: dict) -> str:
     if answer.get("memory") or "bad_alloc" in answer.get("error", "") or not signalled:
         return f"MuJoCo's compiler needed more than {MEMORY / 2**30:g} GiB of memory"
     return f"MuJoCo's compiler crashed (signal {os.WTERMSIG(status)})"
+
+
+def _count_tags(root: Element, tag: str) -> int:
+    """How many elements below `root` have the tag `tag` (iterative: bodies nest deeply)."""
+    count, stack = 0, [root]
+    while stack:
+        el = stack.pop()
+        count += el.tag == tag
+        stack.extend(el.children)
+    return count
 
 
 def _one_line(text: str) -> str:

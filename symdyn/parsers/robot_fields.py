@@ -26,7 +26,7 @@ from ..spatial.transform import Transform
 from .dh import CONVENTIONS
 from .frame_fields import FrameData, read_base, read_frames
 from .loop_fields import LoopData, read_actuated, read_loops
-from .source import did_you_mean
+from .source import check_link_count, did_you_mean
 
 __all__ = [
     "TOP_KEYS",
@@ -264,6 +264,7 @@ class RobotFileReader:
     def _read_links(self, value: object) -> None:
         if not isinstance(value, list):
             raise self.error(f"expected a list of links, got {_kind(value)}", field="links")
+        check_link_count(len(value), "links", self.file)
         names: dict[str, int] = {}
         for i, raw in enumerate(value, start=1):
             link = self._read_link(i, raw)

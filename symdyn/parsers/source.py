@@ -1,5 +1,6 @@
-"""Reading a description file's bytes, with the errors every loader gives for it, and the
-"did you mean" hint loaders add to a misspelt name."""
+"""Reading a description file's bytes, with the errors every loader gives for it (its size, and
+how many links it may describe: MAX_LINKS), and the "did you mean" hint loaders add to a
+misspelt name."""
 
 from __future__ import annotations
 
@@ -10,10 +11,25 @@ from collections.abc import Iterable
 
 from ..errors import SymdynError
 
-__all__ = ["read_source", "did_you_mean", "MAX_BYTES"]
+__all__ = ["read_source", "did_you_mean", "check_link_count", "MAX_BYTES", "MAX_LINKS"]
 
 #: Larger files are refused before parsing (a robot description is kilobytes).
 MAX_BYTES = 64 * 2**20
+#: Most links a model may have (a robot file's links, a URDF's <link> elements, an MJCF file's
+#: bodies), refused before they are read one by one: loading takes milliseconds per link, and a
+#: derivation's M has n^2 / 2 entries (a thousand independent pendulums derive in about 20 s;
+#: real robots have tens of links, MuJoCo Menagerie's largest about a hundred bodies).
+MAX_LINKS = 1000
+
+
+def check_link_count(count: int, what: str, file: str | None) -> None:
+    """SymdynError naming the file when a model has more than MAX_LINKS `what` ("links",
+    "<link> elements", "bodies")."""
+    if count > MAX_LINKS:
+        raise SymdynError(
+            f"{count:,} {what}: symdyn reads models of at most {MAX_LINKS:,} links (MAX_LINKS)",
+            file=file,
+        )
 
 
 def read_source(path: str | os.PathLike, kind: str) -> tuple[str, bytes, str]:

@@ -40,11 +40,10 @@ from ..model.expressions import C_KEYWORDS
 from ..model.inertia import tensor_from_components
 from ..spatial.transform import Transform, rpy_matrix
 from .safe_xml import Element
-from .source import did_you_mean
+from .source import check_link_count, did_you_mean
 
 __all__ = [
     "JOINT_TYPES",
-    "MAX_LINKS",
     "MOVABLE",
     "UrdfInertial",
     "UrdfJoint",
@@ -59,9 +58,6 @@ JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "plan
 MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?\Z")
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-#: At most this many <link> (and <joint>) elements are read: real robots have tens to hundreds,
-#: and each costs milliseconds of symbolic work (a file of 20,000 took minutes).
-MAX_LINKS = 2000
 
 
 @dataclass
@@ -223,14 +219,8 @@ class UrdfReader:
         links = root.all("link")
         if not links:
             raise self.error("the robot has no <link>", line=root.line)
-        for tag in ("link", "joint"):
-            count = len(root.all(tag))
-            if count > MAX_LINKS:
-                raise self.error(
-                    f"the robot has {count:,} <{tag}> elements, more than symdyn reads ({MAX_LINKS:,}: "
-                    "a robot has tens to hundreds, and each costs milliseconds of symbolic work)",
-                    line=root.line,
-                )
+        check_link_count(len(links), "<link> elements", self.file)
+        check_link_count(len(root.all("joint")), "<joint> elements", self.file)
         for i, el in enumerate(links, start=1):
             self._read_link(i, el)
         for el in root.all("joint"):
