@@ -55,7 +55,12 @@ def _imports(path: Path, parts: tuple[str, ...]):
 def _floor(parts: tuple[str, ...]) -> str:
     if parts[0] == "lumped":  # works on a Dynamics, as dynamics does
         return "dynamics"
-    if parts[0] in ("module_files", "leftovers", "progress"):  # helpers of every floor that use only errors
+    if parts[0] in (
+        "module_files",
+        "leftovers",
+        "progress",
+        "destination",
+    ):  # helpers of every floor that use only errors
         return "errors"
     return "oracle" if parts[0] == "rnea" else parts[0]  # symdyn.rnea: the oracle's public entry
 

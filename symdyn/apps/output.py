@@ -1,5 +1,5 @@
 """Writing results: files written all at once (or streamed into a device or FIFO, never replacing
-one: symdyn.codegen.destination), and Matplotlib figures rendered to bytes.
+one: symdyn.destination), and Matplotlib figures rendered to bytes.
 
 Shared by the applications that write files (symdyn.apps.trajectory, analysis_plots
 and the command line). Figures use the Agg canvas directly, never pyplot, so no
@@ -12,7 +12,7 @@ import io
 import os
 from pathlib import Path
 
-from ..codegen.destination import destination, sweep, write_to
+from ..destination import destination, sweep, write_to
 from ..errors import SymdynError
 
 __all__ = ["write_atomic", "check_output", "figure", "figure_bytes", "plot_format", "PLOT_FORMATS"]
@@ -33,7 +33,7 @@ def check_output(path: str | os.PathLike | None, option: str = "") -> None:
 
 
 def write_atomic(path: str | os.PathLike, content: str | bytes) -> Path:
-    """Write a file all at once by symdyn.codegen.destination's rules: a regular file (new, or
+    """Write a file all at once by symdyn.destination's rules: a regular file (new, or
     existing: its mode and owner kept; a link's target) through a temporary beside it and one
     rename; a character device, a FIFO or /dev/stdout streamed in place; anything else refused."""
     dest = destination(path)

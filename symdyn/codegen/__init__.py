@@ -19,12 +19,12 @@ import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
+from ..destination import check_folder
 from ..dynamics import SINGULAR_M, derive
 from ..errors import SymdynError, SymdynWarning
 from ..model.expressions import is_c_identifier
 from ..model.robot import Robot
 from ..progress import stage as progress_stage
-from .destination import check_folder
 from .frame_functions import choose_frames
 from .functions import FRAME_GROUPS, FUNCTION_NAMES, GROUPS, build_functions
 from .output import write_files

@@ -37,8 +37,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import SymdynError
-from ..leftovers import is_stale, remove
+from .errors import SymdynError
+from .leftovers import is_stale, remove
 
 __all__ = [
     "FIFO_WAIT",
