@@ -282,13 +282,13 @@ def test_ten_thousand_links_are_refused_when_loaded(tmp_path, capsys):
         mjcf = tmp_path / f"bodies{nested}.xml"
         mjcf_bodies(mjcf, 10_000, nested)
         assert refused(capsys, "derive", mjcf, seconds=30) == (
-            f"symdyn: error: {mjcf}: 10,000 <body> elements: {LIMIT}"
+            f"symdyn: error: {mjcf}: 10,000 bodies: {LIMIT}"
         )
 
 
 def test_more_than_max_links_are_refused_in_every_format(tmp_path, capsys):
     """MAX_LINKS + 1 links: a robot file's, and an MJCF body that <replicate> makes 1,001 bodies
-    (counted once MuJoCo has compiled it)."""
+    (counted before MuJoCo compiles it, each body times the replicates around it)."""
     path = tmp_path / "pendulums.yaml"
     pendulums_file(path, 1001)
     assert refused(capsys, "derive", path, seconds=30) == f"symdyn: error: {path}: 1,001 links: {LIMIT}"
@@ -298,9 +298,7 @@ def test_more_than_max_links_are_refused_in_every_format(tmp_path, capsys):
     mjcf.write_text(
         f'<mujoco><worldbody><replicate count="1001" offset="0.1 0 0">{body}</replicate></worldbody></mujoco>'
     )
-    assert refused(capsys, "derive", mjcf, seconds=30) == (
-        f"symdyn: error: {mjcf}: 1,001 bodies once compiled: {LIMIT}"
-    )
+    assert refused(capsys, "derive", mjcf, seconds=30) == (f"symdyn: error: {mjcf}: 1,001 bodies: {LIMIT}")
 
 
 def test_the_limit_lets_max_links_through(tmp_path, monkeypatch):

@@ -69,7 +69,7 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
     root = parse_xml(raw, file)
     if root.tag != "mujoco":
         raise SymdynError(f"not an MJCF file: its top element is <{root.tag}>, not <mujoco>", file=file)
-    check_link_count(_count_tags(root, "body"), "<body> elements", file)  # before MuJoCo compiles them
+    check_link_count(_count_tags(root, "body"), "bodies", file)  # before MuJoCo compiles them
     mujoco = mujoco_module(file)
     answer, mjb = _SERVER.request({"file": os.path.abspath(file)}, TIMEOUT, MEMORY)
     for text in dict.fromkeys(answer.get("warnings", [])):
@@ -94,12 +94,17 @@ def _failure(answer: dict) -> str:
 
 
 def _count_tags(root: Element, tag: str) -> int:
-    """How many elements below `root` have the tag `tag` (iterative: bodies nest deeply)."""
-    count, stack = 0, [root]
+    """How many elements with the tag `tag` the file makes below `root`: each counted as many
+    times as the <replicate count=N> elements around it repeat it (iterative: bodies nest
+    deeply). A count that is not a whole number counts once: MuJoCo's compiler names it."""
+    count, stack = 0, [(root, 1)]
     while stack:
-        el = stack.pop()
-        count += el.tag == tag
-        stack.extend(el.children)
+        el, times = stack.pop()
+        count += times * (el.tag == tag)
+        if el.tag == "replicate":
+            text = el.attrib.get("count", "1").strip()
+            times *= int(text) if text.isdigit() else 1
+        stack.extend((child, times) for child in el.children)
     return count
 
 
