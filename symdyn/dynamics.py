@@ -45,7 +45,12 @@ from sympy.core.parameters import distribute
 
 from .algorithms.base_parameters import BaseParameters, find_base_parameters
 from .algorithms.centroidal import Centroidal
-from .algorithms.configuration_space import ConfigurationSpace, configuration_space
+from .algorithms.configuration_space import (
+    READABLE_TERMS,
+    ConfigurationSpace,
+    FormTooLargeError,
+    configuration_space,
+)
 from .algorithms.coordinates import project_matrix, project_vector
 from .algorithms.coriolis import coriolis_matrix_composite
 from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
@@ -151,6 +156,8 @@ class Dynamics:
     _compiled: dict[str, object] = field(default_factory=dict, repr=False)
     _linear: dict[str, object] = field(default_factory=dict, repr=False)
     _configuration: ConfigurationSpace | None = field(default=None, repr=False)
+    #: the configuration-space form was found larger than READABLE_TERMS before it was built
+    _too_large: bool = field(default=False, repr=False)
     _frames: FrameKinematics | FloatingFrames | None = field(default=None, repr=False)
 
     @property
@@ -186,7 +193,7 @@ class Dynamics:
                 and not self.robot.floating
                 and name in ALL_QUANTITIES
                 and name != "F"
-                and self.configuration_space.readable
+                and self.readable_configuration_space() is not None
             ):
                 entries = self.configuration_space.closed(name, self.qd, self.qdd, self.compact["F"])
             else:
@@ -235,6 +242,22 @@ class Dynamics:
         if self._configuration is None:
             c = self.compact
             self._configuration = configuration_space(self.program, c["M"], list(c["G"]), list(self.q))
+        return self._configuration
+
+    def readable_configuration_space(self) -> ConfigurationSpace | None:
+        """The configuration-space form when it is readable (at most READABLE_TERMS terms), else
+        None, found without building a form that is not: its building stops once it is too large
+        (symdyn.algorithms.configuration_space.FormTooLargeError)."""
+        if self._configuration is None and not self._too_large:
+            c = self.compact
+            try:
+                self._configuration = configuration_space(
+                    self.program, c["M"], list(c["G"]), list(self.q), budget=READABLE_TERMS
+                )
+            except FormTooLargeError:
+                self._too_large = True
+        if self._configuration is None or not self._configuration.readable:
+            return None
         return self._configuration
 
     @cached_property

@@ -11,10 +11,12 @@ from functools import cache
 import numpy as np
 import pytest
 import sympy as sp
+import yaml
 from robots import (
     EXAMPLE_NAMES,
     derived,
     derived_rational,
+    example,
     random_params,
     random_state,
     solo_robot,
@@ -22,10 +24,12 @@ from robots import (
     y_robot,
 )
 from test_mimic import CASES as MIMIC_CASES
+from timebound import within
 
 from symdyn import rnea
 from symdyn.algorithms.configuration_space import pair_column, pair_columns
 from symdyn.dynamics import derive
+from symdyn.parsers import robot_from_data
 from symdyn.symbolic.simplify import count_ops
 from symdyn.symbolic.trig_polynomial import add_into, chop, largest
 
@@ -237,3 +241,51 @@ def test_pair_column_inverts_pair_columns():
     for n in (2, 3, 7, 40):
         assert [pair_column(n, i, j) for i, j in pair_columns(n)] == list(range(n * (n - 1) // 2))
     assert pair_columns(0) == pair_columns(1) == ()
+
+
+def _long_chain_data(n: int) -> list[dict]:
+    """A spatial n-joint arm's links (axes turning by +-90 degrees): its form grows exponentially."""
+    return [
+        {
+            "joint": "revolute",
+            "a": 0.3,
+            "alpha": [1.5707963267948966, 0, -1.5707963267948966][i % 3],
+            "d": 0.1 * (i % 2),
+            "mass": 1.0,
+            "com": [0.15, 0, 0],
+            "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.03},
+        }
+        for i in range(n)
+    ]
+
+
+def _long_chain(n: int):
+    return robot_from_data({"name": f"chain{n}", "links": _long_chain_data(n)})
+
+
+def test_a_form_too_large_to_read_is_found_before_it_is_built():
+    """A 16-joint arm's default derive took minutes building a form of millions of terms before
+    finding it unreadable; with the budget it stops at the first intermediate past
+    READABLE_TERMS and prints the compact form within seconds. A readable form is the same built
+    with or without the budget."""
+    from symdyn.algorithms.configuration_space import READABLE_TERMS
+
+    dyn = derive(_long_chain(16), simplify=False)
+    with within(30):
+        assert dyn.readable_configuration_space() is None
+    puma = derive(example("puma560"), simplify=False)
+    budgeted = puma.readable_configuration_space()
+    assert budgeted is not None and budgeted.terms <= READABLE_TERMS
+    assert budgeted.text("M", 1, 2) == derived("puma560", "newton-euler").configuration_space.text("M", 1, 2)
+
+
+def test_derive_of_a_long_chain_falls_back_to_compact_within_seconds(tmp_path, capsys):
+    from symdyn.cli.main import main
+
+    path = tmp_path / "chain.yaml"
+    path.write_text(yaml.safe_dump({"name": "chain16", "links": _long_chain_data(16)}))
+    with within(60):
+        assert main(["derive", str(path)]) == 0
+    captured = capsys.readouterr()
+    assert "has more than 100,000 terms; printing --form compact" in captured.err
+    assert captured.out.splitlines()[2].startswith("# tau = M(q) qdd + V(q, qd) + G(q) + F(qd)")

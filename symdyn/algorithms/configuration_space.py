@@ -257,7 +257,18 @@ def _christoffel(ring: TrigRing, M: list[list[TrigPoly]], big: float) -> dict[tu
     return gamma
 
 
-def configuration_space(program: Program, M: sp.Matrix, G: Sequence[sp.Expr], q: Sequence[sp.Symbol]):
+class FormTooLargeError(Exception):
+    """The configuration-space form grows past the budget it was built with (`terms`: how many
+    terms were reached when the building stopped)."""
+
+    def __init__(self, terms: int) -> None:
+        super().__init__(f"more than {terms:,} terms")
+        self.terms = terms
+
+
+def configuration_space(
+    program: Program, M: sp.Matrix, G: Sequence[sp.Expr], q: Sequence[sp.Symbol], budget: int | None = None
+):
     """The configuration-space form from M and G over a program's named intermediates.
 
     Args:
@@ -265,6 +276,10 @@ def configuration_space(program: Program, M: sp.Matrix, G: Sequence[sp.Expr], q:
         M: n x n mass matrix over the program's intermediates (joint space).
         G: n gravity terms over the program's intermediates.
         q: the n joint position symbols.
+        budget: None, or the most terms the form may have: building stops (FormTooLargeError) as soon
+            as one intermediate, or M's upper triangle and G together, have more. A long chain's
+            form grows exponentially with its joints (a 12-joint arm: 6.3 million terms, 77 s to
+            build), so the readable test is made on the way, not at the end.
 
     Returns:
         The `ConfigurationSpace`: M, G and the Christoffel symbols as canonical trigonometric
@@ -274,7 +289,9 @@ def configuration_space(program: Program, M: sp.Matrix, G: Sequence[sp.Expr], q:
     n = len(q)
     outputs = [*list(M), *list(G)]
     for sym, expr in program.needed(outputs):
-        ring.name(sym, expr)
+        size = len(ring.name(sym, expr))
+        if budget is not None and size > budget:
+            raise FormTooLargeError(size)
     Mp = [[{} for _ in range(n)] for _ in range(n)]
     for i in range(n):
         for j in range(i, n):
@@ -283,4 +300,8 @@ def configuration_space(program: Program, M: sp.Matrix, G: Sequence[sp.Expr], q:
     Mp = [[chop(p, big) for p in row] for row in Mp]
     Gp = [ring.convert(g) for g in G]
     big_g = largest(Gp)
-    return ConfigurationSpace(ring, Mp, [chop(p, big_g) for p in Gp], _christoffel(ring, Mp, big))
+    Gp = [chop(p, big_g) for p in Gp]
+    size = sum(len(Mp[i][j]) for i in range(n) for j in range(i, n)) + sum(len(p) for p in Gp)
+    if budget is not None and size > budget:
+        raise FormTooLargeError(size)
+    return ConfigurationSpace(ring, Mp, Gp, _christoffel(ring, Mp, big))

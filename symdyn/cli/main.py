@@ -119,13 +119,13 @@ def cmd_derive(args: argparse.Namespace) -> int:
     if args.form is None:
         args.form = "configuration"
         with progress_stage("the configuration-space form (M, Christoffel symbols, G)"):
-            readable = dyn.configuration_space.readable
-        if not readable:
+            readable = dyn.readable_configuration_space()
+        if readable is None:
             args.form = "compact"
             print(
-                f"symdyn: note: the configuration-space form of '{robot.name}' has "
-                f"{dyn.configuration_space.terms:,} terms (more than {READABLE_TERMS:,}); printing "
-                "--form compact (ask for --form configuration to print it all the same)",
+                f"symdyn: note: the configuration-space form of '{comment_text(robot.name)}' has more "
+                f"than {READABLE_TERMS:,} terms; printing --form compact (ask for --form configuration "
+                "to print it all the same)",
                 file=sys.stderr,
             )
     with progress_stage(f"the {args.form} form as {args.format}"):
