@@ -214,20 +214,33 @@ def test_ignored_forces_are_warned_about(tmp_path):
         symdyn.load_mjcf(path)
 
 
-def test_mujocos_own_warnings_become_symdyn_warnings(tmp_path, capfd):
-    """MuJoCo prints its warnings itself (to the process's stderr): they become SymdynWarnings.
-    (A nan never reaches MuJoCo now: symdyn.parsers.mjcf_attributes refuses it first; a negative
-    armature makes MuJoCo warn of a singular M while compiling.)"""
+def test_mujocos_own_warnings_become_symdyn_warnings_once_the_model_passes(tmp_path, capfd, monkeypatch):
+    """MuJoCo prints its warnings itself (to the process's stderr): they become SymdynWarnings,
+    said once symdyn's checks of the model pass. A negative armature makes MuJoCo warn of a
+    singular M while compiling: the file is refused in its one line, the warning held back. (A
+    warning of a model that passes: one of the compiling child's answers, given one.)"""
+    from symdyn.parsers import mjcf_compile
+
     path = tmp_path / "negative.xml"
     path.write_text((DATA / "bad_number.xml").read_text().replace('damping="1e200"', 'armature="-5"'))
-    with (
-        pytest.warns(
-            symdyn.SymdynWarning, match=r"negative.xml: MuJoCo: Inertia matrix is too close to singular"
-        ),
-        pytest.raises(SymdynError, match=r"field 'joint\(j\).armature': must not be negative \(got -5\)"),
-    ):
-        symdyn.load_mjcf(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(
+            SymdynError, match=r"field 'joint\(j\).armature': must not be negative \(got -5\)"
+        ):
+            symdyn.load_mjcf(path)
     assert capfd.readouterr() == ("", "")
+    request = mjcf_compile._SERVER.request
+
+    def warned(*args):
+        answer, mjb = request(*args)
+        return {**answer, "warnings": ["Inertia matrix is too close\nto singular"]}, mjb
+
+    monkeypatch.setattr(mjcf_compile._SERVER, "request", warned)
+    with pytest.warns(
+        symdyn.SymdynWarning, match=r"tree.xml: MuJoCo: Inertia matrix is too close; to singular$"
+    ):
+        assert symdyn.load_mjcf(DATA / "tree.xml").n
 
 
 def test_a_nan_is_refused_before_mujoco_reads_it(tmp_path, capfd):

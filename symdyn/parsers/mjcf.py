@@ -137,9 +137,12 @@ def _free_body(model: Any, file: str, body_names: list[str], joint_names: list[s
 def mjcf_from_bytes(raw: bytes, file: str, digest: str, floating: bool = False) -> Robot:
     """The `Robot` of the MJCF file `file` (its bytes `raw`, their sha256 `digest`)."""
     check_attributes(raw, file)  # before MuJoCo reads a nan as 0, which the compiled model hides
-    model = compile_mjcf(raw, file)
+    said: list[str] = []  # MuJoCo's warnings, said once the model passes symdyn's checks
+    model = compile_mjcf(raw, file, said)
     check_link_count(model.nbody - 1, "bodies once compiled", file)  # <replicate> and <include> add some
     check_numbers(model, file)
+    for text in said:
+        warnings.warn(text, SymdynWarning, stacklevel=3)
     flags = _disabled(model)
     body_names = names(model, "body", model.nbody, "body")
     joint_names = names(model, "jnt", model.njnt, "joint")

@@ -57,8 +57,13 @@ def mujoco_module(file: str | None = None) -> Any:
     return optional_module("mujoco", "mjcf", "reading an MJCF (MuJoCo) file", file)
 
 
-def compile_mjcf(raw: bytes, file: str) -> Any:
+def compile_mjcf(raw: bytes, file: str, said: list[str] | None = None) -> Any:
     """The mujoco.MjModel of the MJCF file `file` (whose bytes are `raw`).
+
+    MuJoCo's warnings become SymdynWarnings naming the file, now, or with `said` given, are
+    appended to it for the caller to warn with once its own checks of the model have passed (a
+    file refused for a negative armature then prints its one line, not also the singular M that
+    MuJoCo saw).
 
     The bytes are first read by symdyn's hardened XML parser (a DOCTYPE, and so any entity, is
     refused) and must have the top element <mujoco>; MuJoCo then compiles the file from its path,
@@ -72,8 +77,11 @@ def compile_mjcf(raw: bytes, file: str) -> Any:
     check_link_count(_count_tags(root, "body"), "bodies", file)  # before MuJoCo compiles them
     mujoco = mujoco_module(file)
     answer, mjb = _SERVER.request({"file": os.path.abspath(file)}, TIMEOUT, MEMORY)
-    for text in dict.fromkeys(answer.get("warnings", [])):
-        warnings.warn(f"{file}: MuJoCo: {_one_line(text)}", SymdynWarning, stacklevel=4)
+    texts = [f"{file}: MuJoCo: {_one_line(text)}" for text in dict.fromkeys(answer.get("warnings", []))]
+    if said is not None:
+        said += texts
+    for text in texts if said is None else ():
+        warnings.warn(text, SymdynWarning, stacklevel=4)
     if "error" in answer and "bad_alloc" not in answer["error"]:
         raise SymdynError(f"MuJoCo's compiler refused it: {_one_line(answer['error'])}", file=file)
     if not mjb or answer.get("status"):
