@@ -314,7 +314,7 @@ def test_concurrent_generate_runs_leave_one_robots_files(tmp_path):
         files[-1].write_text(text.replace("m1: 0.2", f"m1: 0.{i + 2}"))
     out = tmp_path / "out"
     generate(files[0], targets=["c", "python"], out_dir=out, functions=["dynamics"])  # warm, in this process
-    context = multiprocessing.get_context("fork")
+    context = multiprocessing.get_context("spawn")  # not fork: the worker may have loaded JAX (threads)
     barrier = context.Barrier(len(files))
     runs = [context.Process(target=_generate_at_once, args=(str(f), str(out), barrier)) for f in files]
     for run in runs:
