@@ -28,7 +28,7 @@ from robots import example, y_robot
 
 import symdyn
 from symdyn.apps import build, calling
-from symdyn.apps.calling import batch_layout, load_library
+from symdyn.apps.compilation.calling import batch_layout, load_library
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
 from symdyn.codegen.c.runtime import function_table, render_runtime
@@ -319,7 +319,7 @@ def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch)
 def test_the_cache_key_holds_the_flags_and_the_machine(monkeypatch):
     """-march=native by default, with the CPU's fingerprint in the key; $SYMDYN_MARCH another target
     (no fingerprint then: the library runs on any machine of that target), or none."""
-    from symdyn.apps.compile import _options
+    from symdyn.apps.compilation.compile import _options
 
     monkeypatch.delenv(build.ARCH_ENV, raising=False)
     native = _options("newton-euler")

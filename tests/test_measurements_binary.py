@@ -1,4 +1,4 @@
-"""Logs in NumPy's binary formats (symdyn.apps.measurements_binary through read_measurements):
+"""Logs in NumPy's binary formats (symdyn.apps.identification.measurements_binary through read_measurements):
 a .npz of t, q, qd, qdd, tau and a structured .npy give the values of the same CSV log exactly;
 a wrong array is one line naming the file and the array, and a pickle is never loaded."""
 
@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from symdyn.apps.measurements import read_measurements
+from symdyn.apps.identification.measurements import read_measurements
 from symdyn.errors import SymdynError
 
 

@@ -43,33 +43,33 @@ import numpy as np
 import sympy as sp
 from sympy.core.parameters import distribute
 
-from .algorithms.base_parameters import BaseParameters, find_base_parameters
-from .algorithms.centroidal import Centroidal
-from .algorithms.configuration_space import ConfigurationSpace, configuration_space
-from .algorithms.coordinates import project_matrix, project_vector
-from .algorithms.coriolis import coriolis_matrix_composite
-from .algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
-from .algorithms.floating import floating_lagrange_terms, floating_newton_euler_terms
-from .algorithms.floating_frames import FloatingFrames
-from .algorithms.frame_kinematics import FrameKinematics
-from .algorithms.frames import joint_frames
-from .algorithms.lagrange import lagrange
-from .algorithms.newton_euler import newton_euler
-from .algorithms.operational_space import operational_space, task_rows
-from .algorithms.product_form import ProductForm, product_form
-from .algorithms.regressor import regressor as regressor_matrix
-from .algorithms.singular import SingularJoint, describe_singular, singular_joints
-from .algorithms.tendons import tendon_terms
-from .algorithms.tip_wrench import tip_wrench_torque
-from .errors import SymdynError, SymdynWarning
-from .model.free_flyer import NQ_BASE, NV_BASE, base_symbols
-from .model.names import latex_text
-from .model.parameters import standard_parameters
-from .model.robot import Robot
-from .model.symbols import joint_symbols
-from .model.tendons import refuse_tendons
-from .symbolic.program import Program
-from .symbolic.simplify import chop_float_noise
+from ..algorithms.base_parameters import BaseParameters, find_base_parameters
+from ..algorithms.centroidal import Centroidal
+from ..algorithms.configuration_space import ConfigurationSpace, configuration_space
+from ..algorithms.coordinates import project_matrix, project_vector
+from ..algorithms.coriolis import coriolis_matrix_composite
+from ..algorithms.crba import composite_inertias, gravity_composite, mass_matrix_crba
+from ..algorithms.floating import floating_lagrange_terms, floating_newton_euler_terms
+from ..algorithms.floating_frames import FloatingFrames
+from ..algorithms.frame_kinematics import FrameKinematics
+from ..algorithms.frames import joint_frames
+from ..algorithms.lagrange import lagrange
+from ..algorithms.newton_euler import newton_euler
+from ..algorithms.operational_space import operational_space, task_rows
+from ..algorithms.product_form import ProductForm, product_form
+from ..algorithms.regressor import regressor as regressor_matrix
+from ..algorithms.singular import SingularJoint, describe_singular, singular_joints
+from ..algorithms.tendons import tendon_terms
+from ..algorithms.tip_wrench import tip_wrench_torque
+from ..errors import SymdynError, SymdynWarning
+from ..model.free_flyer import NQ_BASE, NV_BASE, base_symbols
+from ..model.names import latex_text
+from ..model.parameters import standard_parameters
+from ..model.robot import Robot
+from ..model.symbols import joint_symbols
+from ..model.tendons import refuse_tendons
+from ..symbolic.program import Program
+from ..symbolic.simplify import chop_float_noise
 
 __all__ = ["Dynamics", "derive", "METHODS", "QUANTITIES", "ALL_QUANTITIES", "friction_vector"]
 

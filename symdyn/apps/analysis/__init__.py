@@ -2,7 +2,7 @@
 
 At a state (q, qd), with M, V, G, F the robot's compiled functions and J the
 world-aligned Jacobian of a frame (by default the last link's; the generated
-NAME_F_jacobian, symdyn.apps.task_space), restricted to the chosen task axes
+NAME_F_jacobian, symdyn.apps.analysis.task_space), restricted to the chosen task axes
 (rows x, y, z, rx, ry, rz):
 
 * Generalized inertia ellipsoid (slide 21): with qd = 0 and no gravity,
@@ -31,9 +31,9 @@ NAME_F_jacobian, symdyn.apps.task_space), restricted to the chosen task axes
   counter-clockwise order; in 3 or more dimensions they are the extreme images
   found facet by facet (each facet is normal to a set of generators), sorted.
 
-The work is shared by symdyn.apps.task_space (axes, J, Jdot qd), symdyn.apps.geometry
-(ellipsoids, hulls, zonotopes), symdyn.apps.conditioning (`analyze`, `Analysis`)
-and symdyn.apps.analysis_plots (the pictures); this module gathers their public names.
+The work is shared by symdyn.apps.analysis.task_space (axes, J, Jdot qd), symdyn.apps.analysis.geometry
+(ellipsoids, hulls, zonotopes), symdyn.apps.analysis.conditioning (`analyze`, `Analysis`)
+and symdyn.apps.analysis.analysis_plots (the pictures); this module gathers their public names.
 """
 
 from __future__ import annotations

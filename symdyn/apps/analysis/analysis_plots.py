@@ -15,14 +15,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import SymdynError
+from ...errors import SymdynError
+from ..output import figure, figure_bytes, plot_format, write_atomic
 from .conditioning import Analysis
 from .geometry import ellipse_points
-from .output import figure, figure_bytes, plot_format, write_atomic
 from .task_space import TASK_AXES
 
 if TYPE_CHECKING:
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
 __all__ = ["plot_analysis", "plot_workspace"]
 
@@ -75,7 +75,7 @@ def _draw_shapes(ax, a: Analysis, origin=(0.0, 0.0), scale: float = 1.0, swap=Fa
 
 def _gravity_layout(robot: Robot, axes: tuple[str, ...], params=None) -> tuple[bool, bool, bool]:
     """(swap, invert vertical, invert horizontal) so that gravity points down on the page."""
-    from ..oracle.inputs import numeric_model
+    from ...oracle.inputs import numeric_model
 
     g = numeric_model(robot, robot.param_values(params) if robot.params else None).gravity
     idx = [TASK_AXES.index(a) for a in axes]
@@ -146,7 +146,7 @@ def plot_workspace(
     unbiased ellipse, the gravity-biased ellipse and the gravity-biased polytope, drawn
     to scale (`scale` metres per unit acceleration; automatic when None). Axes x, y only.
     """
-    from ..algorithms.kinematics import numeric_pose
+    from ...algorithms.kinematics import numeric_pose
 
     if not analyses:
         raise SymdynError("plot_workspace needs at least one analysis")

@@ -1,11 +1,11 @@
 """The dynamic conditioning analysis at one state (q, qd): `analyze` and its report `Analysis`.
 
-With M, V, G, F from the robot's compiled functions (symdyn.apps.compiled), J and Jdot qd
-the generated ones of the chosen frame (symdyn.apps.task_space: by default the last link's,
+With M, V, G, F from the robot's compiled functions (symdyn.apps.compilation.compiled), J and Jdot qd
+the generated ones of the chosen frame (symdyn.apps.analysis.task_space: by default the last link's,
 world-aligned, chosen task rows) and L = diag(torque limits):
     xdd = J M^-1 L tau_hat + v_bias,   v_bias = Jdot qd - J M^-1 (V + G + F) = v_vel + v_grav,
     v_vel = Jdot qd - J M^-1 (V + F),  v_grav = -J M^-1 G,
-and the shapes of symdyn.apps.geometry: the inertia ellipsoid of M, the dynamic
+and the shapes of symdyn.apps.analysis.geometry: the inertia ellipsoid of M, the dynamic
 manipulability ellipsoid of J M^-1 L around v_bias, and the acceleration polytope.
 `Analysis` writes them as text or as the JSON document of `symdyn analyze`.
 """
@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import SymdynError
-from .compiled import CompiledDynamics, compiled_dynamics
+from ...errors import SymdynError
+from ..compilation.compiled import CompiledDynamics, compiled_dynamics
 from .geometry import (
     AccelerationPolytope,
     DynamicManipulability,
@@ -31,7 +31,7 @@ from .geometry import (
 from .task_space import default_axes, default_frame, joint_vector, parse_axes, task_jacobian
 
 if TYPE_CHECKING:
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
 __all__ = ["Analysis", "analyze", "MEASURE_NOTE", "LENGTHS_NOTE"]
 
@@ -170,7 +170,7 @@ def analyze(
     """Inertia ellipsoid, dynamic manipulability and acceleration polytope at (q, qd).
 
     torque_limits: one bound for every joint or one per joint (N m or N); frame: the frame whose
-    Jacobian is used (default: the last link's, symdyn.apps.task_space.default_frame); axes: task
+    Jacobian is used (default: the last link's, symdyn.apps.analysis.task_space.default_frame); axes: task
     rows of its Jacobian (default: the linear axes that move, e.g. x, y for a planar arm).
     `dynamics` reuses a CompiledDynamics of the same robot; `robot` may itself be a
     CompiledDynamics (its parameters bound, its frame functions from the cache).

@@ -15,12 +15,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..algorithms.operational_space import TASK_AXES
-from ..errors import SymdynError
-from .compiled import CompiledDynamics, compiled_dynamics
+from ...algorithms.operational_space import TASK_AXES
+from ...errors import SymdynError
+from ..compilation.compiled import CompiledDynamics, compiled_dynamics
 
 if TYPE_CHECKING:
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
 __all__ = ["TASK_AXES", "parse_axes", "default_frame", "default_axes", "task_jacobian", "joint_vector"]
 

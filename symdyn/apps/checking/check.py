@@ -40,11 +40,11 @@ import numpy as np
 import sympy as sp
 import yaml
 
-from ..dynamics import METHODS, derive
-from ..errors import SymdynError
-from ..model.expressions import parse_expression
-from ..model.robot import Robot
-from ..model.symbols import joint_symbols
+from ...dynamics import METHODS, derive
+from ...errors import SymdynError
+from ...model.expressions import parse_expression
+from ...model.robot import Robot
+from ...model.symbols import joint_symbols
 from .check_explain import SIMPLIFY_MAX_OPS, asymmetry_notes, chop, derive_form, difference_text
 from .check_state import AT_KEY, TOLERANCE_KEY, compare_at_state
 from .check_steps import check_steps

@@ -17,7 +17,7 @@ from collections.abc import Callable, Mapping
 
 import sympy as sp
 
-from ..dynamics import Dynamics
+from ...dynamics import Dynamics
 
 __all__ = ["derive_form", "difference_text", "asymmetry_notes", "SIMPLIFY_MAX_OPS", "CHOP"]
 

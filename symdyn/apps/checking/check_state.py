@@ -18,9 +18,9 @@ from collections.abc import Mapping
 import numpy as np
 import sympy as sp
 
-from ..dynamics import Dynamics
-from ..errors import SymdynError
-from ..model.symbols import joint_symbols
+from ...dynamics import Dynamics
+from ...errors import SymdynError
+from ...model.symbols import joint_symbols
 
 __all__ = ["AT_KEY", "TOLERANCE_KEY", "read_state", "compare_at_state"]
 

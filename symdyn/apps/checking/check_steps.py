@@ -22,9 +22,9 @@ from collections.abc import Callable, Mapping
 
 import sympy as sp
 
-from ..dynamics import simplify_entry
-from ..errors import SymdynError
-from ..model.robot import Robot
+from ...dynamics import simplify_entry
+from ...errors import SymdynError
+from ...model.robot import Robot
 from .steps import LAGRANGE_STEPS, NEWTON_EULER_STEPS, derivation_steps
 
 __all__ = ["check_steps"]

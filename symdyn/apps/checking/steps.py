@@ -35,13 +35,13 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..algorithms.kinematics import forward_kinematics, point_jacobian
-from ..dynamics import AUTO_SIMPLIFY_MAX_JOINTS, friction_vector, simplify_entry
-from ..errors import SymdynError
-from ..model.robot import Robot
-from ..model.symbols import joint_symbols
-from ..model.tendons import refuse_tendons
-from ..model.topology import children
+from ...algorithms.kinematics import forward_kinematics, point_jacobian
+from ...dynamics import AUTO_SIMPLIFY_MAX_JOINTS, friction_vector, simplify_entry
+from ...errors import SymdynError
+from ...model.robot import Robot
+from ...model.symbols import joint_symbols
+from ...model.tendons import refuse_tendons
+from ...model.topology import children
 
 __all__ = [
     "NEWTON_EULER_STEPS",

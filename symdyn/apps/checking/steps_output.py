@@ -1,4 +1,4 @@
-"""The derivation's steps (symdyn.apps.steps) as text, LaTeX or JSON, for `symdyn derive --steps`."""
+"""The derivation's steps (symdyn.apps.checking.steps) as text, LaTeX or JSON, for `symdyn derive --steps`."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import json
 
 import sympy as sp
 
-from ..model.names import comment_text
+from ...model.names import comment_text
 from .steps import Step, Steps
 
 __all__ = ["steps_text", "steps_latex", "steps_json", "STEP_FORMATS", "STEP_LABELS"]

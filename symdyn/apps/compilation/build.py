@@ -26,8 +26,8 @@ from collections.abc import Mapping, Sequence
 from functools import lru_cache
 from pathlib import Path
 
-from ..errors import SymdynError
-from ..progress import stage as progress_stage
+from ...errors import SymdynError
+from ...progress import stage as progress_stage
 
 __all__ = [
     "COMPILE_FLAGS",
@@ -124,7 +124,7 @@ def compile_library(
     """
     import tempfile
 
-    from ..leftovers import sweep_folders
+    from ...leftovers import sweep_folders
 
     sweep_folders(Path(tempfile.gettempdir()), BUILD_PREFIX)  # the folders of builds killed mid-way
     size = sum(len(text.encode()) for name, text in sources.items() if name.endswith(".c"))

@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
-from .. import __version__
-from ..errors import SymdynError
-from ..leftovers import sweep_folders
+from ... import __version__
+from ...errors import SymdynError
+from ...leftovers import sweep_folders
 
 __all__ = [
     "CACHE_ENV",

@@ -1,6 +1,6 @@
 """Calling a compiled library's functions from Python: one state, or a batch through NAME_batch.
 
-The methods of `CompiledDynamics` (symdyn.apps.compile) are built here from the library's
+The methods of `CompiledDynamics` (symdyn.apps.compilation.compile) are built here from the library's
 function table (symdyn.codegen.c.runtime.function_table) through cffi's ABI mode. One state
 (vectors of their size) is one C call. A batch (leading axes, e.g. (B, n)) is one call of
 NAME_batch, which evaluates W states per instruction (templates/c/batch.c.j2): the arrays are
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SymdynError
+from ...errors import SymdynError
 
 __all__ = [
     "load_library",

@@ -2,8 +2,8 @@
 
 The robot is derived and its code generated once (symdyn.codegen: the C target, the
 NumPy target and the batch wrappers of symdyn.codegen.c.runtime); the C is compiled
-with the system's compiler for this machine (symdyn.apps.build) into a shared library, and all of
-it is stored in the cache (symdyn.apps.cache) under a hash of the robot's content,
+with the system's compiler for this machine (symdyn.apps.compilation.build) into a shared library, and all of
+it is stored in the cache (symdyn.apps.compilation.cache) under a hash of the robot's content,
 symdyn's version and the options. The next call for the same robot loads the library
 without deriving anything.
 
@@ -12,11 +12,11 @@ function's name and inputs (without p, which is bound): whatever the code genera
 emits, including functions with several outputs (returned as a tuple) or outputs that
 are not square. One state (vectors of their size) runs one C call; a batch (leading
 axes, e.g. (B, n)) runs one call of NAME_batch, W states per instruction, optionally in
-threads (symdyn.apps.calling: the layout, when arrays are passed without a copy). A robot with
+threads (symdyn.apps.compilation.calling: the layout, when arrays are passed without a copy). A robot with
 closed loops also gets `solve_loops`, the generated C NAME_solve_loops (one state, or a batch
-looped in C; symdyn.apps.calling.solve_loops_method). Joint
+looped in C; symdyn.apps.compilation.calling.solve_loops_method). Joint
 quantities are in joint space (rad or m), the base frame fixes gravity, as in
-docs/generated-code.md. The robot's cache key is symdyn.apps.robot_key's.
+docs/generated-code.md. The robot's cache key is symdyn.apps.compilation.robot_key's.
 
 The methods bind through cffi's ABI mode: measured on this machine, a 7-joint function called with
 NumPy arrays costs about 2.7 us through cffi (ffi.from_buffer) against 5.8-6.3 us through
@@ -36,9 +36,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SymdynError, SymdynWarning
-from ..model.parameter_names import parameter_names_problem
-from ..module_files import load_module
+from ...errors import SymdynError, SymdynWarning
+from ...generated_modules import load_module
+from ...model.parameter_names import parameter_names_problem
 from . import cache
 from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
@@ -67,7 +67,7 @@ class RobotInfo:
 
 def _options(method: str, precision: str = "double") -> dict:
     """What a library depends on besides the robot: the method, the compiler, its flags, and with
-    -march=native the machine (symdyn.apps.build)."""
+    -march=native the machine (symdyn.apps.compilation.build)."""
     from .build import COMPILE_FLAGS, arch_flags, find_compiler, machine_fingerprint
 
     compiler = find_compiler()
@@ -90,10 +90,10 @@ def _build(robot, method: str, options: dict, frames: dict | None = None) -> Cal
     """
 
     def build(folder: Path) -> dict:
-        from ..codegen import c as c_target
-        from ..codegen import context
-        from ..codegen import python as numpy_target
-        from ..codegen.c.runtime import function_table, render_runtime, solve_loops_entry
+        from ...codegen import c as c_target
+        from ...codegen import context
+        from ...codegen import python as numpy_target
+        from ...codegen.c.runtime import function_table, render_runtime, solve_loops_entry
         from .build import compile_library, library_suffix
 
         ctx = context(robot, options["precision"], method, **(frames or {}))
@@ -174,7 +174,7 @@ def _function_groups(functions) -> tuple[str, ...] | None:
     or a sequence; "all" for every group), as `symdyn generate --functions` takes them."""
     if functions is None:
         return None
-    from ..codegen.functions import GROUPS
+    from ...codegen.functions import GROUPS
 
     names = (functions,) if isinstance(functions, str) else functions
     try:
@@ -197,27 +197,27 @@ def compile(
 
     params: None (no free parameters), a map name -> value, or one value per free parameter
     in the robot's order. threads: how many threads a batch call uses by default (each method
-    also takes threads=; symdyn.apps.calling). functions: the groups of generated functions to
+    also takes threads=; symdyn.apps.compilation.calling). functions: the groups of generated functions to
     build, as `symdyn generate --functions` (names of symdyn.codegen.functions.GROUPS, or "all");
     None: the default ones (every group but kinematics, operational_space and centroidal; dynamics
     and configuration for a floating robot). The library is built for the machine it runs on
-    (symdyn.apps.build: -march=native unless $SYMDYN_MARCH says otherwise) and cached under the
+    (symdyn.apps.compilation.build: -march=native unless $SYMDYN_MARCH says otherwise) and cached under the
     robot, the options and the groups (docs/speed.md: the cache); the second compile of an
     unchanged robot loads it in milliseconds.
 
     Raises:
         SymdynError: not a Robot, bad parameter values, an unknown group.
     """
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
     groups = _function_groups(functions)
     if robot.params:  # the values pass the robot file's physical checks (mass >= 0, ...)
-        from ..model.physical import check_values
+        from ...model.physical import check_values
 
         check_values(robot, robot.param_values(params, "symdyn.compile"), "symdyn.compile")
-    from ..codegen.functions import FAMILIES
+    from ...codegen.functions import FAMILIES
 
     families = [f"{f.__module__}.{f.__qualname__}" for f in FAMILIES]
     key = {"robot": robot_digest(robot), "families": families}
@@ -304,7 +304,7 @@ class CompiledDynamics(FrameMethods):
         return self.__dict__[name]
 
     def _loaded(self) -> tuple:
-        """(ffi, lib, W) of the library (symdyn.apps.calling.load_library)."""
+        """(ffi, lib, W) of the library (symdyn.apps.compilation.calling.load_library)."""
         meta = self._entry.meta
         width = f"{meta['robot']['name']}_batch_width"
         return load_library(self._library, meta["functions"], width, solve=meta.get("solve_loops"))
@@ -337,7 +337,7 @@ class CompiledDynamics(FrameMethods):
 
     @property
     def cdll(self):
-        """The library through ctypes (loads in microseconds; symdyn.apps.stepping calls it once per run)."""
+        """The library through ctypes (loads in microseconds; simulation.stepping calls it once per run)."""
         assert self.backend == "c"
         import ctypes
 
@@ -370,7 +370,7 @@ class CompiledDynamics(FrameMethods):
         return self._module
 
     def derived_entry(self, kind: str, build: Callable) -> cache.Entry:
-        """A further cache entry of this robot, e.g. its task-space kinematics (symdyn.apps.task_space).
+        """A further cache entry of this robot, e.g. its task-space kinematics (analysis.task_space).
 
         Keyed like the robot's own entry plus `kind`; on a miss build(robot, folder) writes its
         files and returns its metadata, the Robot loaded only then when it came from the cache.
@@ -396,8 +396,8 @@ class CompiledDynamics(FrameMethods):
         """The compiled functions of group `group` ("kinematics" or "operational_space", task axes
         `axes`, default all six) of one frame, in a cache entry of their own built on first use:
         methods <identifier>_pose, ..., com, ... (symdyn.codegen.frame_functions)."""
-        from ..algorithms.operational_space import TASK_AXES, task_rows
-        from ..model.frames import unknown_frame
+        from ...algorithms.operational_space import TASK_AXES, task_rows
+        from ...model.frames import unknown_frame
 
         if frame not in self.frame_names:
             raise unknown_frame(frame, self.frame_names, f"symdyn.compile: robot '{self.robot.name}'")

@@ -1,6 +1,6 @@
 """The derived dynamics as compiled functions, bound to numbers for the robot's parameters.
 
-`CompiledDynamics` (symdyn.apps.compile) holds the robot's generated C, compiled and
+`CompiledDynamics` (symdyn.apps.compilation.compile) holds the robot's generated C, compiled and
 cached, so every evaluation of M(q), V(q, qd) = C(q, qd) qd, G(q), F(qd), the inverse
 dynamics tau = M qdd + V + G + F and the forward dynamics qdd = M^-1 (tau - V - G - F)
 is straight-line C (or the generated NumPy module without a C compiler), never SymPy.
@@ -14,11 +14,11 @@ from collections.abc import Mapping
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from ..errors import SymdynError
+from ...errors import SymdynError
 from .compile import CompiledDynamics
 
 if TYPE_CHECKING:
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
 __all__ = ["CompiledDynamics", "compiled_dynamics", "with_parameters"]
 
@@ -31,8 +31,8 @@ def with_parameters(robot: Robot, values: Mapping[str, float] | None) -> Robot:
     """
     import sympy as sp
 
-    from ..model.parameter_names import parameter_number
-    from ..model.physical import check_values  # here: a warm run from the cache imports no SymPy
+    from ...model.parameter_names import parameter_number
+    from ...model.physical import check_values  # here: a warm run from the cache imports no SymPy
 
     if not values:
         return robot
@@ -61,7 +61,7 @@ def compiled_dynamics(robot: Robot | CompiledDynamics, params=None) -> CompiledD
         if params is None:
             return robot
         robot = robot.robot
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"expected a Robot, not {type(robot).__name__}")

@@ -10,7 +10,7 @@ the generated function: frame F's functions are named after its identifier
 
 from __future__ import annotations
 
-from ..errors import SymdynError
+from ...errors import SymdynError
 
 __all__ = ["FrameMethods"]
 
@@ -25,7 +25,7 @@ class FrameMethods:
         raise NotImplementedError  # CompiledDynamics defines it
 
     def _function(self, frame: str, suffix: str, axes=None):
-        from ..codegen.frame_functions import frame_identifiers  # not at import: a warm run loads no SymPy
+        from ...codegen.frame_functions import frame_identifiers  # not at import: a warm run loads no SymPy
 
         group = "operational_space" if suffix.startswith("operational") else "kinematics"
         ident = frame_identifiers([frame])[frame]

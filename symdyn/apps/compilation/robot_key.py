@@ -1,7 +1,7 @@
 """The content key of a robot for the compile cache: a SHA-256 over every field but its source file.
 
-symdyn.compile (symdyn.apps.compile) keys a cache entry by it, beside symdyn's version and code,
-the compiler, its flags and the machine (symdyn.apps.build), so an unchanged robot loaded from
+symdyn.compile (symdyn.apps.compilation.compile) keys a cache entry by it, beside symdyn's version and code,
+the compiler, its flags and the machine (symdyn.apps.compilation.build), so an unchanged robot loaded from
 another file, or again, hits the same entry.
 """
 

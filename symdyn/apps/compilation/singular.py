@@ -16,7 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..errors import SymdynError
+from ...errors import SymdynError
 
 __all__ = ["INVERTING", "NotGeneratedError", "divergence_error", "guarded"]
 

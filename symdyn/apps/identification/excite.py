@@ -27,11 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SymdynError
-from ..model.robot import Robot
+from ...errors import SymdynError
+from ...model.robot import Robot
+from ..output import write_atomic
 from .identify import base_regressor_samples
 from .measurements import needs_scipy
-from .output import write_atomic
 
 __all__ = ["FourierTrajectory", "excite", "DEFAULTS"]
 
@@ -88,7 +88,7 @@ class FourierTrajectory:
     def csv_text(self, robot: Robot, dt: float) -> str:
         """t, q, qd, qdd and tau (the robot file's inverse dynamics) over one period every dt:
         the columns `symdyn identify` reads."""
-        from .compiled import compiled_dynamics
+        from ..compilation.compiled import compiled_dynamics
 
         t = np.arange(0.0, self.period + 0.5 * dt, dt)
         q, qd, qdd = self(t)

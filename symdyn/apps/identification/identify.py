@@ -36,8 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SymdynError
-from ..model.robot import Robot
+from ...errors import SymdynError
+from ...model.robot import Robot
 from .least_squares import Triangular, combine, one_blas_thread
 from .measurements import SG_ORDER, SG_WINDOW, Measurements, differentiate, needs_scipy, read_measurements
 
@@ -135,11 +135,11 @@ def _regressor(robot: Robot):
     instruction), or the generated NumPy module without a C compiler; the robot's parameters
     must all have values."""
     if robot.floating:  # the regressor group is not among a floating robot's default groups
-        from .compile import compile
+        from ..compilation.compile import compile
 
         f = compile(robot, functions=("regressor",)).base_regressor
     else:
-        from .compiled import compiled_dynamics
+        from ..compilation.compiled import compiled_dynamics
 
         f = compiled_dynamics(robot).base_regressor
 
@@ -239,7 +239,7 @@ def plot_identification(
 ) -> bytes:
     """Measured and predicted (Y_b pi_b) torque per joint against time; the image bytes, also
     written atomically to `path` when given (png, pdf or svg by its suffix)."""
-    from .output import figure, figure_bytes, plot_format, write_atomic
+    from ..output import figure, figure_bytes, plot_format, write_atomic
 
     fmt = plot_format(path) if path is not None else "png"
     n = data.tau.shape[1]

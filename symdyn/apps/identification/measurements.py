@@ -36,8 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import SymdynError
-from ..model.free_flyer_names import (
+from ...errors import SymdynError
+from ...model.free_flyer_names import (
     BASE_ACCELERATION_NAMES,
     BASE_POSITION_NAMES,
     BASE_VELOCITY_NAMES,

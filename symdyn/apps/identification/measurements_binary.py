@@ -16,7 +16,7 @@ import zipfile
 
 import numpy as np
 
-from ..errors import SymdynError
+from ...errors import SymdynError
 
 __all__ = ["read_binary"]
 

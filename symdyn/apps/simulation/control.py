@@ -20,9 +20,9 @@ from collections.abc import Sequence
 import numpy as np
 import sympy as sp
 
-from ..errors import SymdynError
-from ..model.robot import Robot
-from .compiled import CompiledDynamics, compiled_dynamics
+from ...errors import SymdynError
+from ...model.robot import Robot
+from ..compilation.compiled import CompiledDynamics, compiled_dynamics
 from .simulate import TIME, lambdify_time, simulate, time_expressions
 from .trajectory import Trajectory
 
@@ -87,8 +87,8 @@ class SampledReference:
     @classmethod
     def from_csv(cls, path, n: int) -> SampledReference:
         """The columns t, q1..qn and (optionally) qd1..qdn, qdd1..qddn of a CSV file
-        (symdyn.apps.measurements.read_measurements: without them, a Savitzky-Golay estimate)."""
-        from .measurements import read_measurements
+        (identification.measurements.read_measurements: without them, a Savitzky-Golay estimate)."""
+        from ..identification.measurements import read_measurements
 
         data = read_measurements(path, n, torques=False)
         return cls(data.t, data.q, data.qd, data.qdd, where=str(path))

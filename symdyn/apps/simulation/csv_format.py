@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .compile import CompiledDynamics
+    from ..compilation.compile import CompiledDynamics
 
 __all__ = ["csv_text", "csv_bytes"]
 

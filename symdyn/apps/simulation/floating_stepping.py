@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SymdynError
+from ...errors import SymdynError
 
 __all__ = [
     "FLOATING_SCHEMES",

@@ -11,7 +11,7 @@ Integrators: "rk4" (the classical Runge-Kutta scheme on (q_a, qd_a)) and "semi-i
 (symplectic Euler). The trajectory holds every joint (q and qd = W qd_a from loop_motion; tau
 the actuated efforts in their joints' columns, zero in the passive ones) and the largest
 closure residual max |phi| over the samples. Torques: zero, NACT constants or expressions of
-t (symdyn.apps.simulate.torque_function), or a callable tau(t, q_a, qd_a).
+t (symdyn.apps.simulation.simulate.torque_function), or a callable tau(t, q_a, qd_a).
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from ..errors import SymdynError
-from .compiled import CompiledDynamics
+from ...errors import SymdynError
+from ..compilation.compiled import CompiledDynamics
 from .simulate import torque_function
 from .stepping import sample_times
 from .trajectory import Trajectory

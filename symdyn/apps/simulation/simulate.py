@@ -39,19 +39,19 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import SymdynError
+from ...errors import SymdynError
+from ..compilation.compiled import CompiledDynamics, compiled_dynamics, with_parameters
+from ..compilation.singular import divergence_error
+from ..output import write_atomic
 from . import stepping
-from .compiled import CompiledDynamics, compiled_dynamics, with_parameters
 from .floating_stepping import floating_sizes, run_floating
-from .output import write_atomic
-from .singular import divergence_error
 from .stepping import ADAPTIVE, INTEGRATORS, sample_times, torque_rows
 from .trajectory import Trajectory, plot_trajectory
 
 if TYPE_CHECKING:
     import sympy as sp
 
-    from ..model.robot import Robot
+    from ...model.robot import Robot
 
 __all__ = [
     "INTEGRATORS",
@@ -95,7 +95,7 @@ def time_expressions(values: Sequence, n: int, what: str = "tau", broadcast: boo
     """
     import sympy as sp
 
-    from ..model.expressions import parse_expression
+    from ...model.expressions import parse_expression
 
     time = sp.Symbol("t")
     values = list(values)

@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-from .compile import CompiledDynamics
-from .singular import divergence_error
+from ..compilation.compile import CompiledDynamics
+from ..compilation.singular import divergence_error
 
 __all__ = ["INTEGRATORS", "ADAPTIVE", "SCHEMES", "sample_times", "torque_rows", "run"]
 

@@ -1,9 +1,9 @@
 """A simulated run (`Trajectory`): its samples, its CSV text, and its plot against time.
 
 Joint positions q (rad or m), velocities qd and the applied torques tau (N m or N)
-are sampled at the times t of the integrator (symdyn.apps.simulate); a tracked
-reference (symdyn.apps.control) adds q_ref and qd_ref at the same times. The CSV
-(symdyn.apps.csv_format) is written by the plant's compiled library when it has one.
+are sampled at the times t of the integrator (symdyn.apps.simulation.simulate); a tracked
+reference (symdyn.apps.simulation.control) adds q_ref and qd_ref at the same times. The CSV
+(symdyn.apps.simulation.csv_format) is written by the plant's compiled library when it has one.
 """
 
 from __future__ import annotations
@@ -15,15 +15,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import SymdynError
-from ..model.free_flyer_names import NQ_BASE
+from ...errors import SymdynError
+from ...model.free_flyer_names import NQ_BASE
+from ..identification.measurements import log_columns
+from ..output import figure, figure_bytes, plot_format, write_atomic
 from .csv_format import csv_bytes, csv_text
-from .measurements import log_columns
-from .output import figure, figure_bytes, plot_format, write_atomic
 
 if TYPE_CHECKING:
-    from ..model.robot import Robot
-    from .compile import CompiledDynamics
+    from ...model.robot import Robot
+    from ..compilation.compile import CompiledDynamics
 
 __all__ = ["Trajectory", "plot_trajectory"]
 
@@ -56,7 +56,7 @@ class Trajectory:
         if self.q.ndim != 2:
             raise SymdynError("CSV output holds one trajectory, not a batch")
         nq, nv = self.q.shape[1], self.qd.shape[1]
-        if nq != nv:  # floating: the log symdyn identify reads (symdyn.apps.measurements)
+        if nq != nv:  # floating: the log symdyn identify reads (symdyn.apps.identification.measurements)
             columns = log_columns(nq - NQ_BASE, floating=True)
             values = {"t": self.t, "q": self.q, "qd": self.qd, "qdd": self.qdd, "tau": self.tau}
             heads = [head for head, a in values.items() if a is not None]  # qdd: None in a hand-made run
