@@ -1,10 +1,10 @@
 """`derive` and `Dynamics`: the equations of motion tau = M(q) qdd + V(q, qd) + G(q) + F(qd).
 
 The floor between the algorithms and code generation, by concern: the joint-space model
-(`joint_space`: `Dynamics`, its compact and closed forms, regressor and base parameters) and
-its derivation by either route (`derivation`: `derive`), the frame and task-space facade
-(`frames`: poses, Jacobians, centre of mass, operational space) and numeric evaluation
-(`numeric`: `Dynamics.evaluate`). `symdyn.dynamics` keeps every public name of the one module
+(`joint_space`: `derive` by either route and `Dynamics`, its compact and closed forms, the
+regressor and the base parameters; the quantities' names in `quantities`), the frame and
+task-space facade (`frames`: poses, Jacobians, centre of mass, operational space) and numeric
+evaluation (`numeric`: `Dynamics.evaluate`). `symdyn.dynamics` keeps every public name of the one module
 it was, so that user code and pickles keep working.
 """
 

@@ -44,7 +44,6 @@ import sympy as sp
 from sympy.core.parameters import distribute
 
 from ..algorithms.base_parameters import BaseParameters, find_base_parameters
-from ..algorithms.centroidal import Centroidal
 from ..algorithms.configuration_space import ConfigurationSpace, configuration_space
 from ..algorithms.coordinates import project_matrix, project_vector
 from ..algorithms.coriolis import coriolis_matrix_composite
@@ -55,39 +54,29 @@ from ..algorithms.frame_kinematics import FrameKinematics
 from ..algorithms.frames import joint_frames
 from ..algorithms.lagrange import lagrange
 from ..algorithms.newton_euler import newton_euler
-from ..algorithms.operational_space import operational_space, task_rows
 from ..algorithms.product_form import ProductForm, product_form
 from ..algorithms.regressor import regressor as regressor_matrix
 from ..algorithms.singular import SingularJoint, describe_singular, singular_joints
 from ..algorithms.tendons import tendon_terms
-from ..algorithms.tip_wrench import tip_wrench_torque
 from ..errors import SymdynError, SymdynWarning
-from ..model.free_flyer import NQ_BASE, NV_BASE, base_symbols
+from ..model.free_flyer import NV_BASE, base_symbols
 from ..model.names import latex_text
 from ..model.parameters import standard_parameters
 from ..model.robot import Robot
 from ..model.symbols import joint_symbols
 from ..model.tendons import refuse_tendons
 from ..symbolic.program import Program
-from ..symbolic.simplify import chop_float_noise
+from .frames import FrameFacade
+from .numeric import NumericEvaluation
+from .quantities import ALL_QUANTITIES, QUANTITIES, check_quantity, simplify_entry
 
 __all__ = ["Dynamics", "derive", "METHODS", "QUANTITIES", "ALL_QUANTITIES", "friction_vector"]
 
 METHODS = ("newton-euler", "lagrange")
-#: the terms of tau = M qdd + V + G + F (slide 16), and tau itself
-QUANTITIES = ("M", "C", "V", "G", "F", "tau")
-#: every name `Dynamics.closed_form` and `Dynamics.evaluate` accept: QUANTITIES and the bias V + G + F
-ALL_QUANTITIES = (*QUANTITIES, "bias")
 AUTO_SIMPLIFY_MAX_JOINTS = 3
 #: how many random states decide a floating base's pivots (Dynamics.singular_joints), and their seed
 SINGULAR_SAMPLES = 3
 SINGULAR_SEED = 20231
-
-
-def _check_quantity(name, where: str) -> str:
-    if name not in ALL_QUANTITIES:
-        raise SymdynError(f"{where}: unknown quantity {name!r} (one of {', '.join(ALL_QUANTITIES)})")
-    return name
 
 
 def friction_vector(robot: Robot, qd) -> sp.Matrix:
@@ -117,17 +106,8 @@ def friction_vector(robot: Robot, qd) -> sp.Matrix:
     return sp.Matrix(F)
 
 
-def simplify_entry(expr: sp.Expr) -> sp.Expr:
-    """A readable closed form: expanded, trigonometric identities applied, float rounding
-    residues dropped, common factors pulled out."""
-    if expr == 0 or expr.is_Atom:
-        return expr
-    e = sp.trigsimp(sp.expand(expr))
-    return sp.factor_terms(chop_float_noise(e))
-
-
 @dataclass
-class Dynamics:
+class Dynamics(FrameFacade, NumericEvaluation):
     """The equations of motion tau = M(q) qdd + V(q, qd) + G(q) + F(qd) of a robot (slide 16),
     compact (over intermediates) and closed-form, all in joint space.
 
@@ -135,7 +115,8 @@ class Dynamics:
     Newton-Euler pass with qdd = 0, for forward dynamics), as a SymPy Matrix over
     the named intermediates of `program`; the attributes `M`, `C`, `V`, `G`, `F`,
     `tau` and `bias` are closed forms over q, qd, qdd and `params` only. M and C are
-    n x n, the others n x 1.
+    n x n, the others n x 1. The frame and task-space methods come from `FrameFacade`
+    (symdyn.dynamics.frames), `evaluate` from `NumericEvaluation` (symdyn.dynamics.numeric).
     """
 
     robot: Robot
@@ -172,7 +153,7 @@ class Dynamics:
         Raises:
             SymdynError: an unknown name.
         """
-        _check_quantity(name, "Dynamics.closed_form")
+        check_quantity(name, "Dynamics.closed_form")
         return self._expanded(name, self.compact[name])
 
     def _expanded(self, name: str, m: sp.Matrix) -> sp.Matrix:
@@ -199,7 +180,7 @@ class Dynamics:
     def expanded(self, name: str) -> list[sp.Expr]:
         """Quantity `name` by substituting the program's intermediates back (simplified if
         requested): the full expansion of the recursion, entries in row-major order."""
-        _check_quantity(name, "Dynamics.expanded")
+        check_quantity(name, "Dynamics.expanded")
         entries = self.program.expand(list(self.compact[name]))
         return [simplify_entry(e) for e in entries] if self.simplified else entries
 
@@ -350,186 +331,9 @@ class Dynamics:
         if isinstance(names, str):
             raise SymdynError(f"Dynamics.assignments: names must be a sequence of names, got {names!r}")
         for name in names:
-            _check_quantity(name, "Dynamics.assignments")
+            check_quantity(name, "Dynamics.assignments")
         outs = [e for name in names for e in self.compact[name]]
         return self.program.needed(outs)
-
-    def _numeric(self, name: str):
-        """NumPy function of quantity `name` over the eliminated form, compiled on first use."""
-        f = self._compiled.get(name)
-        if f is None:
-            m = self.compact[name]
-            steps = self.program.needed(list(m))
-            args = [list(self.q), list(self.qd), list(self.qdd), list(self.params)]
-            f = sp.lambdify(args, sp.Matrix(m), modules="numpy", cse=lambda exprs: (steps, exprs))
-            self._compiled[name] = f
-        return f
-
-    def evaluate(self, name: str, q=None, qd=None, qdd=None, params=None) -> np.ndarray:
-        """Numeric value of quantity `name` at one state (missing vectors are zero).
-
-        Args:
-            name: one of M, C, V, G, F, tau, bias (ALL_QUANTITIES).
-            q, qd, qdd: n numbers each (joint positions, velocities, accelerations) or None.
-            params: values of the free parameters `params`: a sequence in that order or a
-                name -> number map; None when there are none.
-
-        Returns:
-            An (n, n) array for M and C, an (n,) array otherwise (joint space).
-
-        Raises:
-            SymdynError: an unknown name, a vector without n numbers, missing, extra or
-                unknown parameters.
-        """
-        where = "Dynamics.evaluate"
-        _check_quantity(name, where)
-        named = ((q, self.q, "q"), (qd, self.qd, "qd"), (qdd, self.qdd, "qdd"))
-        if self.robot.floating:
-            vec = [_state_vector(v, len(s), label, where) for v, s, label in named]
-        else:
-            vec = [self.robot.joint_values(v, label, where) for v, _, label in named]
-        values = self.robot.param_values(params, where)
-        p = [values[s] for s in self.params]
-        shape = self.compact[name].shape
-        out = np.asarray(self._numeric(name)(*vec, p), dtype=float).reshape(shape)
-        return out[:, 0] if name not in ("M", "C") else out
-
-    def tip_wrench_torque(self, F, q=None, params=None):
-        """J_b(q)^T F: the joint torques balancing a wrench F = [m; f] that the end effector
-        applies to its environment, in the end-effector frame (Modern Robotics' F_tip;
-        symdyn.algorithms.tip_wrench). Add it to tau for MR's InverseDynamics.
-
-        On a floating base J_b has the base's six columns too, and the six base rows are the
-        wrench the tip wrench puts on the base (force, then moment about the base origin, base
-        frame; symdyn.algorithms.tip_wrench).
-
-        Returns:
-            With q None: an n x 1 (NV x 1) SymPy matrix over q (and F, if it holds symbols);
-            with q (n numbers; NQ on a floating base) and params: an (n,) ((NV,)) array.
-        """
-        if q is None:
-            return tip_wrench_torque(self.robot, F, list(self.q))
-        where = "Dynamics.tip_wrench_torque"
-        if self.robot.floating:
-            q = _state_vector(q, self.robot.nq, "q", where)
-        else:
-            q = self.robot.joint_values(q, "q", where)
-        self.robot.param_values(params, where)
-        robot = self.robot.numeric(params)
-        return np.asarray(tip_wrench_torque(robot, F, [float(x) for x in q]), dtype=float)[:, 0]
-
-    # -- frames and task space (docs/frames.md; symdyn.algorithms.frame_kinematics)
-    @property
-    def frames(self) -> FrameKinematics | FloatingFrames:
-        """The frame quantities over named intermediates of a copy of `program` (intermediates
-        `_F...`), shared by the methods below; of a floating robot over q (NQ) and qd (NV), the
-        Jacobians 6 x NV with the base's columns (symdyn.algorithms.floating_frames)."""
-        if self._frames is None:
-            r, q, qd, prog = self.robot, list(self.q), list(self.qd), self.program.copy("F")
-            if r.floating:  # the base's coordinates first (symdyn.algorithms.floating_frames)
-                joints, rates = q[NQ_BASE:], qd[NV_BASE:]
-                cen = Centroidal(r, joints, rates, prog, q[:NQ_BASE], qd[:NV_BASE])
-                self._frames = FloatingFrames(FrameKinematics(r, joints, rates, prog), cen)
-            else:
-                self._frames = FrameKinematics(r, q, qd, prog)
-        return self._frames
-
-    def _frame_value(self, key: tuple, m: sp.Matrix, q, qd, params, where: str):
-        """m's closed form (q None) or its numbers at (q, qd, params) (lambdified once per key)."""
-        if q is None:
-            entries = self.frames.program.expand(list(m))
-            if self.simplified:
-                entries = [simplify_entry(e) for e in entries]
-            return sp.ImmutableMatrix(m.rows, m.cols, entries)
-        f = self._compiled.get(key)
-        if f is None:
-            steps = self.frames.program.needed(list(m))
-            args = [list(self.q), list(self.qd), list(self.params)]
-            f = sp.lambdify(args, sp.Matrix(m), modules="numpy", cse=lambda exprs: (steps, exprs))
-            self._compiled[key] = f
-        if self.robot.floating:
-            vq = _state_vector(q, self.robot.nq, "q", where)
-            vqd = _state_vector(qd, self.robot.nv, "qd", where)
-        else:
-            vq = self.robot.joint_values(q, "q", where)
-            vqd = self.robot.joint_values(qd, "qd", where)
-        values = self.robot.param_values(params, where)
-        out = np.asarray(f(vq, vqd, [values[s] for s in self.params]), dtype=float).reshape(m.shape)
-        return out[:, 0] if m.cols == 1 else out
-
-    def frame_pose(self, frame: str, q=None, params=None):
-        """world_T_F (4 x 4) of frame `frame` (a link's or one of Robot.frames): closed form over
-        q with q None, else an array at q."""
-        m = self.frames.pose(frame)
-        return self._frame_value(("pose", frame), m, q, None, params, "Dynamics.frame_pose")
-
-    def frame_jacobian(self, frame: str, reference: str = "world", q=None, params=None):
-        """J (6 x n), rows v_x v_y v_z w_x w_y w_z, of F's origin: world-aligned ("world",
-        Pinocchio's LOCAL_WORLD_ALIGNED) or in F's own axes ("local", LOCAL)."""
-        if reference not in ("world", "local"):
-            raise SymdynError(
-                f"Dynamics.frame_jacobian: reference must be 'world' or 'local', got {reference!r}"
-            )
-        m = self.frames.jacobian(frame, reference)
-        return self._frame_value((reference, frame), m, q, None, params, "Dynamics.frame_jacobian")
-
-    def frame_jacobian_dot_qd(self, frame: str, q=None, qd=None, params=None):
-        """Jdot qd (6): F's origin's classical acceleration and F's angular acceleration at
-        qdd = 0, world-aligned (Pinocchio's getFrameClassicalAcceleration, LOCAL_WORLD_ALIGNED)."""
-        m = self.frames.jacobian_dot_qd(frame)
-        return self._frame_value(("drift", frame), m, q, qd, params, "Dynamics.frame_jacobian_dot_qd")
-
-    def com(self, q=None, params=None):
-        """The centre of mass c(q) (3), world frame."""
-        return self._frame_value(("com",), self.frames.com(), q, None, params, "Dynamics.com")
-
-    def com_jacobian(self, q=None, params=None):
-        """Jc (3 x n), world frame: dc/dt = Jc qd."""
-        return self._frame_value(
-            ("Jc",), self.frames.com_jacobian(), q, None, params, "Dynamics.com_jacobian"
-        )
-
-    def com_jacobian_dot_qd(self, q=None, qd=None, params=None):
-        """Jc_dot qd (3), world frame: the centre of mass's acceleration at qdd = 0."""
-        m = self.frames.com_jacobian_dot_qd()
-        return self._frame_value(("Jcd",), m, q, qd, params, "Dynamics.com_jacobian_dot_qd")
-
-    def _operational(self, frame: str, axes, where: str):
-        rows = task_rows(axes, where)
-        key = ("os", frame, rows)
-        if key not in self._compiled:
-            fk = self.frames
-            J = fk.jacobian(frame, "world")
-            os = operational_space(
-                self.compact["M"],
-                J.extract(list(rows), list(range(self.n))),
-                self.compact["bias"],
-                fk.jacobian_dot_qd(frame).extract(list(rows), [0]),
-                self.robot.is_chain and not self.robot.floating,
-                fk.program,
-            )
-            self._compiled[key] = os
-        return key, self._compiled[key]
-
-    def operational_space_inertia(self, frame: str, q, axes=None, params=None) -> np.ndarray:
-        """Lambda = (J M^-1 J^T)^-1 (k x k) at q, J the world-aligned Jacobian's rows `axes`
-        (any of x, y, z, rx, ry, rz; default all six); symdyn.algorithms.operational_space."""
-        key, os = self._operational(frame, axes, "Dynamics.operational_space_inertia")
-        return self._frame_value(
-            (*key, "L"), os.inertia, q, None, params, "Dynamics.operational_space_inertia"
-        )
-
-    def operational_space_bias(self, frame: str, q, qd=None, axes=None, params=None) -> np.ndarray:
-        """mu + p = Lambda (J M^-1 (V + G + F) - Jdot qd) (k) at (q, qd)."""
-        key, os = self._operational(frame, axes, "Dynamics.operational_space_bias")
-        return self._frame_value((*key, "b"), os.bias, q, qd, params, "Dynamics.operational_space_bias")
-
-    def dynamically_consistent_inverse(self, frame: str, q, axes=None, params=None) -> np.ndarray:
-        """Jbar = M^-1 J^T Lambda (n x k) at q."""
-        key, os = self._operational(frame, axes, "Dynamics.dynamically_consistent_inverse")
-        return self._frame_value(
-            (*key, "B"), os.inverse, q, None, params, "Dynamics.dynamically_consistent_inverse"
-        )
 
     def __repr__(self) -> str:
         """One line: robot, joints, method and free parameters (the robot's table: `table()`)."""
@@ -545,7 +349,7 @@ class Dynamics:
     def latex(self, name: str) -> str:
         """Closed form of quantity `name` (ALL_QUANTITIES) in LaTeX, joint space, with q_{i},
         \\dot{q}_{i}, \\ddot{q}_{i} for the joint symbols (as in docs/generated-code.md)."""
-        _check_quantity(name, "Dynamics.latex")
+        check_quantity(name, "Dynamics.latex")
         names = {}
         for head, v in (("q", self.q), ("\\dot{q}", self.qd), ("\\ddot{q}", self.qdd)):
             names.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})
@@ -616,19 +420,6 @@ def state_symbols(robot: Robot) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
     if robot.n == 0:  # a single rigid body: the base's coordinates only
         return bq, bv, ba
     return sp.Matrix.vstack(bq, q), sp.Matrix.vstack(bv, qd), sp.Matrix.vstack(ba, qdd)
-
-
-def _state_vector(values, size: int, name: str, where: str) -> np.ndarray:
-    """`size` numbers (None: zeros) as a float array, else a SymdynError naming the vector."""
-    if values is None:
-        return np.zeros(size)
-    try:
-        a = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        raise SymdynError(f"{where}: {name} must hold numbers, got {values!r}") from None
-    if a.shape != (size,):
-        raise SymdynError(f"{where}: {name} has shape {a.shape}, expected ({size},)")
-    return a
 
 
 def derive(robot: Robot, method: str = "newton-euler", simplify: bool | None = None) -> Dynamics:
