@@ -2,7 +2,7 @@
 
 `symdyn.inertia` and `symdyn.kinematics` are short names of `symdyn.model.inertia` and
 `symdyn.algorithms.kinematics`. The applications moved from `symdyn/apps/` into one package each
-(issue 35, docs/changelog.md): `symdyn.apps.compile` is now `symdyn.apps.compilation.compile`,
+(issue 35; docs/layout.md, "Moved modules"): `symdyn.apps.compile` is now `symdyn.apps.compilation.compile`,
 and so on (`MOVED`). Importing an alias gives the very module object of its new home (not a
 copy, and its code runs once), so that classes compare equal, module state is shared and a
 pickle written under an old path still loads.
@@ -51,7 +51,7 @@ _APPLICATIONS = {
     "analysis": ("analysis_plots", "conditioning", "geometry", "task_space"),
 }
 
-#: old module path -> where the module lives now (issue 35's move; docs/changelog.md)
+#: old module path -> where the module lives now (issue 35; docs/layout.md)
 MOVED = {
     **{f"symdyn.apps.{m}": f"symdyn.apps.{p}.{m}" for p, modules in _APPLICATIONS.items() for m in modules},
     "symdyn.module_files": "symdyn.generated_modules",

@@ -12,11 +12,16 @@ inside a floor or across floors.
 from __future__ import annotations
 
 import ast
+import importlib
+import pickle
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 import symdyn
+from symdyn.module_aliases import MOVED
 
 PACKAGE = Path(symdyn.__file__).parent
 RANK = {
@@ -212,3 +217,28 @@ def test_the_cycle_finder_finds_cycles():
     assert _cycles(graph) == {("a", "b", "c"), ("d",)}
     assert _cycles({"a": {"b"}, "b": set()}) == set()
     assert {"errors", "oracle.inputs"} <= _import_graph()["oracle.singular"]  # edges are found
+
+
+@pytest.mark.parametrize("old,new", sorted(MOVED.items()))
+def test_old_module_paths_import_the_moved_modules(old, new):
+    """A moved module's old path (docs/layout.md, "Moved modules") gives the very module of its new
+    home, and a pickle that names a class by the old path loads the class itself."""
+    module = importlib.import_module(new)
+    assert importlib.import_module(old) is module
+    assert module.__spec__.name == new and module.__name__ == new
+    public = [n for n in getattr(module, "__all__", ()) if isinstance(getattr(module, n), type)]
+    for name in public[:1]:
+        assert pickle.loads(f"c{old}\n{name}\n.".encode()) is getattr(module, name)
+
+
+def test_an_alias_imported_after_its_module_is_that_module():
+    """In a fresh interpreter, `symdyn.inertia` after `symdyn.model.inertia` (and an old path after
+    the new one) is the module already imported, not a second copy run again."""
+    code = (
+        "import symdyn.model.inertia as a, symdyn.inertia as b; assert a is b\n"
+        "import symdyn.apps.simulation.trajectory as c, symdyn.apps.trajectory as d; assert c is d\n"
+        "import symdyn.apps.compile as e; from symdyn.apps.compilation import compile as f; assert e is f\n"
+        "import symdyn; assert symdyn.compile is f.compile\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr

@@ -23,25 +23,25 @@ NumPy arrays costs about 2.7 us through cffi (ffi.from_buffer) against 5.8-6.3 u
 ctypes (docs/speed.md). cffi parses the declarations when a method is first used (about
 0.1 s), so the stepping loop, called once per run, goes through ctypes instead. Without a C
 compiler the methods are the generated NumPy module's, with one warning.
+
+What an entry holds and how it is built: symdyn.apps.compilation.entry; the free parameters'
+values: symdyn.apps.compilation.parameter_binding.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import types
 import warnings
-from collections.abc import Callable, Mapping
-from pathlib import Path
-
-import numpy as np
+from collections.abc import Callable
 
 from ...errors import SymdynError, SymdynWarning
 from ...generated_modules import load_module
-from ...model.parameter_names import parameter_names_problem
 from . import cache
 from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
+from .entry import build_options, entry_builder, loaded_files
+from .parameter_binding import RobotInfo, bind_parameters
 from .robot_key import robot_digest
 from .singular import INVERTING, NotGeneratedError, guarded
 
@@ -54,80 +54,6 @@ _FALLBACK_NOTE = (
     "install a C compiler (cc, gcc or clang) or set CC"
 )
 _warned = False
-
-
-@dataclasses.dataclass(frozen=True)
-class RobotInfo:
-    """What the applications need of a robot when it comes from the cache: its name and size."""
-
-    name: str
-    n: int
-    params: tuple[str, ...] = ()
-
-
-def _options(method: str, precision: str = "double") -> dict:
-    """What a library depends on besides the robot: the method, the compiler, its flags, and with
-    -march=native the machine (symdyn.apps.compilation.build)."""
-    from .build import COMPILE_FLAGS, arch_flags, find_compiler, machine_fingerprint
-
-    compiler = find_compiler()
-    arch = list(arch_flags()) if compiler else []
-    return {
-        "method": method,
-        "precision": precision,
-        "compiler": compiler,
-        "flags": [*COMPILE_FLAGS, *arch] if compiler else None,
-        "arch": arch,
-        "machine": machine_fingerprint() if "-march=native" in arch else None,
-    }
-
-
-def _build(robot, method: str, options: dict, frames: dict | None = None) -> Callable[[Path], dict]:
-    """build(folder): derive, generate (C, NumPy, runtime), compile; return the entry's metadata.
-
-    `frames`: None (the functions of symdyn.codegen.context's default groups) or the keywords
-    functions, frames and task_axes of the frame functions' own entry (CompiledDynamics.frame_functions).
-    """
-
-    def build(folder: Path) -> dict:
-        from ...codegen import c as c_target
-        from ...codegen import context
-        from ...codegen import python as numpy_target
-        from ...codegen.c.runtime import function_table, render_runtime, solve_loops_entry
-        from .build import compile_library, library_suffix
-
-        ctx = context(robot, options["precision"], method, **(frames or {}))
-        files = {**c_target.render(ctx), **render_runtime(ctx), **numpy_target.render(ctx)}
-        for name, text in files.items():
-            (folder / name).write_text(text, encoding="utf-8")
-        library = None
-        if options["compiler"]:
-            library = f"lib{ctx.name}{library_suffix()}"
-            compile_library(
-                options["compiler"],
-                {k: v for k, v in files.items() if k.endswith((".c", ".h"))},
-                folder / library,
-                options["arch"],
-            )
-        return {
-            "robot": {
-                "name": ctx.name,
-                "n": ctx.robot.n,
-                "params": [str(s) for s in ctx.dynamics.params],
-                "frames": list(ctx.robot.frame_names),
-            },
-            "functions": function_table(ctx),
-            "solve_loops": solve_loops_entry(ctx),
-            "numpy": numpy_target.file_name(ctx.name),
-            "library": library,
-        }
-
-    return build
-
-
-def _loaded_files(meta: dict) -> list[str]:
-    """The file of an entry a CompiledDynamics loads at once: its library, or the NumPy module without one."""
-    return [meta["library"] or meta["numpy"]]
 
 
 def cached_dynamics(
@@ -147,23 +73,23 @@ def cached_dynamics(
     None: symdyn.codegen.context's default groups); `key_parts` must tell them apart.
     """
     check_threads(threads)
-    options = _options(method)
+    options = build_options(method)
     key = cache.entry_key(**key_parts, **options)
-    entry = cache.lookup(key, _loaded_files)
+    entry = cache.lookup(key, loaded_files)
     robot = None
     chosen = None if functions is None else {"functions": list(functions)}
     if entry is None:
         robot = make_robot()
-        entry = cache.get_or_build(key, _build(robot, method, options, chosen))
+        entry = cache.get_or_build(key, entry_builder(robot, method, options, chosen))
     self = CompiledDynamics._from_entry(entry, robot, params)
     self.threads = threads
     self._source = ({**key_parts, "method": method}, make_robot)
-    self._build_frames = lambda robot, folder, frames: _build(robot, method, options, frames)(folder)
+    self._build_frames = lambda robot, folder, frames: entry_builder(robot, method, options, frames)(folder)
     self._options = options
 
     def rebuild() -> cache.Entry:
         made = robot if robot is not None else make_robot()
-        return cache.get_or_build(key, _build(made, method, options, chosen))
+        return cache.get_or_build(key, entry_builder(made, method, options, chosen))
 
     self._rebuild = rebuild
     return self
@@ -226,33 +152,6 @@ def compile(
     return cached_dynamics(key, lambda: robot, params, method, threads, groups)
 
 
-def _bind(names: list[str], robot, params) -> np.ndarray | None:
-    """The parameter vector in `names` order (None when there are none); `robot` is the Robot, or
-    the RobotInfo of a cache hit."""
-    if robot is not None and not isinstance(robot, RobotInfo):
-        values = robot.param_values(params) if robot.params else {}
-        by_name = {str(k): v for k, v in values.items()}
-        if params is not None and not robot.params and len(params):
-            raise SymdynError(f"robot '{robot.name}' has no free parameters, got {params!r}")
-    elif params is None:
-        if names:
-            raise SymdynError(f"the robot has free parameters ({', '.join(names)}); give their values")
-        by_name = {}
-    elif isinstance(params, Mapping):
-        by_name = {str(k): float(v) for k, v in params.items()}
-        problem = parameter_names_problem(by_name, names, robot.name)
-        if problem:
-            raise SymdynError(f"parameters: {problem}")
-    else:
-        given = [float(v) for v in params]
-        if len(given) != len(names):
-            raise SymdynError(
-                f"parameters: expected {len(names)} values ({', '.join(names)}), got {len(given)}"
-            )
-        by_name = dict(zip(names, given, strict=True))
-    return np.array([float(by_name[n]) for n in names], dtype=np.float64) if names else None
-
-
 class CompiledDynamics(FrameMethods):
     """The generated functions of a robot as methods, bound to values of its free parameters.
 
@@ -274,7 +173,7 @@ class CompiledDynamics(FrameMethods):
         info = meta["robot"]
         self.robot = robot if robot is not None else RobotInfo(info["name"], info["n"], tuple(info["params"]))
         self.param_names = tuple(info["params"])
-        self.p = _bind(info["params"], self.robot, params)
+        self.p = bind_parameters(info["params"], self.robot, params)
         self._entry = entry
         self._params = params
         self._frame_libraries: dict = {}
