@@ -4,7 +4,7 @@
     python bench/batch.py --quick    # 10,000 states; 100,000 samples
 
 Part 1: the Panda's inverse dynamics, M and forward dynamics. A C harness links NAME_dynamics.c
-and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.build: COMPILE_FLAGS and
+and NAME_batch.c compiled with symdyn.compile's own flags (symdyn.apps.compilation.build: COMPILE_FLAGS and
 -march=native unless $SYMDYN_MARCH says otherwise) and times, over the same states, the scalar
 function called once per state in a C loop and one call of NAME_batch (the best of 15 rounds,
 interleaved); it also checks that both give the same bits. Then the batch through Python
@@ -33,7 +33,7 @@ from identify import lines as identify_lines  # noqa: E402
 from machine import RESULTS, load_averages, log, machine, project_path  # noqa: E402
 
 import symdyn  # noqa: E402
-from symdyn.apps.build import COMPILE_FLAGS, arch_flags, find_compiler  # noqa: E402
+from symdyn.apps.compilation.build import COMPILE_FLAGS, arch_flags, find_compiler  # noqa: E402
 from symdyn.codegen import c as c_target  # noqa: E402
 from symdyn.codegen import context  # noqa: E402
 from symdyn.codegen.c.runtime import render_runtime  # noqa: E402

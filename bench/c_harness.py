@@ -24,7 +24,7 @@ from states import CHECK_TOL, NCHECK, NSTATES, rel_err
 import symdyn
 from symdyn.model.parameters import numeric_parameters
 
-__all__ = ["HARNESS", "parse_harness", "build_c", "check_c", "time_compiled"]
+__all__ = ["HARNESS", "CR_WORK", "parse_harness", "build_harness", "build_c", "check_c", "time_compiled"]
 
 HARNESS = r"""/* Timing harness for {name}: written by bench/c_harness.py (bench/run.py), do not edit. */
 {prelude}
@@ -41,26 +41,13 @@ static double OUT[N * N + N * {prefix}_NSTD]; /* the largest output: M or Y */
 static const double *P = NULL; /* numeric robot: no free parameters */
 static const casadi_real *cr_arg[64];
 static casadi_real *cr_res[64];
-static casadi_int *cr_iw;
-static casadi_real *cr_w;
 
 static const char *LABELS[NB] = {{
     "inverse_dynamics", "cr_inverse_dynamics", "mass_matrix", "cr_mass_matrix", "gravity",
     "cr_gravity", "coriolis_matrix", "coriolis", "friction", "forward_dynamics", "regressor",
     "base_regressor"}};
 
-static void cr_work(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_int *),
-                    casadi_int *sz_iw, casadi_int *sz_w)
-{{
-    casadi_int a, r, i, w;
-    work(&a, &r, &i, &w);
-    if (a > 64 || r > 64) {{
-        fprintf(stderr, "casadi work sizes too large\n");
-        exit(2);
-    }}
-    if (i > *sz_iw) *sz_iw = i;
-    if (w > *sz_w) *sz_w = w;
-}}
+{cr_work}
 
 #define CR(FN, ...)                                                                       \
     do {{                                                                                  \
@@ -77,12 +64,7 @@ static void cr_work(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi
 int main(int argc, char **argv)
 {{
 {main_head}    casadi_int sz_iw = 1, sz_w = 1;
-{read_states}    cr_work(cr_{prefix}_inverse_dynamics_work, &sz_iw, &sz_w);
-    cr_work(cr_{prefix}_mass_matrix_work, &sz_iw, &sz_w);
-    cr_work(cr_{prefix}_gravity_work, &sz_iw, &sz_w);
-    cr_iw = malloc(sizeof(casadi_int) * (size_t)sz_iw);
-    cr_w = malloc(sizeof(casadi_real) * (size_t)sz_w);
-
+{read_states}{cr_workspace}
     if (strcmp(argv[2], "check") == 0) {{
         int ncheck = argc > 3 ? atoi(argv[3]) : 4;
         for (k = 0; k < ncheck && k < K; ++k) {{
@@ -106,6 +88,65 @@ int main(int argc, char **argv)
     }}
 {time_main}}}
 """
+
+
+#: The CasADi functions' work space, shared by every harness (`{cr_work}` of a template): their
+#: integer and real work arrays, sized by `cr_work` over the functions used (`cr_workspace`).
+CR_WORK = r"""static casadi_int *cr_iw;
+static casadi_real *cr_w;
+
+static void cr_work(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_int *),
+                    casadi_int *sz_iw, casadi_int *sz_w)
+{
+    casadi_int a, r, i, w;
+    work(&a, &r, &i, &w);
+    if (a > 64 || r > 64) {
+        fprintf(stderr, "casadi work sizes too large\n");
+        exit(2);
+    }
+    if (i > *sz_iw) *sz_iw = i;
+    if (w > *sz_w) *sz_w = w;
+}"""
+
+
+def cr_workspace(functions: list[str]) -> str:
+    """main's lines that size and allocate CR_WORK's arrays for the CasADi `functions` (their C
+    names; sz_iw and sz_w declared before)."""
+    sizes = "".join(f"    cr_work({f}_work, &sz_iw, &sz_w);\n" for f in functions)
+    return (
+        sizes + "    cr_iw = malloc(sizeof(casadi_int) * (size_t)sz_iw);\n"
+        "    cr_w = malloc(sizeof(casadi_real) * (size_t)sz_w);\n"
+    )
+
+
+def build_harness(
+    template: str, loops, fns: dict, cr_name: str, stem: str, robot, work: Path, gen_dir: Path, **fields
+):
+    """Write the CasADi route's C of `fns` as `cr_name`.c and `template` filled in (the robot, the
+    states, the timing `loops`, the CasADi work space of every function of `fns`, `fields`) as
+    `stem`.c, and compile them with symdyn's NAME_dynamics.c (machine.FLAGS).
+
+    Returns:
+        (the program, the seconds the compiler took).
+    """
+    casadi_route.write_c(fns, cr_name, work)
+    harness = work / f"{stem}.c"
+    harness.write_text(
+        template.format(
+            prefix=robot.name,
+            n=robot.n,
+            nstates=NSTATES,
+            cr_work=CR_WORK,
+            cr_workspace=cr_workspace([f.name() for f in fns.values()]),
+            **fields,
+            **skeleton([loop.format(p=robot.name) for loop in loops], *JOINT_STATES),
+        )
+    )
+    exe = work / stem
+    sources = [harness, gen_dir / f"{robot.name}_dynamics.c", work / f"{cr_name}.c"]
+    t0 = time.perf_counter()
+    run([C_COMPILER, *FLAGS, "-I", gen_dir, "-I", work, "-o", exe, *sources, "-lm"])
+    return exe, time.perf_counter() - t0
 
 
 LOOPS = (  # run_bench's benchmarks in LABELS order: LOOP(call, one output element)
@@ -143,21 +184,10 @@ def parse_harness(text: str) -> tuple[dict, dict]:
 
 def build_c(row: Row, robot, gen_dir: Path, work: Path, fns) -> Path:
     """Write the CasADi route's C and the harness; compile all three with FLAGS."""
-    casadi_route.write_c(fns, f"cr_{row.name}", work)
-    harness = work / f"bench_{row.name}.c"
-    text = HARNESS.format(
-        name=row.name,
-        prefix=robot.name,
-        n=robot.n,
-        nstates=NSTATES,
-        **skeleton([loop.format(p=robot.name) for loop in LOOPS], *JOINT_STATES),
+    exe, seconds = build_harness(
+        HARNESS, LOOPS, fns, f"cr_{row.name}", f"bench_{row.name}", robot, work, gen_dir, name=row.name
     )
-    harness.write_text(text)
-    exe = work / f"bench_{row.name}"
-    sources = [harness, gen_dir / f"{robot.name}_dynamics.c", work / f"cr_{row.name}.c"]
-    t0 = time.perf_counter()
-    run([C_COMPILER, *FLAGS, "-I", gen_dir, "-I", work, "-o", exe, *sources, "-lm"])
-    row.notes.append(f"C build {time.perf_counter() - t0:.1f} s")
+    row.notes.append(f"C build {seconds:.1f} s")
     return exe
 
 

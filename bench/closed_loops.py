@@ -43,7 +43,7 @@ from states import NCHECK  # noqa: E402
 
 from symdyn.algorithms.closed_loops import analyse  # noqa: E402
 from symdyn.codegen import render  # noqa: E402
-from symdyn.module_files import load_module  # noqa: E402
+from symdyn.generated_modules import load_module  # noqa: E402
 from symdyn.oracle import closed_loops as oc  # noqa: E402
 from symdyn.parsers import robot_from_data  # noqa: E402
 

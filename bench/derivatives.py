@@ -21,17 +21,15 @@ benchmark robots' viscous terms cost a few additions).
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import casadi_route
 import casadi_route_derivatives as crd
 import numpy as np
-from c_harness import parse_harness, time_compiled
-from c_snippets import JOINT_STATES, skeleton
-from machine import C_COMPILER, FLAGS, RESULTS, log, run
+from c_harness import build_harness, parse_harness, time_compiled
+from machine import RESULTS, log, run
 from row import Row
-from states import NCHECK, NSTATES
+from states import NCHECK
 
 from symdyn import rnea as rn_rnea
 from symdyn.rnea import forward_dynamics as rn_fd
@@ -65,8 +63,8 @@ HARNESS = r"""/* Derivative timing harness for {name}: written by bench/derivati
 static double Q[K][N], QD[K][N], QDD[K][N], TAU[K][N];
 static double O1[4 * N * N], O2[4 * N * N], O3[N * N];
 static const double *P = NULL;
-static casadi_int *iw;
-static casadi_real *w;
+
+{cr_work}
 
 static const char *LABELS[NB] = {{
     "inverse_dynamics_derivatives", "cr_rnea_derivatives", "forward_dynamics_derivatives",
@@ -79,16 +77,7 @@ static void cr(int (*f)(const casadi_real **, casadi_real **, casadi_int *, casa
     casadi_real *res[3];
     arg[0] = a; arg[1] = b; arg[2] = c;
     res[0] = O1; res[1] = O2; res[2] = O3;
-    f(arg, res, iw, w, 0);
-}}
-
-static void sizes(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_int *),
-                  casadi_int *si, casadi_int *sw)
-{{
-    casadi_int a, r, i, ww;
-    work(&a, &r, &i, &ww);
-    if (i > *si) *si = i;
-    if (ww > *sw) *sw = ww;
+    f(arg, res, cr_iw, cr_w, 0);
 }}
 
 {run_bench}
@@ -97,13 +86,8 @@ static void sizes(int (*work)(casadi_int *, casadi_int *, casadi_int *, casadi_i
 
 int main(int argc, char **argv)
 {{
-{main_head}    casadi_int si = 1, sw = 1;
-{read_states}    sizes(crd_{prefix}_rnea_derivatives_work, &si, &sw);
-    sizes(crd_{prefix}_aba_derivatives_work, &si, &sw);
-    sizes(crd_{prefix}_minverse_work, &si, &sw);
-    iw = malloc(sizeof(casadi_int) * (size_t)si);
-    w = malloc(sizeof(casadi_real) * (size_t)sw);
-    if (strcmp(argv[2], "check") == 0) {{
+{main_head}    casadi_int sz_iw = 1, sz_w = 1;
+{read_states}{cr_workspace}    if (strcmp(argv[2], "check") == 0) {{
         for (k = 0; k < {ncheck}; ++k) {{
             {prefix}_inverse_dynamics_derivatives(Q[k], QD[k], QDD[k], P, O1, O2);
             print_out("id_dq", k, O1, N * N); print_out("id_dqd", k, O2, N * N);
@@ -194,22 +178,10 @@ def bench_derivatives(row: Row, robot, gen_dir: Path, work: Path, states_file: P
     """Build, check and time the derivative functions of one robot; results in `row.derivatives`."""
     log(f"[{row.name}] derivatives: CasADi route, build, check, time ...")
     fns = crd.derivative_functions(robot)
-    casadi_route.write_c(fns, f"crd_{row.name}", work)
-    src = work / f"bench_derivatives_{row.name}.c"
-    text = HARNESS.format(
-        name=row.name,
-        prefix=robot.name,
-        n=robot.n,
-        nstates=NSTATES,
-        ncheck=NCHECK,
-        **skeleton([loop.format(p=robot.name) for loop in LOOPS], *JOINT_STATES),
+    stem = f"bench_derivatives_{row.name}"
+    exe, build_s = build_harness(
+        HARNESS, LOOPS, fns, f"crd_{row.name}", stem, robot, work, gen_dir, name=row.name, ncheck=NCHECK
     )
-    src.write_text(text)
-    exe = work / f"bench_derivatives_{row.name}"
-    t0 = time.perf_counter()
-    sources = [src, gen_dir / f"{robot.name}_dynamics.c", work / f"crd_{row.name}.c"]
-    run([C_COMPILER, *FLAGS, "-I", gen_dir, "-I", work, "-o", exe, *sources, "-lm"])
-    build_s = time.perf_counter() - t0
     checks = _check(robot, exe, states_file, states)
     bad = {k: v for k, v in checks.items() if not v <= FD_TOL}
     if bad:

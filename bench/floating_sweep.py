@@ -44,7 +44,7 @@ from machine import RESULTS, log  # noqa: E402
 
 import symdyn  # noqa: E402
 from symdyn.codegen import render  # noqa: E402
-from symdyn.module_files import load_module  # noqa: E402
+from symdyn.generated_modules import load_module  # noqa: E402
 from symdyn.regenerate import example_robot_data_folder  # noqa: E402
 
 #: the robots whose generated NumPy functions (--generated) are compared with Pinocchio

@@ -5,8 +5,9 @@
 
 The log (t, q, qd, qdd, tau at 1 kHz, sines; tau from the compiled inverse dynamics plus noise)
 is written to a temporary folder (never committed). Timed in this process: reading the CSV
-(symdyn.apps.measurements.read_measurements: pandas' parser), the same file by numpy.loadtxt (the
-reader before) and the same values as a .npz log, the derivation of the base parameters (SymPy), the base
+(read_measurements of symdyn.apps.identification.measurements: pandas' parser), the same file
+by numpy.loadtxt (the reader before) and the same values as a .npz log, the derivation of the base
+parameters (SymPy), the base
 regressor alone over the chunks identify uses (batch calls into one reused-size buffer), and
 identify itself (regressor chunks folded by incremental QR, both least squares, no prediction);
 then the whole command `symdyn identify panda.yaml LOG.csv` (and LOG.npz) as a subprocess, with
@@ -36,7 +37,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def write_log(robot, fast, samples: int, path: Path) -> None:
     """A Panda log of `samples` samples at 1 kHz (sines), tau from the compiled inverse dynamics + noise."""
-    from symdyn.apps.csv_format import csv_bytes
+    from symdyn.apps.simulation.csv_format import csv_bytes
 
     n = robot.n
     t = np.arange(samples) * 1e-3
@@ -52,8 +53,8 @@ def identify_part(samples: int, folder: Path) -> dict[str, float]:
     """Seconds of each stage of identification on a Panda log of `samples` samples, and of the
     whole command (on the CSV and on the .npz); 'nbase', 'chunk' and 'peak MB', 'peak MB on the
     .npz log' (the command's maximum resident set)."""
-    from symdyn.apps.identify import base_regressor_samples, chunk_samples, identify
-    from symdyn.apps.measurements import read_measurements
+    from symdyn.apps.identification.identify import base_regressor_samples, chunk_samples, identify
+    from symdyn.apps.identification.measurements import read_measurements
     from symdyn.dynamics import derive
 
     path = ROOT / "examples" / "panda.yaml"

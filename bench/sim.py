@@ -101,7 +101,7 @@ def _median_run(argv: list[str], env: dict, repeat: int, stepping: bool) -> tupl
 def _stepping(env: dict, repeat: int) -> float:
     """Median seconds of symdyn.simulate alone (the C stepping loop), on the warm cache entry of the CLI."""
     os.environ["SYMDYN_CACHE_DIR"] = env["SYMDYN_CACHE_DIR"]
-    from symdyn.apps.simulate import simulate
+    from symdyn.apps.simulation.simulate import simulate
     from symdyn.cli.cache import cached_plant
 
     args = argparse.Namespace(robot=str(ROBOT), base=None, tip=None)

@@ -14,15 +14,15 @@ spatial -> model -> parsers; symbolic -> algorithms -> dynamics -> codegen -> ap
 __version__ = "0.1.0"
 
 import importlib as _importlib
-import sys as _sys
 from typing import TYPE_CHECKING
 
+from . import module_aliases as _module_aliases
 from .errors import SymdynError, SymdynWarning  # noqa: E402
 
 if TYPE_CHECKING:  # what the names below are, for type checkers and the API reference
     from . import rnea
     from .algorithms import kinematics
-    from .apps.compile import compile
+    from .apps.compilation.compile import compile
     from .codegen import generate
     from .dynamics import Dynamics, derive
     from .model import inertia
@@ -38,7 +38,7 @@ _LAZY = {
     "kinematics": (".algorithms.kinematics", None),
     "inertia": (".model.inertia", None),
     "generate": (".codegen", "generate"),
-    "compile": (".apps.compile", "compile"),
+    "compile": (".apps.compilation.compile", "compile"),
     "Dynamics": (".dynamics", "Dynamics"),
     "derive": (".dynamics", "derive"),
     "standard_parameters": (".model.parameters", "standard_parameters"),
@@ -51,8 +51,9 @@ _LAZY = {
     "robot_from_data": (".parsers", "robot_from_data"),
     "robot_from_poe": (".parsers", "robot_from_poe"),
 }
-#: `symdyn.inertia` and `symdyn.kinematics` are public modules: `import symdyn.inertia` works too.
-_ALIASES = {"inertia": ".model.inertia", "kinematics": ".algorithms.kinematics"}
+#: `symdyn.inertia` and `symdyn.kinematics` are public modules (`import symdyn.inertia` works too),
+#: and the old paths of moved modules (`symdyn.apps.compile`) still import: symdyn.module_aliases.
+_module_aliases.install()
 
 
 def __getattr__(name: str):
@@ -63,22 +64,6 @@ def __getattr__(name: str):
     value = module if attribute is None else getattr(module, attribute)
     globals()[name] = value
     return value
-
-
-class _AliasFinder:
-    """Finds `symdyn.inertia` and `symdyn.kinematics` as the modules they stand for."""
-
-    @staticmethod
-    def find_spec(fullname, path=None, target=None):
-        alias = fullname.rpartition(".")[2]
-        if fullname.startswith(__name__ + ".") and fullname.count(".") == 1 and alias in _ALIASES:
-            module = _importlib.import_module(_ALIASES[alias], __name__)
-            _sys.modules[fullname] = module
-            return module.__spec__
-        return None
-
-
-_sys.meta_path.insert(0, _AliasFinder)
 
 
 def __dir__():

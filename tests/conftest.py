@@ -1,7 +1,7 @@
 """Shared pytest set-up.
 
 - The helper modules of tests/ (`robots`, `cbuild`) are importable from every test file.
-- symdyn.compile builds its libraries without -march (SYMDYN_MARCH=none, symdyn.apps.build), the
+- symdyn.compile builds its libraries without -march (SYMDYN_MARCH=none, symdyn.apps.compilation.build), the
   compiler's default target: the SIMD bodies of the batch wrappers are then left out by the
   preprocessor, so the many libraries the suite compiles cost what they cost before them (the
   vector bodies double a library's compile time). tests/test_batch.py compiles and checks the
@@ -45,7 +45,7 @@ def pytest_runtest_makereport(item, call):
 
 @pytest.fixture(autouse=True, scope="session")
 def _temporary_symdyn_cache(tmp_path_factory):
-    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.cache).
+    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.compilation.cache).
 
     Under pytest-xdist the workers share one folder (in the run's common temporary root), so a
     library one worker compiled is a cache hit for the others: the cache's writes are atomic and

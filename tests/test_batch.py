@@ -28,7 +28,7 @@ from robots import example, y_robot
 
 import symdyn
 from symdyn.apps import build, calling
-from symdyn.apps.calling import batch_layout, load_library
+from symdyn.apps.compilation.calling import batch_layout, load_library
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
 from symdyn.codegen.c.runtime import function_table, render_runtime
@@ -319,17 +319,17 @@ def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch)
 def test_the_cache_key_holds_the_flags_and_the_machine(monkeypatch):
     """-march=native by default, with the CPU's fingerprint in the key; $SYMDYN_MARCH another target
     (no fingerprint then: the library runs on any machine of that target), or none."""
-    from symdyn.apps.compile import _options
+    from symdyn.apps.compilation.entry import build_options
 
     monkeypatch.delenv(build.ARCH_ENV, raising=False)
-    native = _options("newton-euler")
+    native = build_options("newton-euler")
     assert "-march=native" in native["flags"] and native["machine"] == build.machine_fingerprint()
     assert "-ffp-contract=off" in native["flags"]
     monkeypatch.setenv(build.ARCH_ENV, "x86-64-v3")
-    portable = _options("newton-euler")
+    portable = build_options("newton-euler")
     assert "-march=x86-64-v3" in portable["flags"] and portable["machine"] is None
     monkeypatch.setenv(build.ARCH_ENV, "none")
-    assert not any(f.startswith("-march") for f in _options("newton-euler")["flags"])
+    assert not any(f.startswith("-march") for f in build_options("newton-euler")["flags"])
     monkeypatch.setenv(build.ARCH_ENV, "native; rm -rf /")
     with pytest.raises(SymdynError, match="SYMDYN_MARCH"):
-        _options("newton-euler")
+        build_options("newton-euler")

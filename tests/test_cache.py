@@ -1,4 +1,4 @@
-"""The cache's leftovers and errors (symdyn.apps.cache, symdyn.leftovers).
+"""The cache's leftovers and errors (symdyn.apps.compilation.cache, symdyn.leftovers).
 
 A build killed before its rename leaves a `.build-PID-XXXXXXXX` folder; the next build
 removes it once stale (its process gone, or older than an hour) and `symdyn cache` counts it.
@@ -129,7 +129,7 @@ DOUBLE = {"double.c": "double twice(double x) { return 2.0 * x; }\n"}
 
 
 def _compiler():
-    from symdyn.apps.build import find_compiler
+    from symdyn.apps.compilation.build import find_compiler
 
     compiler = find_compiler()
     if compiler is None:
@@ -149,7 +149,7 @@ def test_a_killed_compilers_folder_is_removed_by_the_next_build(tmp_path, monkey
     import signal
     import tempfile
 
-    from symdyn.apps.build import BUILD_PREFIX, compile_library
+    from symdyn.apps.compilation.build import BUILD_PREFIX, compile_library
 
     compiler = _compiler()
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
@@ -180,7 +180,7 @@ def test_a_killed_compilers_folder_is_removed_by_the_next_build(tmp_path, monkey
 
 
 def test_a_relative_cache_folder_is_taken_from_the_current_folder(tmp_path, monkeypatch):
-    from symdyn.apps.build import compile_library
+    from symdyn.apps.compilation.build import compile_library
 
     compiler = _compiler()
     monkeypatch.chdir(tmp_path)

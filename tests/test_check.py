@@ -13,9 +13,9 @@ import sympy as sp
 import yaml
 from timebound import refused, within
 
-import symdyn.apps.check as check_module
+import symdyn.apps.checking.check as check_module
 from symdyn import cli
-from symdyn.apps.check import check_answers, load_answers
+from symdyn.apps.checking.check import check_answers, load_answers
 from symdyn.errors import SymdynError
 from symdyn.parsers import load_robot
 

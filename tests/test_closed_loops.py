@@ -25,7 +25,7 @@ from symdyn.algorithms.closed_loops import analyse
 from symdyn.cli.main import main
 from symdyn.codegen import render
 from symdyn.errors import SymdynError
-from symdyn.module_files import load_module
+from symdyn.generated_modules import load_module
 from symdyn.oracle import closed_loops as oc
 from symdyn.parsers import robot_from_data
 from symdyn.rnea import kinetic_energy, mass_matrix, potential_energy, rnea

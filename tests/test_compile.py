@@ -30,10 +30,10 @@ from robots import (
 
 import symdyn
 from symdyn.apps import cache
-from symdyn.apps.calling import numpy_solve_loops
-from symdyn.apps.compile import CompiledDynamics, compile
-from symdyn.apps.control import ComputedTorque, Reference, track
-from symdyn.apps.simulate import simulate
+from symdyn.apps.compilation.calling import numpy_solve_loops
+from symdyn.apps.compilation.compile import CompiledDynamics, compile
+from symdyn.apps.simulation.control import ComputedTorque, Reference, track
+from symdyn.apps.simulation.simulate import simulate
 from symdyn.cli.main import main
 from symdyn.codegen import functions as fn
 from symdyn.errors import SymdynError, SymdynWarning
@@ -66,7 +66,7 @@ def _numpy_backend(robot, monkeypatch, params=None):
     with monkeypatch.context() as mp:
         mp.setenv("CC", "no-such-compiler-symdyn")
         with pytest.warns(SymdynWarning, match="times slower"):
-            mp.setattr("symdyn.apps.compile._warned", False)
+            mp.setattr("symdyn.apps.compilation.compile._warned", False)
             slow = compile(robot, params)
     assert slow.backend == "numpy"
     return slow
@@ -274,7 +274,7 @@ def test_the_parser_methods_are_the_derivations():
 def test_analyze_on_the_cached_plant_equals_the_robot_route():
     """analyze on a CompiledDynamics (its kinematics read back from the cache) is analyze on the Robot."""
     from symdyn.apps.analysis import analyze
-    from symdyn.apps.compile import cached_dynamics
+    from symdyn.apps.compilation.compile import cached_dynamics
 
     robot = example("puma560")
     q, qd = np.linspace(0.1, 0.6, 6), np.linspace(-0.3, 0.2, 6)
@@ -341,7 +341,7 @@ def test_the_cached_plant_is_keyed_by_the_floating_base(tmp_path, monkeypatch):
     robot's entry); a xacro file, an MJCF file and --xacro-arg go to the uncached route."""
     import argparse
 
-    import symdyn.apps.compile as compiled
+    import symdyn.apps.compilation.compile as compiled
     from symdyn.cli import cache as cli_cache
 
     keys, uncached = [], []

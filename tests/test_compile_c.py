@@ -17,9 +17,9 @@ import pytest
 from cbuild import SANITIZE_FLAGS, compile_program, compile_shared, compilers, write_files
 
 import symdyn
-from symdyn.apps.control import ComputedTorque, Reference, track
-from symdyn.apps.csv_format import csv_text
-from symdyn.apps.simulate import simulate
+from symdyn.apps.simulation.control import ComputedTorque, Reference, track
+from symdyn.apps.simulation.csv_format import csv_text
+from symdyn.apps.simulation.simulate import simulate
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
 from symdyn.codegen.c.runtime import render_runtime

@@ -15,8 +15,8 @@ import pytest
 import yaml
 
 from symdyn import cli
-from symdyn.apps.control import ComputedTorque, Reference, SampledReference, pd_gains, track
-from symdyn.apps.simulate import with_parameters
+from symdyn.apps.simulation.control import ComputedTorque, Reference, SampledReference, pd_gains, track
+from symdyn.apps.simulation.simulate import with_parameters
 from symdyn.errors import SymdynError
 from symdyn.parsers import load_robot, robot_from_data
 

@@ -1,4 +1,5 @@
-"""The CSV writer in C (symdyn_csv, templates/c/csv.c.j2) against Python's "%.17g" (symdyn.apps.csv_format).
+"""The CSV writer in C (symdyn_csv, templates/c/csv.c.j2) against Python's "%.17g"
+(symdyn.apps.simulation.csv_format).
 
 The C writer must give the bytes of Python's `%` formatting for every double: the awkward ones
 (negative, -0.0, 0.1, integers, 1e-300, 1e300, subnormals, the largest double, nan, inf),
@@ -17,8 +18,8 @@ import pytest
 from cbuild import compilers
 
 import symdyn
-from symdyn.apps.csv_format import csv_bytes, csv_text
-from symdyn.apps.simulate import simulate
+from symdyn.apps.simulation.csv_format import csv_bytes, csv_text
+from symdyn.apps.simulation.simulate import simulate
 from symdyn.errors import SymdynWarning
 
 PLANAR = Path(__file__).resolve().parent.parent / "examples" / "planar_3r.yaml"
@@ -111,7 +112,7 @@ def test_a_trajectory_writes_its_csv_text(plant, tmp_path):
 
 def test_without_a_compiler_the_python_route(monkeypatch):
     monkeypatch.setenv("CC", "no-such-compiler-symdyn")
-    monkeypatch.setattr("symdyn.apps.compile._warned", False)
+    monkeypatch.setattr("symdyn.apps.compilation.compile._warned", False)
     with pytest.warns(SymdynWarning, match="times slower"):
         slow = symdyn.compile(symdyn.load_robot(PLANAR))
     assert slow.backend == "numpy"

@@ -1,4 +1,5 @@
-"""The fast reader of large CSV logs (symdyn.apps.csv_read, pandas' C parser) against Python's float.
+"""The fast reader of large CSV logs (symdyn.apps.identification.csv_read, pandas' C parser)
+against Python's float.
 
 Values of every magnitude written as "%.17g" (and shorter spellings, spaces, CRLF, blank lines,
 a subnormal) parse to the doubles float() gives; anything outside that syntax, or a wrong count
@@ -12,7 +13,7 @@ import numpy as np
 import pytest
 
 from symdyn.apps import csv_read
-from symdyn.apps.measurements import read_measurements
+from symdyn.apps.identification.measurements import read_measurements
 
 pytest.importorskip("pandas", reason="the ident and test extras install pandas")
 

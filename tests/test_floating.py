@@ -17,7 +17,7 @@ from robots import FLYER
 from timebound import refused, within
 
 import symdyn
-import symdyn.apps.simulate
+import symdyn.apps.simulation.simulate
 from symdyn import SymdynError
 from symdyn.cli.main import main
 from symdyn.codegen import render
@@ -346,7 +346,12 @@ def test_quaternion_norms_outside_the_bound_are_refused(tmp_path, capsys):
                 ),
                 (lambda bad=bad: compiled.difference(q, bad), "difference: q_next: "),
                 (lambda bad=bad: symdyn.rnea(robot, bad, v, a), "rnea: q: "),
-                (lambda bad=bad: symdyn.apps.simulate.simulate(compiled, bad, duration=0.1, dt=0.01), "q0: "),
+                (
+                    lambda bad=bad: symdyn.apps.simulation.simulate.simulate(
+                        compiled, bad, duration=0.1, dt=0.01
+                    ),
+                    "q0: ",
+                ),
             ):
                 with pytest.raises(SymdynError) as info:
                     call()
@@ -363,8 +368,8 @@ def test_quaternion_norms_outside_the_bound_are_refused(tmp_path, capsys):
     np.testing.assert_allclose(
         symdyn.rnea(robot, inside, v, a), symdyn.rnea(robot, q, v, a), rtol=1e-10, atol=1e-12
     )
-    run = symdyn.apps.simulate.simulate(compiled, inside, duration=0.02, dt=0.01)
-    unit = symdyn.apps.simulate.simulate(compiled, q, duration=0.02, dt=0.01)
+    run = symdyn.apps.simulation.simulate.simulate(compiled, inside, duration=0.02, dt=0.01)
+    unit = symdyn.apps.simulation.simulate.simulate(compiled, q, duration=0.02, dt=0.01)
     assert np.allclose(np.linalg.norm(run.q[0, 3:7]), 1.0) and np.allclose(
         run.q, unit.q, rtol=1e-12, atol=1e-14
     )

@@ -132,8 +132,8 @@ def test_generated_regressor_functions_equal_the_oracle(arm, tmp_path):
 def test_identification_checks_the_floating_sizes(arm):
     """identify takes a floating robot (tests/test_identify.py identifies this arm) but not
     measurements of a fixed base's sizes."""
-    from symdyn.apps.identify import identify
-    from symdyn.apps.measurements import Measurements
+    from symdyn.apps.identification.identify import identify
+    from symdyn.apps.identification.measurements import Measurements
 
     z = np.zeros((50, 3))
     with pytest.raises(SymdynError, match=r"^identify: robot 'floating_arm' has NQ = 10 positions and NV = "):

@@ -17,9 +17,9 @@ import sympy as sp
 from robots import EXAMPLES_DIR, example
 
 import symdyn
-from symdyn.apps.floating_stepping import run_floating
-from symdyn.apps.simulate import simulate
-from symdyn.apps.stepping import sample_times
+from symdyn.apps.simulation.floating_stepping import run_floating
+from symdyn.apps.simulation.simulate import simulate
+from symdyn.apps.simulation.stepping import sample_times
 from symdyn.model.free_flyer import BaseBody
 from symdyn.oracle.centroidal import centroidal, floating_frame_jacobian, generalized_jacobian
 from symdyn.rnea import forward_dynamics

@@ -1,4 +1,4 @@
-"""Identification (symdyn.apps.identify, symdyn.apps.excite, `symdyn identify`, `symdyn excite`).
+"""Identification (symdyn.apps.identification: identify, excite; `symdyn identify`, `symdyn excite`).
 
 The round trip: torques computed by the numeric RNEA symdyn.rnea (independent of the regressor and
 of the generated code) along an exciting trajectory of `excite` must give back the base parameters
@@ -30,10 +30,15 @@ from robots import (
 from timebound import refused, within
 
 import symdyn
-from symdyn.apps.excite import excite
-from symdyn.apps.identify import base_regressor_samples, identify
-from symdyn.apps.measurements import Measurements, differentiate, log_columns, read_measurements
-from symdyn.apps.simulate import time_expressions
+from symdyn.apps.identification.excite import excite
+from symdyn.apps.identification.identify import base_regressor_samples, identify
+from symdyn.apps.identification.measurements import (
+    Measurements,
+    differentiate,
+    log_columns,
+    read_measurements,
+)
+from symdyn.apps.simulation.simulate import time_expressions
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError
 from symdyn.model.parameters import numeric_parameters

@@ -26,7 +26,7 @@ from symdyn.algorithms.closed_loops import analyse
 from symdyn.cli import main
 from symdyn.codegen import render
 from symdyn.errors import SymdynWarning
-from symdyn.module_files import load_module
+from symdyn.generated_modules import load_module
 from symdyn.oracle import closed_loops as oc
 from symdyn.regenerate import example_robot
 

@@ -1,10 +1,11 @@
-"""Least squares from chunks (symdyn.apps.least_squares) against numpy.linalg on all rows at once."""
+"""Least squares from chunks (symdyn.apps.identification.least_squares) against numpy.linalg on all
+rows at once."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from symdyn.apps.least_squares import Triangular, combine, triangular_factor
+from symdyn.apps.identification.least_squares import Triangular, combine, triangular_factor
 
 
 def test_chunks_give_the_least_squares_of_all_rows():

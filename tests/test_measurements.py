@@ -1,4 +1,5 @@
-"""Hostile logs for symdyn.apps.measurements (the readers of `symdyn identify` and `simulate --track`).
+"""Hostile logs for symdyn.apps.identification.measurements (the readers of `symdyn identify` and
+`simulate --track`).
 
 A log is a regular file: /dev/zero, a FIFO or a folder is refused at once (reading one might
 never end); a CSV whose values would take more than MAX_LOG_BYTES is refused from its count of
@@ -17,7 +18,7 @@ from robots import EXAMPLES_DIR
 from timebound import refused, within
 
 from symdyn.apps import measurements
-from symdyn.apps.measurements import read_measurements
+from symdyn.apps.identification.measurements import read_measurements
 from symdyn.errors import SymdynError
 
 SCARA = str(EXAMPLES_DIR / "scara.yaml")
@@ -52,7 +53,7 @@ def test_csv_whose_values_exceed_the_limit_is_refused_before_parsing(tmp_path, m
         read_measurements(path, 4)
     assert str(info.value) == (
         f"{path}: 102 lines of 9 values take 7.17 KiB, more than a log may hold "
-        "(4 KiB: symdyn.apps.measurements.MAX_LOG_BYTES)"
+        "(4 KiB: symdyn.apps.identification.measurements.MAX_LOG_BYTES)"
     )
     path.write_text(HEADER + "\n" + "".join(f"{k * 0.01},0,0,0,0,0,0,0,0\n" for k in range(50)))
     assert len(read_measurements(path, 4).t) == 50

@@ -1,4 +1,4 @@
-"""Logs in NumPy's binary formats (symdyn.apps.measurements_binary through read_measurements):
+"""Logs in NumPy's binary formats (symdyn.apps.identification.measurements_binary through read_measurements):
 a .npz of t, q, qd, qdd, tau and a structured .npy give the values of the same CSV log exactly;
 a wrong array is one line naming the file and the array, and a pickle is never loaded; sizes are
 read from the arrays' headers before anything is allocated (MAX_LOG_BYTES)."""
@@ -13,7 +13,7 @@ import pytest
 from robots import EXAMPLES_DIR
 from timebound import refused, within
 
-from symdyn.apps.measurements import read_measurements
+from symdyn.apps.identification.measurements import read_measurements
 from symdyn.errors import SymdynError
 
 
@@ -84,13 +84,13 @@ def test_sizes_are_read_from_the_headers_before_anything_is_loaded(tmp_path, cap
     line = refused(capsys, "identify", scara, tmp_path / "huge.npy", seconds=5)
     assert line.endswith(
         "huge.npy: 100000000000 records take 6.55 TiB, more than a log may hold "
-        "(2 GiB: symdyn.apps.measurements.MAX_LOG_BYTES)"
+        "(2 GiB: symdyn.apps.identification.measurements.MAX_LOG_BYTES)"
     )
     with zipfile.ZipFile(tmp_path / "big.npz", "w") as z:
         z.writestr("t.npy", _header_only((3 * 2**30 // 8,)))
     line = refused(capsys, "identify", scara, tmp_path / "big.npz", seconds=5)
     assert line.endswith("big.npz: its arrays t, q, qd, qdd, tau take 3 GiB, more than a log may hold "
-                         "(2 GiB: symdyn.apps.measurements.MAX_LOG_BYTES)")  # fmt: skip
+                         "(2 GiB: symdyn.apps.identification.measurements.MAX_LOG_BYTES)")  # fmt: skip
 
 
 def test_truncated_and_object_arrays_are_one_line_and_other_arrays_are_not_read(tmp_path, capsys):

@@ -1,7 +1,7 @@
 """Values given at run time pass the robot file's physical checks (symdyn.model.physical).
 
 `simulate --params`, `symdyn.compile(robot, params)` and identify's model parameters
-(symdyn.apps.compiled.with_parameters) used to skip the checks a value in the file gets:
+(symdyn.apps.compilation.compiled.with_parameters) used to skip the checks a value in the file gets:
 `--params m1=-1` ran and wrote a trajectory. The expected refusals are the loader's own: the
 same numbers written into the file are refused by it too.
 """
@@ -16,7 +16,7 @@ import yaml
 from robots import ASYMMETRIC_PARAMS, EXAMPLES_DIR, asymmetric_friction
 
 import symdyn
-from symdyn.apps.compiled import with_parameters
+from symdyn.apps.compilation.compiled import with_parameters
 from symdyn.errors import SymdynError
 from symdyn.parsers.robot_file import robot_from_data
 

@@ -26,7 +26,7 @@ import symdyn
 import symdyn.codegen
 from symdyn.algorithms.kinematics import frame_poses
 from symdyn.algorithms.tip_wrench import body_jacobian
-from symdyn.apps.check import check_answers
+from symdyn.apps.checking.check import check_answers
 from symdyn.errors import SymdynError
 from symdyn.parsers import load_urdf, robot_from_data
 from symdyn.parsers.poe import robot_from_poe

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from symdyn import progress
-from symdyn.apps.build import SECONDS_PER_BYTE, compile_estimate
+from symdyn.apps.compilation.build import SECONDS_PER_BYTE, compile_estimate
 
 cli_main = importlib.import_module("symdyn.cli.main")  # the module (symdyn.cli.main is also its function)
 

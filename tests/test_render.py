@@ -18,7 +18,7 @@ import pytest
 from symdyn.codegen import generate
 from symdyn.codegen.render import comment_text
 from symdyn.errors import SymdynError
-from symdyn.module_files import load_module
+from symdyn.generated_modules import load_module
 from symdyn.parsers import load
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -18,7 +18,7 @@ import yaml
 from timebound import refused
 
 import symdyn.codegen
-from symdyn.apps.compiled import CompiledDynamics
+from symdyn.apps.compilation.compiled import CompiledDynamics
 from symdyn.errors import SymdynError, SymdynWarning
 from symdyn.parsers import load_robot, robot_from_data
 from symdyn.parsers.dh import dh_link

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from symdyn import cli
-from symdyn.apps.simulate import (
+from symdyn.apps.simulation.simulate import (
     CompiledDynamics,
     ProgressBar,
     simulate,

@@ -1,4 +1,4 @@
-"""A mass matrix singular at run time (symdyn.apps.singular): an error, not NaN.
+"""A mass matrix singular at run time (symdyn.apps.compilation.singular): an error, not NaN.
 
 `symdyn.compile(robot, {"m2": 0})` passes the physical checks (a zero mass is allowed) but
 makes M singular for Roger's arm, whose links are point masses: forward dynamics used to

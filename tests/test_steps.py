@@ -1,4 +1,4 @@
-"""The derivation step by step (symdyn.apps.steps, `symdyn derive --steps`, `symdyn check` steps).
+"""The derivation step by step (symdyn.apps.checking.steps, `symdyn derive --steps`, `symdyn check` steps).
 
 Expected values come from an independent route: the numeric oracle's spatial recursion
 (Featherstone's spatial vectors at the body origin, symdyn.oracle.spatial) rerun here so that
@@ -19,8 +19,8 @@ import sympy as sp
 from robots import assert_close, example
 
 from symdyn import rnea
-from symdyn.apps.check import check_answers
-from symdyn.apps.steps import derivation_steps
+from symdyn.apps.checking.check import check_answers
+from symdyn.apps.checking.steps import derivation_steps
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError
 from symdyn.oracle.inputs import numeric_model

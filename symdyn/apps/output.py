@@ -1,7 +1,7 @@
 """Writing results: files written all at once (or streamed into a device or FIFO, never replacing
 one: symdyn.destination), and Matplotlib figures rendered to bytes.
 
-Shared by the applications that write files (symdyn.apps.trajectory, analysis_plots
+Shared by the applications that write files (symdyn.apps.simulation.trajectory, analysis_plots
 and the command line). Figures use the Agg canvas directly, never pyplot, so no
 global backend is changed; plot formats are png, pdf and svg, chosen by the suffix.
 """

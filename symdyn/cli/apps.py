@@ -106,7 +106,7 @@ def _gains(items, n: int, what: str, default: float) -> np.ndarray:
 
 def _with_params(robot, params: dict[str, float], option: str = "--params"):
     """The robot with parameter values applied; every free parameter must then have one."""
-    from ..apps.compiled import with_parameters
+    from ..apps.compilation.compiled import with_parameters
 
     robot = with_parameters(robot, params)
     if robot.params:
@@ -146,7 +146,7 @@ def _plant(args: argparse.Namespace, params: dict, model_params: dict | None = N
 
 def _torques(items, n: int):
     """--tau: plain numbers as floats (no parsing), else numbers or expressions of t."""
-    from ..apps.simulate import time_expressions
+    from ..apps.simulation.simulate import time_expressions
 
     words = _words(items, "--tau")
     if all(_PLAIN.fullmatch(w) for w in words) and len(words) in (1, n):
@@ -155,10 +155,10 @@ def _torques(items, n: int):
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from ..apps.floating_stepping import floating_sizes, initial_configuration
     from ..apps.output import check_output, write_atomic
-    from ..apps.simulate import simulate
-    from ..apps.trajectory import plot_trajectory
+    from ..apps.simulation.floating_stepping import floating_sizes, initial_configuration
+    from ..apps.simulation.simulate import simulate
+    from ..apps.simulation.trajectory import plot_trajectory
 
     check_output(args.out, "--out")
     _check_plot_path(args.plot)
@@ -189,7 +189,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             **tolerances,
         )
     elif args.track is not None:
-        from ..apps.control import ComputedTorque, Reference, SampledReference, track
+        from ..apps.simulation.control import ComputedTorque, Reference, SampledReference, track
 
         words = _words(args.track, "--track")
         if len(words) == 1 and words[0].lower().endswith(".csv"):
@@ -262,12 +262,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _simulate_loops(args: argparse.Namespace, plant) -> int:
-    """simulate for a robot with closed loops (symdyn.apps.loop_simulate): --q0 every joint (a
+    """simulate for a robot with closed loops (symdyn.apps.simulation.loop_simulate): --q0 every joint (a
     closed configuration or a guess near one), --qd0 every joint (its actuated entries used),
     --tau the actuated joints' efforts."""
-    from ..apps.loop_simulate import simulate_loops
     from ..apps.output import write_atomic
-    from ..apps.trajectory import plot_trajectory
+    from ..apps.simulation.loop_simulate import simulate_loops
+    from ..apps.simulation.trajectory import plot_trajectory
 
     n, nact = plant.n, len(plant.module.ACTUATED)
     q0 = _vector(args.q0, n, "--q0", default=np.zeros(n))
@@ -321,7 +321,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
                 "--plot draws a 2-D task space: give two --axes "
                 f"(the default here is {','.join(result.axes)})"
             )
-        from ..apps.compile import RobotInfo
+        from ..apps.compilation.compile import RobotInfo
 
         robot = plant.robot
         if isinstance(robot, RobotInfo):  # the plant came from the cache: the picture needs the Robot
@@ -339,7 +339,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    from ..apps.check import MAX_SAMPLES, check_answers
+    from ..apps.checking.check import MAX_SAMPLES, check_answers
 
     if not 1 <= args.samples <= MAX_SAMPLES:
         raise SymdynError(f"--samples {args.samples}: must be from 1 to {MAX_SAMPLES:,}")
@@ -383,7 +383,7 @@ _VECTOR = {"nargs": "+", "metavar": "V"}
 
 
 def _simulate_arguments(s: argparse.ArgumentParser) -> None:
-    from ..apps.stepping import INTEGRATORS
+    from ..apps.simulation.stepping import INTEGRATORS
 
     vec = _VECTOR
     s.description = (

@@ -3,7 +3,7 @@
 The applications (simulate, analyze) key their cache entry by the robot file's bytes and
 the options that change the robot (--base, --tip, --floating, --params), so a second run of an
 unchanged file finds its compiled library without parsing the file, deriving or importing SymPy
-(symdyn.apps.compile.cached_dynamics). A URDF is read this way too when it needs no expansion:
+(symdyn.apps.compilation.compile.cached_dynamics). A URDF is read this way too when it needs no expansion:
 the loader's own test (symdyn.parsers.xacro_expand.is_xacro) decides, so the xacro namespace that
 exported URDFs declare does not count. MJCF and xacro files, whose robot depends on the files they
 include (and on --xacro-arg), are loaded every time and compiled through symdyn.compile's cache,
@@ -24,7 +24,7 @@ def cached_plant(args: argparse.Namespace, make_robot, **options):
     make_robot() loads the robot (with its options applied) on a cache miss; `options`
     (e.g. params={...}) are part of the key.
     """
-    from ..apps.compile import cached_dynamics
+    from ..apps.compilation.compile import cached_dynamics
 
     try:
         with open(args.robot, "rb") as fh:
@@ -60,7 +60,7 @@ def _uncached(make_robot):
     """The robot compiled through symdyn.compile's own cache (keyed by the loaded robot): for the
     loader's own error on a file that cannot be read, and for files whose robot depends on other
     files (MJCF and xacro includes), which the key of the file's bytes would miss."""
-    from ..apps.compile import compile
+    from ..apps.compilation.compile import compile
 
     return compile(make_robot())
 
@@ -74,7 +74,7 @@ def _size(count: int) -> str:
 
 
 def cmd_cache(args: argparse.Namespace) -> int:
-    from ..apps import cache
+    from ..apps.compilation import cache
 
     if args.clear:
         removed = cache.clear()

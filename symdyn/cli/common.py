@@ -16,7 +16,7 @@ FLOATING_COMMANDS = ("derive", "generate", "simulate", "identify")
 
 def load_robot_argument(args: argparse.Namespace):
     """A robot from a robot file, an MJCF file, or a URDF file with --base/--tip (a xacro file with
-    --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.loading), whatever
+    --xacro-arg and --package-dir): recognised by its content (symdyn.parsers.by_content), whatever
     its name."""
     from ..errors import SymdynError
     from ..parsers import load

@@ -5,9 +5,10 @@
            [--period T] [--harmonics L] [--samples S] [--evaluations E] [--dt H] [--seed K]
            [--params NAME=VALUE ...]
 
-identify estimates the base parameters (symdyn.apps.identify) from a CSV of t, q, [qd, qdd,] tau;
-excite writes an exciting trajectory (symdyn.apps.excite) as a CSV identify reads and prints the
---track expressions `symdyn simulate` follows. Warnings go to stderr as `symdyn: warning: ...`.
+identify estimates the base parameters (symdyn.apps.identification.identify) from a CSV of t, q,
+[qd, qdd,] tau; excite writes an exciting trajectory (symdyn.apps.identification.excite) as a CSV
+identify reads and prints the --track expressions `symdyn simulate` follows. Warnings go to stderr
+as `symdyn: warning: ...`.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ def _values(items, what: str) -> list[float]:
 
 def _robot(args: argparse.Namespace):
     """The robot with --params applied; every free parameter must have a value."""
-    from ..apps.compiled import with_parameters
+    from ..apps.compilation.compiled import with_parameters
 
     params = {}
     for w in [w.strip() for item in args.params or [] for w in str(item).split(",")]:
@@ -68,8 +69,8 @@ def _per_joint(items, n: int, what: str):
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
-    from ..apps.identify import identify, plot_identification
-    from ..apps.measurements import read_measurements
+    from ..apps.identification.identify import identify, plot_identification
+    from ..apps.identification.measurements import read_measurements
     from ..apps.output import check_output
     from ..dynamics import derive
 
@@ -94,7 +95,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def cmd_excite(args: argparse.Namespace) -> int:
-    from ..apps.excite import excite
+    from ..apps.identification.excite import excite
     from ..apps.output import check_output
 
     check_output(args.out, "--out")
@@ -125,7 +126,7 @@ def cmd_excite(args: argparse.Namespace) -> int:
 
 def _check_excite_options(args: argparse.Namespace) -> None:
     """The options of `excite` in range, before the optimisation runs (excite checks them again)."""
-    from ..apps.excite import MAX_HARMONICS, MAX_SAMPLES, PERIOD_RANGE, csv_samples
+    from ..apps.identification.excite import MAX_HARMONICS, MAX_SAMPLES, PERIOD_RANGE, csv_samples
 
     for option, value, low, high in (
         ("--harmonics", args.harmonics, 1, MAX_HARMONICS),

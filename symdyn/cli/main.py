@@ -188,7 +188,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     c_files = [p for p in paths if p.suffix == ".c"]
     size = sum(p.stat().st_size for p in c_files if p.is_file())
     if size >= BIG_C:
-        from ..apps.build import compile_estimate
+        from ..apps.compilation.build import compile_estimate
 
         progress_note(
             f"{size / 1000:.0f} KB of C in {len(c_files)} file{'s' * (len(c_files) != 1)}: a build takes "
@@ -235,7 +235,7 @@ def _derive_arguments(d: argparse.ArgumentParser) -> None:
         "one of the robot's frames; docs/frames.md)",
     )
     d.add_argument(
-        "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.steps)"
+        "--steps", action="store_true", help="print the derivation link by link (symdyn.apps.checking.steps)"
     )
     d.add_argument("--at", nargs="+", metavar="NAME=VALUES", help="with --steps: numbers, q=.. qd=.. qdd=..")
     d.set_defaults(func=cmd_derive)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..apps.steps import derivation_steps
-from ..apps.steps_output import STEP_FORMATS
+from ..apps.checking.steps import derivation_steps
+from ..apps.checking.steps_output import STEP_FORMATS
 from ..errors import SymdynError
 from .common import load_robot_argument
 from .derive_loops import loop_report, with_loops

@@ -1,6 +1,6 @@
 """The names of a free flyer's coordinates (symdyn.model.free_flyer), without SymPy.
 
-Kept apart so that the warm command-line paths (a simulation's CSV columns, symdyn.apps.trajectory)
+Kept apart so that the warm command-line paths (a simulation's CSV columns, symdyn.apps.simulation.trajectory)
 name a floating robot's coordinates without importing SymPy (docs/speed.md).
 """
 

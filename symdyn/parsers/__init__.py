@@ -11,7 +11,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # for type checkers and the API reference, which read the source
-    from .loading import load_robot
+    from .by_content import load_robot
     from .mjcf import load_mjcf
     from .poe import robot_from_poe
     from .robot_file import robot_from_data
@@ -24,8 +24,8 @@ __all__ = ["load", "load_mjcf", "load_robot", "load_urdf", "robot_from_data", "r
 #: where each public name lives; `load` is the name the command line and `symdyn.generate` use
 #: (one loader: by content)
 _HOMES = {
-    "load": ("loading", "load_robot"),
-    "load_robot": ("loading", "load_robot"),
+    "load": ("by_content", "load_robot"),
+    "load_robot": ("by_content", "load_robot"),
     "load_mjcf": ("mjcf", "load_mjcf"),
     "load_urdf": ("urdf", "load_urdf"),
     "robot_from_data": ("robot_file", "robot_from_data"),

@@ -56,7 +56,7 @@ def robot_from_bytes(raw: bytes, file: str, digest: str) -> Robot:
     `digest` is their sha256, symdyn.parsers.source.read_source).
 
     Raises SymdynError (naming file, link and field) for any bad input; warns
-    with SymdynWarning for implausible inertial data. symdyn.parsers.loading.load_robot
+    with SymdynWarning for implausible inertial data. symdyn.parsers.by_content.load_robot
     reads the file and sends it here or to the URDF reader, by its content.
     """
     try:

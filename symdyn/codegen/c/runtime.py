@@ -1,7 +1,7 @@
 """What `symdyn.compile` builds beside the generated C: batch wrappers, the stepping loop, a table.
 
 `function_table(ctx)` describes every generated function as plain data (its C name,
-its inputs and outputs with their sizes), so the Python binding (symdyn.apps.compile)
+its inputs and outputs with their sizes), so the Python binding (symdyn.apps.compilation.compile)
 needs no knowledge of which functions exist: whatever `build_functions` generates,
 with any number of outputs of any shape, becomes a method; `solve_loops_entry(ctx)` describes
 NAME_solve_loops of a robot with closed loops, the one function with a loop (not in the table:
@@ -9,8 +9,8 @@ it returns an int). `render_runtime(ctx)` gives
 NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C, W states
 per instruction through the function's body over vectors: symdyn.codegen.c.vector; and
 NAME_solve_loops_batch, a plain loop over the states),
-symdyn_step.c (the fixed-step integrators of symdyn.apps.simulate) and symdyn_csv.c (the
-CSV writer of symdyn.apps.csv_format), the last two robot-independent. Every C statement
+symdyn_step.c (the fixed-step integrators of symdyn.apps.simulation.simulate) and symdyn_csv.c (the
+CSV writer of symdyn.apps.simulation.csv_format), the last two robot-independent. Every C statement
 is spelled in templates/c/batch.c.j2, templates/c/step.c.j2 and templates/c/csv.c.j2.
 """
 

@@ -25,7 +25,7 @@ import tempfile
 from dataclasses import asdict, replace
 
 from ...errors import SymdynError
-from ...module_files import load_module
+from ...generated_modules import load_module
 from ..functions import FunctionSpec
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
@@ -105,7 +105,7 @@ def render_module(ctx: RenderContext) -> str:
 
 
 def serialise(text: str, ctx: RenderContext) -> dict[str, bytes]:
-    """Write the module text to a temporary file, import it from there (symdyn.module_files:
+    """Write the module text to a temporary file, import it from there (symdyn.generated_modules:
     never exec'd from a string) and save every function with casadi."""
     files: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory(prefix="symdyn-casadi-") as tmp:

@@ -1,0 +1,3 @@
+"""`symdyn.compile`: a robot's generated C built with the system compiler for this machine and
+cached (`compile`, `build`, `cache`, `robot_key`), its functions called one state or a batch at a
+time, in threads (`calling`, `compiled_frames`), and M singular at run time (`singular`)."""

@@ -1,0 +1,180 @@
+"""Compiling generated C into a shared library with the system's C compiler (symdyn.compile).
+
+The compiler is $CC when set (it may carry flags: "clang -m64"), else the first of
+cc, gcc and clang on PATH. The flags are COMPILE_FLAGS: optimised (-O2) but with the
+floating-point semantics of the source kept (no -ffast-math, and no contraction of
+a*b + c into one fused multiply-add, so results are the ones of the NumPy module's
+operation order), position-independent code, linked against libm; then `arch_flags()`: the
+library is built for the machine it runs on (-march=native: AVX2 or AVX-512 where the CPU has
+them, which the batch wrappers use, templates/c/batch.c.j2), unless $SYMDYN_MARCH names another
+target: SYMDYN_MARCH=x86-64-v3 (any AVX2 machine), SYMDYN_MARCH=x86-64 (every x86-64), or
+SYMDYN_MARCH=none (no -march: the compiler's default) for a library that runs on other machines.
+A compiler that refuses -march=native (some compilers for ARM) builds without it.
+A build reports its size and a rough time (`compile_estimate`) as a progress stage
+(symdyn.progress).
+The cache key holds the flags, and with -march=native the machine (`machine_fingerprint`), so a
+cache shared by several machines never loads a library built for another CPU.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import shutil
+from collections.abc import Mapping, Sequence
+from functools import lru_cache
+from pathlib import Path
+
+from ...errors import SymdynError
+from ...progress import stage as progress_stage
+
+__all__ = [
+    "COMPILE_FLAGS",
+    "BUILD_PREFIX",
+    "ARCH_ENV",
+    "arch_flags",
+    "machine_fingerprint",
+    "find_compiler",
+    "compile_estimate",
+    "compile_library",
+    "library_suffix",
+]
+
+#: The start of the name of the temporary folder the compiler runs in ($TMPDIR/symdyn-build-PID-XXXXXXXX).
+BUILD_PREFIX = "symdyn-build-"
+
+COMPILE_FLAGS = ("-std=c99", "-O2", "-fPIC", "-ffp-contract=off", "-shared")
+
+#: The environment variable naming the -march target of symdyn.compile's libraries (default native).
+ARCH_ENV = "SYMDYN_MARCH"
+_ARCH = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.+-]*\Z")
+
+
+def arch_flags() -> tuple[str, ...]:
+    """("-march=native",), or the target $SYMDYN_MARCH names ("-march=x86-64-v3"); () for "none"."""
+    value = os.environ.get(ARCH_ENV, "").strip() or "native"
+    if value == "none":
+        return ()
+    if not _ARCH.match(value):
+        raise SymdynError(f"${ARCH_ENV}={value!r} is not a -march target (e.g. native, x86-64-v3, none)")
+    return (f"-march={value}",)
+
+
+@lru_cache(maxsize=1)
+def machine_fingerprint() -> str:
+    """SHA-256 of what -march=native depends on: the architecture, the CPU's model and its feature flags
+    (/proc/cpuinfo on Linux, else the platform's processor string)."""
+    import hashlib
+    import platform
+
+    text = f"{platform.machine()} {platform.processor()}"
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as f:
+            keep = ("model name", "flags", "Features", "CPU implementer", "CPU part", "vendor_id")
+            lines = sorted({line.strip() for line in f if line.startswith(keep)})
+        text += "\n" + "\n".join(lines)
+    except OSError:
+        pass
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def find_compiler() -> list[str] | None:
+    """The C compiler command ($CC, else cc, gcc or clang on PATH), or None when there is none."""
+    env = os.environ.get("CC", "").strip()
+    if env:
+        words = shlex.split(env)
+        return words if shutil.which(words[0]) else None
+    for name in ("cc", "gcc", "clang"):
+        path = shutil.which(name)
+        if path:
+            return [path]
+    return None
+
+
+def library_suffix() -> str:
+    """.so, .dylib or .dll: what the platform's dynamic loader opens."""
+    import sys
+
+    return {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
+
+
+#: seconds of one core per byte of generated C at -O2 (gcc 12, x86-64): the PUMA 560's 308 KB
+#: file 7.3e-6, the Panda's 729 KB 9.7e-6, Solo-12's floating 435 KB (larger functions) 2.7e-5
+SECONDS_PER_BYTE = (7e-6, 3e-5)
+
+
+def compile_estimate(size: int) -> str:
+    """How long `size` bytes of generated C take to compile at -O2, roughly: 'roughly 3-13 s of one
+    core' (gcc's time grows faster than the size of one function, hence the range)."""
+    low, high = (max(1, round(size * rate)) for rate in SECONDS_PER_BYTE)
+    return f"roughly {low}-{high} s of one core at -O2"
+
+
+def compile_library(
+    compiler: list[str], sources: Mapping[str, str], target: str | os.PathLike, arch: Sequence[str] = ()
+) -> Path:
+    """Compile the C `sources` (file name -> text; headers included) into the library `target`,
+    with COMPILE_FLAGS and `arch` (arch_flags()); without -march=native when the compiler refuses it.
+    Each .c file compiles in a process of its own, all at once (the large generated files dominate),
+    then they are linked, in $TMPDIR/symdyn-build-PID-XXXXXXXX; the folders that builds killed
+    mid-way left there are removed first, once stale (symdyn.leftovers).
+
+    Raises SymdynError with the compiler's messages when it fails.
+    """
+    import tempfile
+
+    from ...leftovers import sweep_folders
+
+    sweep_folders(Path(tempfile.gettempdir()), BUILD_PREFIX)  # the folders of builds killed mid-way
+    size = sum(len(text.encode()) for name, text in sources.items() if name.endswith(".c"))
+    count = sum(name.endswith(".c") for name in sources)
+    label = f"compiling {Path(target).name}: {size / 1000:.0f} KB of C in {count} files"
+    label += f" ({compile_estimate(size)})"
+    with (
+        progress_stage(label),
+        tempfile.TemporaryDirectory(prefix=f"{BUILD_PREFIX}{os.getpid()}-") as tmp,
+    ):
+        for name, text in sources.items():
+            Path(tmp, name).write_text(text, encoding="utf-8")
+        c_files = sorted(name for name in sources if name.endswith(".c"))
+        try:
+            failed = _compile_objects(compiler, c_files, arch, tmp)
+            if failed and tuple(arch) == ("-march=native",) and "march" in failed[1]:
+                arch = ()
+                failed = _compile_objects(compiler, c_files, arch, tmp)
+            if not failed:
+                objects = [name[:-2] + ".o" for name in c_files]
+                link = [*compiler, *COMPILE_FLAGS, *arch, "-o", os.fspath(target), *objects, "-lm"]
+                failed = _run(link, tmp)
+        except OSError as exc:
+            raise SymdynError(f"cannot run the C compiler {compiler[0]}: {exc}") from exc
+        if failed:
+            raise SymdynError(f"the C compiler failed ({shlex.join(failed[0])}):\n{failed[1].strip()}")
+    return Path(target)
+
+
+def _compile_objects(compiler: list[str], c_files: list[str], arch: Sequence[str], folder: str):
+    """Compile every file of `c_files` to its .o at once; (command, messages) of the first that
+    failed, or None."""
+    import subprocess  # here, not at the top: a cached run (find_compiler only) does not need it
+
+    flags = [f for f in COMPILE_FLAGS if f != "-shared"]
+    commands = [[*compiler, *flags, *arch, "-c", name, "-o", name[:-2] + ".o"] for name in c_files]
+    running = [
+        subprocess.Popen(cmd, cwd=folder, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        for cmd in commands
+    ]
+    errors = [proc.communicate()[1] for proc in running]
+    return next(
+        ((cmd, err) for cmd, err, proc in zip(commands, errors, running, strict=True) if proc.returncode),
+        None,
+    )
+
+
+def _run(cmd: list[str], folder: str):
+    """(command, messages) when `cmd` fails in `folder`, else None."""
+    import subprocess
+
+    proc = subprocess.run(cmd, cwd=folder, capture_output=True, text=True)
+    return (cmd, proc.stderr) if proc.returncode != 0 else None
