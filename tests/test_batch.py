@@ -27,7 +27,7 @@ from cbuild import SANITIZE_FLAGS, STRICT_FLAGS, TEST_OPT, compile_program, comp
 from robots import example, y_robot
 
 import symdyn
-from symdyn.apps import build, calling
+from symdyn.apps.compilation import build, calling
 from symdyn.apps.compilation.calling import batch_layout, load_library
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context

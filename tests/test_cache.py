@@ -18,7 +18,7 @@ import pytest
 from robots import dead_pid
 
 from symdyn import cli
-from symdyn.apps import cache
+from symdyn.apps.compilation import cache
 from symdyn.errors import SymdynError
 from symdyn.leftovers import STALE_SECONDS
 
@@ -69,7 +69,7 @@ def test_eight_concurrent_builds_survive(temporary_cache):
     code = (
         "import sys, time\n"
         "from pathlib import Path\n"
-        "from symdyn.apps import cache\n"
+        "from symdyn.apps.compilation import cache\n"
         "def build(folder):\n"
         "    time.sleep(0.3)\n"
         "    (folder / 'data.txt').write_text(sys.argv[1])\n"
@@ -156,7 +156,7 @@ def test_a_killed_compilers_folder_is_removed_by_the_next_build(tmp_path, monkey
     (tmp_path / "tmp").mkdir()
     code = (
         "import os, sys, tempfile\n"
-        "from symdyn.apps import build\n"
+        "from symdyn.apps.compilation import build\n"
         "def stop(*args, **kwargs):\n"  # the compiler started: die as by kill -9, mid-build
         "    os.kill(os.getpid(), 9)\n"
         "build._compile_objects = stop\n"

@@ -386,3 +386,24 @@ def test_direction_dependent_friction_against_rnea(tmp_path):
             fd = [(rn.rnea(robot, q, qd + e, qdd, p) - rn.rnea(robot, q, qd - e, qdd, p)) / 2e-6 for e in E]
             got = np.asarray(out[f.name_out(1)].full()).reshape(3, 3)
             np.testing.assert_allclose(got, np.column_stack(fd), rtol=1e-6, atol=1e-7)
+
+
+def test_a_killed_runs_temporary_folder_is_removed_by_the_next(tmp_path, monkeypatch):
+    """Issue 34 item 9: serialise's TMPDIR/symdyn-casadi-* of a run killed by kill -9 stayed; the
+    next run removes those whose process is gone, and keeps a live run's."""
+    import os
+    import tempfile
+
+    from symdyn.codegen.casadi import target
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    dead = tmp_path / f"{target.TEMPORARY_PREFIX}999999999-abcdefgh"  # no such process
+    live = tmp_path / f"{target.TEMPORARY_PREFIX}{os.getpid()}-abcdefgh"
+    for folder in (dead, live):
+        folder.mkdir()
+        (folder / "arm_casadi.py").write_text("x = 1\n")
+    from robots import example_context
+
+    files = target.render(example_context("roger_arm"))
+    assert "roger_arm_mass_matrix.casadi" in files
+    assert sorted(tmp_path.iterdir()) == [live]  # and its own folder is gone

@@ -29,7 +29,7 @@ from robots import (
 )
 
 import symdyn
-from symdyn.apps import cache
+from symdyn.apps.compilation import cache
 from symdyn.apps.compilation.calling import numpy_solve_loops
 from symdyn.apps.compilation.compile import CompiledDynamics, compile
 from symdyn.apps.simulation.control import ComputedTorque, Reference, track

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from symdyn.apps import csv_read
+from symdyn.apps.identification import csv_read
 from symdyn.apps.identification.measurements import read_measurements
 
 pytest.importorskip("pandas", reason="the ident and test extras install pandas")

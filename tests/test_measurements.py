@@ -17,7 +17,7 @@ import pytest
 from robots import EXAMPLES_DIR
 from timebound import refused, within
 
-from symdyn.apps import measurements
+from symdyn.apps.identification import measurements
 from symdyn.apps.identification.measurements import read_measurements
 from symdyn.errors import SymdynError
 

@@ -23,9 +23,11 @@ import os
 import re
 import tempfile
 from dataclasses import asdict, replace
+from pathlib import Path
 
 from ...errors import SymdynError
 from ...generated_modules import load_module
+from ...leftovers import sweep_folders
 from ..functions import FunctionSpec
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
@@ -104,11 +106,17 @@ def render_module(ctx: RenderContext) -> str:
     )
 
 
+#: the temporary folders of `serialise`: TMPDIR/symdyn-casadi-PID-XXXXXXXX
+TEMPORARY_PREFIX = "symdyn-casadi-"
+
+
 def serialise(text: str, ctx: RenderContext) -> dict[str, bytes]:
     """Write the module text to a temporary file, import it from there (symdyn.generated_modules:
-    never exec'd from a string) and save every function with casadi."""
+    never exec'd from a string) and save every function with casadi. The folders that runs killed
+    on the way left (their process gone, or an hour old) are removed first."""
     files: dict[str, bytes] = {}
-    with tempfile.TemporaryDirectory(prefix="symdyn-casadi-") as tmp:
+    sweep_folders(Path(tempfile.gettempdir()), TEMPORARY_PREFIX)
+    with tempfile.TemporaryDirectory(prefix=f"{TEMPORARY_PREFIX}{os.getpid()}-") as tmp:
         source = os.path.join(tmp, f"{module_name(ctx)}.py")
         with open(source, "w", encoding="utf-8") as fh:
             fh.write(text)
