@@ -114,6 +114,7 @@ def read_frames(reader, value: object, pattern) -> list[FrameData]:
             f"expected a list of frames {{name, link, xyz, rpy}}, got {value!r}", field="frames"
         )
     out: list[FrameData] = []
+    seen: dict[str, FrameData] = {}  # by name: a file of 30,000 frames was quadratic here
     for k, raw in enumerate(value):
         field = f"frames[{k}]"
         entries = reader.mapping(raw, FRAME_FIELDS, field)
@@ -125,10 +126,11 @@ def read_frames(reader, value: object, pattern) -> list[FrameData]:
                 what = "missing required field" if key not in entries else f"must be a name, got {text!r}"
                 raise reader.error(what, field=f"{field}.{key}")
         name = entries["name"]
-        clash = next((f for f in out if f.name == name), None)
+        clash = seen.get(name)
         if clash is not None:
             raise reader.error(f"duplicate frame name '{name}' (also {clash.field})", field=f"{field}.name")
         out.append(FrameData(field, name, entries["link"], _placement(reader, entries, field)))
+        seen[name] = out[-1]
     return out
 
 
