@@ -3,7 +3,7 @@ messages that several floors print."""
 
 from __future__ import annotations
 
-__all__ = ["SymdynError", "SymdynWarning", "location", "link_fields", "SINGULAR_REASONS"]
+__all__ = ["SymdynError", "SymdynWarning", "location", "link_fields", "one_line", "SINGULAR_REASONS"]
 
 #: Why a joint makes M(q) singular, as the end of a sentence whose subject is the joint: said by
 #: the derivation (symdyn.algorithms.singular) and by the numeric oracle (symdyn.oracle) alike.
@@ -71,3 +71,12 @@ class SymdynError(ValueError):
 
 class SymdynWarning(UserWarning):
     """Implausible (but possible) input, e.g. principal moments breaking the triangle inequality."""
+
+
+def one_line(text) -> str:
+    """`text` with every control character (newlines, escape sequences that would drive the
+    terminal, line separators) written as a Python escape, so that a message quoting a user's
+    file name or robot name stays one line and cannot clear or recolour the screen."""
+    return "".join(
+        c if c.isprintable() or c == " " else c.encode("unicode_escape").decode("ascii") for c in str(text)
+    )

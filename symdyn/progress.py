@@ -23,6 +23,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TextIO
 
+from .errors import one_line
+
 __all__ = ["DELAY", "QUIET_ENV", "stage", "note", "quiet", "finish", "restart"]
 
 #: seconds a command runs before it reports anything
@@ -70,7 +72,7 @@ def _stream() -> TextIO:
 
 def _line(label: str) -> None:
     with _run.lock:
-        print(f"symdyn: {time.monotonic() - _run.start:.1f} s: {label}", file=_stream(), flush=True)
+        print(f"symdyn: {time.monotonic() - _run.start:.1f} s: {one_line(label)}", file=_stream(), flush=True)
         _run.said = True
 
 
@@ -127,7 +129,7 @@ def _bar(label: str, total: int | None, unit: str) -> Iterator[Callable[[int], N
     fmt = None if total is not None else "{desc}: {elapsed}"
     bar = tqdm(
         total=total,
-        desc=f"symdyn: {label}",
+        desc=f"symdyn: {one_line(label)}",
         unit=unit,
         delay=delay,
         leave=False,
@@ -156,7 +158,7 @@ def note(text: str) -> None:
     """`symdyn: note: text` on standard error, now (not after DELAY), unless silenced."""
     if not _silent():
         with _run.lock:
-            print(f"symdyn: note: {text}", file=_stream(), flush=True)
+            print(f"symdyn: note: {one_line(text)}", file=_stream(), flush=True)
 
 
 def finish() -> None:

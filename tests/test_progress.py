@@ -125,3 +125,11 @@ def test_the_estimate_brackets_the_measured_builds():
     for size, seconds in ((308_374, 2.26), (729_267, 7.04), (434_570, 11.77)):
         low, high = map(int, re.search(r"(\d+)-(\d+)", compile_estimate(size)).groups())
         assert low <= seconds <= high + 0.5
+
+
+def test_a_name_with_newlines_and_escapes_stays_on_its_line(reporting):
+    """A URDF robot's name may hold a newline or a terminal escape: its stage line stays one line."""
+    with progress.stage("deriving 'a\nsymdyn: 0.0 s: done\x1b[2J'"):
+        progress.note("x\ny")
+    assert reporting.getvalue().splitlines()[0].endswith("deriving 'a\\nsymdyn: 0.0 s: done\\x1b[2J'")
+    assert reporting.getvalue().splitlines()[1] == "symdyn: note: x\\ny"

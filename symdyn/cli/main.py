@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Callable, Sequence
 
 from .. import __version__
-from ..errors import SymdynError, SymdynWarning
+from ..errors import SymdynError, SymdynWarning, one_line
 from ..model.names import comment_text
 from ..progress import finish as progress_finish
 from ..progress import note as progress_note
@@ -330,18 +330,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
-def _one_line(text) -> str:
-    """`text` with every control character (newlines, escape sequences that would drive the
-    terminal, line separators) written as a Python escape, so that a message quoting a user's
-    file name or robot name stays one line and cannot clear or recolour the screen."""
-    return "".join(
-        c if c.isprintable() or c == " " else c.encode("unicode_escape").decode("ascii") for c in str(text)
-    )
-
-
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     prefix = "symdyn: warning: " if issubclass(category, SymdynWarning) else "warning: "
-    print(f"{prefix}{_one_line(message)}", file=sys.stderr)
+    print(f"{prefix}{one_line(message)}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -358,11 +349,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             progress_finish()
             return status
         except SymdynError as exc:
-            print(f"symdyn: error: {_one_line(exc)}", file=sys.stderr)
+            print(f"symdyn: error: {one_line(exc)}", file=sys.stderr)
             return EXIT_BAD_INPUT
         except OSError as exc:
             print(
-                f"symdyn: error: {_one_line(exc.filename or '')}: {_one_line(exc.strerror or exc)}",
+                f"symdyn: error: {one_line(exc.filename or '')}: {one_line(exc.strerror or exc)}",
                 file=sys.stderr,
             )
             return EXIT_BAD_INPUT
@@ -371,7 +362,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return 130
         except Exception as exc:  # a bug in symdyn: say so in one line, not a traceback
             print(
-                f"symdyn: internal error: {type(exc).__name__}: {_one_line(exc)} (please report it with the "
+                f"symdyn: internal error: {type(exc).__name__}: {one_line(exc)} (please report it with the "
                 "robot file)",
                 file=sys.stderr,
             )
