@@ -5,6 +5,7 @@ dyn = symdyn.derive(robot, method="newton-euler")   # or "lagrange"
 dyn.M, dyn.C, dyn.V, dyn.G, dyn.F, dyn.tau
 symdyn.rnea(robot, q, qd, qdd, params)              # independent numeric oracle
 symdyn.generate(robot, targets=("c", "casadi"), out_dir="out")
+symdyn.draw(robot, q, "robot.svg")                  # the robot with its frames (.svg, .png, .html)
 
 The package is layered, each floor importing only the ones below it:
 spatial -> model -> parsers; symbolic -> algorithms -> dynamics -> codegen -> apps -> cli.
@@ -23,6 +24,7 @@ if TYPE_CHECKING:  # what the names below are, for type checkers and the API ref
     from . import rnea
     from .algorithms import kinematics
     from .apps.compilation.compile import compile
+    from .apps.drawing.draw import draw
     from .codegen import generate
     from .dynamics import Dynamics, derive
     from .model import inertia
@@ -39,6 +41,7 @@ _LAZY = {
     "inertia": (".model.inertia", None),
     "generate": (".codegen", "generate"),
     "compile": (".apps.compilation.compile", "compile"),
+    "draw": (".apps.drawing.draw", "draw"),
     "Dynamics": (".dynamics", "Dynamics"),
     "derive": (".dynamics", "derive"),
     "standard_parameters": (".model.parameters", "standard_parameters"),
@@ -80,6 +83,7 @@ __all__ = [
     "SymdynError",
     "SymdynWarning",
     "derive",
+    "draw",
     "generate",
     "inertia",
     "kinematics",

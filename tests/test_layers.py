@@ -44,6 +44,7 @@ APPLICATIONS = {
     "output": 0,
     "compilation": 1,
     "checking": 1,
+    "drawing": 1,
     "identification": 2,
     "analysis": 2,
     "simulation": 3,

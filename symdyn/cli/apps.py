@@ -32,7 +32,16 @@ from .common import METHODS, add_robot_argument, load_robot_argument
 #: A plain decimal number, read with float() instead of the expression parser (no SymPy needed).
 _PLAIN = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
-__all__ = ["COMMANDS", "cmd_simulate", "cmd_analyze", "cmd_check", "whole_number"]
+__all__ = [
+    "COMMANDS",
+    "cmd_simulate",
+    "cmd_analyze",
+    "cmd_check",
+    "whole_number",
+    "vector_option",
+    "assignments_option",
+    "with_params",
+]
 
 
 # --------------------------------------------------------------------------- argument helpers
@@ -159,9 +168,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from ..apps.simulation.floating_stepping import floating_sizes, initial_configuration
     from ..apps.simulation.simulate import simulate
     from ..apps.simulation.trajectory import plot_trajectory
+    from .animation import check_animation, write_animation
 
     check_output(args.out, "--out")
     _check_plot_path(args.plot)
+    check_animation(args)
     params = _assignments(args.params, "--params")
     if args.track is not None and args.tau is not None:
         raise SymdynError("--tau and --track exclude each other (--track computes the torque)")
@@ -244,6 +255,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     write_atomic(args.out, traj.csv_bytes())  # in C with the compiled plant: the same bytes as csv_text
     if image is not None:
         write_atomic(args.plot, image)
+    if args.animate:
+        write_animation(args, plant.robot, traj, lambda: _with_params(load_robot_argument(args), params))
     print(
         f"{args.out}: {len(traj.t)} samples, t = 0 .. {traj.t[-1]:g} s, dt = {args.dt:g} s, "
         f"integrator {traj.integrator}"
@@ -280,6 +293,11 @@ def _simulate_loops(args: argparse.Namespace, plant) -> int:
     write_atomic(args.out, traj.csv_bytes())
     if image is not None:
         write_atomic(args.plot, image)
+    if args.animate:
+        from .animation import write_animation
+
+        params = _assignments(args.params, "--params")
+        write_animation(args, plant.robot, traj, lambda: _with_params(load_robot_argument(args), params))
     print(
         f"{args.out}: {len(traj.t)} samples, t = 0 .. {traj.t[-1]:g} s, dt = {args.dt:g} s, "
         f"integrator {traj.integrator}, {nact} actuated joints"
@@ -384,6 +402,7 @@ _VECTOR = {"nargs": "+", "metavar": "V"}
 
 def _simulate_arguments(s: argparse.ArgumentParser) -> None:
     from ..apps.simulation.stepping import INTEGRATORS
+    from .animation import animation_arguments
 
     vec = _VECTOR
     s.description = (
@@ -436,6 +455,7 @@ def _simulate_arguments(s: argparse.ArgumentParser) -> None:
     s.add_argument(
         "--progress", action="store_true", help="show a progress bar even when stderr is not a terminal"
     )
+    animation_arguments(s)
     s.set_defaults(func=cmd_simulate)
 
 
@@ -483,6 +503,9 @@ def _check_arguments(c: argparse.ArgumentParser) -> None:
     c.add_argument("--verbose", action="store_true", help="also list the entries that match")
     c.set_defaults(func=cmd_check)
 
+
+#: The option readers `symdyn draw` shares (symdyn.cli.draw).
+vector_option, assignments_option, with_params = _vector, _assignments, _with_params
 
 #: The subcommands of this module (symdyn.cli.main.COMMANDS): name -> (help, adds its arguments).
 COMMANDS = {

@@ -11,7 +11,7 @@ __all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METH
 #: (tests/test_cli.py checks that the two agree).
 METHODS = ("newton-euler", "lagrange")
 #: the commands that handle a floating robot (docs/floating-base.md)
-FLOATING_COMMANDS = ("derive", "generate", "simulate", "identify")
+FLOATING_COMMANDS = ("derive", "generate", "simulate", "identify", "draw")
 
 
 def load_robot_argument(args: argparse.Namespace):

@@ -23,6 +23,7 @@ from ..progress import restart as progress_restart
 from ..progress import stage as progress_stage
 from .apps import COMMANDS as APPLICATIONS
 from .common import METHODS, add_robot_argument, load_robot_argument
+from .draw import COMMANDS as DRAWING
 from .identification import COMMANDS as IDENTIFICATION
 
 __all__ = ["main", "build_parser", "COMMANDS"]
@@ -301,6 +302,7 @@ COMMANDS: dict[str, tuple[str, Callable[[argparse.ArgumentParser], None]]] = {
     "generate": ("generate code (C, CasADi, NumPy, JAX, LaTeX, MATLAB)", _generate_arguments),
     **APPLICATIONS,  # simulate, analyze, check, cache (the lecture's applications)
     **IDENTIFICATION,  # identify, excite
+    **DRAWING,  # draw
 }
 
 
