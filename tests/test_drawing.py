@@ -263,8 +263,8 @@ def test_simulate_animates_a_gif_with_the_stated_frame_count(tmp_path, capsys):
     from PIL import Image
 
     out = tmp_path / "run.gif"
-    args = ["simulate", str(EXAMPLES_DIR / "craig_two_link.yaml"), "--duration", "0.5", "--dt", "0.01"]
-    args += ["--params", "g=9.81", "l1=1", "l2=0.8", "m1=1", "m2=1", "--out", str(tmp_path / "t.csv")]
+    args = ["simulate", str(EXAMPLES_DIR / "roger_arm_values.yaml"), "--duration", "0.5", "--dt", "0.01"]
+    args += ["--tau", "0.1", "--out", str(tmp_path / "t.csv")]
     assert main([*args, "--animate", str(out), "--frames", "7", "--view", "front"]) == 0
     with Image.open(out) as im:
         assert im.n_frames == 7
@@ -361,3 +361,24 @@ def test_the_animation_page_holds_the_frames_and_the_tool_path(tmp_path):
     want = [frame_state(robot, "link6", x).pose[:3, 3] for x in q]
     np.testing.assert_allclose(d["trace"], want, atol=1e-9)
     assert Path(tmp_path / "a.html").read_bytes() == page.encode()
+
+
+# --------------------------------------------------------------------------- the documentation's pictures
+
+
+def test_the_committed_pictures_are_what_symdyn_draw_writes(tmp_path, monkeypatch):
+    """docs/images/robots/*.svg drawn again by docs/pictures.py (`symdyn draw`) are the same bytes."""
+    if example_robot_data_folder() is None:
+        pytest.skip("Solo-12's picture needs example-robot-data")
+    root = EXAMPLES_DIR.parent
+    monkeypatch.chdir(root)
+    monkeypatch.syspath_prepend(str(root / "docs"))
+    import pictures
+
+    written = pictures.write(tmp_path)
+    committed = sorted(p.name for p in (root / pictures.OUT).glob("*.svg"))
+    assert sorted(p.name for p in written) == committed
+    for path in written:
+        assert path.read_bytes() == (root / pictures.OUT / path.name).read_bytes(), (
+            f"{path.name} differs: run python docs/pictures.py"
+        )

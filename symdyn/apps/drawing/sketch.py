@@ -144,8 +144,9 @@ class _Pixels:
 
 
 def _origin_text(p: np.ndarray) -> str:
-    """data-origin: x y z in metres, shortest round-trip decimals (exact to the last bit)."""
-    return " ".join(repr(float(x)) for x in p)
+    """data-origin: x y z in metres, 12 significant digits (1e-12 m on a robot of a metre; the
+    last bits, which libm may round differently on another machine, left out)."""
+    return " ".join("0" if (t := f"{float(x):.12g}") == "-0" else t for x in p)
 
 
 def extent(scene: Scene) -> np.ndarray:
