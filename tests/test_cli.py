@@ -214,6 +214,7 @@ VALID = {
     "cache": [],
     "identify": ["robot.yaml", "data.csv"],
     "excite": ["robot.yaml", "--out", "e.csv"],
+    "draw": ["robot.yaml", "--out", "robot.svg"],
 }
 
 

@@ -93,6 +93,15 @@ def test_every_frame_origin_in_the_svg_is_the_oracle_frame(name):
     assert origins[robot.links[0].name][0] == "link"
 
 
+def test_an_mjcf_tree_is_drawn_where_the_oracle_puts_its_frames():
+    pytest.importorskip("mujoco")
+    robot = _quiet(symdyn.load_mjcf, EXAMPLES_DIR.parent / "tests/data/mjcf/tree.xml")
+    q = np.random.default_rng(2).uniform(-1, 1, robot.n)
+    origins = _origins(draw(robot, q))
+    for f in robot.frame_names:
+        np.testing.assert_allclose(origins[f][1], frame_state(robot, f, q).pose[:3, 3], atol=TOL, err_msg=f)
+
+
 def test_the_dh_parameters_on_the_picture_are_the_files_rows():
     """PUMA (standard) and the modified planar arm: a, d, alpha from the file, theta = q + offset."""
     for name in ("puma560", "planar_prismatic_modified"):

@@ -43,6 +43,8 @@ def test_wheel_contains_every_target_template(wheel):
     for target in ("c", "casadi", "python", "jax", "latex", "matlab"):
         assert any(n.startswith(f"symdyn/templates/{target}/") and n.endswith(".j2") for n in names), target
     assert "symdyn/cli/main.py" in names
+    for page in ("page.js", "vendor/three/three.module.min.js", "vendor/three/LICENSE"):  # symdyn draw's HTML
+        assert f"symdyn/apps/drawing/{page}" in names, page
     assert not any(n.startswith("tests/") or n.startswith("generated/") for n in names)
 
 
