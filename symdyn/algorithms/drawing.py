@@ -26,6 +26,9 @@ from ..model.scene import DHMark, FrameMarker, JointMarker, MassMarker, Scene, S
 
 __all__ = ["scene", "scene_function", "default_configuration"]
 
+#: The farthest a drawn point may be from the world's origin (m): beyond, a picture's arithmetic
+#: overflows.
+FAR = 1e12
 #: Residual below which a relative transform counts as a DH row (the frames of a DH file are
 #: exact up to rounding).
 _DH_TOLERANCE = 1e-9
@@ -150,6 +153,10 @@ class _Geometry:
 
     def scene(self, q) -> Scene:
         base, qb = self.configuration(q)
+        with np.errstate(over="ignore", invalid="ignore"):  # a far configuration is refused below
+            return self._scene(q, base, qb)
+
+    def _scene(self, q, base: np.ndarray, qb: np.ndarray) -> Scene:
         T = self.bodies(base, qb)
         on = lambda k: base if k < 0 else T[k]  # noqa: E731  (the pose of link k, -1: the base)
         frames = [FrameMarker("base", "base", base[:3, 3].copy(), base[:3, :3].copy(), "0")]
@@ -185,7 +192,9 @@ class _Geometry:
             for i, (Ti, c, m) in enumerate(zip(T, self.com, self.mass, strict=True))
         ]
         dh = self._dh(base, link_frames)
-        pts = np.array([f.origin for f in frames] + [s.end for s in segments]).reshape(-1, 3)
+        pts = np.array([f.origin for f in frames] + [s.end for s in segments] + [m.position for m in masses])
+        if not (np.isfinite(pts).all() and np.abs(pts).max() < FAR):
+            raise SymdynError(f"draw: the robot reaches beyond {FAR:g} m (or is not finite) at this q")
         size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if len(pts) else 0.0
         scale = 0.12 * size if size > 1e-9 else 0.1
         q_all = np.asarray(q, dtype=float).copy()

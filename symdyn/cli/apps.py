@@ -5,6 +5,7 @@
            --duration T --dt H [--integrator rk4|euler|lecture|semi-implicit|rk45|dop853]
            [--rtol R --atol A]
            [--params NAME=VALUE ...] --out traj.csv [--plot traj.png] [--progress]
+           [--animate run.html|run.gif [--frames N] [--view iso|front|side|top]]
     symdyn analyze ROBOT --q Q ... [--qd QD ...] --torque-limits L ... [--frame F] [--axes x,y]
            [--params NAME=VALUE ...] [--format text|json] [--plot fig.png]
     symdyn check ROBOT ANSWERS.yaml [--method newton-euler|lagrange] [--samples N] [--verbose]

@@ -3,7 +3,8 @@ time slider and play/pause) or an animated GIF, with the tool frame's path and c
 
 `frames` samples are taken evenly over the run (the first and the last included; all of them
 when the run has fewer), the scene of each computed by symdyn.algorithms.drawing (world frame);
-the tool's path uses every sample. A GIF has exactly `frames` frames (each shows its time, so no
+the tool's path uses every sample of runs of up to TRACE_POINTS samples (that many, evenly
+spaced, of a longer run). A GIF has exactly `frames` frames (each shows its time, so no
 two are merged), one picture map for all of them so that the robot does not jump.
 """
 
@@ -18,13 +19,15 @@ from ...errors import SymdynError
 from ..output import check_output, write_atomic
 from .draw import picture_format
 from .page import html_page
-from .sketch import VIEWS, Label, extent, pixel_map, sketch
+from .sketch import Label, extent, pixel_map, sketch, view_basis
 
 __all__ = ["animate", "ANIMATION_FORMATS", "MAX_FRAMES"]
 
 ANIMATION_FORMATS = ("html", "gif")
 #: The most frames an animation holds (a GIF of 2,000 pictures takes minutes and hundreds of MB).
 MAX_FRAMES = 2000
+#: The most samples of the tool's path (a run may have millions of steps).
+TRACE_POINTS = 2000
 
 
 def _tool(robot, tool: str | None) -> str:
@@ -67,8 +70,7 @@ def animate(
     fmt = picture_format(out, ANIMATION_FORMATS, "--animate")
     if not 1 <= int(frames) <= MAX_FRAMES:
         raise SymdynError(f"--frames {frames}: must be from 1 to {MAX_FRAMES:,}")
-    if view not in VIEWS:
-        raise SymdynError(f"animate: unknown view {view!r} (use {', '.join(VIEWS)})")
+    view_basis(view)
     t, q = np.asarray(t, dtype=float), np.asarray(q, dtype=float)
     if t.ndim != 1 or q.ndim != 2 or len(t) != len(q) or len(t) == 0:
         raise SymdynError(f"animate: t {t.shape} and q {q.shape} must be (N,) and (N, nq)")
@@ -76,7 +78,8 @@ def animate(
     name = _tool(robot, tool)
     picks = np.unique(np.round(np.linspace(0, len(t) - 1, min(int(frames), len(t)))).astype(int))
     scenes = [make(q[k]) for k in picks]
-    trace = np.array([make(x).frame(name).origin for x in q]) if len(q) > 1 else None
+    along = np.unique(np.round(np.linspace(0, len(t) - 1, min(len(t), TRACE_POINTS))).astype(int))
+    trace = np.array([make(q[k]).frame(name).origin for k in along]) if len(q) > 1 else None
     pairs = None
     if forces is not None:
         F = np.asarray(forces, dtype=float)

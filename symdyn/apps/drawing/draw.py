@@ -16,7 +16,7 @@ from ...algorithms.drawing import default_configuration, scene
 from ...errors import SymdynError
 from ..output import check_output, write_atomic
 from .page import html_page
-from .sketch import VIEWS, sketch
+from .sketch import sketch, view_basis
 from .svg import svg_text
 
 __all__ = ["draw", "picture", "FORMATS", "picture_format"]
@@ -42,8 +42,7 @@ def _q_text(q: np.ndarray) -> str:
 
 def picture(scn, fmt: str, view: str = "iso") -> bytes:
     """The bytes of a drawing of the scene `scn` in format `fmt` (svg, png, html) from `view`."""
-    if view not in VIEWS:
-        raise SymdynError(f"draw: unknown view {view!r} (use {', '.join(VIEWS)})")
+    view_basis(view)
     if fmt == "html":
         return html_page([scn], view).encode("utf-8")
     sk = sketch(scn, view)
@@ -80,8 +79,7 @@ def draw(robot, q=None, out=None, *, view: str = "iso", params=None, fmt: str | 
     fmt = fmt or "svg"
     if fmt not in FORMATS:
         raise SymdynError(f"draw: format {fmt!r} is not one of {', '.join(FORMATS)}")
-    if view not in VIEWS:
-        raise SymdynError(f"draw: unknown view {view!r} (use {', '.join(VIEWS)})")
+    view_basis(view)  # an unknown view refused before any work
     scn = scene(robot, default_configuration(robot) if q is None else q, params)
     data = picture(scn, fmt, view)
     if out is not None:

@@ -130,7 +130,7 @@ class _Pixels:
     """World -> pixel map of one picture: the projection, then a fit into the canvas."""
 
     def __init__(self, P: np.ndarray, points: np.ndarray, width: int, pad: float = 0.0) -> None:
-        uv = points @ P.T
+        uv = points @ P.T  # finite and below 1e15 m (symdyn.algorithms.drawing checks)
         lo, hi = uv.min(axis=0), uv.max(axis=0)
         span = np.maximum(hi - lo, 1e-9)
         self.s = (width - 2 * MARGIN) / max(span[0], span[1] * 0.75, 1e-9)
