@@ -213,31 +213,35 @@ def _masses(scene: Scene, px: _Pixels) -> Group:
 
 
 def _dh(scene: Scene, px: _Pixels) -> Group:
-    """Each row's d and a as dashed lines with their values, alpha at frame i, theta at the foot."""
+    """Each row's d and a as dashed lines with their values, alpha and theta beside them, and the
+    table in the top left corner. A modified row i holds Craig's a_{i-1} and alpha_{i-1}."""
     c = COLORS["dh"]
     items = []
     for row in scene.dh:
         i = str(row.index)
-        d_span = (row.start, row.foot) if row.convention == "standard" else (row.foot, row.end)
-        a_span = (row.foot, row.end) if row.convention == "standard" else (row.start, row.foot)
-        for name, (p, q), value in (("d", d_span, row.d), ("a", a_span, row.a)):
+        standard = row.convention == "standard"
+        before = i if standard else str(row.index - 1)  # the subscript of a and alpha
+        d_span = (row.start, row.foot) if standard else (row.foot, row.end)
+        a_span = (row.foot, row.end) if standard else (row.start, row.foot)
+        for name, sub, (p, q), value in (("d", i, d_span, row.d), ("a", before, a_span, row.a)):
             if abs(value) > 1e-9:
                 (x1, y1), (x2, y2) = px(p), px(q)
                 items.append(Line(x1, y1, x2, y2, c, 1.5, dash="4 3"))
                 items.append(
-                    Label((x1 + x2) / 2 + 6, (y1 + y2) / 2 - 6, name, f"{i} = {_number(value)}", c, 12)
+                    Label((x1 + x2) / 2 + 6, (y1 + y2) / 2 - 6, name, f"{sub} = {_number(value)}", c, 12)
                 )
         if abs(row.theta) > 1e-9:
             x, y = px(row.foot)
             items.append(Label(x + 8, y + 16, "θ", f"{i} = {_degrees(row.theta)}°", c, 12))
         if abs(row.alpha) > 1e-9:
-            x, y = px(row.end)
-            items.append(Label(x + 8, y + 30, "α", f"{i} = {_degrees(row.alpha)}°", c, 12))
-    rows = [("i", "a", "d", "α", "θ")] + [
-        (str(r.index), _number(r.a), _number(r.d), _degrees(r.alpha) + "°", _degrees(r.theta) + "°")
-        for r in scene.dh
-    ]
-    for k, cells in enumerate(rows):  # the table, in the top left corner
+            x, y = px(row.end if standard else row.foot)
+            items.append(Label(x + 8, y + 30, "α", f"{before} = {_degrees(row.alpha)}°", c, 12))
+    before = "i" if scene.dh[0].convention == "standard" else "i-1"
+    header = [("i", ""), ("a", before), ("d", "i"), ("α", before), ("θ", "i")]
+    for j, (text, sub) in enumerate(header):  # the table, in the top left corner
+        items.append(Label(10 + 70 * j, 18, text, sub, c, 12))
+    for k, r in enumerate(scene.dh, 1):
+        cells = (str(r.index), _number(r.a), _number(r.d), _degrees(r.alpha) + "°", _degrees(r.theta) + "°")
         for j, text in enumerate(cells):
             items.append(Label(10 + 70 * j, 18 + 16 * k, text, "", c, 12))
     return Group("dh", tuple(items), (("data-convention", scene.dh[0].convention),))
