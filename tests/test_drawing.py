@@ -370,6 +370,8 @@ def test_the_animation_page_holds_the_frames_and_the_tool_path(tmp_path):
     want = [frame_state(robot, "link6", x).pose[:3, 3] for x in q]
     np.testing.assert_allclose(d["trace"], want, atol=1e-9)
     assert Path(tmp_path / "a.html").read_bytes() == page.encode()
+    assert not re.search(r"""(src|href)\s*=\s*["']?(https?:|//)""", page)  # nothing from the network
+    assert '"three":"data:text/javascript;base64,' in page.replace(" ", "")
 
 
 # --------------------------------------------------------------------------- the documentation's pictures
