@@ -123,8 +123,8 @@ def test_every_file_is_compared_unless_its_own_tool_changed():
 
 def test_files_without_casadi_among_their_tools_render_without_casadi(fresh, monkeypatch):
     """The dependency table follows the code: with casadi unimportable, every file whose tools
-    exclude casadi (the C, NumPy, JAX, PyTorch, LaTeX and MATLAB files and the casadi module's text) renders to the
-    same bytes, and the .casadi files cannot be made at all."""
+    exclude casadi (the C, NumPy, JAX, PyTorch, LaTeX and MATLAB files and the casadi module's
+    text) renders to the same bytes, and the .casadi files cannot be made at all."""
     import symdyn.codegen
     from symdyn.codegen import casadi as casadi_backend
 

@@ -207,8 +207,9 @@ def test_torch_compile_gives_the_eager_values_without_a_graph_break(modules):
 
 
 def test_inputs_devices_and_bad_arguments(modules):
-    """Lists and NumPy arrays become CPU tensors; tensors on two devices, wrong shapes and a
-    missing p are refused with one ValueError naming the argument."""
+    """Lists and NumPy arrays become CPU tensors; tensors on two devices, wrong shapes, batch
+    shapes that do not broadcast, complex tensors and a missing p are refused with one
+    ValueError naming the argument; the meta device (shapes without data) works."""
     tm, nm, _ = modules["roger_arm"]
     p = [1.0, 1.2, 0.5, 0.4, 9.81]
     got = tm.gravity([0.1, 0.2], p)
@@ -225,6 +226,10 @@ def test_inputs_devices_and_bad_arguments(modules):
         tm.gravity(torch.zeros(2), torch.ones(4))
     with pytest.raises(ValueError, match=r"qd must have shape"):
         tm.friction(torch.tensor(1.0), p)
+    with pytest.raises(ValueError, match=r"q must be real; got a tensor of torch.complex128"):
+        tm.gravity(torch.zeros(2, dtype=torch.complex128), p)
+    with pytest.raises(ValueError, match=r"batch shapes \(3,\), \(4,\), \(\) do not broadcast"):
+        tm.coriolis(torch.zeros(3, 2), torch.zeros(4, 2), p)
     meta = tm.inverse_dynamics(
         *(torch.zeros(7, 2, device="meta") for _ in range(3)), torch.ones(5, device="meta")
     )

@@ -58,6 +58,8 @@ def _device(*args):
 
 def _vector(x, size, name, device):
     if isinstance(x, torch.Tensor):
+        if x.is_complex():
+            raise ValueError(f"{name} must be real; got a tensor of {x.dtype}")
         a = x.to(dtype=DTYPE)
     else:
         a = torch.as_tensor(x, dtype=DTYPE, device=device)
@@ -72,6 +74,14 @@ def _params(p, device):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return torch.zeros((0,), dtype=DTYPE, device=device)
     return _vector(p, NPARAM, "p", device)
+
+
+def _leading(*shapes):
+    """The leading (batch) shape the inputs' leading shapes broadcast to."""
+    try:
+        return torch.broadcast_shapes(*shapes)
+    except RuntimeError:
+        raise ValueError(f"the inputs' batch shapes {', '.join(str(tuple(s)) for s in shapes)} do not broadcast") from None
 
 
 def _assemble(device, lead, shape, entries):
@@ -93,7 +103,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -433,7 +443,7 @@ def mass_matrix(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -691,7 +701,7 @@ def coriolis_matrix(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -1420,7 +1430,7 @@ def coriolis(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -1777,7 +1787,7 @@ def gravity(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -1860,7 +1870,7 @@ def friction(qd, p=None):
     device = _device(qd, p)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(qd.shape[:-1], p.shape[:-1])
     return _assemble(
         device,
         _lead,
@@ -1887,7 +1897,7 @@ def forward_dynamics(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -2560,7 +2570,7 @@ def regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -3754,7 +3764,7 @@ def base_regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -4669,7 +4679,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -6782,7 +6792,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -9303,7 +9313,7 @@ def mass_matrix_inverse(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -9663,7 +9673,7 @@ def linearize(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -12324,7 +12334,7 @@ def link7_pose(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -12425,7 +12435,7 @@ def link7_jacobian(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -12568,7 +12578,7 @@ def link7_jacobian_local(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -12709,7 +12719,7 @@ def link7_jacobian_dot_qd(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -12878,7 +12888,7 @@ def com(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -12969,7 +12979,7 @@ def com_jacobian(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -13199,7 +13209,7 @@ def com_jacobian_dot_qd(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -13455,7 +13465,7 @@ def link7_operational_space_inertia(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -13998,7 +14008,7 @@ def link7_operational_space_bias(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]

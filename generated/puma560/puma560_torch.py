@@ -49,6 +49,8 @@ def _device(*args):
 
 def _vector(x, size, name, device):
     if isinstance(x, torch.Tensor):
+        if x.is_complex():
+            raise ValueError(f"{name} must be real; got a tensor of {x.dtype}")
         a = x.to(dtype=DTYPE)
     else:
         a = torch.as_tensor(x, dtype=DTYPE, device=device)
@@ -63,6 +65,14 @@ def _params(p, device):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return torch.zeros((0,), dtype=DTYPE, device=device)
     return _vector(p, NPARAM, "p", device)
+
+
+def _leading(*shapes):
+    """The leading (batch) shape the inputs' leading shapes broadcast to."""
+    try:
+        return torch.broadcast_shapes(*shapes)
+    except RuntimeError:
+        raise ValueError(f"the inputs' batch shapes {', '.join(str(tuple(s)) for s in shapes)} do not broadcast") from None
 
 
 def _assemble(device, lead, shape, entries):
@@ -84,7 +94,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -321,7 +331,7 @@ def mass_matrix(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -474,7 +484,7 @@ def coriolis_matrix(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -897,7 +907,7 @@ def coriolis(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -1126,7 +1136,7 @@ def gravity(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -1179,7 +1189,7 @@ def friction(qd, p=None):
     device = _device(qd, p)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(qd.shape[:-1], p.shape[:-1])
     qd1 = qd[..., 0]
     qd2 = qd[..., 1]
     qd3 = qd[..., 2]
@@ -1217,7 +1227,7 @@ def forward_dynamics(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -1640,7 +1650,7 @@ def regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -2495,7 +2505,7 @@ def base_regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -3136,7 +3146,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -4234,7 +4244,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -5627,7 +5637,7 @@ def mass_matrix_inverse(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]
@@ -5853,7 +5863,7 @@ def linearize(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q4 = q[..., 3]

@@ -49,6 +49,8 @@ def _device(*args):
 
 def _vector(x, size, name, device):
     if isinstance(x, torch.Tensor):
+        if x.is_complex():
+            raise ValueError(f"{name} must be real; got a tensor of {x.dtype}")
         a = x.to(dtype=DTYPE)
     else:
         a = torch.as_tensor(x, dtype=DTYPE, device=device)
@@ -63,6 +65,14 @@ def _params(p, device):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return torch.zeros((0,), dtype=DTYPE, device=device)
     return _vector(p, NPARAM, "p", device)
+
+
+def _leading(*shapes):
+    """The leading (batch) shape the inputs' leading shapes broadcast to."""
+    try:
+        return torch.broadcast_shapes(*shapes)
+    except RuntimeError:
+        raise ValueError(f"the inputs' batch shapes {', '.join(str(tuple(s)) for s in shapes)} do not broadcast") from None
 
 
 def _assemble(device, lead, shape, entries):
@@ -84,7 +94,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -140,7 +150,7 @@ def mass_matrix(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     l1 = p[..., 1]
     m1 = p[..., 2]
@@ -177,7 +187,7 @@ def coriolis_matrix(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     qd1 = qd[..., 0]
     qd2 = qd[..., 1]
@@ -225,7 +235,7 @@ def coriolis(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     qd1 = qd[..., 0]
     qd2 = qd[..., 1]
@@ -266,7 +276,7 @@ def gravity(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     g = p[..., 0]
@@ -304,7 +314,7 @@ def friction(qd, p=None):
     device = _device(qd, p)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(qd.shape[:-1], p.shape[:-1])
     return _assemble(
         device,
         _lead,
@@ -326,7 +336,7 @@ def forward_dynamics(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -400,7 +410,7 @@ def regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -499,7 +509,7 @@ def base_regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -567,7 +577,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -670,7 +680,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]
@@ -817,7 +827,7 @@ def mass_matrix_inverse(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     l1 = p[..., 1]
     m1 = p[..., 2]
@@ -861,7 +871,7 @@ def linearize(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     qd1 = qd[..., 0]

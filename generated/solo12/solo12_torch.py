@@ -49,6 +49,8 @@ def _device(*args):
 
 def _vector(x, size, name, device):
     if isinstance(x, torch.Tensor):
+        if x.is_complex():
+            raise ValueError(f"{name} must be real; got a tensor of {x.dtype}")
         a = x.to(dtype=DTYPE)
     else:
         a = torch.as_tensor(x, dtype=DTYPE, device=device)
@@ -63,6 +65,14 @@ def _params(p, device):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return torch.zeros((0,), dtype=DTYPE, device=device)
     return _vector(p, NPARAM, "p", device)
+
+
+def _leading(*shapes):
+    """The leading (batch) shape the inputs' leading shapes broadcast to."""
+    try:
+        return torch.broadcast_shapes(*shapes)
+    except RuntimeError:
+        raise ValueError(f"the inputs' batch shapes {', '.join(str(tuple(s)) for s in shapes)} do not broadcast") from None
 
 
 def _assemble(device, lead, shape, entries):
@@ -84,7 +94,7 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -536,7 +546,7 @@ def mass_matrix(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -827,7 +837,7 @@ def coriolis_matrix(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -1516,7 +1526,7 @@ def coriolis(q, qd, p=None):
     q = _vector(q, NDOF, "q", device)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -1908,7 +1918,7 @@ def gravity(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -2006,7 +2016,7 @@ def friction(qd, p=None):
     device = _device(qd, p)
     qd = _vector(qd, NDOF, "qd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(qd.shape[:-1], p.shape[:-1])
+    _lead = _leading(qd.shape[:-1], p.shape[:-1])
     return _assemble(
         device,
         _lead,
@@ -2038,7 +2048,7 @@ def forward_dynamics(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -2684,7 +2694,7 @@ def regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -5016,7 +5026,7 @@ def base_regressor(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -6584,7 +6594,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     qdd = _vector(qdd, NDOF, "qdd", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], qdd.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -8227,7 +8237,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]
@@ -10331,7 +10341,7 @@ def mass_matrix_inverse(q, p=None):
     device = _device(q, p)
     q = _vector(q, NDOF, "q", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], p.shape[:-1])
     q2 = q[..., 1]
     q3 = q[..., 2]
     q5 = q[..., 4]
@@ -10679,7 +10689,7 @@ def linearize(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd", device)
     tau = _vector(tau, NDOF, "tau", device)
     p = _params(p, device)
-    _lead = torch.broadcast_shapes(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
+    _lead = _leading(q.shape[:-1], qd.shape[:-1], tau.shape[:-1], p.shape[:-1])
     q1 = q[..., 0]
     q2 = q[..., 1]
     q3 = q[..., 2]

@@ -32,7 +32,7 @@ _RESERVED = frozenset(
     | {"DTYPE"}
     | {"array_namespace", "is_array_api_obj", "device", "_array_device", "_NUMPY", "_NUMPY_INPUTS"}
     | {"_namespace", "_batch", "functools"}
-    | {"_vector", "_params", "_assemble", "_lead", "_check_x64", "_device"}
+    | {"_vector", "_params", "_assemble", "_lead", "_check_x64", "_device", "_leading"}
 )
 _GENERATED_NAME = re.compile(r"(x|q|qd|qdd|tau)[0-9]+\Z")
 
