@@ -123,15 +123,15 @@ def test_every_file_is_compared_unless_its_own_tool_changed():
 
 def test_files_without_casadi_among_their_tools_render_without_casadi(fresh, monkeypatch):
     """The dependency table follows the code: with casadi unimportable, every file whose tools
-    exclude casadi (the C, NumPy, JAX, LaTeX and MATLAB files and the casadi module's text) renders to the
-    same bytes, and the .casadi files cannot be made at all."""
+    exclude casadi (the C, NumPy, JAX, PyTorch, LaTeX and MATLAB files and the casadi module's
+    text) renders to the same bytes, and the .casadi files cannot be made at all."""
     import symdyn.codegen
     from symdyn.codegen import casadi as casadi_backend
 
     robot = load_robot(ROOT / "examples" / "roger_arm.yaml")
     ctx = symdyn.codegen.context(robot)
     monkeypatch.setitem(sys.modules, "casadi", None)  # `import casadi` raises ImportError
-    files = symdyn.codegen.render(robot, targets=("c", "python", "jax", "latex", "matlab"))
+    files = symdyn.codegen.render(robot, targets=("c", "python", "jax", "torch", "latex", "matlab"))
     files["roger_arm_casadi.py"] = casadi_backend.render_module(ctx)
     want = {name for name in fresh["roger_arm"] if "casadi" not in file_tools(name)}
     assert set(files) == want

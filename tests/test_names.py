@@ -100,7 +100,7 @@ def test_a_robot_name_of_250_characters_makes_files_the_file_system_takes(tmp_pa
     robot = robot_from_data(raw_example("roger_arm_values") | {"name": name})
     with within(60):
         paths = generate(
-            robot, ("c", "casadi", "python", "jax", "latex"), tmp_path, functions=("kinematics",)
+            robot, ("c", "casadi", "python", "jax", "torch", "latex"), tmp_path, functions=("kinematics",)
         )
     assert paths and all(len(p.name.encode()) <= 200 and p.name.startswith(short_name(name)) for p in paths)
     header = (tmp_path / f"{short_name(name)}_dynamics.h").read_text()

@@ -40,7 +40,7 @@ def wheel(tmp_path_factory) -> Path:
 
 def test_wheel_contains_every_target_template(wheel):
     names = zipfile.ZipFile(wheel).namelist()
-    for target in ("c", "casadi", "python", "jax", "latex", "matlab"):
+    for target in ("c", "casadi", "python", "jax", "torch", "latex", "matlab"):
         assert any(n.startswith(f"symdyn/templates/{target}/") and n.endswith(".j2") for n in names), target
     assert "symdyn/cli/main.py" in names
     for page in ("page.js", "vendor/three/three.module.min.js", "vendor/three/LICENSE"):  # symdyn draw's HTML

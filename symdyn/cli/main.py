@@ -247,7 +247,7 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--target",
         action="append",
-        choices=("c", "casadi", "python", "jax", "latex", "matlab"),
+        choices=("c", "casadi", "python", "jax", "torch", "latex", "matlab"),
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")

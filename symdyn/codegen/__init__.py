@@ -1,4 +1,5 @@
-"""Code generation: the functions of docs/generated-code.md rendered for C, CasADi, NumPy, JAX, LaTeX, MATLAB.
+"""Code generation: the functions of docs/generated-code.md rendered for C, CasADi, NumPy, JAX,
+PyTorch, LaTeX, MATLAB.
 
 Each target is a backend package `symdyn.codegen.<backend>` (TARGETS maps target
 names to them) shaped like a SymForce backend: a config of names and a printer
@@ -37,6 +38,7 @@ TARGETS = {
     "casadi": "casadi",
     "python": "python",
     "jax": "jax",
+    "torch": "pytorch",
     "latex": "latex",
     "matlab": "matlab",
 }

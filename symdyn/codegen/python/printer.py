@@ -27,11 +27,12 @@ __all__ = ["NumpyPrinter", "local_names", "dtype"]
 
 #: Names the generated function bodies use besides their locals.
 _RESERVED = frozenset(
-    {"np", "xp", "jnp", "jax", "q", "qd", "qdd", "tau", "p", "NDOF", "NQ", "NV", "NPARAM", "PARAM_NAMES"}
+    {"np", "xp", "jnp", "jax", "torch"}
+    | {"q", "qd", "qdd", "tau", "p", "NDOF", "NQ", "NV", "NPARAM", "PARAM_NAMES"}
     | {"DTYPE"}
     | {"array_namespace", "is_array_api_obj", "device", "_array_device", "_NUMPY", "_NUMPY_INPUTS"}
     | {"_namespace", "_batch", "functools"}
-    | {"_vector", "_params", "_assemble", "_lead", "_check_x64"}
+    | {"_vector", "_params", "_assemble", "_lead", "_check_x64", "_device", "_leading"}
 )
 _GENERATED_NAME = re.compile(r"(x|q|qd|qdd|tau)[0-9]+\Z")
 
