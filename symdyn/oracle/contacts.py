@@ -1,22 +1,11 @@
-"""The oracle's contact dynamics, NumPy only: the contact Jacobian Jc and drift gamma of named
-frames, the constrained forward dynamics (a KKT system) and the impulse dynamics of a touchdown.
+"""The oracle's contact dynamics, NumPy only: the constrained forward dynamics of a robot whose
+named frames touch the world (a KKT system) and the impulse dynamics of a touchdown.
 
-Independent of the symbolic code (symdyn.algorithms.contacts): it reads only the model. The
-bodies' world motions come from the oracle's own spatial kinematics (symdyn.oracle.centroidal's
-walk over symdyn.oracle.spatial's joint poses, a floating base's twist constant in its body
-frame), M from the CRBA and b + F = rnea(q, qd, 0) from the RNEA (symdyn.oracle.rnea).
-
-Conventions (Pinocchio's, issue 36; q, qd as symdyn.model.free_flyer on a floating base):
-
-* point (Pinocchio's CONTACT_3D, LOCAL_WORLD_ALIGNED): 3 rows, the linear velocity of the
-  frame's origin in world axes; its drift is the origin's classical acceleration at qdd = 0,
-  a_F = a_O + wd x r + w x (w x r) (r: the origin from the link's, world axes);
-* 6d (CONTACT_6D, LOCAL): 6 rows, the frame's spatial velocity in its own axes, linear then
-  angular, [R^T v_F; R^T w]; its drift is the spatial acceleration in those axes at qdd = 0,
-  [R^T (a_F - w x v_F); R^T wd] (Pinocchio's getFrameAcceleration(LOCAL), not the classical one).
-
-Rows are stacked in the contacts' order (NLAMBDA = 3 a point + 6 a 6d contact). With the mask
-`active` (1 in contact, 0 free) only the active contacts' rows enter:
+Independent of the symbolic code (symdyn.algorithms.contacts): it reads only the model. Jc and
+gamma come from symdyn.oracle.contact_kinematics (the conventions: Pinocchio's CONTACT_3D
+LOCAL_WORLD_ALIGNED rows for a point, CONTACT_6D LOCAL rows for a 6d contact), M from the CRBA
+and b + F = rnea(q, qd, 0) from the RNEA (symdyn.oracle.rnea). With the mask `active` (1 in
+contact, 0 free) only the active contacts' rows enter:
 
     [ M   Jc^T ] [ qdd     ]   [ tau - b - F ]
     [ Jc  0    ] [ -lambda ] = [ -gamma      ]
@@ -24,130 +13,33 @@ Rows are stacked in the contacts' order (NLAMBDA = 3 a point + 6 a 6d contact). 
 solved by the Schur complement: (Jc M^-1 Jc^T + mu I) lambda = -gamma - Jc M^-1 (tau - b - F),
 qdd = M^-1 (tau - b - F + Jc^T lambda); lambda is the force (and moment) on the robot in the rows'
 axes, zero on the free contacts' rows. mu >= 0 (`damping`, default 0) regularises redundant sets
-(Pinocchio's forwardDynamics(..., damping)): with mu = 0 a Delassus matrix whose smallest
-eigenvalue is below SINGULAR times its largest is refused (SymdynError), never a NaN.
-Impulse dynamics (restitution e in [0, 1]): M (qd+ - qd) = Jc^T P, Jc qd+ = -e Jc qd, so
-(Jc M^-1 Jc^T + mu I) P = -(1 + e) Jc qd and qd+ = qd + M^-1 Jc^T P.
+as Pinocchio's forwardDynamics(..., damping) does (then Jc qdd + gamma = -mu lambda): a Delassus
+matrix Jc M^-1 Jc^T + mu I whose smallest eigenvalue is not above SINGULAR times its largest is
+refused (SymdynError), never a NaN. Impulse dynamics (restitution e in [0, 1]):
+M (qd+ - qd) = Jc^T P, Jc qd+ = -e Jc qd, so (Jc M^-1 Jc^T + mu I) P = -(1 + e) Jc qd and
+qd+ = qd + M^-1 Jc^T P.
 """
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Sequence
-from typing import NamedTuple
-
 import numpy as np
 
 from ..errors import SymdynError
-from .centroidal import _Bodies
+from .contact_kinematics import ContactRows, contact_kinematics, contact_rows
 from .floating import floating_inputs
-from .inputs import checked_inputs, numeric_model
+from .inputs import checked_inputs
 from .rnea import mass_matrix, rnea
 
 __all__ = [
-    "KINDS",
     "SINGULAR",
-    "ContactRows",
-    "contact_rows",
     "contact_jacobian",
     "contact_drift",
     "contact_forward_dynamics",
     "impulse_dynamics",
 ]
 
-#: the rows of each kind of contact
-KINDS = {"point": 3, "6d": 6}
 #: with no damping, a Delassus matrix whose eigenvalues' ratio is below this is singular
 SINGULAR = 1e-12
-
-
-@dataclasses.dataclass(frozen=True)
-class ContactRows:
-    """The checked contacts of a robot: per contact its frame's name, its kind and its first row;
-    nlambda the total number of rows."""
-
-    frames: tuple[str, ...]
-    kinds: tuple[str, ...]
-    starts: tuple[int, ...]
-    nlambda: int
-
-    def rows(self, active: np.ndarray) -> np.ndarray:
-        """The row indices of the active contacts (active: NCONTACT booleans)."""
-        spans = [range(s, s + KINDS[k]) for s, k, a in zip(self.starts, self.kinds, active, strict=True) if a]
-        return np.array([r for span in spans for r in span], dtype=int)
-
-
-def _pair(robot, contact, i: int, where: str) -> tuple[object, object]:
-    """(frame, kind) of a Contact-like object or of a pair."""
-    if hasattr(contact, "frame") and hasattr(contact, "kind"):
-        return contact.frame, contact.kind
-    if isinstance(contact, Sequence) and not isinstance(contact, (str, bytes)) and len(contact) == 2:
-        return contact[0], contact[1]
-    raise SymdynError(f"{where}: robot '{robot.name}': contact {i} is not a (frame, kind) pair: {contact!r}")
-
-
-def contact_rows(robot, contacts, where: str = "contacts") -> ContactRows:
-    """The contacts, (frame_name, kind) pairs or objects with `.frame` and `.kind`, checked.
-
-    Raises:
-        SymdynError: not a sequence, an unknown frame or kind.
-    """
-    if isinstance(contacts, (str, bytes)) or not isinstance(contacts, Sequence):
-        raise SymdynError(f"{where}: robot '{robot.name}': contacts must be a list of (frame, kind) pairs")
-    frames, kinds, starts, row = [], [], [], 0
-    for i, contact in enumerate(contacts):
-        frame, kind = _pair(robot, contact, i, where)
-        if not isinstance(frame, str):
-            raise SymdynError(f"{where}: robot '{robot.name}': contact {i}'s frame is not a name: {frame!r}")
-        if not isinstance(kind, str) or kind not in KINDS:
-            raise SymdynError(
-                f"{where}: robot '{robot.name}': contact {i} ({frame!r}) has kind {kind!r}, "
-                "expected 'point' or '6d'"
-            )
-        robot.frame(frame, where)  # raises for an unknown name, naming the near matches
-        frames.append(frame)
-        kinds.append(kind)
-        starts.append(row)
-        row += KINDS[kind]
-    return ContactRows(tuple(frames), tuple(kinds), tuple(starts), row)
-
-
-class Kinematics(NamedTuple):
-    """Contact rows at one q: Jc (NLAMBDA, NV) and the drifts gamma = Jc_dot qd (K, NLAMBDA) of K
-    velocities qd."""
-
-    jacobian: np.ndarray
-    drift: np.ndarray
-
-
-def contact_kinematics(robot, rows: ContactRows, q: np.ndarray, qd: np.ndarray, params=None) -> Kinematics:
-    """Jc at a checked q and the drifts of the checked velocities qd (K, NV) (module docstring).
-
-    The bodies' world motions (symdyn.oracle.centroidal) are computed column by column: Jc's
-    columns are the frames' velocities at qd = e_k, each drift is the acceleration at one qd.
-    """
-    mdl = numeric_model(robot, params)
-    bodies = _Bodies(robot, q, params)
-    nv, K = robot.nv, len(qd)
-    motions = bodies.motions(robot, np.concatenate([np.eye(nv), qd.T], 1))
-    J, gamma = np.zeros((rows.nlambda, nv)), np.zeros((rows.nlambda, K))
-    for name, kind, start in zip(rows.frames, rows.kinds, rows.starts, strict=True):
-        f = mdl.frame_names.index(name)
-        k = int(mdl.frame_link[f])
-        if k < 0 and not robot.floating:  # the fixed base: no motion, zero rows
-            continue
-        R_k = bodies.R[k] if k >= 0 else bodies.R0
-        R_F, r = R_k @ mdl.frame_R[f], (R_k @ mdl.frame_p[f])[:, None]
-        w, wd, v_o, a_o = motions[k]  # k = -1 on a floating base: the base body, last
-        v_F = v_o + np.cross(w, r, axis=0)
-        a_F = a_o + np.cross(wd, r, axis=0) + np.cross(w, np.cross(w, r, axis=0), axis=0)  # classical, world
-        if kind == "point":
-            J[start : start + 3], gamma[start : start + 3] = v_F[:, :nv], a_F[:, nv:]
-        else:
-            J[start : start + 6] = np.vstack([R_F.T @ v_F[:, :nv], R_F.T @ w[:, :nv]])
-            spatial = a_F[:, nv:] - np.cross(w[:, nv:], v_F[:, nv:], axis=0)
-            gamma[start : start + 6] = np.vstack([R_F.T @ spatial, R_F.T @ wd[:, nv:]])
-    return Kinematics(J, gamma.T)
 
 
 def checked_state(where: str, robot, params, **vectors) -> list[np.ndarray]:
@@ -176,7 +68,7 @@ def contact_jacobian(robot, contacts, q, params=None) -> np.ndarray:
     """
     rows = _contacts(robot, contacts, "contact_jacobian")
     (q,) = checked_state("contact_jacobian", robot, params, q=q)
-    return contact_kinematics(robot, rows, q, np.zeros((0, robot.nv)), params).jacobian
+    return contact_kinematics(robot, rows, q[None], np.zeros((1, robot.nv)), params)[0][0]
 
 
 def contact_drift(robot, contacts, q, qd, params=None) -> np.ndarray:
@@ -188,7 +80,7 @@ def contact_drift(robot, contacts, q, qd, params=None) -> np.ndarray:
     """
     rows = _contacts(robot, contacts, "contact_drift")
     q, qd = checked_state("contact_drift", robot, params, q=q, qd=qd)
-    return contact_kinematics(robot, rows, q, qd[None], params).drift[0]
+    return contact_kinematics(robot, rows, q[None], qd[None], params)[1][0]
 
 
 def checked_mask(robot, rows: ContactRows, active, where: str) -> np.ndarray:
@@ -244,45 +136,29 @@ def kkt_solve(M: np.ndarray, J: np.ndarray, rhs: np.ndarray, con: np.ndarray, da
     return Minv_rhs + MinvJt @ lam, lam
 
 
-def _unique(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct rows of Q (in first-seen order) and, per row of Q, its index among them."""
-    keys = [x.tobytes() for x in Q]
-    first: dict[bytes, int] = {}
-    for i, key in enumerate(keys):
-        first.setdefault(key, i)
-    position = {key: u for u, key in enumerate(first)}
-    return Q[list(first.values())], np.array([position[key] for key in keys], dtype=int)
-
-
 def constrained(robot, rows, mask, Q, QD, TAU, params, damping: float, where: str, *, friction: bool = True):
-    """(qdd (N, NV), lambda (N, NLAMBDA)) of N checked states: the KKT system (module docstring),
-    one Jc, M and kinematic pass per distinct q."""
-    distinct, index = _unique(Q)
-    M = mass_matrix(robot, distinct, params)
+    """(qdd (N, NV), lambda (N, NLAMBDA)) of N checked states: the KKT system (module docstring)."""
+    J, gamma = contact_kinematics(robot, rows, Q, QD, params)
+    M = mass_matrix(robot, Q, params)
     h = rnea(robot, Q, QD, np.zeros_like(QD), params, friction=friction)
     r = rows.rows(mask)
     qdd, lam = np.zeros_like(QD), np.zeros((len(Q), rows.nlambda))
-    for u in range(len(distinct)):
-        which = np.flatnonzero(index == u)
-        kin = contact_kinematics(robot, rows, distinct[u], QD[which], params)
-        for k, i in enumerate(which):
-            qdd[i], lam[i, r] = kkt_solve(
-                M[u], kin.jacobian[r], TAU[i] - h[i], -kin.drift[k, r], damping, where
-            )
+    for i in range(len(Q)):
+        qdd[i], lam[i, r] = kkt_solve(M[i], J[i][r], TAU[i] - h[i], -gamma[i, r], damping, where)
     return qdd, lam
 
 
 def impulse(robot, rows, mask, Q, QD, params, restitution: float, damping: float, where: str):
     """(qd_plus (N, NV), impulse (N, NLAMBDA)) of N checked states: M dqd = Jc^T P, Jc qd+ = -e Jc qd."""
-    distinct, index = _unique(Q)
-    M = mass_matrix(robot, distinct, params)
+    J = contact_kinematics(robot, rows, Q, np.zeros_like(QD), params)[0]
+    M = mass_matrix(robot, Q, params)
     r = rows.rows(mask)
     jump, P = np.zeros_like(QD), np.zeros((len(Q), rows.nlambda))
-    for u in range(len(distinct)):
-        J = contact_kinematics(robot, rows, distinct[u], np.zeros((0, robot.nv)), params).jacobian[r]
-        for i in np.flatnonzero(index == u):
-            con = -(1 + restitution) * J @ QD[i]
-            jump[i], P[i, r] = kkt_solve(M[u], J, np.zeros(robot.nv), con, damping, where)
+    for i in range(len(Q)):
+        Ji = J[i][r]
+        jump[i], P[i, r] = kkt_solve(
+            M[i], Ji, np.zeros(robot.nv), -(1 + restitution) * Ji @ QD[i], damping, where
+        )
     return QD + jump, P
 
 
