@@ -43,8 +43,8 @@ SINGULAR = 1e-12
 
 
 def checked_state(where: str, robot, params, **vectors) -> list[np.ndarray]:
-    """One state's vectors, checked: q (NQ entries), the others NV (floating) or n (fixed)."""
-    named = [(k, v) for k, v in vectors.items()]
+    """One state's vectors, checked: q (NQ entries), the others NV (floating) or n (fixed), finite."""
+    named = list(vectors.items())
     if getattr(robot, "floating", False) is True:
         _, out, single = floating_inputs(
             where, robot, params, *((k, v, "q" if k == "q" else "v") for k, v in named)
@@ -53,6 +53,9 @@ def checked_state(where: str, robot, params, **vectors) -> list[np.ndarray]:
         _, out, single = checked_inputs(where, robot, params, *named)
     if not single:
         raise SymdynError(f"{where}: robot '{robot.name}': give one state (vectors, not rows of states)")
+    for (name, _), a in zip(named, out, strict=True):
+        if not np.all(np.isfinite(a)):
+            raise SymdynError(f"{where}: robot '{robot.name}': {name} has entries that are not finite")
     return [a[0] for a in out]
 
 
