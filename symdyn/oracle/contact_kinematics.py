@@ -34,16 +34,26 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import SymdynError
+from ..errors import SymdynError, one_line
 from .floating import base_rotation
 from .inputs import body_positions, body_rates, numeric_model
 from .spatial import joint_poses
 
-__all__ = ["KINDS", "ContactRows", "contact_rows", "contact_kinematics"]
+__all__ = ["KINDS", "ContactRows", "contact_rows", "contact_kinematics", "shown"]
 
 
 #: the rows of each kind of contact
 KINDS = {"point": 3, "6d": 6}
+
+
+#: the longest quotation of a user's value in a message
+SHOWN = 60
+
+
+def shown(value) -> str:
+    """repr(value) for a message: one line (symdyn.errors.one_line), cut to SHOWN characters."""
+    text = one_line(repr(value))
+    return text if len(text) <= SHOWN else text[: SHOWN - 3] + "..."
 
 
 @dataclasses.dataclass(frozen=True)
@@ -68,7 +78,9 @@ def _pair(robot, contact, i: int, where: str) -> tuple[object, object]:
         return contact.frame, contact.kind
     if isinstance(contact, Sequence) and not isinstance(contact, (str, bytes)) and len(contact) == 2:
         return contact[0], contact[1]
-    raise SymdynError(f"{where}: robot '{robot.name}': contact {i} is not a (frame, kind) pair: {contact!r}")
+    raise SymdynError(
+        f"{where}: robot '{robot.name}': contact {i} is not a (frame, kind) pair: {shown(contact)}"
+    )
 
 
 def contact_rows(robot, contacts, where: str = "contacts") -> ContactRows:
@@ -83,13 +95,18 @@ def contact_rows(robot, contacts, where: str = "contacts") -> ContactRows:
     for i, contact in enumerate(contacts):
         frame, kind = _pair(robot, contact, i, where)
         if not isinstance(frame, str):
-            raise SymdynError(f"{where}: robot '{robot.name}': contact {i}'s frame is not a name: {frame!r}")
+            raise SymdynError(
+                f"{where}: robot '{robot.name}': contact {i}'s frame is not a name: {shown(frame)}"
+            )
         if not isinstance(kind, str) or kind not in KINDS:
             raise SymdynError(
-                f"{where}: robot '{robot.name}': contact {i} ({frame!r}) has kind {kind!r}, "
+                f"{where}: robot '{robot.name}': contact {i} ({shown(frame)}) has kind {shown(kind)}, "
                 "expected 'point' or '6d'"
             )
-        robot.frame(frame, where)  # raises for an unknown name, naming the near matches
+        if frame not in robot.frame_names:
+            if len(frame) <= SHOWN:
+                robot.frame(frame, where)  # raises, naming the near matches
+            raise SymdynError(f"{where}: robot '{robot.name}': contact {i}: no frame is named {shown(frame)}")
         frames.append(frame)
         kinds.append(kind)
         starts.append(row)

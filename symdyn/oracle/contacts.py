@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SymdynError
-from .contact_kinematics import ContactRows, contact_kinematics, contact_rows
+from .contact_kinematics import ContactRows, contact_kinematics, contact_rows, shown
 from .floating import floating_inputs
 from .inputs import checked_inputs
 from .rnea import mass_matrix, rnea
@@ -95,12 +95,12 @@ def checked_mask(robot, rows: ContactRows, active, where: str) -> np.ndarray:
         a = np.asarray(active, dtype=float)
     except (TypeError, ValueError):
         raise SymdynError(
-            f"{where}: robot '{robot.name}': active must hold numbers, got {active!r}"
+            f"{where}: robot '{robot.name}': active must hold numbers, got {shown(active)}"
         ) from None
     if a.shape != (count,) or not np.all((a == 0) | (a == 1)):
         raise SymdynError(
             f"{where}: robot '{robot.name}': active must be {count} entries of 0 or 1 (one per contact), "
-            f"got {np.asarray(active).tolist()!r}"
+            f"got {shown(np.asarray(active).tolist())}"
         )
     return a == 1
 
@@ -110,7 +110,9 @@ def checked_number(robot, value, name: str, low: float, high: float, where: str)
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise SymdynError(f"{where}: robot '{robot.name}': {name} must be a number, got {value!r}") from None
+        raise SymdynError(
+            f"{where}: robot '{robot.name}': {name} must be a number, got {shown(value)}"
+        ) from None
     if not low <= x <= high:
         raise SymdynError(f"{where}: robot '{robot.name}': {name} must be in [{low:g}, {high:g}], got {x!r}")
     return x
