@@ -44,11 +44,12 @@ from states import CHECK_TOL, NCHECK, NSTATES, SEED, rel_err  # noqa: E402
 
 import symdyn  # noqa: E402
 from symdyn.model.friction import Friction  # noqa: E402
-from symdyn.oracle.contact_derivatives import (  # noqa: E402
+from symdyn.oracle.contacts import (  # noqa: E402
+    contact_forward_dynamics,
     contact_forward_dynamics_derivatives,
+    impulse_dynamics,
     impulse_dynamics_derivatives,
 )
-from symdyn.oracle.contacts import contact_forward_dynamics, impulse_dynamics  # noqa: E402
 from symdyn.oracle.inputs import numeric_model  # noqa: E402
 from symdyn.regenerate import example_robot_data_folder  # noqa: E402
 

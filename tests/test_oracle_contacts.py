@@ -29,15 +29,13 @@ from timebound import within
 import symdyn
 from symdyn import SymdynError
 from symdyn.oracle.centroidal import centroidal
-from symdyn.oracle.contact_derivatives import (
-    contact_forward_dynamics_derivatives,
-    impulse_dynamics_derivatives,
-)
 from symdyn.oracle.contacts import (
     contact_drift,
     contact_forward_dynamics,
+    contact_forward_dynamics_derivatives,
     contact_jacobian,
     impulse_dynamics,
+    impulse_dynamics_derivatives,
 )
 from symdyn.rnea import forward_dynamics, friction_torque, gravity_torque, mass_matrix, rnea
 

@@ -20,14 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contacts import (
-    checked_mask,
-    checked_number,
-    checked_state,
-    constrained,
-    contact_rows,
-    impulse,
-)
+from .contact_kinematics import contact_rows
+from .contact_solve import checked_mask, checked_number, checked_state, constrained, impulse
 from .derivatives import STEP, integrate
 from .rnea import friction_torque
 
