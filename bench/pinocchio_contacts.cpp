@@ -61,7 +61,7 @@ int main(int argc, char ** argv)
       fail("contact " + std::to_string(c) + ": kind 3 or 6, link -1 .. n-1");
     const MatrixXd R = read_matrix(in, 3, 3, "contact R");
     const MatrixXd p = read_matrix(in, 3, 1, "contact p");
-    const pinocchio::SE3 placement(Eigen::Matrix3d(R), Eigen::Vector3d(p));
+    const pinocchio::SE3 placement{Eigen::Matrix3d(R), Eigen::Vector3d(p)};
     const auto joint = pinocchio::JointIndex(link + 2);  // the free flyer is joint 1, link 0 joint 2
     if (kind == 3)
       constraints.push_back(Constraint(pinocchio::CONTACT_3D, model, joint, placement, pinocchio::LOCAL_WORLD_ALIGNED));
@@ -72,7 +72,7 @@ int main(int argc, char ** argv)
   ConstraintDatas datas;
   for (const auto & c : constraints)
     datas.push_back(ConstraintData(c));
-  pinocchio::initConstraintDynamics(model, data, constraints);
+  pinocchio::initConstraintDynamics(model, data, constraints, datas);
   pinocchio::ProximalSettings prox(1e-12, 0.0, 1);  // no proximal damping, one iteration (exact solve)
 
   expect(in, "nstates");
