@@ -308,6 +308,7 @@ def test_solve_loops_equals_numpy(tmp_path):
     assert torch.equal(guess, torch.as_tensor(q0))  # the guess is not written
 
 
+@pytest.mark.accelerator
 @pytest.mark.skipif(not torch.cuda.is_available(), reason="no CUDA device")
 def test_a_gpu_gives_the_cpu_values(modules):
     """On a CUDA device: outputs stay on it and equal the CPU's (float64)."""
