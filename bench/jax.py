@@ -10,8 +10,11 @@ merged into link 7) is generated in double precision for the targets python and 
 * JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit with XLA's CPU fusion
   emitters off, the module's own compiler option) on the batch, the arrays already on the device,
   after a first call that compiles (its time is listed); then jax.jit(jax.vmap(f)) of the
-  one-state function with XLA's defaults, as one's own jit gets it, and f_batch again in a
-  process with XLA_FLAGS turning the emitters off for everything;
+  one-state function with XLA's defaults, as one's own jit gets it, and
+  jax.jit(jax.grad(lambda x: jnp.sum(jax.vmap(f)(x, ...) ** 2))), its gradient with respect to
+  the first argument (q, or for M its entries' squares), checked against central differences of
+  the same loss along one direction; then f_batch again in a process with XLA_FLAGS turning the
+  emitters off for everything;
 * ADAM (adam-robotics, its JAX backend) on the same URDF and the same batch, jax.jit(jax.vmap(..)):
   M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + h, h its
   bias_force plus the URDF's joint damping b qd (ADAM's RNEA takes no accelerations, and it
@@ -147,6 +150,23 @@ def adam_functions(urdf: str, gravity: list[float]):
     }
 
 
+def _grad_route(jax, jnp, f):
+    """jit(grad) of the sum of squares of jax.vmap(f) over the batch, with respect to argument 0."""
+    return jax.jit(jax.grad(lambda x, *rest: jnp.sum(jax.vmap(f)(x, *rest) ** 2)))
+
+
+def _grad_error(jax, jnp, f, grad, args) -> float:
+    """Relative error of grad's derivative along one direction against central differences."""
+    loss = jax.jit(lambda x, *rest: jnp.sum(jax.vmap(f)(x, *rest) ** 2))
+    x = jnp.asarray(args[0])
+    rest = tuple(jnp.asarray(a) for a in args[1:])
+    d = jnp.asarray(np.random.default_rng(7).uniform(-1.0, 1.0, x.shape))
+    h = 1e-6
+    fd = float((loss(x + h * d, *rest) - loss(x - h * d, *rest)) / (2 * h))
+    exact = float(jnp.sum(grad(x, *rest) * d))
+    return abs(fd - exact) / max(abs(exact), 1e-300)
+
+
 def worker(
     module_path: str, urdf: str | None, count: int, reps: int, reference: dict, gravity=None, own=False
 ) -> dict:
@@ -167,6 +187,12 @@ def worker(
     if own:
         out["own"] = {}
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in FUNCTIONS}
+        out["grad"] = {}
+        for f in FUNCTIONS:
+            grad = _grad_route(jax, jnp, getattr(arm, f))
+            error = _grad_error(jax, jnp, getattr(arm, f), grad, _arguments(check, f))
+            out["error"][f"grad {f} (against central differences)"] = error
+            out["grad"][f] = _jax_timing(grad, _arguments(device, f), count, max(1, reps // 2))
     if urdf is not None:
         from importlib.metadata import version
 
@@ -229,10 +255,10 @@ def table(results: dict, opts) -> list[str]:
     here, plain, there = results["here"], results["plain"], results.get("there")
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
     head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
-    head += ["jit(vmap(f))", "f_batch, XLA_FLAGS"]
+    head += ["jit(vmap(f))", "jit(grad)", "f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
-    head += ["JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
+    head += ["vmap/f_batch", "grad/vmap", "JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
     rows = [head]
     for f in FUNCTIONS:
         one, batch = results["numpy"][f]
@@ -243,10 +269,13 @@ def table(results: dict, opts) -> list[str]:
             ns(batch),
             ns(here["symdyn"][f][1]),
             ns(here["own"][f][1]),
+            ns(here["grad"][f][1]),
             ns(plain["symdyn"][f][1]),
         ]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
+        own, grad = here["own"][f][1], here["grad"][f][1]
+        row += [f"{own / here['symdyn'][f][1]:.2f}x", f"{grad / own:.2f}x"]
         row += [f"{jx / batch:.2f}x"]
         if there:
             row += [f"{there['symdyn'][f][1] / there['adam'][f][1]:.2f}x"]
@@ -260,16 +289,20 @@ def table(results: dict, opts) -> list[str]:
         *(_row(r, widths) for r in rows[1:]),
         "",
         "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
-        f"the one-state function under XLA's defaults; XLA_FLAGS: {NO_EMITTERS} for the process; "
-        "JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
+        "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
+        "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0, XLA's defaults; "
+        f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
+        "(one run); JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
         "compile time of the first batch call (s): "
         + ", ".join(f"{f} {here['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
         + "; jit(vmap(f)) "
         + ", ".join(f"{f} {here['own'][f][0]:.1f}" for f in FUNCTIONS)
+        + "; jit(grad) "
+        + ", ".join(f"{f} {here['grad'][f][0]:.1f}" for f in FUNCTIONS)
         + "; XLA_FLAGS "
         + ", ".join(f"{f} {plain['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
         + ("; ADAM " + ", ".join(f"{f} {there['adam'][f][0]:.1f}" for f in FUNCTIONS) if there else ""),
-        "largest relative error against symdyn.rnea on 8 states: "
+        "largest relative error against symdyn.rnea on 8 states (grad: its derivative along one direction): "
         + ", ".join(f"{k} {v:.1e}" for k, v in {**here["error"], **(there or {}).get("error", {})}.items()),
     ]
     if not there:
@@ -333,7 +366,7 @@ def main(argv=None) -> int:
             results["there"] = _external(opts.adam_python, payload, tmp)
     for route in ("here", "plain", "there"):
         for key, err in results.get(route, {}).get("error", {}).items():
-            assert err < 1e-9, (route, key, err)
+            assert err < (1e-5 if key.startswith("grad") else 1e-9), (route, key, err)
     results.update(machine=machine(), load=(load_before, load_averages()), wall=time.perf_counter() - start)
     text = "\n".join(table(results, opts)) + "\n"
     Path(opts.out).write_text(text)

@@ -33,10 +33,12 @@ in-place update, so that jax.jit, jax.vmap, jax.grad, jax.jacfwd and
 jax.lax.scan apply to them unchanged, on any device JAX runs on; p is an
 argument, so parameters can be fitted by gradient.
 
-Each function f has a batched twin f_batch: f vmapped over the leading axis of
-every argument that has one more axis than for one state (an argument of one
-state's shape is shared by all), and jitted; at the top level with XLA's CPU
-fusion emitters off (_BATCH_OPTIONS), which made long bodies far slower.
+jax.jit(jax.vmap(f)) under XLA's default flags is the fast path for the
+functions returning vectors (built by _vector_of). Each function f also has a
+batched twin f_batch: f vmapped over the leading axis of every argument that has
+one more axis than for one state (an argument of one state's shape is shared by
+all), and jitted; at the top level with XLA's CPU fusion emitters off
+(_BATCH_OPTIONS).
 
 Double precision: JAX computes in float32 unless its 64-bit mode is on, so this
 module refuses to import (ImportError) until it is enabled, before the import:
@@ -81,6 +83,21 @@ def _params(p):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return jnp.zeros((0,), dtype=DTYPE)
     return _vector(p, NPARAM, "p")
+
+
+def _vector_of(*entries):
+    """The vector [entries] of dtype DTYPE, built by selecting entry i at position i
+    (jax.lax.select_n over jnp.arange) rather than by jnp.array, a concatenate: under
+    jax.vmap, XLA's CPU fusion emitters give every operand of a concatenate its own
+    indexing and evaluate the statements shared by several entries once per path to
+    them (the Panda's inverse dynamics: about 25,000 sines and cosines per state for
+    its 12), where a selection reads every entry at one indexing and computes each
+    statement once. A selection costs about one operation per entry for each entry, so
+    it serves vectors; matrices keep jnp.array (selected, the Panda's derivative
+    matrices took 11 times longer under jax.vmap)."""
+    size = len(entries)
+    cases = (jnp.broadcast_to(jnp.asarray(e, dtype=DTYPE), (size,)) for e in entries)
+    return jax.lax.select_n(jnp.arange(size, dtype=jnp.int32), *cases)
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
@@ -458,18 +475,15 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x292 = 0.026534991901690206*qdd2 + 0.01026110182100817*x12 + 0.0007689361029464*x14 + x290 + x291
     x293 = x2*x267 - x278*x3
     x294 = x2*x261 + x237*x3 + x292 + 0.316*x293
-    return jnp.array(
-        [
-            x289,
-            x294,
-            x287,
-            x251,
-            x235,
-            x189,
-            x159,
-        ],
-        dtype=DTYPE,
-    ).reshape((7,))
+    return _vector_of(
+        x289,
+        x294,
+        x287,
+        x251,
+        x235,
+        x189,
+        x159,
+    )
 
 
 def mass_matrix(q, p=None):
@@ -1790,18 +1804,15 @@ def coriolis(q, qd, p=None):
     x316 = x315 - 0.01026110182100817*x5 + 0.0007689361029464*x7
     x317 = x2*x290 - x3*x303
     x318 = x2*x283 + x254*x3 + x316 + 0.316*x317
-    return jnp.array(
-        [
-            x314,
-            x318,
-            x312,
-            x271,
-            x252,
-            x199,
-            x164,
-        ],
-        dtype=DTYPE,
-    ).reshape((7,))
+    return _vector_of(
+        x314,
+        x318,
+        x312,
+        x271,
+        x252,
+        x199,
+        x164,
+    )
 
 
 def gravity(q, p=None):
@@ -1869,18 +1880,15 @@ def gravity(q, p=None):
     x49 = x45*x6 - x46*x5
     x50 = -x47*x7 + x48*x8
     x51 = -x47*x8 - x48*x7
-    return jnp.array(
-        [
-            0,
-            -x34*x41 + x37*x39,
-            x29*x43 + x32*x42,
-            -x22*x45 + x27*x44,
-            -x12*x47 + x19*x46,
-            -x10*x49 - 0.068832705569*x48,
-            -0.0031274395439999996*x50 - 0.007735484874*x51,
-        ],
-        dtype=DTYPE,
-    ).reshape((7,))
+    return _vector_of(
+        0,
+        -x34*x41 + x37*x39,
+        x29*x43 + x32*x42,
+        -x22*x45 + x27*x44,
+        -x12*x47 + x19*x46,
+        -x10*x49 - 0.068832705569*x48,
+        -0.0031274395439999996*x50 - 0.007735484874*x51,
+    )
 
 
 def friction(qd, p=None):
@@ -1890,18 +1898,15 @@ def friction(qd, p=None):
     """
     qd = _vector(qd, NDOF, "qd")
     p = _params(p)
-    return jnp.array(
-        [
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-        ],
-        dtype=DTYPE,
-    ).reshape((7,))
+    return _vector_of(
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+    )
 
 
 def forward_dynamics(q, qd, tau, p=None):
@@ -2559,18 +2564,15 @@ def forward_dynamics(q, qd, tau, p=None):
     x623 = x512*x622
     x624 = x323 - x439*x623 - x444*x621 - x452*x619 - x467*x617 - x485*x615 - x509*x613
     x625 = x425*x624
-    return jnp.array(
-        [
-            x625,
-            x623,
-            x621,
-            x619,
-            x617,
-            x615,
-            x613,
-        ],
-        dtype=DTYPE,
-    ).reshape((7,))
+    return _vector_of(
+        x625,
+        x623,
+        x621,
+        x619,
+        x617,
+        x615,
+        x613,
+    )
 
 
 def regressor(q, qd, qdd, p=None):
@@ -12832,17 +12834,14 @@ def link7_jacobian_dot_qd(q, qd, p=None):
     x129 = qd7*x128
     x130 = x102 + x126*x58 - x129*x78
     x131 = x104 - x124*x58 + x129*x68
-    return jnp.array(
-        [
-            x105,
-            x118,
-            x122,
-            x127,
-            x130,
-            x131,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        x105,
+        x118,
+        x122,
+        x127,
+        x130,
+        x131,
+    )
 
 
 def com(q, p=None):
@@ -12922,14 +12921,11 @@ def com(q, p=None):
     x60 = -0.0825*x50 + 0.384*x51 + x59
     x61 = 0.088*x54 + x60
     x62 = -0.01221063981344444*x2 + 0.00012650839664373321*x4 - 0.005531315822332925*x48 + 0.0017573691262156238*x49 - 0.011876902589892798*x50 + 0.020390986800693706*x51 - 0.0009123155343263272*x52 + 0.004225505768785861*x53 + 0.006240866199767254*x54 - 0.004285402807609849*x55 + 0.00048159764058718974*x56 - 0.0001947088682872236*x57 + 0.2010071888339605*x58 + 0.22337601259907464*x59 + 0.18008200903840163*x60 + 0.04579230204309116*x61 + 0.1164642483326622
-    return jnp.array(
-        [
-            x30,
-            x47,
-            x62,
-        ],
-        dtype=DTYPE,
-    ).reshape((3,))
+    return _vector_of(
+        x30,
+        x47,
+        x62,
+    )
 
 
 def com_jacobian(q, p=None):
@@ -13400,14 +13396,11 @@ def com_jacobian_dot_qd(q, qd, p=None):
     x218 = -x152*x168 + x166*x203 + x172*x85 - x207*x91 + x217
     x219 = x103*x185 - x107*x211 - x174*x183 + x181*x209 + x218
     x220 = -0.04027647139246521*x1*x193 + 0.103756774007336*x103*x140 + 0.04579230204309116*x104*x134 - 0.103756774007336*x107*x198 - 0.04579230204309116*x108*x195 - 0.04027647139246521*x119*x66 + 0.07632523503106561*x127*x86 + 0.22337601259907464*x136*x85 + 0.2010071888339605*x138*x84 + x142*x214 - x143*x189 - x152*x190 - x163*x191 - x174*x188 - x176*x192 - 0.07632523503106561*x194*x92 - 0.22337601259907464*x196*x91 - 0.2010071888339605*x197*x90 - x199*x215 + x200*x51 + x203*x55 + x206*x59 + x209*x42 + x210*x65 + 0.2010071888339605*x216 + 0.22337601259907464*x217 + 0.18008200903840163*x218 + 0.04579230204309116*x219
-    return jnp.array(
-        [
-            x187,
-            x213,
-            x220,
-        ],
-        dtype=DTYPE,
-    ).reshape((3,))
+    return _vector_of(
+        x187,
+        x213,
+        x220,
+    )
 
 
 def link7_operational_space_inertia(q, p=None):
@@ -14758,17 +14751,14 @@ def link7_operational_space_bias(q, qd, p=None):
     x785 = x428 + x431*x784
     x786 = x460*x733 + x747*x770 + x752*x777 + x756*x782 + x758*x785 - x761*x784
     x787 = x444*x761 + x445*x733 + x747*x763 + x752*x772 + x756*x779 - x758*x784
-    return jnp.array(
-        [
-            x762,
-            x771,
-            x778,
-            x783,
-            x786,
-            x787,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        x762,
+        x771,
+        x778,
+        x783,
+        x786,
+        x787,
+    )
 
 
 inverse_dynamics_batch = _batch(inverse_dynamics)

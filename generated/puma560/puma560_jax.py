@@ -24,10 +24,12 @@ in-place update, so that jax.jit, jax.vmap, jax.grad, jax.jacfwd and
 jax.lax.scan apply to them unchanged, on any device JAX runs on; p is an
 argument, so parameters can be fitted by gradient.
 
-Each function f has a batched twin f_batch: f vmapped over the leading axis of
-every argument that has one more axis than for one state (an argument of one
-state's shape is shared by all), and jitted; at the top level with XLA's CPU
-fusion emitters off (_BATCH_OPTIONS), which made long bodies far slower.
+jax.jit(jax.vmap(f)) under XLA's default flags is the fast path for the
+functions returning vectors (built by _vector_of). Each function f also has a
+batched twin f_batch: f vmapped over the leading axis of every argument that has
+one more axis than for one state (an argument of one state's shape is shared by
+all), and jitted; at the top level with XLA's CPU fusion emitters off
+(_BATCH_OPTIONS).
 
 Double precision: JAX computes in float32 unless its 64-bit mode is on, so this
 module refuses to import (ImportError) until it is enabled, before the import:
@@ -72,6 +74,21 @@ def _params(p):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return jnp.zeros((0,), dtype=DTYPE)
     return _vector(p, NPARAM, "p")
+
+
+def _vector_of(*entries):
+    """The vector [entries] of dtype DTYPE, built by selecting entry i at position i
+    (jax.lax.select_n over jnp.arange) rather than by jnp.array, a concatenate: under
+    jax.vmap, XLA's CPU fusion emitters give every operand of a concatenate its own
+    indexing and evaluate the statements shared by several entries once per path to
+    them (the Panda's inverse dynamics: about 25,000 sines and cosines per state for
+    its 12), where a selection reads every entry at one indexing and computes each
+    statement once. A selection costs about one operation per entry for each entry, so
+    it serves vectors; matrices keep jnp.array (selected, the Panda's derivative
+    matrices took 11 times longer under jax.vmap)."""
+    size = len(entries)
+    cases = (jnp.broadcast_to(jnp.asarray(e, dtype=DTYPE), (size,)) for e in entries)
+    return jax.lax.select_n(jnp.arange(size, dtype=jnp.int32), *cases)
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
@@ -347,17 +364,14 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x193 = 0.41164522969715195*qd4 + 0.85160768*jnp.sign(qd4)
     x194 = 0.42728302093540005*qd5 + 0.6660069799999999*jnp.sign(qd5)
     x195 = 0.2158232532732*qd6 + 0.30367656000000004*jnp.sign(qd6)
-    return jnp.array(
-        [
-            0.784029968642*qdd1 + x0 + x184,
-            2.324814845*qdd2 + x185 + x191,
-            0.576873331938*qdd3 + x190 + x192,
-            0.19079062612368*qdd4 + x162 + x193,
-            0.17070629165700002*qdd5 + x138 + x194,
-            0.19406450566800004*qdd6 + x128 + x195,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        0.784029968642*qdd1 + x0 + x184,
+        2.324814845*qdd2 + x185 + x191,
+        0.576873331938*qdd3 + x190 + x192,
+        0.19079062612368*qdd4 + x162 + x193,
+        0.17070629165700002*qdd5 + x138 + x194,
+        0.19406450566800004*qdd6 + x128 + x195,
+    )
 
 
 def mass_matrix(q, p=None):
@@ -1140,17 +1154,14 @@ def coriolis(q, qd, p=None):
     x191 = -0.336*x161 - x190
     x192 = -x128*x22 - x138*x21 - 0.4318*x166 + 0.0203*x174 + x191
     x193 = 0.4318*x176 + x189 + x192
-    return jnp.array(
-        [
-            x187,
-            x193,
-            x192,
-            x164,
-            x137,
-            x64,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        x187,
+        x193,
+        x192,
+        x164,
+        x137,
+        x64,
+    )
 
 
 def gravity(q, p=None):
@@ -1189,17 +1200,14 @@ def gravity(q, p=None):
     x22 = x19*x21
     x23 = x19*x2
     x24 = x20*x3 + x23*x7
-    return jnp.array(
-        [
-            0,
-            x12*x18 - x14*x16,
-            x10*x19 - x20*x6,
-            -x22*x4,
-            0.0028799999999999997*x24,
-            0,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        0,
+        x12*x18 - x14*x16,
+        x10*x19 - x20*x6,
+        -x22*x4,
+        0.0028799999999999997*x24,
+        0,
+    )
 
 
 def friction(qd, p=None):
@@ -1221,17 +1229,14 @@ def friction(qd, p=None):
     x3 = 0.41164522969715195*qd4 + 0.85160768*jnp.sign(qd4)
     x4 = 0.42728302093540005*qd5 + 0.6660069799999999*jnp.sign(qd5)
     x5 = 0.2158232532732*qd6 + 0.30367656000000004*jnp.sign(qd6)
-    return jnp.array(
-        [
-            x0,
-            x1,
-            x2,
-            x3,
-            x4,
-            x5,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        x0,
+        x1,
+        x2,
+        x3,
+        x4,
+        x5,
+    )
 
 
 def forward_dynamics(q, qd, tau, p=None):
@@ -1640,17 +1645,14 @@ def forward_dynamics(q, qd, tau, p=None):
     x377 = x296*x376
     x378 = x195 - x256*x377 - x264*x375 - x272*x373 - x285*x371 - x293*x369
     x379 = x239*x378
-    return jnp.array(
-        [
-            x379,
-            x377,
-            x375,
-            x373,
-            x371,
-            x369,
-        ],
-        dtype=DTYPE,
-    ).reshape((6,))
+    return _vector_of(
+        x379,
+        x377,
+        x375,
+        x373,
+        x371,
+        x369,
+    )
 
 
 def regressor(q, qd, qdd, p=None):

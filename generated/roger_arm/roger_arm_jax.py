@@ -24,10 +24,12 @@ in-place update, so that jax.jit, jax.vmap, jax.grad, jax.jacfwd and
 jax.lax.scan apply to them unchanged, on any device JAX runs on; p is an
 argument, so parameters can be fitted by gradient.
 
-Each function f has a batched twin f_batch: f vmapped over the leading axis of
-every argument that has one more axis than for one state (an argument of one
-state's shape is shared by all), and jitted; at the top level with XLA's CPU
-fusion emitters off (_BATCH_OPTIONS), which made long bodies far slower.
+jax.jit(jax.vmap(f)) under XLA's default flags is the fast path for the
+functions returning vectors (built by _vector_of). Each function f also has a
+batched twin f_batch: f vmapped over the leading axis of every argument that has
+one more axis than for one state (an argument of one state's shape is shared by
+all), and jitted; at the top level with XLA's CPU fusion emitters off
+(_BATCH_OPTIONS).
 
 Double precision: JAX computes in float32 unless its 64-bit mode is on, so this
 module refuses to import (ImportError) until it is enabled, before the import:
@@ -72,6 +74,21 @@ def _params(p):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return jnp.zeros((0,), dtype=DTYPE)
     return _vector(p, NPARAM, "p")
+
+
+def _vector_of(*entries):
+    """The vector [entries] of dtype DTYPE, built by selecting entry i at position i
+    (jax.lax.select_n over jnp.arange) rather than by jnp.array, a concatenate: under
+    jax.vmap, XLA's CPU fusion emitters give every operand of a concatenate its own
+    indexing and evaluate the statements shared by several entries once per path to
+    them (the Panda's inverse dynamics: about 25,000 sines and cosines per state for
+    its 12), where a selection reads every entry at one indexing and computes each
+    statement once. A selection costs about one operation per entry for each entry, so
+    it serves vectors; matrices keep jnp.array (selected, the Panda's derivative
+    matrices took 11 times longer under jax.vmap)."""
+    size = len(entries)
+    cases = (jnp.broadcast_to(jnp.asarray(e, dtype=DTYPE), (size,)) for e in entries)
+    return jax.lax.select_n(jnp.arange(size, dtype=jnp.int32), *cases)
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
@@ -170,13 +187,10 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x22 = m2*x21
     x23 = x14*x5 + x22*x6
     x24 = l1*x23 + x15 + x3
-    return jnp.array(
-        [
-            x24,
-            x15,
-        ],
-        dtype=DTYPE,
-    ).reshape((2,))
+    return _vector_of(
+        x24,
+        x15,
+    )
 
 
 def mass_matrix(q, p=None):
@@ -284,13 +298,10 @@ def coriolis(q, qd, p=None):
     x12 = m2*x11
     x13 = x0*x12 + x4*x6
     x14 = l1*x13 + x5
-    return jnp.array(
-        [
-            x14,
-            x5,
-        ],
-        dtype=DTYPE,
-    ).reshape((2,))
+    return _vector_of(
+        x14,
+        x5,
+    )
 
 
 def gravity(q, p=None):
@@ -318,13 +329,10 @@ def gravity(q, p=None):
     x8 = g*jnp.sin(q1)
     x9 = x4*x8
     x10 = -x1*x7 - x9
-    return jnp.array(
-        [
-            x2*x7 + x6*x8,
-            -x0*x10,
-        ],
-        dtype=DTYPE,
-    ).reshape((2,))
+    return _vector_of(
+        x2*x7 + x6*x8,
+        -x0*x10,
+    )
 
 
 def friction(qd, p=None):
@@ -334,13 +342,10 @@ def friction(qd, p=None):
     """
     qd = _vector(qd, NDOF, "qd")
     p = _params(p)
-    return jnp.array(
-        [
-            0,
-            0,
-        ],
-        dtype=DTYPE,
-    ).reshape((2,))
+    return _vector_of(
+        0,
+        0,
+    )
 
 
 def forward_dynamics(q, qd, tau, p=None):
@@ -404,13 +409,10 @@ def forward_dynamics(q, qd, tau, p=None):
     x38 = x36*x37
     x39 = x23 - x33*x38
     x40 = x31*x39
-    return jnp.array(
-        [
-            x40,
-            x38,
-        ],
-        dtype=DTYPE,
-    ).reshape((2,))
+    return _vector_of(
+        x40,
+        x38,
+    )
 
 
 def regressor(q, qd, qdd, p=None):

@@ -24,10 +24,12 @@ in-place update, so that jax.jit, jax.vmap, jax.grad, jax.jacfwd and
 jax.lax.scan apply to them unchanged, on any device JAX runs on; p is an
 argument, so parameters can be fitted by gradient.
 
-Each function f has a batched twin f_batch: f vmapped over the leading axis of
-every argument that has one more axis than for one state (an argument of one
-state's shape is shared by all), and jitted; at the top level with XLA's CPU
-fusion emitters off (_BATCH_OPTIONS), which made long bodies far slower.
+jax.jit(jax.vmap(f)) under XLA's default flags is the fast path for the
+functions returning vectors (built by _vector_of). Each function f also has a
+batched twin f_batch: f vmapped over the leading axis of every argument that has
+one more axis than for one state (an argument of one state's shape is shared by
+all), and jitted; at the top level with XLA's CPU fusion emitters off
+(_BATCH_OPTIONS).
 
 Double precision: JAX computes in float32 unless its 64-bit mode is on, so this
 module refuses to import (ImportError) until it is enabled, before the import:
@@ -72,6 +74,21 @@ def _params(p):
             raise ValueError(f"p is required: the {NPARAM} free parameters {PARAM_NAMES}")
         return jnp.zeros((0,), dtype=DTYPE)
     return _vector(p, NPARAM, "p")
+
+
+def _vector_of(*entries):
+    """The vector [entries] of dtype DTYPE, built by selecting entry i at position i
+    (jax.lax.select_n over jnp.arange) rather than by jnp.array, a concatenate: under
+    jax.vmap, XLA's CPU fusion emitters give every operand of a concatenate its own
+    indexing and evaluate the statements shared by several entries once per path to
+    them (the Panda's inverse dynamics: about 25,000 sines and cosines per state for
+    its 12), where a selection reads every entry at one indexing and computes each
+    statement once. A selection costs about one operation per entry for each entry, so
+    it serves vectors; matrices keep jnp.array (selected, the Panda's derivative
+    matrices took 11 times longer under jax.vmap)."""
+    size = len(entries)
+    cases = (jnp.broadcast_to(jnp.asarray(e, dtype=DTYPE), (size,)) for e in entries)
+    return jax.lax.select_n(jnp.arange(size, dtype=jnp.int32), *cases)
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
@@ -556,23 +573,20 @@ def inverse_dynamics(q, qd, qdd, p=None):
     x383 = -0.0005446477058047094*x314*x316 + x314*x333
     x384 = 0.0005426192213171668*x349 - 3.3497340042275575e-05*x351 - 0.0038482516772413004*x352 - x383
     x385 = -0.16*x369 + x382 + x384
-    return jnp.array(
-        [
-            x90,
-            x96,
-            x95,
-            x187,
-            x192,
-            x191,
-            x283,
-            x289,
-            x288,
-            x380,
-            x385,
-            x384,
-        ],
-        dtype=DTYPE,
-    ).reshape((12,))
+    return _vector_of(
+        x90,
+        x96,
+        x95,
+        x187,
+        x192,
+        x191,
+        x283,
+        x289,
+        x288,
+        x380,
+        x385,
+        x384,
+    )
 
 
 def mass_matrix(q, p=None):
@@ -1916,23 +1930,20 @@ def coriolis(q, qd, p=None):
     x339 = 3.3497340042275575e-05*x305 + x338
     x340 = -0.0038482516772413004*x307 - x339
     x341 = -0.16*x325 + x337 + x340
-    return jnp.array(
-        [
-            x78,
-            x85,
-            x84,
-            x164,
-            x170,
-            x169,
-            x249,
-            x256,
-            x255,
-            x335,
-            x341,
-            x340,
-        ],
-        dtype=DTYPE,
-    ).reshape((12,))
+    return _vector_of(
+        x78,
+        x85,
+        x84,
+        x164,
+        x170,
+        x169,
+        x249,
+        x256,
+        x255,
+        x335,
+        x341,
+        x340,
+    )
 
 
 def gravity(q, p=None):
@@ -2010,23 +2021,20 @@ def gravity(q, p=None):
     x53 = x43*x52
     x54 = x42*x52
     x55 = x44*x54 + x47*x53
-    return jnp.array(
-        [
-            0.008674079908742898*x10 - x8*x9,
-            -x11*x7 - x12*x4,
-            0.0038482516772413004*x13,
-            -x22*x23 - 0.008674079908742898*x24,
-            -x18*x26 - x21*x25,
-            0.0038482516772413004*x27,
-            -x36*x37 + 0.008674079908742898*x38,
-            -x32*x40 - x35*x39,
-            0.0038482516772413004*x41,
-            -x50*x51 - 0.008674079908742898*x52,
-            -x46*x54 - x49*x53,
-            0.0038482516772413004*x55,
-        ],
-        dtype=DTYPE,
-    ).reshape((12,))
+    return _vector_of(
+        0.008674079908742898*x10 - x8*x9,
+        -x11*x7 - x12*x4,
+        0.0038482516772413004*x13,
+        -x22*x23 - 0.008674079908742898*x24,
+        -x18*x26 - x21*x25,
+        0.0038482516772413004*x27,
+        -x36*x37 + 0.008674079908742898*x38,
+        -x32*x40 - x35*x39,
+        0.0038482516772413004*x41,
+        -x50*x51 - 0.008674079908742898*x52,
+        -x46*x54 - x49*x53,
+        0.0038482516772413004*x55,
+    )
 
 
 def friction(qd, p=None):
@@ -2036,23 +2044,20 @@ def friction(qd, p=None):
     """
     qd = _vector(qd, NDOF, "qd")
     p = _params(p)
-    return jnp.array(
-        [
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-        ],
-        dtype=DTYPE,
-    ).reshape((12,))
+    return _vector_of(
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+    )
 
 
 def forward_dynamics(q, qd, tau, p=None):
@@ -2678,23 +2683,20 @@ def forward_dynamics(q, qd, tau, p=None):
     x575 = x574*x73
     x576 = x29 - x55*x575 - x573*x70
     x577 = 1842.9129686423128*x576
-    return jnp.array(
-        [
-            x558,
-            x560,
-            x562,
-            x563,
-            x565,
-            x567,
-            x568,
-            x570,
-            x572,
-            x573,
-            x575,
-            x577,
-        ],
-        dtype=DTYPE,
-    ).reshape((12,))
+    return _vector_of(
+        x558,
+        x560,
+        x562,
+        x563,
+        x565,
+        x567,
+        x568,
+        x570,
+        x572,
+        x573,
+        x575,
+        x577,
+    )
 
 
 def regressor(q, qd, qdd, p=None):

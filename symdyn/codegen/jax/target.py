@@ -5,8 +5,10 @@ names and arguments, written for ONE state: vectors of shape (n,), p of shape (k
 bodies are the eliminated straight-line code, one statement per temporary, with no branch
 on a value, no in-place update and no NumPy call, so that jax.jit, jax.vmap, jax.grad and
 jax.jacfwd, and jax.lax.scan apply to them unchanged; p is an argument, so parameters can
-be fitted by gradient. Each function has a batched twin NAME_batch (vmapped over the
-leading axis of the arguments that have one, jitted). Inputs and outputs are float64
+be fitted by gradient. Vectors are returned through jax.lax.select_n (the module's
+_vector_of), not jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times
+slower under jax.vmap for the Panda (docs/jax.md). Each function has a batched twin NAME_batch
+(vmapped over the leading axis of the arguments that have one, jitted). Inputs and outputs are float64
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
 rather than compute in float32) or float32.
 
