@@ -267,6 +267,7 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
             "configuration",
             "centroidal",
             "contacts",
+            "contact_derivatives",
             "all",
         ),
         default=["dynamics"],
@@ -274,8 +275,8 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
         "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives, "
         "kinematics and operational_space (per frame, see --frames); configuration (a floating robot's "
         "integrate and difference), centroidal (momentum matrix, its drift, com, total mass), contacts "
-        "(a robot with contacts: Jc, drift, constrained and impulse dynamics, their derivatives; "
-        "docs/contacts.md); all: every group",
+        "(a robot with contacts: Jc, drift, constrained and impulse dynamics; docs/contacts.md), "
+        "contact_derivatives (their derivatives); all: every group",
     )
     g.add_argument(
         "--frames",
