@@ -36,7 +36,13 @@ from ..dynamics import Dynamics
 from .frame_functions import _frames_of
 from .function_rows import FunctionRow, Input, Inputs, Output
 
-__all__ = ["CONTACT_FUNCTIONS", "contact_rows_of", "contact_derivative_rows", "contact_inputs"]
+__all__ = [
+    "CONTACT_FUNCTIONS",
+    "contact_rows_of",
+    "contact_derivative_rows",
+    "contact_inputs",
+    "contacts_of",
+]
 
 CONTACT_FUNCTIONS = (
     "contact_jacobian",
@@ -240,3 +246,9 @@ def _derivative_rows(dyn, x, prog, kkt: KKT, Jc, gamma, solved, inputs, cols) ->
             _entries(dpq, dpv, diq, div),
         ),
     ]
+
+
+def contacts_of(ctx) -> tuple:
+    """The robot's contacts when a RenderContext's functions include the contact functions, else ()
+    (the targets' NCONTACT, NLAMBDA and CONTACT_NAMES constants)."""
+    return ctx.robot.contacts if any(f.name == "contact_jacobian" for f in ctx.functions) else ()
