@@ -33,7 +33,7 @@ from ..algorithms.contact_dynamics import KKT
 from ..algorithms.contacts import ContactKinematics
 from ..algorithms.derivatives import elimination_order, floating_effort_jacobians, jacobian, substitute
 from ..dynamics import Dynamics
-from .frame_functions import _frames_of
+from .frame_functions import frames_of
 from .function_rows import FunctionRow, Input, Inputs, Output
 
 __all__ = [
@@ -80,7 +80,7 @@ def _setup(dyn: Dynamics, x: Inputs, tag: str):
     robot = dyn.robot
     prog = dyn.program.copy(tag)
     first = len(prog.assignments)
-    fk, q_in, v_in, nv, cols = _frames_of(dyn, x, prog)
+    fk, q_in, v_in, nv, cols = frames_of(dyn, x, prog)
     qd = list(v_in.symbols)
     assert list(q_in.symbols) == list(dyn.q) and qd == list(dyn.qd), (
         "the frames' inputs are the dynamics' own"
