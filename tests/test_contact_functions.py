@@ -71,7 +71,7 @@ ROBOTS = {
 class Generated:
     """One robot's generated contact functions in NumPy and C: call(target, name, *inputs)."""
 
-    def __init__(self, key: str, directory) -> None:
+    def __init__(self, key: str, directory, c: bool = True) -> None:
         path, floating, contacts, groups = ROBOTS[key]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -85,7 +85,7 @@ class Generated:
         self.numpy = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(self.numpy)
         self.lib = None
-        if compilers():
+        if c and compilers():
             paths = write_files(c_target.render(self.ctx), directory)
             self.lib = ctypes.CDLL(
                 str(compile_shared([p for p in paths if p.suffix == ".c"], directory / "l.so"))
@@ -380,3 +380,25 @@ def test_floating_derivatives_equal_differences_of_the_generated_functions(tmp_p
         )
         got = g.contact_forward_dynamics_derivatives(q, v, tau, active)
         _close(np.vstack([got[2], got[5]]), dt, f"{active} by tau", 1e-5)
+
+
+def test_symdyn_compile_binds_the_contact_functions(tmp_path, monkeypatch):
+    monkeypatch.setenv("SYMDYN_CACHE_DIR", str(tmp_path))
+    data = __import__("yaml").safe_load(FLYER2.replace("flyer2", "flyer3"))
+    robot = symdyn.robot_from_data(data)
+    cd = symdyn.compile(robot, functions=["contacts"])
+    rng = np.random.default_rng(9)
+    quat = rng.normal(size=4)
+    q = np.r_[rng.normal(size=3), quat / np.linalg.norm(quat), rng.normal(size=1)]
+    v, tau = rng.normal(size=7), rng.normal(size=7)
+    active = np.array([1.0, 1.0, 0.0])
+    qdd, lam = cd.contact_forward_dynamics(q, v, tau, active)
+    Jc = cd.contact_jacobian(q)
+    # the oracle's M qdd + b (symdyn.rnea, friction included) equals tau + Jc^T lam
+    _close(symdyn.rnea(robot, q, v, qdd) - tau - Jc.T @ lam, np.zeros(7), "dynamics", 1e-9)
+    assert np.all(lam[6:] == 0)
+    Q, V, T = (np.tile(x, (20, 1)) for x in (q, v, tau))
+    batch = cd.contact_forward_dynamics(Q, V, T, np.tile(active, (20, 1)))
+    assert np.array_equal(batch[0][7], qdd) and np.array_equal(batch[1][3], lam)
+    qd_plus, imp = cd.impulse_dynamics(q, v, active, [0.0])
+    _close((Jc @ qd_plus + MU * imp)[:6], np.zeros(6), "impact", 1e-9)

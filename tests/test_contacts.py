@@ -137,7 +137,9 @@ def test_generate_writes_the_contact_functions(tmp_path, capsys):
     path.write_text(TWO)
     out = tmp_path / "out"
     args = ["generate", str(path), "--out", str(out), "--contacts", "tip:6d", "l1", "--functions", "contacts"]
-    assert main(args) == 0
+    assert main([*args, "--target", "c", "--target", "latex"]) == 0
     header = (out / "two_dynamics.h").read_text()
     assert "#define two_NCONTACT 2" in header and "#define two_NLAMBDA 9" in header
     assert "void two_contact_forward_dynamics(" in header and "void two_impulse_dynamics(" in header
+    tex = (out / "two_dynamics.tex").read_text()
+    assert "\\section*{Contacts}" in tex and "contact\\_jacobian" in tex and "contact\\_drift" in tex
