@@ -117,7 +117,9 @@ def _lines(label: str, total: int | None, unit: str) -> Iterator[None]:
 def _plural(unit: str, count: int) -> str:
     if count == 1:
         return unit
-    return unit[:-1] + "ies" if unit.endswith("y") else unit + "s"
+    if unit.endswith("y"):
+        return unit[:-1] + "ies"
+    return unit + "es" if unit.endswith(("s", "sh", "ch", "x")) else unit + "s"
 
 
 @contextmanager

@@ -318,3 +318,46 @@ def test_a_gpu_gives_the_cpu_values(modules):
     got = tm.inverse_dynamics(*(torch.as_tensor(a, device="cuda") for a in (q, qd, qdd)))
     assert got.device.type == "cuda"
     _close(got, nm.inverse_dynamics(q, qd, qdd), 1e-10)
+
+
+def test_contact_functions_equal_numpy(tmp_path):
+    """A robot with a contact (Roger's arm, a point at its forearm): the torch module has NCONTACT,
+    NLAMBDA and CONTACT_NAMES, and its six contact functions give the NumPy module's values, the
+    free contact's rows of lam and of the impulse exactly zero."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = load_robot(ROOT / "examples" / "roger_arm_values.yaml", contacts=["forearm:point"])
+        files = render(robot, targets=("python", "torch"), functions=("contacts", "contact_derivatives"))
+    mods = []
+    for kind in ("torch", "numpy"):
+        (tmp_path / f"rc_{kind}.py").write_text(files[f"roger_arm_values_{kind}.py"])
+        mods.append(load_module(tmp_path / f"rc_{kind}.py", f"_symdyn_test_contacts_{kind}_t"))
+    tm, nm = mods
+    assert (
+        (tm.NCONTACT, tm.NLAMBDA, tm.CONTACT_NAMES)
+        == (nm.NCONTACT, nm.NLAMBDA, nm.CONTACT_NAMES)
+        == (
+            1,
+            3,
+            ("forearm",),
+        )
+    )
+    rng = np.random.default_rng(7)
+    q, qd, tau = rng.uniform(-1.0, 1.0, (3, tm.NDOF))
+    for active in ([1.0], [0.0]):
+        cases = {
+            "contact_jacobian": (q,),
+            "contact_drift": (q, qd),
+            "contact_forward_dynamics": (q, qd, tau, active),
+            "impulse_dynamics": (q, qd, active, [0.5]),
+            "contact_forward_dynamics_derivatives": (q, qd, tau, active),
+            "impulse_dynamics_derivatives": (q, qd, active, [0.5]),
+        }
+        for name, args in cases.items():
+            got = _tuple(getattr(tm, name)(*(_tensor(a) for a in args)))
+            want = _tuple(getattr(nm, name)(*(np.asarray(a, dtype=float) for a in args)))
+            for g, w in zip(got, want, strict=True):
+                _close(g, w)
+        if not active[0]:
+            assert not tm.contact_forward_dynamics(*(_tensor(a) for a in (q, qd, tau, active)))[1].any()
+            assert not tm.impulse_dynamics(*(_tensor(a) for a in (q, qd, active, [0.5])))[1].any()
