@@ -1,0 +1,193 @@
+"""The generated C on a microcontroller: cross-compiled for ARM Cortex-M, run under QEMU.
+
+The seven functions of the PUMA 560, the Panda and Solo-12 on its floating base, in float and
+double, compiled by arm-none-eabi-gcc for the Cortex-M4F (single-precision FPU) and the
+Cortex-M7 (double-precision FPU) at -Os and -O2 with the embedded strict flags
+(tests/embedded.WARNINGS, -Werror); a float object calls no double-precision helper of libgcc
+(__aeabi_d*) and no double function of libm. A harness (tests/embedded.py) runs every function
+at 100 states under QEMU (mps2-an386, mps2-an500) and its outputs are compared with the host's
+double results from the numeric oracle symdyn.rnea (C qd with the oracle's V).
+
+Tolerances. Norm-wise, relative to the largest entry of the oracle's output (a matrix's or
+vector's), with u the unit roundoff of the precision (2^-24 for float, 2^-53 for double):
+every function but forward dynamics within 2^8 u (hundreds of roundings along the longest
+chains of the generated code, each of the size of the largest term, rarely aligned), forward
+dynamics within 2^8 u times the condition number of M at that state (the solve of M qdd = b
+amplifies the errors of M and b by up to cond(M)).
+
+What runs (about 40 s of CPU on one core, cold cache; the budget of the file is 60 s): the
+PUMA's and the Panda's whole matrix (2 cores x -Os/-O2 x float/double: 16 builds of 0.2 to
+1.5 s each), QEMU on the M4F at -Os in float and double for each robot (the double through
+the M4F's software double-precision calls, the slowest path), and the M7 at -O2 in double (its
+double-precision FPU). Solo-12's file is 430 KB of C: gcc's pre-RA instruction scheduler and
+register allocator take 30 to 64 s per build at -O2 and 17 s at -Os in double on the M4F, so
+by default it is built at -Os in float for the M4F and in double for the M7 (5 and 8 s) and
+both are run under QEMU; SYMDYN_EMBEDDED_FULL=1 builds its other six cells too.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from cbuild import write_files
+from embedded import (
+    CPUS,
+    available,
+    cross_compile,
+    link_harness,
+    output_sizes,
+    run_harness,
+    undefined_symbols,
+)
+from robots import derived
+
+import symdyn
+from symdyn.codegen import c as c_backend
+from symdyn.codegen import context
+from symdyn.codegen.c.config import MATH_CALLS
+from symdyn.codegen.functions import build_functions
+from symdyn.codegen.render import RenderContext
+from symdyn.regenerate import example_robot_data_folder
+from symdyn.rnea import bias_torque, forward_dynamics, friction_torque, gravity_torque, mass_matrix, rnea
+
+pytestmark = pytest.mark.skipif(not available(), reason="arm-none-eabi-gcc and qemu-system-arm are needed")
+
+ROBOTS = ("puma560", "panda", "solo12")
+PRECISIONS = ("float", "double")
+OPTS = ("-Os", "-O2")
+STATES = 100
+UNIT_ROUNDOFF = {"float": 2.0**-24, "double": 2.0**-53}
+#: the norm-wise error bound in units of the unit roundoff (see the module's docstring)
+ROUNDINGS = 2.0**8
+FULL = os.environ.get("SYMDYN_EMBEDDED_FULL", "") not in ("", "0")
+#: the cells run under QEMU: (robot, core, -O level, precision)
+QEMU_CELLS = [(r, "m4f", "-Os", p) for r in ("puma560", "panda") for p in PRECISIONS]
+QEMU_CELLS += [(r, "m7", "-O2", "double") for r in ("puma560", "panda")]
+QEMU_CELLS += [("solo12", "m4f", "-Os", "float"), ("solo12", "m7", "-Os", "double")]
+COMPILE_CELLS = [
+    (r, cpu, opt, p)
+    for r in ROBOTS
+    for cpu in CPUS
+    for opt in OPTS
+    for p in PRECISIONS
+    if (r, cpu, opt, p) not in QEMU_CELLS and (r != "solo12" or FULL)
+]
+
+#: libm's double-precision functions of the generated code, which a float object must not call
+DOUBLE_LIBM = set(MATH_CALLS.values()) | {"sqrt", "pow", "exp", "log", "atan2"}
+
+
+@cache
+def _robot(name: str) -> symdyn.Robot:
+    if name == "solo12":
+        folder = example_robot_data_folder()
+        if folder is None:
+            pytest.skip("example-robot-data is not installed")
+        return symdyn.load_urdf(folder / "solo_description/robots/solo12.urdf", floating=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return symdyn.load_robot(Path(__file__).resolve().parents[1] / "examples" / f"{name}.yaml")
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """robot -> precision -> the folder of its C target's files (the seven functions only)."""
+    folders: dict[str, dict[str, Path]] = {}
+
+    def get(robot: str, precision: str) -> Path:
+        if robot not in folders:
+            if robot == "solo12":
+                ctx = context(_robot(robot), functions=("dynamics",))
+            else:
+                dyn = derived(robot, "newton-euler")  # shared with the other test files
+                ctx = RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, ("dynamics",))), "double")
+            folders[robot] = {}
+            for p in PRECISIONS:
+                folder = tmp_path_factory.mktemp(f"{robot}-{p}")
+                ctx_p = RenderContext(ctx.robot, ctx.dynamics, ctx.functions, p)
+                write_files(c_backend.render(ctx_p), folder)
+                folders[robot][p] = folder
+        return folders[robot][precision]
+
+    return get
+
+
+def _check_object(objects, precision: str) -> None:
+    """A float object calls no double helper of libgcc and no double function of libm."""
+    undefined = undefined_symbols(objects)
+    if precision == "float":
+        assert not {s for s in undefined if s.startswith("__aeabi_d")}, undefined
+        assert not undefined & DOUBLE_LIBM, undefined
+
+
+@pytest.mark.parametrize("robot,cpu,opt,precision", COMPILE_CELLS)
+def test_cross_compiles(rendered, tmp_path, robot, cpu, opt, precision):
+    """Warning-free with the embedded strict flags; no double arithmetic in a float object."""
+    objects = cross_compile(rendered(robot, precision), cpu, opt, tmp_path)
+    _check_object(objects, precision)
+
+
+def _states(robot: symdyn.Robot, rng: np.random.Generator) -> np.ndarray:
+    """STATES rows of (q, qd, qdd, tau): angles over a full turn, a floating base's position
+    within 1 m and its orientation a random unit quaternion, rates and efforts of order one."""
+    k = STATES
+    q = rng.uniform(-np.pi, np.pi, (k, robot.n))
+    if robot.floating:
+        quat = rng.normal(size=(k, 4))
+        q = np.hstack([rng.uniform(-1, 1, (k, 3)), quat / np.linalg.norm(quat, axis=1, keepdims=True), q])
+    return np.hstack([q, rng.uniform(-2, 2, (k, 3 * robot.nv))])
+
+
+def _oracle(robot: symdyn.Robot, states: np.ndarray) -> dict[str, np.ndarray]:
+    """The host's double results: each function's output at each state, and cond(M)."""
+    nq, nv = robot.nq, robot.nv
+    q, qd, qdd, tau = np.split(states, [nq, nq + nv, nq + 2 * nv], axis=1)
+    m = mass_matrix(robot, q)
+    return {
+        "inverse_dynamics": rnea(robot, q, qd, qdd),
+        "mass_matrix": m.reshape(len(q), -1),
+        "coriolis": bias_torque(robot, q, qd),
+        "gravity": gravity_torque(robot, q),
+        "friction": friction_torque(robot, qd),
+        "forward_dynamics": forward_dynamics(robot, q, qd, tau),
+        "cond": np.linalg.cond(m),
+        "qd": qd,
+    }
+
+
+@pytest.mark.parametrize("robot,cpu,opt,precision", QEMU_CELLS)
+def test_runs_under_qemu(rendered, tmp_path, robot, cpu, opt, precision):
+    """Every function at 100 states on the emulated core, within the stated tolerances of the
+    host's double results (see the module's docstring)."""
+    r = _robot(robot)
+    folder = rendered(robot, precision)
+    objects = cross_compile(folder, cpu, opt, tmp_path)
+    _check_object(objects, precision)
+    name = next(folder.glob("*_dynamics.h")).name.removesuffix("_dynamics.h")
+    elf = link_harness(folder, objects, cpu, name, precision, r.nq, r.nv, tmp_path)
+    states = _states(r, np.random.default_rng(38))
+    got = run_harness(elf, cpu, states, precision, r.nv)
+    want = _oracle(r, states)
+    sizes = output_sizes(r.nv)
+    offsets = np.cumsum([0, *sizes.values()])
+    out = {f: got[:, a:b] for f, a, b in zip(sizes, offsets[:-1], offsets[1:], strict=True)}
+    # C is not unique: its product with qd is V
+    out["coriolis_matrix"] = np.einsum(
+        "kij,kj->ki", out["coriolis_matrix"].reshape(-1, r.nv, r.nv), want["qd"]
+    )
+    want["coriolis_matrix"] = want["coriolis"]
+    bound = ROUNDINGS * UNIT_ROUNDOFF[precision]
+    for f in sizes:
+        scale = np.max(np.abs(want[f]), axis=1)
+        error = np.max(np.abs(out[f] - want[f]), axis=1) / np.where(scale > 0, scale, 1.0)
+        allowed = bound * (want["cond"] if f == "forward_dynamics" else 1.0)
+        worst = int(np.argmax(error / allowed))
+        assert np.all(error <= allowed), (
+            f"{robot} {cpu} {opt} {precision} {f}: relative error {error[worst]:.3g} at state {worst} "
+            f"(allowed {np.broadcast_to(allowed, error.shape)[worst]:.3g})"
+        )
