@@ -43,6 +43,7 @@ __all__ = [
     "cross_compile",
     "undefined_symbols",
     "link_harness",
+    "link_bare",
     "run_harness",
     "harness_source",
     "output_sizes",
@@ -289,6 +290,14 @@ def link_harness(
             str(elf),
         ]
     )
+    return elf
+
+
+def link_bare(objects: Sequence[Path], cpu: str, entry: str, out_dir: str | os.PathLike) -> Path:
+    """The objects linked alone with -nostdlib (no C library, no libgcc, no start-up files),
+    `entry` as the entry point: fails on any symbol they need from elsewhere."""
+    elf = Path(out_dir) / "bare.elf"
+    _run([CC, *CPUS[cpu][1], "-nostdlib", f"-Wl,-e,{entry}", *map(str, objects), "-o", str(elf)])
     return elf
 
 

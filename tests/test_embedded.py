@@ -27,7 +27,9 @@ both are run under QEMU; SYMDYN_EMBEDDED_FULL=1 builds its other six cells too.
 
 from __future__ import annotations
 
+import dataclasses
 import os
+import subprocess
 import warnings
 from functools import cache
 from pathlib import Path
@@ -39,12 +41,14 @@ from embedded import (
     CPUS,
     available,
     cross_compile,
+    link_bare,
     link_harness,
     output_sizes,
     run_harness,
     undefined_symbols,
 )
 from robots import derived
+from timebound import refused
 
 import symdyn
 from symdyn.codegen import c as c_backend
@@ -96,23 +100,24 @@ def _robot(name: str) -> symdyn.Robot:
 
 @pytest.fixture(scope="module")
 def rendered(tmp_path_factory):
-    """robot -> precision -> the folder of its C target's files (the seven functions only)."""
-    folders: dict[str, dict[str, Path]] = {}
+    """(robot, precision, freestanding) -> the folder of its C target's files (the seven
+    functions only), each robot derived once."""
+    contexts: dict[str, RenderContext] = {}
+    folders: dict[tuple[str, str, bool], Path] = {}
 
-    def get(robot: str, precision: str) -> Path:
-        if robot not in folders:
+    def get(robot: str, precision: str, freestanding: bool = False) -> Path:
+        if robot not in contexts:
             if robot == "solo12":
-                ctx = context(_robot(robot), functions=("dynamics",))
+                contexts[robot] = context(_robot(robot), functions=("dynamics",))
             else:
                 dyn = derived(robot, "newton-euler")  # shared with the other test files
-                ctx = RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, ("dynamics",))), "double")
-            folders[robot] = {}
-            for p in PRECISIONS:
-                folder = tmp_path_factory.mktemp(f"{robot}-{p}")
-                ctx_p = RenderContext(ctx.robot, ctx.dynamics, ctx.functions, p)
-                write_files(c_backend.render(ctx_p), folder)
-                folders[robot][p] = folder
-        return folders[robot][precision]
+                contexts[robot] = RenderContext(dyn.robot, dyn, tuple(build_functions(dyn, ("dynamics",))))
+        key = (robot, precision, freestanding)
+        if key not in folders:
+            ctx = dataclasses.replace(contexts[robot], precision=precision, freestanding=freestanding)
+            folders[key] = tmp_path_factory.mktemp(f"{robot}-{precision}{'-free' * freestanding}")
+            write_files(c_backend.render(ctx), folders[key])
+        return folders[key]
 
     return get
 
@@ -160,16 +165,14 @@ def _oracle(robot: symdyn.Robot, states: np.ndarray) -> dict[str, np.ndarray]:
     }
 
 
-@pytest.mark.parametrize("robot,cpu,opt,precision", QEMU_CELLS)
-def test_runs_under_qemu(rendered, tmp_path, robot, cpu, opt, precision):
-    """Every function at 100 states on the emulated core, within the stated tolerances of the
-    host's double results (see the module's docstring)."""
+def _compare(folder: Path, build: Path, robot: str, cpu: str, opt: str, precision: str) -> None:
+    """Every function of the C in `folder` at 100 states on the emulated core, within the stated
+    tolerances of the host's double results (see the module's docstring)."""
     r = _robot(robot)
-    folder = rendered(robot, precision)
-    objects = cross_compile(folder, cpu, opt, tmp_path)
+    objects = cross_compile(folder, cpu, opt, build)
     _check_object(objects, precision)
     name = next(folder.glob("*_dynamics.h")).name.removesuffix("_dynamics.h")
-    elf = link_harness(folder, objects, cpu, name, precision, r.nq, r.nv, tmp_path)
+    elf = link_harness(folder, objects, cpu, name, precision, r.nq, r.nv, build)
     states = _states(r, np.random.default_rng(38))
     got = run_harness(elf, cpu, states, precision, r.nv)
     want = _oracle(r, states)
@@ -177,9 +180,8 @@ def test_runs_under_qemu(rendered, tmp_path, robot, cpu, opt, precision):
     offsets = np.cumsum([0, *sizes.values()])
     out = {f: got[:, a:b] for f, a, b in zip(sizes, offsets[:-1], offsets[1:], strict=True)}
     # C is not unique: its product with qd is V
-    out["coriolis_matrix"] = np.einsum(
-        "kij,kj->ki", out["coriolis_matrix"].reshape(-1, r.nv, r.nv), want["qd"]
-    )
+    c = out["coriolis_matrix"].reshape(-1, r.nv, r.nv)
+    out["coriolis_matrix"] = np.einsum("kij,kj->ki", c, want["qd"])
     want["coriolis_matrix"] = want["coriolis"]
     bound = ROUNDINGS * UNIT_ROUNDOFF[precision]
     for f in sizes:
@@ -191,3 +193,112 @@ def test_runs_under_qemu(rendered, tmp_path, robot, cpu, opt, precision):
             f"{robot} {cpu} {opt} {precision} {f}: relative error {error[worst]:.3g} at state {worst} "
             f"(allowed {np.broadcast_to(allowed, error.shape)[worst]:.3g})"
         )
+
+
+@pytest.mark.parametrize("robot,cpu,opt,precision", QEMU_CELLS)
+def test_runs_under_qemu(rendered, tmp_path, robot, cpu, opt, precision):
+    """Every function at 100 states on the emulated core, within the stated tolerances of the
+    host's double results (see the module's docstring)."""
+    _compare(rendered(robot, precision), tmp_path, robot, cpu, opt, precision)
+
+
+# --------------------------------------------------------------------------- --freestanding
+
+
+@pytest.mark.parametrize("precision", PRECISIONS)
+def test_freestanding_runs_under_qemu(rendered, tmp_path, precision):
+    """--freestanding: no header of the C library in the files, and the same tolerances on the
+    M4F (the float file with symdyn's own sinf and cosf, the double one with its own sin and cos)."""
+    folder = rendered("puma560", precision, True)
+    for path in folder.iterdir():
+        text = path.read_text()
+        assert "#include <" not in text, path.name
+    assert "its own" in (folder / "puma560_dynamics.h").read_text()
+    _compare(folder, tmp_path, "puma560", "m4f", "-Os", precision)
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_freestanding_float_needs_nothing(rendered, tmp_path, robot):
+    """A freestanding float object has no undefined symbol (no libm, no libgcc, no memset for the
+    zeros of a floating base's M), so it links with -nostdlib."""
+    objects = cross_compile(rendered(robot, "float", True), "m4f", "-Os", tmp_path)
+    assert undefined_symbols(objects) == set()
+    name = next(rendered(robot, "float", True).glob("*_dynamics.h")).name.removesuffix("_dynamics.h")
+    link_bare(objects, "m4f", f"{name}_inverse_dynamics", tmp_path)
+
+
+SWEEP = r"""
+#include <math.h>
+#include <stdio.h>
+#include "puma560_dynamics.c"
+/* max |error| of puma560_sincos over 2^20 floats evenly in [-8, 8] and 2^20 pseudo-random floats
+   in [-8192, 8192], against the double sine and cosine of the same float */
+int main(void)
+{
+    static float x[1024], s[1024], c[1024];
+    double worst = 0.0;
+    unsigned long long state = 38;
+    long i;
+    int k;
+    for (i = 0; i < 2048; ++i) {
+        for (k = 0; k < 1024; ++k) {
+            state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+            x[k] = i < 1024 ? (float)(-8.0 + 16.0 * (double)(i * 1024 + k) / 1048576.0)
+                            : (float)((double)(state >> 11) / 9007199254740992.0 * 16384.0 - 8192.0);
+        }
+        puma560_sincos(1024, x, s, c);
+        for (k = 0; k < 1024; ++k) {
+            double es = fabs((double)s[k] - sin((double)x[k])), ec = fabs((double)c[k] - cos((double)x[k]));
+            worst = es > worst ? es : worst;
+            worst = ec > worst ? ec : worst;
+        }
+    }
+    printf("%.17g\n", worst);
+    return 0;
+}
+"""
+
+
+def test_freestanding_sincos_error_bound(rendered, tmp_path):
+    """The float sine and cosine of a freestanding file keep the bound its header states
+    (symdyn.codegen.c.sincos.FREESTANDING_ERROR: 1e-7 absolute for |x| <= 8192), on the host's
+    IEEE single precision (the M4F's FPU rounds the same way)."""
+    folder = rendered("puma560", "float", True)
+    (tmp_path / "sweep.c").write_text(SWEEP)
+    exe = tmp_path / "sweep"
+    cmd = [
+        "gcc",
+        "-std=c99",
+        "-O2",
+        "-ffp-contract=off",
+        f"-I{folder}",
+        str(tmp_path / "sweep.c"),
+        "-o",
+        str(exe),
+    ]
+    subprocess.run([*cmd, "-lm"], check=True, capture_output=True)
+    worst = float(subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout)
+    assert 0 < worst <= 1e-7
+
+
+def test_freestanding_refused_where_it_cannot_hold(capsys, tmp_path):
+    """--freestanding without the C target, or with a function that needs more of <math.h> than
+    sine and cosine (a floating robot's configuration group: sqrt, atan2), is one line of error
+    and no file."""
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    line = refused(
+        capsys,
+        "generate",
+        examples / "roger_arm.yaml",
+        "--target",
+        "casadi",
+        "--freestanding",
+        "--out",
+        tmp_path / "a",
+    )
+    assert "option of the C target" in line
+    arm = Path(__file__).parent / "data" / "floating_arm.yaml"
+    args = ("--target", "c", "--functions", "configuration", "--freestanding", "--out", tmp_path / "b")
+    line = refused(capsys, "generate", arm, *args, seconds=60)
+    assert "--freestanding" in line and "sqrt" in line
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()

@@ -25,7 +25,7 @@ from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .printer import CPrinter
-from .sincos import BLOCK, gather
+from .sincos import BLOCK, FREESTANDING_ERROR, gather
 
 __all__ = ["render", "render_context", "symbol_names", "function_inputs", "TOOLS"]
 
@@ -53,20 +53,23 @@ def _sincos_view(
     function's k-th angle a (symdyn.codegen.c.sincos): entry k of the arrays NAME_sincos fills
     when the compiler targets AVX2, else sin(a) and cos(a) (templates/c/sincos.c.j2). The
     angles are printed with the C library's calls (an angle may itself hold a sine) and padded
-    with zeros to the arrays' size. Under --precision float every call stays sinf or cosf.
+    with zeros to the arrays' size. Under --precision float every call stays sinf or cosf, unless
+    the file is freestanding: then, in either precision, the arrays are always filled by
+    NAME_sincos, symdyn's own (templates/c/sincos.c.j2), and no other call of the C library may
+    appear (symdyn.codegen.c.config.CConfig.math).
     """
-    plain = CPrinter(symbol_names, ctx.precision)
-    if ctx.precision != "double":
+    plain = CPrinter(symbol_names, ctx.precision, freestanding=ctx.freestanding)
+    if ctx.precision != "double" and not ctx.freestanding:
         return plain, list(spec.temporaries), None
     trig = gather(spec.temporaries, spec.outputs)
     temporaries = [(s, e) for s, e in spec.temporaries if s in trig.live]
     angles = [plain.doprint(a) for a in trig.angles]
     macros = (names.sincos["sin"], names.sincos["cos"])
     calls = {call: f"{macros[which]}({k}, {angles[k]})" for call, (which, k) in trig.calls.items()}
-    printer = CPrinter(symbol_names, ctx.precision, calls)
+    printer = CPrinter(symbol_names, ctx.precision, calls, ctx.freestanding)
     if not angles:
         return printer, temporaries, None
-    padding = ["0.0"] * (trig.size - len(angles))
+    padding = [CPrinter({}, ctx.precision).literal(0.0)] * (trig.size - len(angles))
     return printer, temporaries, {"count": len(angles), "size": trig.size, "angles": angles + padding}
 
 
@@ -221,6 +224,8 @@ def render_context(ctx: RenderContext) -> dict:
         "column_sizes": _column_sizes(ctx, names),
         "frames": [(comment_text(name), ident, link) for name, ident, link in ctx.frames],
         "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
+        "freestanding": ctx.freestanding,
+        "sincos_error": FREESTANDING_ERROR[ctx.precision],
         "loops": _loops_view(ctx, names),
     }
 
@@ -231,6 +236,11 @@ def _loops_view(ctx: RenderContext, names: CNames) -> dict | None:
     view = loop_solve_context(ctx)
     if view is None:
         return None
+    if ctx.freestanding:
+        raise SymdynError(
+            f"robot '{ctx.name}': --freestanding: the solver of its closed loops needs the C library's "
+            "<math.h> (fabs, isnan, isfinite); generate it without --freestanding"
+        )
     suffix = CConfig(ctx.precision).literal_suffix
     return {
         **view,
