@@ -47,6 +47,9 @@ __all__ = [
     "run_harness",
     "harness_source",
     "output_sizes",
+    "random_states",
+    "host_results",
+    "relative_errors",
 ]
 
 CC, NM, QEMU = "arm-none-eabi-gcc", "arm-none-eabi-nm", "qemu-system-arm"
@@ -317,3 +320,51 @@ def run_harness(
     if out.size != len(states) * width:
         raise RuntimeError(f"{elf}: {out.size} values written, {len(states) * width} expected")
     return out.reshape(len(states), width).astype(np.float64)
+
+
+def random_states(robot, k: int, seed: int = 38) -> np.ndarray:
+    """k rows of (q, qd, qdd, tau): angles over a full turn, a floating base's position within 1 m
+    and its orientation a random unit quaternion, rates and efforts in [-2, 2]."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-np.pi, np.pi, (k, robot.n))
+    if robot.floating:
+        quat = rng.normal(size=(k, 4))
+        q = np.hstack([rng.uniform(-1, 1, (k, 3)), quat / np.linalg.norm(quat, axis=1, keepdims=True), q])
+    return np.hstack([q, rng.uniform(-2, 2, (k, 3 * robot.nv))])
+
+
+def host_results(robot, states: np.ndarray) -> dict[str, np.ndarray]:
+    """The host's double results of the numeric oracle symdyn.rnea: each function's output at each
+    state (for C, V: the harness's C is compared through C qd), and cond(M) ("cond")."""
+    from symdyn.rnea import bias_torque, forward_dynamics, friction_torque, gravity_torque, mass_matrix, rnea
+
+    nq, nv = robot.nq, robot.nv
+    q, qd, qdd, tau = np.split(states, [nq, nq + nv, nq + 2 * nv], axis=1)
+    m = mass_matrix(robot, q)
+    v = bias_torque(robot, q, qd)
+    return {
+        "inverse_dynamics": rnea(robot, q, qd, qdd),
+        "mass_matrix": m.reshape(len(q), -1),
+        "coriolis_matrix": v,
+        "coriolis": v,
+        "gravity": gravity_torque(robot, q),
+        "friction": friction_torque(robot, qd),
+        "forward_dynamics": forward_dynamics(robot, q, qd, tau),
+        "cond": np.linalg.cond(m),
+    }
+
+
+def relative_errors(robot, states: np.ndarray, got: np.ndarray, want: dict) -> dict[str, np.ndarray]:
+    """function -> each state's largest error over the largest entry of the host's result (C
+    through C qd against V)."""
+    nv = robot.nv
+    sizes = output_sizes(nv)
+    offsets = np.cumsum([0, *sizes.values()])
+    out = {f: got[:, a:b] for f, a, b in zip(sizes, offsets[:-1], offsets[1:], strict=True)}
+    qd = states[:, robot.nq : robot.nq + nv]
+    out["coriolis_matrix"] = np.einsum("kij,kj->ki", out["coriolis_matrix"].reshape(-1, nv, nv), qd)
+    errors = {}
+    for f in sizes:
+        scale = np.max(np.abs(want[f]), axis=1)
+        errors[f] = np.max(np.abs(out[f] - want[f]), axis=1) / np.where(scale > 0, scale, 1.0)
+    return errors

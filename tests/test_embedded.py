@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import shutil
 import subprocess
 import warnings
 from functools import cache
@@ -36,14 +37,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cbuild import write_files
+from cbuild import STRICT_FLAGS, write_files
 from embedded import (
     CPUS,
     available,
     cross_compile,
+    host_results,
     link_bare,
     link_harness,
-    output_sizes,
+    random_states,
+    relative_errors,
     run_harness,
     undefined_symbols,
 )
@@ -57,7 +60,7 @@ from symdyn.codegen.c.config import MATH_CALLS
 from symdyn.codegen.functions import build_functions
 from symdyn.codegen.render import RenderContext
 from symdyn.regenerate import example_robot_data_folder
-from symdyn.rnea import bias_torque, forward_dynamics, friction_torque, gravity_torque, mass_matrix, rnea
+from symdyn.rnea import mass_matrix
 
 pytestmark = pytest.mark.skipif(not available(), reason="arm-none-eabi-gcc and qemu-system-arm are needed")
 
@@ -86,6 +89,12 @@ COMPILE_CELLS = [
 DOUBLE_LIBM = set(MATH_CALLS.values()) | {"sqrt", "pow", "exp", "log", "atan2"}
 
 
+def _robot_file(name: str) -> symdyn.Robot:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return symdyn.load_robot(Path(__file__).resolve().parents[1] / "examples" / f"{name}.yaml")
+
+
 @cache
 def _robot(name: str) -> symdyn.Robot:
     if name == "solo12":
@@ -93,9 +102,7 @@ def _robot(name: str) -> symdyn.Robot:
         if folder is None:
             pytest.skip("example-robot-data is not installed")
         return symdyn.load_urdf(folder / "solo_description/robots/solo12.urdf", floating=True)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return symdyn.load_robot(Path(__file__).resolve().parents[1] / "examples" / f"{name}.yaml")
+    return _robot_file(name)
 
 
 @pytest.fixture(scope="module")
@@ -137,34 +144,6 @@ def test_cross_compiles(rendered, tmp_path, robot, cpu, opt, precision):
     _check_object(objects, precision)
 
 
-def _states(robot: symdyn.Robot, rng: np.random.Generator) -> np.ndarray:
-    """STATES rows of (q, qd, qdd, tau): angles over a full turn, a floating base's position
-    within 1 m and its orientation a random unit quaternion, rates and efforts of order one."""
-    k = STATES
-    q = rng.uniform(-np.pi, np.pi, (k, robot.n))
-    if robot.floating:
-        quat = rng.normal(size=(k, 4))
-        q = np.hstack([rng.uniform(-1, 1, (k, 3)), quat / np.linalg.norm(quat, axis=1, keepdims=True), q])
-    return np.hstack([q, rng.uniform(-2, 2, (k, 3 * robot.nv))])
-
-
-def _oracle(robot: symdyn.Robot, states: np.ndarray) -> dict[str, np.ndarray]:
-    """The host's double results: each function's output at each state, and cond(M)."""
-    nq, nv = robot.nq, robot.nv
-    q, qd, qdd, tau = np.split(states, [nq, nq + nv, nq + 2 * nv], axis=1)
-    m = mass_matrix(robot, q)
-    return {
-        "inverse_dynamics": rnea(robot, q, qd, qdd),
-        "mass_matrix": m.reshape(len(q), -1),
-        "coriolis": bias_torque(robot, q, qd),
-        "gravity": gravity_torque(robot, q),
-        "friction": friction_torque(robot, qd),
-        "forward_dynamics": forward_dynamics(robot, q, qd, tau),
-        "cond": np.linalg.cond(m),
-        "qd": qd,
-    }
-
-
 def _compare(folder: Path, build: Path, robot: str, cpu: str, opt: str, precision: str) -> None:
     """Every function of the C in `folder` at 100 states on the emulated core, within the stated
     tolerances of the host's double results (see the module's docstring)."""
@@ -173,20 +152,11 @@ def _compare(folder: Path, build: Path, robot: str, cpu: str, opt: str, precisio
     _check_object(objects, precision)
     name = next(folder.glob("*_dynamics.h")).name.removesuffix("_dynamics.h")
     elf = link_harness(folder, objects, cpu, name, precision, r.nq, r.nv, build)
-    states = _states(r, np.random.default_rng(38))
+    states = random_states(r, STATES)
     got = run_harness(elf, cpu, states, precision, r.nv)
-    want = _oracle(r, states)
-    sizes = output_sizes(r.nv)
-    offsets = np.cumsum([0, *sizes.values()])
-    out = {f: got[:, a:b] for f, a, b in zip(sizes, offsets[:-1], offsets[1:], strict=True)}
-    # C is not unique: its product with qd is V
-    c = out["coriolis_matrix"].reshape(-1, r.nv, r.nv)
-    out["coriolis_matrix"] = np.einsum("kij,kj->ki", c, want["qd"])
-    want["coriolis_matrix"] = want["coriolis"]
+    want = host_results(r, states)
     bound = ROUNDINGS * UNIT_ROUNDOFF[precision]
-    for f in sizes:
-        scale = np.max(np.abs(want[f]), axis=1)
-        error = np.max(np.abs(out[f] - want[f]), axis=1) / np.where(scale > 0, scale, 1.0)
+    for f, error in relative_errors(r, states, got, want).items():
         allowed = bound * (want["cond"] if f == "forward_dynamics" else 1.0)
         worst = int(np.argmax(error / allowed))
         assert np.all(error <= allowed), (
@@ -302,3 +272,43 @@ def test_freestanding_refused_where_it_cannot_hold(capsys, tmp_path):
     line = refused(capsys, "generate", arm, *args, seconds=60)
     assert "--freestanding" in line and "sqrt" in line
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+# --------------------------------------------------------------------------- CMakeLists.txt
+
+APP = r"""
+#include <stdio.h>
+#include "roger_arm_values_dynamics.h"
+int main(void)
+{
+    const float q[2] = {0.3f, -0.7f};
+    float M[4];
+    roger_arm_values_mass_matrix(q, NULL, M);
+    printf("%.9g %.9g %.9g %.9g\n", (double)M[0], (double)M[1], (double)M[2], (double)M[3]);
+    return 0;
+}
+"""
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="cmake is not installed")
+def test_cmake_builds_the_library(tmp_path):
+    """The C target's CMakeLists.txt, added to a parent project with add_subdirectory, builds a static
+    library (host gcc, the strict flags) that a program links; its M is the oracle's. Asking for
+    the other precision stops the configuration with the command that regenerates the files."""
+    robot = _robot_file("roger_arm_values")
+    symdyn.generate(robot, targets=("c",), out_dir=tmp_path / "dyn", precision="float")
+    (tmp_path / "main.c").write_text(APP)
+    (tmp_path / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.13)\nproject(app C)\nadd_subdirectory(dyn)\n"
+        "add_executable(app main.c)\ntarget_link_libraries(app PRIVATE roger_arm_values_dynamics)\n"
+    )
+    flags = "-DCMAKE_C_FLAGS=" + " ".join(STRICT_FLAGS[1:])
+    configure = ["cmake", "-S", str(tmp_path), "-B", str(tmp_path / "build"), flags]
+    subprocess.run(configure, check=True, capture_output=True)
+    subprocess.run(["cmake", "--build", str(tmp_path / "build")], check=True, capture_output=True)
+    out = subprocess.run([str(tmp_path / "build" / "app")], check=True, capture_output=True, text=True)
+    got = np.array(out.stdout.split(), dtype=float)
+    np.testing.assert_allclose(got, mass_matrix(robot, [0.3, -0.7]).ravel(), rtol=1e-6)
+    wrong = ["cmake", "-S", str(tmp_path), "-B", str(tmp_path / "b2"), "-Droger_arm_values_PRECISION=double"]
+    proc = subprocess.run(wrong, capture_output=True, text=True)
+    assert proc.returncode != 0 and "--precision double" in proc.stderr.replace("\n", " ")

@@ -1,4 +1,5 @@
-"""The C target: NAME_dynamics.h and NAME_dynamics.c (C99, no allocation, libm only).
+"""The C target: NAME_dynamics.h and NAME_dynamics.c (C99, no allocation, libm only), and a
+CMakeLists.txt building them as a static library.
 
 The contract is docs/generated-code.md. Each of the seven functions
 (symdyn.codegen.functions) becomes straight-line code: the inputs it reads are
@@ -40,8 +41,12 @@ ACTUATED_INPUTS = ("qda", "qdda", "tau_a")
 #: and one store per zero costs more
 FILL_ZEROS = 16
 
-#: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
-TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
+#: The tools each file's bytes depend on besides symdyn (SymPy builds every expression; the
+#: CMakeLists.txt header carries the operation counts).
+TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",), "CMakeLists.txt": ("sympy",)}
+
+#: the build file written beside the C files (templates/c/CMakeLists.txt.j2)
+CMAKE_FILE = "CMakeLists.txt"
 
 
 def _sincos_view(
@@ -274,10 +279,14 @@ def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
-    """NAME_dynamics.h and NAME_dynamics.c for the robot of `ctx`."""
+    """NAME_dynamics.h, NAME_dynamics.c and CMakeLists.txt (a static library of every .c file
+    written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`."""
     values = render_context(ctx)
     env = environment()
-    return {
+    files = {
         values["header_file"]: env.get_template("c/dynamics.h.j2").render(values),
         values["source_file"]: env.get_template("c/dynamics.c.j2").render(values),
     }
+    sources = sorted(name for name in files if name.endswith(".c"))
+    files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render({**values, "sources": sources})
+    return files
