@@ -324,6 +324,7 @@ def test_concurrent_generate_runs_leave_one_robots_files(tmp_path):
     assert [run.exitcode for run in runs] == [0] * len(runs)
     written = sorted(out.iterdir())
     assert [p.name for p in written] == [
+        "CMakeLists.txt",
         "roger_arm_values_dynamics.c",
         "roger_arm_values_dynamics.h",
         "roger_arm_values_numpy.py",

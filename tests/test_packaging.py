@@ -66,7 +66,7 @@ def test_installed_wheel_generates_code_outside_the_source_tree(wheel, tmp_path)
         [sys.executable, "-c", script], cwd=work, env=env, capture_output=True, text=True, timeout=300
     )
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "4"
+    assert out.stdout.strip() == "5"  # .h, .c, CMakeLists.txt, NumPy, LaTeX
     assert (work / "out" / "roger_arm_dynamics.c").read_text().startswith("/*")
 
 

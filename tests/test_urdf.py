@@ -861,7 +861,7 @@ def test_hostile_xml_is_refused(tmp_path):
 def test_generated_c_of_a_urdf_robot(tmp_path, rng):
     robot = load("branch.urdf", tip="l2")
     files = symdyn.codegen.render(robot, targets=("c",))
-    assert set(files) == {"branch_dynamics.h", "branch_dynamics.c"}
+    assert set(files) == {"branch_dynamics.h", "branch_dynamics.c", "CMakeLists.txt"}
     assert "branch.urdf (sha256 " + robot.source_sha256 in files["branch_dynamics.c"]
     lib = build_dynamics(files, tmp_path, "branch")
     for _ in range(3):
@@ -1084,7 +1084,7 @@ def test_real_robot_derivation_matches_rnea(name, rng):
 def test_real_robot_generated_c_matches_rnea(name, tmp_path, rng):
     robot, ctx = real(name), real_context(name)
     files = c_target.render(ctx)
-    assert set(files) == {f"{robot.name}_dynamics.h", f"{robot.name}_dynamics.c"}
+    assert set(files) == {f"{robot.name}_dynamics.h", f"{robot.name}_dynamics.c", "CMakeLists.txt"}
     assert f"void {robot.name}_inverse_dynamics(" in files[f"{robot.name}_dynamics.h"]
     lib = build_dynamics(files, tmp_path, robot.name)
     for _ in range(3):

@@ -183,6 +183,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         functions=args.functions,
         frames=args.frames,
         task_axes=args.task_axes,
+        freestanding=args.freestanding,
     )
     for p in paths:
         print(p)
@@ -254,6 +255,12 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--out", required=True, help="output folder")
     g.add_argument("--precision", choices=("double", "float"), default="double")
+    g.add_argument(
+        "--freestanding",
+        action="store_true",
+        help="C target: no C library (no <math.h>; symdyn's own sine and cosine), for bare-metal builds "
+        "linked with -nostdlib (docs/embedded.md)",
+    )
     g.add_argument("--method", choices=METHODS, default="newton-euler")
     g.add_argument(
         "--functions",

@@ -70,13 +70,15 @@ def context(
     functions: Sequence[str] | None = None,
     frames: Sequence[str] | str | None = None,
     task_axes: Sequence[str] | str | None = None,
+    freestanding: bool = False,
 ) -> RenderContext:
     """Derive the robot and build the target-independent function specs (from the pruned
     configuration-space form when `prune` is given, symdyn.codegen.pruned; only the groups of
     symdyn.codegen.functions.GROUPS named in `functions`, when given; None: every group but the
     frame groups; "all": every group). The frame groups (kinematics, operational_space) are built
     for `frames` (names or "F1,F2"; None: the default frames) and `task_axes`
-    (symdyn.codegen.frame_functions.choose_frames), which are checked before anything is derived."""
+    (symdyn.codegen.frame_functions.choose_frames), which are checked before anything is derived.
+    `freestanding`: the C target without the C library (RenderContext.freestanding)."""
     if precision not in PRECISIONS:
         raise SymdynError(f"unknown precision '{precision}' (double or float)")
     if not is_c_identifier(robot.name):
@@ -112,7 +114,8 @@ def context(
 
         dyn, notes = pruned_dynamics(dyn, prune)
     specs = tuple(build_functions(dyn, groups, choice))
-    return RenderContext(dyn.robot, dyn, specs, precision, notes, choice.frames if choice else ())
+    frame_names = choice.frames if choice else ()
+    return RenderContext(dyn.robot, dyn, specs, precision, notes, frame_names, freestanding)
 
 
 def _groups(functions: Sequence[str] | None) -> Sequence[str] | None:
@@ -139,10 +142,13 @@ def render(
     functions: Sequence[str] | None = None,
     frames: Sequence[str] | str | None = None,
     task_axes: Sequence[str] | str | None = None,
+    freestanding: bool = False,
 ) -> dict[str, str | bytes]:
     """All files of the requested targets, in memory (name -> content)."""
     modules = [_target_module(t) for t in dict.fromkeys(targets)]
-    ctx = context(robot, precision, method, prune, functions, frames, task_axes)
+    if freestanding and "c" not in targets:
+        raise SymdynError("--freestanding is an option of the C target: add --target c")
+    ctx = context(robot, precision, method, prune, functions, frames, task_axes, freestanding)
     files: dict[str, str | bytes] = {}
     for target, module in zip(dict.fromkeys(targets), modules, strict=True):
         with progress_stage(f"rendering {target} ({len(ctx.functions)} functions)"):
@@ -161,6 +167,7 @@ def generate(
     functions: Sequence[str] = ("dynamics",),
     frames: Sequence[str] | str | None = None,
     task_axes: Sequence[str] | str | None = None,
+    freestanding: bool = False,
 ) -> list[Path]:
     """Render the targets for `robot` (a Robot, a robot file or a URDF file) into out_dir.
 
@@ -170,12 +177,13 @@ def generate(
     and the frame groups kinematics and operational_space). The frame groups are built for
     `frames` (frame names, or "F1,F2"; None: every leaf link and every frame of Robot.frames) and,
     for operational_space, the rows `task_axes` ("x,y,z"; None: all six), docs/generated-code.md.
-    `prune`: from the significance-pruned model, symdyn.codegen.pruned.
+    `prune`: from the significance-pruned model, symdyn.codegen.pruned. `freestanding`: the C
+    target without the C library (no <math.h>; symdyn's own sines and cosines; docs/embedded.md).
     """
     check_folder(out_dir)  # before the work: '', a file, a path through a missing folder
     if not isinstance(robot, Robot):
         from ..parsers import load
 
         robot = load(robot)
-    files = render(robot, targets, precision, method, prune, functions, frames, task_axes)
+    files = render(robot, targets, precision, method, prune, functions, frames, task_axes, freestanding)
     return write_files(out_dir, files, force=force)

@@ -47,6 +47,9 @@ class RenderContext:
     notes: tuple[str, ...] = ()
     #: (name, identifier, link) of each frame of the frame functions (symdyn.codegen.frame_functions)
     frames: tuple[tuple[str, str, str], ...] = ()
+    #: the C target without the C library (--freestanding, docs/embedded.md): no <math.h>,
+    #: symdyn's own sines and cosines (templates/c/sincos.c.j2); the other targets ignore it
+    freestanding: bool = False
 
     @property
     def name(self) -> str:

@@ -60,9 +60,11 @@ TEMPORARY = re.compile(r"x[0-9]+\Z")
 
 @dataclass(frozen=True)
 class CConfig:
-    """What the generated C depends on besides the robot: the floating type ("double" or "float")."""
+    """What the generated C depends on besides the robot: the floating type ("double" or "float"),
+    and whether it may use the C library (`freestanding`: no <math.h>, docs/embedded.md)."""
 
     precision: str = "double"
+    freestanding: bool = False
 
     def __post_init__(self) -> None:
         if self.precision not in PRECISIONS:
@@ -79,7 +81,15 @@ class CConfig:
         return "f" if self.precision == "float" else ""
 
     def math(self, name: str) -> str:
-        """The <math.h> function for `name` (a double function) in this precision: sin or sinf."""
+        """The <math.h> function for `name` (a double function) in this precision: sin or sinf.
+        A freestanding build has no <math.h>: every call but the sines and cosines, which the
+        file computes itself (symdyn.codegen.c.sincos), is refused."""
+        if self.freestanding:
+            raise SymdynError(
+                f"--freestanding: the generated code needs {name + self.literal_suffix} from the C "
+                "library's <math.h>, which a freestanding build does not have (only sin and cos are "
+                "symdyn's own): leave out the functions that need it or drop --freestanding"
+            )
         return name + self.literal_suffix
 
 

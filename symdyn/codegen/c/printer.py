@@ -43,10 +43,14 @@ class CPrinter(TreePrinter):
     """
 
     def __init__(
-        self, names: dict[sp.Symbol, str], precision: str = "double", calls: dict[sp.Expr, str] | None = None
+        self,
+        names: dict[sp.Symbol, str],
+        precision: str = "double",
+        calls: dict[sp.Expr, str] | None = None,
+        freestanding: bool = False,
     ):
         self.names = names
-        self.config = CConfig(precision)
+        self.config = CConfig(precision, freestanding)
         self.calls = calls or {}
 
     # numbers

@@ -1,4 +1,5 @@
-"""The C target: NAME_dynamics.h and NAME_dynamics.c (C99, no allocation, libm only).
+"""The C target: NAME_dynamics.h and NAME_dynamics.c (C99, no allocation, libm only), and a
+CMakeLists.txt building them as a static library.
 
 The contract is docs/generated-code.md. Each of the seven functions
 (symdyn.codegen.functions) becomes straight-line code: the inputs it reads are
@@ -25,7 +26,7 @@ from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .printer import CPrinter
-from .sincos import BLOCK, gather
+from .sincos import BLOCK, FREESTANDING_ERROR, gather
 
 __all__ = ["render", "render_context", "symbol_names", "function_inputs", "TOOLS"]
 
@@ -40,8 +41,12 @@ ACTUATED_INPUTS = ("qda", "qdda", "tau_a")
 #: and one store per zero costs more
 FILL_ZEROS = 16
 
-#: The tools each file's bytes depend on besides symdyn (SymPy builds every expression).
-TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",)}
+#: The tools each file's bytes depend on besides symdyn (SymPy builds every expression; the
+#: CMakeLists.txt header carries the operation counts).
+TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",), "CMakeLists.txt": ("sympy",)}
+
+#: the build file written beside the C files (templates/c/CMakeLists.txt.j2)
+CMAKE_FILE = "CMakeLists.txt"
 
 
 def _sincos_view(
@@ -53,20 +58,23 @@ def _sincos_view(
     function's k-th angle a (symdyn.codegen.c.sincos): entry k of the arrays NAME_sincos fills
     when the compiler targets AVX2, else sin(a) and cos(a) (templates/c/sincos.c.j2). The
     angles are printed with the C library's calls (an angle may itself hold a sine) and padded
-    with zeros to the arrays' size. Under --precision float every call stays sinf or cosf.
+    with zeros to the arrays' size. Under --precision float every call stays sinf or cosf, unless
+    the file is freestanding: then, in either precision, the arrays are always filled by
+    NAME_sincos, symdyn's own (templates/c/sincos.c.j2), and no other call of the C library may
+    appear (symdyn.codegen.c.config.CConfig.math).
     """
-    plain = CPrinter(symbol_names, ctx.precision)
-    if ctx.precision != "double":
+    plain = CPrinter(symbol_names, ctx.precision, freestanding=ctx.freestanding)
+    if ctx.precision != "double" and not ctx.freestanding:
         return plain, list(spec.temporaries), None
     trig = gather(spec.temporaries, spec.outputs)
     temporaries = [(s, e) for s, e in spec.temporaries if s in trig.live]
     angles = [plain.doprint(a) for a in trig.angles]
     macros = (names.sincos["sin"], names.sincos["cos"])
     calls = {call: f"{macros[which]}({k}, {angles[k]})" for call, (which, k) in trig.calls.items()}
-    printer = CPrinter(symbol_names, ctx.precision, calls)
+    printer = CPrinter(symbol_names, ctx.precision, calls, ctx.freestanding)
     if not angles:
         return printer, temporaries, None
-    padding = ["0.0"] * (trig.size - len(angles))
+    padding = [CPrinter({}, ctx.precision).literal(0.0)] * (trig.size - len(angles))
     return printer, temporaries, {"count": len(angles), "size": trig.size, "angles": angles + padding}
 
 
@@ -222,6 +230,8 @@ def render_context(ctx: RenderContext) -> dict:
         "column_sizes": _column_sizes(ctx, names),
         "frames": [(comment_text(name), ident, link) for name, ident, link in ctx.frames],
         "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
+        "freestanding": ctx.freestanding,
+        "sincos_error": FREESTANDING_ERROR[ctx.precision],
         "loops": _loops_view(ctx, names),
         "contacts": _contacts_view(ctx, names),
     }
@@ -247,6 +257,11 @@ def _loops_view(ctx: RenderContext, names: CNames) -> dict | None:
     view = loop_solve_context(ctx)
     if view is None:
         return None
+    if ctx.freestanding:
+        raise SymdynError(
+            f"robot '{ctx.name}': --freestanding: the solver of its closed loops needs the C library's "
+            "<math.h> (fabs, isnan, isfinite); generate it without --freestanding"
+        )
     suffix = CConfig(ctx.precision).literal_suffix
     return {
         **view,
@@ -280,10 +295,14 @@ def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
-    """NAME_dynamics.h and NAME_dynamics.c for the robot of `ctx`."""
+    """NAME_dynamics.h, NAME_dynamics.c and CMakeLists.txt (a static library of every .c file
+    written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`."""
     values = render_context(ctx)
     env = environment()
-    return {
+    files = {
         values["header_file"]: env.get_template("c/dynamics.h.j2").render(values),
         values["source_file"]: env.get_template("c/dynamics.c.j2").render(values),
     }
+    sources = sorted(name for name in files if name.endswith(".c"))
+    files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render({**values, "sources": sources})
+    return files
