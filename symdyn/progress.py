@@ -7,6 +7,10 @@ A command that has run for DELAY (2) seconds starts to report (a quick one says 
 - elsewhere (a log, a pipe, CI), one line per stage as it starts, `symdyn: 12.3 s: generating C
   (7 functions)`, and a last line `symdyn: 51.0 s: done`.
 
+A run that counts its own steps (a simulation) shows a `Steps` bar instead, at once and to the end,
+`symdyn: simulate:  50%|#####     | 1500/3000 [00:01<00:01, t = 1.500 / 3.000 s]`, on a terminal or
+wherever its caller asks for it.
+
 Stages nest (a stage inside another is reported with the other's label before its own). Nothing
 is reported under `quiet()` (the command line's --quiet) or with the environment variable
 SYMDYN_QUIET set to anything but 0 or an empty string; the test suite sets it, and turns the
@@ -21,11 +25,14 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from .errors import one_line
 
-__all__ = ["DELAY", "QUIET_ENV", "stage", "note", "quiet", "finish", "restart"]
+if TYPE_CHECKING:
+    from tqdm import tqdm
+
+__all__ = ["DELAY", "QUIET_ENV", "Steps", "stage", "note", "quiet", "finish", "restart"]
 
 #: seconds a command runs before it reports anything
 DELAY = 2.0
@@ -122,22 +129,26 @@ def _plural(unit: str, count: int) -> str:
     return unit + "es" if unit.endswith(("s", "sh", "ch", "x")) else unit + "s"
 
 
-@contextmanager
-def _bar(label: str, total: int | None, unit: str) -> Iterator[Callable[[int], None]]:
-    """A tqdm bar shown once the command has run DELAY s, refreshed while the stage runs."""
+def _tqdm(label: str, total: int | None, unit: str, delay: float, leave: bool) -> tqdm:
+    """The one kind of bar of this module: `symdyn: LABEL` on standard error, with the count of a
+    `total` and its elapsed time, or without a total its elapsed time alone."""
     from tqdm import tqdm
 
-    delay = max(0.0, DELAY - (time.monotonic() - _run.start))
-    fmt = None if total is not None else "{desc}: {elapsed}"
-    bar = tqdm(
+    return tqdm(
         total=total,
         desc=f"symdyn: {one_line(label)}",
         unit=unit,
         delay=delay,
-        leave=False,
+        leave=leave,
         file=_stream(),
-        bar_format=fmt,
+        bar_format=None if total is not None else "{desc}: {elapsed}",
     )
+
+
+@contextmanager
+def _bar(label: str, total: int | None, unit: str) -> Iterator[Callable[[int], None]]:
+    """A bar shown once the command has run DELAY s, refreshed while the stage runs."""
+    bar = _tqdm(label, total, unit, max(0.0, DELAY - (time.monotonic() - _run.start)), leave=False)
     stop = threading.Event()
 
     def refresh() -> None:
@@ -154,6 +165,43 @@ def _bar(label: str, total: int | None, unit: str) -> Iterator[Callable[[int], N
         stop.set()
         ticker.join()
         bar.close()
+
+
+class Steps:
+    """The bar of a run of `total` steps that counts them itself (a simulation over `until` seconds
+    of simulated time): `symdyn: LABEL:  50%|#####     | 1500/3000 [..., t = 1.500 / 3.000 s]`.
+
+    Shown when `shown` is True; with None, when standard error is a terminal and no report is
+    silenced (`quiet()`, SYMDYN_QUIET). It moves at most once per percent (a run of millions of
+    steps calls `update` for each), and its last state stays on its line, ended by a newline.
+    """
+
+    def __init__(self, label: str, total: int, shown: bool | None = None, until: float | None = None) -> None:
+        if shown is None:
+            shown = not _silent() and _stream().isatty()
+        self.enabled = bool(shown)
+        self.total = max(total, 1)
+        self.until = until
+        self._percent = -1
+        self._bar = _tqdm(label, self.total, "step", 0.0, leave=True) if self.enabled else None
+
+    def update(self, done: int, t: float | None = None) -> None:
+        """`done` of the steps are done, the simulated time at `t` seconds."""
+        if self._bar is None:
+            return
+        percent = 100 * done // self.total
+        if percent == self._percent:
+            return
+        self._percent = percent
+        if t is not None and self.until is not None:
+            self._bar.set_postfix_str(f"t = {t:.3f} / {self.until:.3f} s", refresh=False)
+        self._bar.update(done - self._bar.n)
+
+    def close(self) -> None:
+        """End the bar's line (its last state stays)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
 
 def note(text: str) -> None:

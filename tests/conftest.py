@@ -14,10 +14,13 @@
   skip there would only hide a missing install step. Locally, tests of absent tools still skip.
   The one exception is hardware no install step provides: a test marked `accelerator` (it needs a
   GPU) skips without one, in CI too.
+- A pytest-xdist worker collects its garbage and freezes its heap before it reports its end
+  (`pytest_sessionfinish` below), so that it stops at once when asked to.
 """
 
 from __future__ import annotations
 
+import gc
 import os
 import sys
 from pathlib import Path
@@ -48,6 +51,24 @@ def pytest_runtest_makereport(item, call):
         reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else str(report.longrepr)
         report.outcome = "failed"
         report.longrepr = f"skipped under CI, where every tool the tests use is installed: {reason}"
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_sessionfinish(session):
+    """A worker's last full garbage collection, before it reports its end to the controller.
+
+    Its heap (every example robot derived, SymPy's caches: about 1 GB) takes a full collection of
+    1 to 12 s on a busy machine. pytest collects once more when it unconfigures, after the worker
+    has reported its end (pytest-xdist sends `workerfinished` once the non-wrapper hooks here have
+    run, session fixtures torn down), and execnet interrupts a worker still busy 5 s after the
+    controller asked it to stop: a SIGINT, whose KeyboardInterrupt struck inside hypothesis' gc
+    callback and ended a green suite with a PytestUnraisableExceptionWarning. So the worker
+    collects here, while the controller still waits for it, and freezes what is left
+    (gc.freeze): pytest's last collection then only looks at the objects made since.
+    """
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        gc.collect()
+        gc.freeze()
 
 
 @pytest.fixture(autouse=True, scope="session")

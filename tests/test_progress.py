@@ -133,3 +133,33 @@ def test_a_name_with_newlines_and_escapes_stays_on_its_line(reporting):
         progress.note("x\ny")
     assert reporting.getvalue().splitlines()[0].endswith("deriving 'a\\nsymdyn: 0.0 s: done\\x1b[2J'")
     assert reporting.getvalue().splitlines()[1] == "symdyn: note: x\\ny"
+
+
+def test_steps_show_on_a_terminal_unless_silenced_or_where_asked_moving_once_per_percent(monkeypatch):
+    """symdyn.progress.Steps, the bar of a simulation: by default only on a terminal and not under
+    quiet() or SYMDYN_QUIET; shown=True shows it anywhere; 100,000 updates redraw it 101 times."""
+    monkeypatch.delenv(progress.QUIET_ENV, raising=False)
+    progress.quiet(False)
+    screen, log = Terminal(), io.StringIO()
+    monkeypatch.setattr(progress, "_stream", lambda: screen)
+    assert progress.Steps("simulate", 10).enabled
+    progress.quiet()
+    assert not progress.Steps("simulate", 10).enabled and progress.Steps("simulate", 10, True).enabled
+    progress.quiet(False)
+    monkeypatch.setenv(progress.QUIET_ENV, "1")
+    assert not progress.Steps("simulate", 10).enabled
+    monkeypatch.setattr(progress, "_stream", lambda: log)
+    monkeypatch.delenv(progress.QUIET_ENV)
+    off = progress.Steps("simulate", 10)
+    off.update(5, 0.5)
+    off.close()
+    assert not off.enabled and log.getvalue() == ""
+    bar = progress.Steps("simulate", 100_000, True, until=2.0)
+    moves = []
+    update = bar._bar.update
+    monkeypatch.setattr(bar._bar, "update", lambda k: moves.append(k) or update(k))
+    for k in range(1, 100_001):
+        bar.update(k, 2e-5 * k)
+    bar.close()
+    assert len(moves) == 101 and sum(moves) == 100_000  # 0 % .. 100 %
+    assert "100%" in log.getvalue() and "t = 2.000 / 2.000 s]\n" in log.getvalue()

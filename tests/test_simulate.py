@@ -15,10 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from symdyn import cli
+from symdyn import cli, progress
 from symdyn.apps.simulation.simulate import (
     CompiledDynamics,
-    ProgressBar,
     simulate,
     time_expressions,
     torque_function,
@@ -223,17 +222,22 @@ def test_a_singular_mass_matrix_is_named_as_the_cause(tmp_path, capsys):
     assert "the mass matrix M(q) is singular at q = [0, 0]" in line, line
 
 
-def test_progress_bar():
-    out = io.StringIO()
-    bar = ProgressBar(200, 2.0, True, out)
-    for k in range(1, 201):
-        bar.update(k, k / 100)
-    bar.close()
-    text = out.getvalue()
-    assert text.count("\r") == 101 and "100%" in text and text.endswith("\n")  # 0 % .. 100 %
-    off = io.StringIO()
-    ProgressBar(10, 1.0, False, off).update(5, 0.5)
-    assert off.getvalue() == ""
+def test_the_progress_bar_leaves_the_run_unchanged(roger, monkeypatch):
+    """progress=True (--progress): the bar of symdyn.progress (Steps) on stderr even when it is not
+    a terminal and the suite silences reports; the C loop then runs in 100 chunks and the Python
+    loop (a callable torque) reports every step, both with the result of a run without a bar."""
+    log = io.StringIO()
+    monkeypatch.setattr(progress, "_stream", lambda: log)
+    plain = simulate(roger, Q0, QD0, duration=0.2, dt=1e-3)
+    assert log.getvalue() == ""  # 200 steps: no bar by default
+    for tau in (None, lambda t, q, qd: np.zeros(2)):
+        log.seek(0)
+        log.truncate()
+        shown = simulate(roger, Q0, QD0, duration=0.2, dt=1e-3, tau=tau, progress=True)
+        assert np.array_equal(shown.q, plain.q) and np.array_equal(shown.qd, plain.qd)
+        text = log.getvalue()
+        assert text.startswith("\rsymdyn: simulate:") and text.endswith("\n"), text
+        assert "100%" in text and "200/200" in text and "t = 0.200 / 0.200 s" in text, text
 
 
 def test_csv_columns_and_atomic_write(roger, tmp_path, monkeypatch):

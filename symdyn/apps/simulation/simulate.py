@@ -33,7 +33,6 @@ public names are re-exported here.
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -41,6 +40,7 @@ import numpy as np
 
 from ...errors import SymdynError
 from ...model.quaternion_norm import check_quaternions, quaternion_norms
+from ...progress import Steps
 from ..compilation.compiled import CompiledDynamics, compiled_dynamics, with_parameters
 from ..compilation.singular import divergence_error
 from ..output import write_atomic
@@ -185,34 +185,6 @@ def torque_function(tau, n: int) -> Callable:
 
 
 # --------------------------------------------------------------------------- integration
-
-
-class ProgressBar:
-    """A one-line progress bar on stderr: `simulate [#####-----]  50%  t = 1.50 / 3.00 s`."""
-
-    def __init__(self, total_steps: int, duration: float, enabled: bool, stream=None) -> None:
-        self.total = max(total_steps, 1)
-        self.duration = duration
-        self.enabled = enabled
-        self.stream = stream if stream is not None else sys.stderr
-        self.shown = -1
-
-    def update(self, step: int, t: float) -> None:
-        if not self.enabled:
-            return
-        pct = int(100 * step / self.total)
-        if pct == self.shown:
-            return
-        self.shown = pct
-        filled = pct * 30 // 100
-        bar = "#" * filled + "-" * (30 - filled)
-        self.stream.write(f"\rsimulate [{bar}] {pct:3d}%  t = {t:.3f} / {self.duration:.3f} s")
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.enabled and self.shown >= 0:
-            self.stream.write("\n")
-            self.stream.flush()
 
 
 def _state(x, n: int, name: str) -> np.ndarray:
@@ -378,7 +350,8 @@ def simulate(
     a Python callable (a computed-torque law of symdyn.apps.simulation.control runs in C too). rk45
     and dop853 (scipy's solve_ivp) adapt their step to the tolerances rtol, atol and
     report the state every dt. progress: True/False, or None for a bar on stderr when it
-    is a terminal and the run has at least PROGRESS_MIN_STEPS steps. Raises SymdynError
+    is a terminal, the run has at least PROGRESS_MIN_STEPS steps and no report is silenced
+    (symdyn.progress.Steps). Raises SymdynError
     for bad input and when the state stops being finite (diverged).
     """
     plant = compiled_dynamics(robot, params)
@@ -420,9 +393,9 @@ def simulate(
     if scheme in ADAPTIVE:
         Q, QD, U = _adaptive(plant, scheme, q, qd, t, tau_at, rtol, atol)
         return Trajectory(plant.robot, t, Q, QD, U, scheme, plant=plant)
-    if progress is None:
-        progress = steps >= PROGRESS_MIN_STEPS and sys.stderr.isatty()
-    bar = ProgressBar(steps, duration, bool(progress))
+    if progress is None and steps < PROGRESS_MIN_STEPS:
+        progress = False
+    bar = Steps("simulate", steps, progress, until=duration)
     try:
         out = _in_c(plant, scheme, q, qd, t, h, tau, tau_at, bar)
         Q, QD, U = out if out is not None else _in_python(plant, scheme, q, qd, t, h, tau_at, bar)

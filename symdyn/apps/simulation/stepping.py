@@ -101,6 +101,7 @@ def run(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Integrate from one state (q0, qd0) in C; (Q, QD, U) of shapes (N+1, n), U[N] left unset.
 
+    bar: a progress bar (symdyn.progress.Steps) moved 100 times, or None.
     torque: the (3N+1, n) table, or None with `controller` (a ComputedTorque) and its
     (3N+1, 3n) `reference` table. Returns None when the C loop cannot run (NumPy backend,
     a controller model without compiled inverse dynamics); raises SymdynError on divergence.
