@@ -118,7 +118,8 @@ def test_split_c_compiles_strict_at_O2(monkeypatch, tmp_path, arch):
 
 
 def test_stash_slots_are_reused_once_read():
-    """x0 is read by parts 2 and 3, x1 by part 2 only: x1's slot is free for x3, computed in part 2."""
+    """x0 is read by parts 2 and 3, x1 by part 2 only: x1's slot is free after part 2, so x3,
+    computed in part 2 (after x1 is loaded there), takes a new one; a save in part 3 would reuse it."""
     body = [
         ("let", "x0", "q1"),
         ("let", "x1", "2*x0"),
@@ -133,8 +134,9 @@ def test_stash_slots_are_reused_once_read():
     first, second, third = split["parts"]
     assert [p["name"] for p in split["parts"]] == ["f_part1", "f_part2", "f_part3"]
     assert first["body"] == [body[0], ("save", "0", "x0"), body[1], ("save", "1", "x1")]
-    assert second["loads"] == [("x0", 0), ("x1", 1)] and ("save", "1", "x3") in second["body"]
-    assert third["loads"] == [("x0", 0), ("x3", 1)] and split["slots"] == 2
+    assert second["loads"] == [("x0", 0), ("x1", 1)]
+    assert second["body"] == [("load", "x0", "0"), ("load", "x1", "1"), body[2], body[3], ("save", "2", "x3")]
+    assert third["loads"] == [("x0", 0), ("x3", 2)] and split["slots"] == 3
     assert first["unused"] == ["tau"] and third["unused"] == ["q"] and third["reads"] == []
 
 

@@ -11,8 +11,8 @@ more than PART_STATEMENTS statements is cut into parts of at most that many cons
 function's own arguments, called in order by the function, never inlined (NAME_NOINLINE). A
 temporary read by a later part than the one that computes it goes through the function's local
 array `stash`: stored right after it is computed, loaded at the start of each part that reads it;
-a slot is reused once the last part reading its value has loaded it (a greedy colouring of the
-intervals [defining part, last reading part]). Each part reads the inputs it needs from the input
+a slot is reused after the last part that reads its value (a greedy colouring of the intervals
+[defining part, last reading part]). Each part reads the inputs it needs from the input
 arrays itself.
 
 Files. `file_groups` puts the functions into the source files: one NAME_dynamics.c while the whole C
@@ -49,8 +49,9 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
     `reads` are the function's (local, input, index): each input value it copies into a local;
     `arguments` the names of its inputs and outputs, which each part takes too.
     Each part is {"name", "reads" (the reads it needs), "loads" ((name, slot): the temporaries of
-    earlier parts it reads), "body" (its statements, ("save", slot, name) after a temporary a later
-    part reads), "unused" (the arguments it neither reads nor writes, and the stash's name "" when it
+    earlier parts it reads), "body" (its statements, ("load", name, slot) before the first that
+    reads a temporary of an earlier part, ("save", slot, name) after a temporary a later part
+    reads), "unused" (the arguments it neither reads nor writes, and the stash's name "" when it
     neither loads nor saves)}.
     """
     if len(body) <= PART_STATEMENTS:
@@ -75,16 +76,22 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
     for c, chunk in enumerate(chunks):
         statements = []
         part_loads = [(n, slot_of[n]) for n in loads[c]]
-        # a slot is free again once the last part reading its value has loaded it (at its start)
-        free.extend(slot for n, slot in part_loads if last[n] == c)
-        free.sort(reverse=True)
+        pending = dict(part_loads)
         for s in chunk:
+            # each temporary of an earlier part loaded right before its first use: a load at the
+            # part's start could not move past the stores to the outputs (they may alias the
+            # stash), and the value would stay alive, in a register or spilled, through the part
+            for n in sorted(_names_read(s[2], set(pending)), key=_number):
+                statements.append(("load", n, str(pending.pop(n))))
             statements.append(s)
             if s[0] == "let" and s[1] in last:
                 slot = free.pop() if free else slots
                 slots = max(slots, slot + 1)
                 slot_of[s[1]] = slot
                 statements.append(("save", str(slot), s[1]))
+        # a slot is free again after the last part that reads its value (it loads it where it first reads it)
+        free.extend(slot for n, slot in part_loads if last[n] == c)
+        free.sort(reverse=True)
         part_reads = [r for r in reads if r[0] in used[c]]
         touched = {r[1] for r in part_reads}
         touched |= set().union(*(_names_read(s[1], set(arguments)) for s in chunk if s[0] == "store"))
