@@ -6,8 +6,9 @@ builds every function's statements, templates/c/*.j2 spell them.
 Parts. gcc's time on straight-line code grows faster than the code: most of a -O2 build of a large
 function goes to register allocation (LRA's hard register assignment, half of the time of the
 Panda's 143 KB forward-dynamics derivatives), which looks at every value live at once. A function of
-more than PART_STATEMENTS statements is cut into parts of at most that many consecutive statements
-(as many parts as needed, of equal length); part k is a static function NAME_FUNCTION_partk with the
+more than PART_STATEMENTS statements is cut into parts of about that many consecutive statements
+(as many parts as needed, each cut within a quarter of a part of the even cut where the fewest
+temporaries are alive); part k is a static function NAME_FUNCTION_partk with the
 function's own arguments, called in order by the function, never inlined (NAME_NOINLINE). A
 temporary read by a later part than the one that computes it goes through the function's local
 array `stash`: stored right after it is computed, loaded at the start of each part that reads it;
@@ -28,7 +29,7 @@ from math import ceil
 __all__ = ["PART_STATEMENTS", "SPLIT_BYTES", "split_body", "reads_in", "file_groups", "source_file_name"]
 
 #: a function with more statements (temporaries and output stores) than this is cut into parts
-PART_STATEMENTS = 1000
+PART_STATEMENTS = 3000
 
 #: C text of about this many bytes per source file, when the whole is larger
 SPLIT_BYTES = 1_000_000
@@ -56,9 +57,7 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
     """
     if len(body) <= PART_STATEMENTS:
         return None
-    count = ceil(len(body) / PART_STATEMENTS)
-    size = ceil(len(body) / count)
-    chunks = [body[k : k + size] for k in range(0, len(body), size)]
+    chunks = [body[a:b] for a, b in _cuts(body)]
     defined_in = {s[1]: c for c, chunk in enumerate(chunks) for s in chunk if s[0] == "let"}
     inputs = {local for local, _, _ in reads}
     known = set(defined_in) | inputs
@@ -106,6 +105,38 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
             }
         )
     return {"parts": parts, "slots": slots}
+
+
+def _cuts(body: list) -> list[tuple[int, int]]:
+    """The parts' [start, end) in `body`: as many as PART_STATEMENTS asks, each cut placed, within a
+    quarter of a part's length of the even cut, where the fewest temporaries are alive (computed
+    before it, read after it): every such value costs a store and a load per later part reading it."""
+    n = len(body)
+    count = ceil(n / PART_STATEMENTS)
+    size = n / count
+    defined = {s[1]: k for k, s in enumerate(body) if s[0] == "let"}
+    last: dict[str, int] = {}
+    for k, s in enumerate(body):
+        for name in _names_read(s[2], set(defined)):
+            last[name] = k
+    # alive[i]: the temporaries alive across a cut before statement i (defined before i, read at i or later)
+    change = [0] * (n + 2)
+    for name, k in defined.items():
+        if name in last:
+            change[k + 1] += 1
+            change[last[name] + 1] -= 1
+    alive, running = [], 0
+    for i in range(n + 1):
+        running += change[i]
+        alive.append(running)
+    cuts, start = [], 0
+    for part in range(1, count):
+        even = round(part * size)
+        window = range(max(start + 1, even - int(size) // 4), min(n, even + int(size) // 4) + 1)
+        cut = min(window, key=lambda i: (alive[i], abs(i - even), i))
+        cuts.append((start, cut))
+        start = cut
+    return [*cuts, (start, n)]
 
 
 def reads_in(texts: list[str], reads: list) -> list:
