@@ -187,6 +187,18 @@ def largest(files: dict[str, str]) -> str:
     return f"{name} ({counts[name]} lines)"
 
 
+def measure_parts(label: str, ctx) -> None:
+    """--parts-only: the compile time of the current layout alone (a large robot's whole functions
+    can take many minutes)."""
+    with tempfile.TemporaryDirectory(prefix="symdyn-compile-time-") as tmp:
+        files = render(ctx, False)
+        b = build(ctx, files, Path(tmp, "parts"))
+        print(f"\n{label}: {ctx.robot.n} joints, largest function {largest(render(ctx, True))}")
+        print(f"{b['size'] / 1000:.0f} KB of C in {b['files']} files, all at once {b['parallel']:.1f} s wall")
+        for name, cpu in b["serial"].items():
+            print(f"  {name}: {len(files[name].encode()) / 1000:.0f} KB, gcc -O2 {cpu:.1f} s of CPU")
+
+
 def measure(label: str, ctx) -> None:
     with tempfile.TemporaryDirectory(prefix="symdyn-compile-time-") as tmp:
         builds, whole = {}, render(ctx, True)
@@ -235,12 +247,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("robots", nargs="*", default=list(DEFAULT))
     parser.add_argument("--floating", action="store_true", help="URDFs on a free flyer (default robots: yes)")
+    parser.add_argument("--parts-only", action="store_true", help="compile only the current layout")
     args = parser.parse_args()
     print(f"{os.cpu_count()} cores, load averages {os.getloadavg()} (a shared machine: compare ratios)")
     for name in args.robots:
         floating = args.floating or name in DEFAULT
         ctx = context(load(name, floating))
-        measure(f"{Path(name).stem}{' floating' if floating and name in URDFS else ''}", ctx)
+        label = f"{Path(name).stem}{' floating' if floating and name in URDFS else ''}"
+        (measure_parts if args.parts_only else measure)(label, ctx)
         sys.stdout.flush()
 
 

@@ -130,6 +130,7 @@ def compile_library(
     size = sum(len(text.encode()) for name, text in sources.items() if name.endswith(".c"))
     count = sum(name.endswith(".c") for name in sources)
     label = f"compiling {Path(target).name}: {size / 1000:.0f} KB of C in {count} files"
+    label += f", {min(count, os.cpu_count() or 1)} at once" if count > 1 else ""
     label += f" ({compile_estimate(size)})"
     with (
         progress_stage(label),

@@ -29,7 +29,7 @@ from math import ceil
 __all__ = ["PART_STATEMENTS", "SPLIT_BYTES", "split_body", "reads_in", "file_groups", "source_file_name"]
 
 #: a function with more statements (temporaries and output stores) than this is cut into parts
-PART_STATEMENTS = 3000
+PART_STATEMENTS = 4000
 
 #: C text of about this many bytes per source file, when the whole is larger
 SPLIT_BYTES = 1_000_000
