@@ -98,15 +98,6 @@ static void puma560_sincos(int n, const double *restrict x, double *restrict s, 
 #define puma560_COS(k, a) cos(a)
 #endif
 
-/* keeps each part of a large function a function of its own (symdyn.codegen.c.parts) */
-#if defined(__GNUC__)
-#define puma560_NOINLINE __attribute__((noinline))
-#elif defined(_MSC_VER)
-#define puma560_NOINLINE __declspec(noinline)
-#else
-#define puma560_NOINLINE
-#endif
-
 /* tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (434 operations: 230 multiplications, 188 additions, 0 divisions, 10 trigonometric calls, 6 other calls) */
 void puma560_inverse_dynamics(const double q[], const double qd[], const double qdd[], const double p[], double tau[])
 {
@@ -2765,52 +2756,41 @@ void puma560_base_regressor(const double q[], const double qd[], const double qd
     ((volatile double *)Yb)[311] = x291;
 }
 
-/* part 1 of 2 of puma560_inverse_dynamics_derivatives */
-static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[], double stash[]
-#ifdef puma560_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
+/* dtau/dq and dtau/dqd of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (2288 operations: 1279 multiplications, 999 additions, 0 divisions, 10 trigonometric calls, 0 other calls) */
+void puma560_inverse_dynamics_derivatives(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[])
 {
     (void)p;
-#ifdef puma560_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
     const double q2 = q[1];
-    (void)q2; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q3 = q[2];
-    (void)q3; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q4 = q[3];
-    (void)q4; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q5 = q[4];
-    (void)q5; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q6 = q[5];
-    (void)q6; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd1 = qd[0];
-    (void)qd1; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd3 = qd[2];
-    (void)qd3; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qdd1 = qdd[0];
-    (void)qdd1; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qdd2 = qdd[1];
-    (void)qdd2; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qdd3 = qdd[2];
-    (void)qdd3; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qdd4 = qdd[3];
-    (void)qdd4; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qdd5 = qdd[4];
-    (void)qdd5; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qdd6 = qdd[5];
-    (void)qdd6; /* with AVX2, puma560_SIN(k, a) does not read a */
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q2,
+        q3,
+        q4,
+        q5,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
     ((volatile double *)dtau_dq)[0] = 0.0;
     ((volatile double *)dtau_dq)[6] = 0.0;
     ((volatile double *)dtau_dq)[12] = 0.0;
@@ -2821,39 +2801,24 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     ((volatile double *)dtau_dqd)[28] = 0.42728302093540005;
     ((volatile double *)dtau_dqd)[35] = 0.2158232532732;
     const double x0 = puma560_SIN(0, q2);
-    stash[0] = x0;
     const double x1 = puma560_COS(0, q2);
-    stash[1] = x1;
     const double x2 = puma560_COS(1, q3);
-    stash[2] = x2;
     const double x3 = puma560_SIN(1, q3);
-    stash[3] = x3;
     const double x4 = puma560_COS(2, q4);
-    stash[4] = x4;
     const double x5 = puma560_SIN(2, q4);
-    stash[5] = x5;
     const double x6 = puma560_SIN(3, q5);
-    stash[6] = x6;
     const double x7 = puma560_COS(3, q5);
-    stash[7] = x7;
     const double x8 = qd1*x1;
-    stash[8] = x8;
     const double x9 = x8*x2;
-    stash[9] = x9;
     const double x10 = qd1*x0;
-    stash[10] = x10;
     const double x11 = x9 - x3*x10;
-    stash[11] = x11;
     const double x12 = x11*x11;
-    stash[12] = x12;
     const double x13 = qd2 + qd3;
-    stash[13] = x13;
     const double x14 = x13*x13;
     const double x15 = x12 + x14;
     const double x16 = -0.0203*x15;
     const double x17 = 9.81*x0;
     const double x18 = x8*x8;
-    stash[14] = x18;
     const double x19 = qd2*qd2;
     const double x20 = x18 + x19;
     const double x21 = x17 - 0.4318*x20;
@@ -2870,16 +2835,13 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x32 = x26 + 0.15005*x31 + 0.4318*x28;
     const double x33 = x25*x2 + x32*x3;
     const double x34 = x8*x3;
-    stash[15] = x34;
     const double x35 = x10*x2 + x34;
-    stash[16] = x35;
     const double x36 = x35*x11;
     const double x37 = qdd2 + qdd3;
     const double x38 = x36 - x37;
     const double x39 = x16 + x33 + 0.4318*x38;
     const double x40 = x39*x4;
     const double x41 = x10*x10;
-    stash[17] = x41;
     const double x42 = x41 + x18;
     const double x43 = -0.15005*x42;
     const double x44 = x22 - x23;
@@ -2904,74 +2866,50 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x63 = x36 + x37;
     const double x64 = x62 + 0.0203*x63 + x61;
     const double x65 = x58*x7 + x64*x6;
-    stash[18] = x65;
     const double x66 = puma560_COS(4, q6);
-    stash[19] = x66;
     const double x67 = puma560_SIN(4, q6);
-    stash[20] = x67;
     const double x68 = -x39*x5 - x56*x4;
     const double x69 = x65*x66 + x68*x67;
-    stash[21] = x69;
     const double x70 = x35*x4;
     const double x71 = x13*x5;
     const double x72 = x70 - x71;
-    stash[22] = x72;
     const double x73 = x11 + qd4;
-    stash[23] = x73;
     const double x74 = x72*x7 + x73*x6;
-    stash[24] = x74;
     const double x75 = x74*x66;
-    stash[25] = x75;
     const double x76 = -x35*x5 - x13*x4;
-    stash[26] = x76;
     const double x77 = qd5 - x76;
-    stash[27] = x77;
     const double x78 = x77*x67;
-    stash[28] = x78;
     const double x79 = x75 - x78;
-    stash[29] = x79;
     const double x80 = x73*x7 - x6*x72;
-    stash[30] = x80;
     const double x81 = x80 + qd6;
-    stash[31] = x81;
     const double x82 = x79*x81;
     const double x83 = x79*qd6;
     const double x84 = x80*qd5;
     const double x85 = x76*qd4;
     const double x86 = x85 + x54*x4 - x5*x37;
     const double x87 = x49 + qdd4;
-    stash[32] = x87;
     const double x88 = x84 + x86*x7 + x87*x6;
-    stash[33] = x88;
     const double x89 = x72*qd4;
     const double x90 = x54*x5 + x37*x4;
     const double x91 = -x90 - x89;
     const double x92 = qdd5 - x91;
     const double x93 = x88*x67 + x92*x66;
-    stash[34] = x93;
     const double x94 = -x83 - x93;
     const double x95 = x82 + x94;
     const double x96 = x69 + 0.032*x95;
     const double x97 = 0.09*x96;
     const double x98 = x68*x66 - x65*x67;
-    stash[35] = x98;
     const double x99 = -x74*x67 - x77*x66;
-    stash[36] = x99;
     const double x100 = x99*x81;
-    stash[37] = x100;
     const double x101 = x99*qd6;
     const double x102 = x101 + x88*x66 - x67*x92;
-    stash[38] = x102;
     const double x103 = x100 - x102;
     const double x104 = x98 + 0.032*x103;
     const double x105 = 0.09*x104;
     const double x106 = x97*x66 - x105*x67;
-    stash[39] = x106;
     const double x107 = x106 + 0.34*x65;
     const double x108 = x64*x7 - x6*x58;
-    stash[40] = x108;
     const double x109 = 0.34*x108;
-    stash[41] = x109;
     const double x110 = x79*x79;
     const double x111 = x99*x99;
     const double x112 = x110 + x111;
@@ -2979,7 +2917,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x114 = x108 + x113;
     const double x115 = 0.09*x114 + x109;
     const double x116 = x107*x7 - x6*x115;
-    stash[42] = x116;
     const double x117 = x72*x73;
     const double x118 = x117 + x91;
     const double x119 = x58 + 0.019*x118;
@@ -2988,7 +2925,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x122 = x121 - x86;
     const double x123 = x68 + 0.019*x122;
     const double x124 = x97*x67 + x105*x66;
-    stash[43] = x124;
     const double x125 = -x124 - 0.34*x68;
     const double x126 = -x125 + 0.82*x123;
     const double x127 = x120*x4 - x5*x126;
@@ -2999,7 +2935,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x132 = x51 - x54;
     const double x133 = x62 + 0.0141*x132 + x131;
     const double x134 = x107*x6 + x115*x7;
-    stash[44] = x134;
     const double x135 = x72*x72;
     const double x136 = x76*x76;
     const double x137 = x135 + x136;
@@ -3010,39 +2945,31 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x142 = x130*x3 + x141*x2;
     const double x143 = x120*x5 + x126*x4;
     const double x144 = 0.00010999999999999999*x100;
-    stash[45] = x144;
     const double x145 = -x144 + 0.00015*x102 - 0.0028799999999999997*x104;
     const double x146 = 0.00010999999999999999*x82;
     const double x147 = 0.0028799999999999997*x96 + 0.00015*x94 + x146;
     const double x148 = x145*x66 - x147*x67;
-    stash[46] = x148;
     const double x149 = 0.00010000000000000005*x77;
-    stash[47] = x149;
     const double x150 = x149*x80;
-    stash[48] = x150;
     const double x151 = x150 + 0.0003*x88;
     const double x152 = x151 + x148;
     const double x153 = -x74*x149;
     const double x154 = x74*qd5;
     const double x155 = x6*x86;
-    stash[49] = x155;
     const double x156 = -x155 - x154 + x87*x7;
     const double x157 = 0.0003*x156 + x153;
     const double x158 = x156 + qdd6;
     const double x159 = x157 + 4e-05*x158;
     const double x160 = x152*x7 - x6*x159;
-    stash[50] = x160;
     const double x161 = 0.0005*x121;
     const double x162 = -x161 + 0.0018*x86 - 0.015579999999999998*x123;
     const double x163 = x162 + x160;
     const double x164 = 0.0005*x117;
     const double x165 = 0.0018*x91 + 0.015579999999999998*x119 + x164;
     const double x166 = x145*x67 + x147*x66;
-    stash[51] = x166;
     const double x167 = -x166 + 0.0004*x92;
     const double x168 = x165 - x167;
     const double x169 = x163*x4 - x5*x168;
-    stash[52] = x169;
     const double x170 = 0.0735*x51;
     const double x171 = x12 + x59;
     const double x172 = -0.0141*x171;
@@ -3052,7 +2979,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x176 = -0.01999999999999999*x46;
     const double x177 = 0.06767999999999999*x129 + 0.0125*x49 + x176;
     const double x178 = x152*x6 + x159*x7;
-    stash[53] = x178;
     const double x179 = x178 + 0.0013*x87;
     const double x180 = x177 + x179 + 0.0203*x143;
     const double x181 = x175*x2 - x3*x180;
@@ -3079,7 +3005,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x202 = x18 - x41;
     const double x203 = -x17 + 0.068*x202 - 0.006*x201;
     const double x204 = x203 - 0.2275*x24;
-    stash[54] = x204;
     const double x205 = x30 + x29;
     const double x206 = x23 - x22;
     const double x207 = 0.068*x205 + 0.006*x206;
@@ -3113,7 +3038,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x235 = -x232*qd4;
     const double x236 = x213*x4 + x235;
     const double x237 = -x35*x35;
-    stash[55] = x237;
     const double x238 = x12 + x237;
     const double x239 = 0.4318*x238 - 0.0203*x225;
     const double x240 = x218*x2 + x220*x3;
@@ -3171,7 +3095,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x291 = -x290 + 0.0003*x288;
     const double x292 = x291 + x289;
     const double x293 = x249 + x286*x7 - x6*x292;
-    stash[56] = x293;
     const double x294 = -x35*x72;
     const double x295 = x251*x73;
     const double x296 = 0.0005*x294 + 0.0005*x295;
@@ -3182,17 +3105,14 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x301 = -0.0004*x264 - x274*x67 - x285*x66;
     ((volatile double *)dtau_dq)[25] = x301;
     const double x302 = x300 - x301;
-    stash[57] = x302;
     const double x303 = 0.09*x284;
     const double x304 = 0.09*x273;
     const double x305 = x303*x66 - x304*x67;
     const double x306 = x305 + 0.34*x269;
     const double x307 = x268*x7 - x6*x266;
     const double x308 = 2.0*x79;
-    stash[58] = x308;
     const double x309 = x308*x276;
     const double x310 = 2.0*x99;
-    stash[59] = x310;
     const double x311 = x310*x259;
     const double x312 = x309 + x311;
     const double x313 = -0.032*x312;
@@ -3209,13 +3129,11 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x324 = 0.07*x238;
     const double x325 = x51 + x242;
     const double x326 = x240 + x324 + 0.0141*x325;
-    stash[60] = x326;
     const double x327 = 0.06767999999999999*x326 + 0.0125*x242 + x323;
     const double x328 = 0.0013*x242 + x286*x6 + x292*x7;
     ((volatile double *)dtau_dq)[19] = x328;
     const double x329 = x328 + x327 - 0.0203*x321;
     const double x330 = x317*x4 - x5*x320;
-    stash[61] = x330;
     const double x331 = x330 + 4.8*x326;
     const double x332 = 2.0*x72;
     const double x333 = x332*x251;
@@ -3226,15 +3144,12 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x338 = x268 + x337;
     const double x339 = x306*x6 + x315*x7;
     const double x340 = x339 + 0.82*x338;
-    stash[62] = x340;
     const double x341 = x340 + 4.8*x223;
     const double x342 = x331*x3 + x341*x2;
-    stash[63] = x342;
     const double x343 = x208 - 0.15005*x342 + x322*x2 - x3*x329;
     const double x344 = -0.40900000000000003*x29;
     const double x345 = x26 + 0.068*x201 + 0.006*x202;
     const double x346 = x345 + 0.2275*x217;
-    stash[64] = x346;
     const double x347 = x344 + 3.9585*x346 - 0.524*x30 - 1.1832*x207;
     const double x348 = x321 + 4.8*x229;
     const double x349 = x331*x2 - x3*x341;
@@ -3278,14 +3193,12 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x385 = -x290 + 0.0003*x383;
     const double x386 = x385 + x384;
     const double x387 = x365 + x382*x7 - x6*x386;
-    stash[65] = x387;
     const double x388 = x297 + x368;
     const double x389 = x370 + 0.019*x388;
     const double x390 = x296 + 0.0018*x368 + 0.015579999999999998*x389;
     const double x391 = -0.0004*x368 - x376*x67 - x381*x66;
     ((volatile double *)dtau_dq)[26] = x391;
     const double x392 = x390 - x391;
-    stash[66] = x392;
     const double x393 = 0.09*x380;
     const double x394 = 0.09*x375;
     const double x395 = x393*x66 - x394*x67;
@@ -3302,21 +3215,17 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x406 = x357 + 0.4318*x405 + x387*x4 - x5*x392;
     const double x407 = x51 - x54;
     const double x408 = x62 + x324 + 0.0141*x407;
-    stash[67] = x408;
     const double x409 = x323 + 0.06767999999999999*x408 - 0.0125*x54;
     const double x410 = -0.0013*x54 + x382*x6 + x386*x7;
     ((volatile double *)dtau_dq)[20] = x410;
     const double x411 = x409 + x410 - 0.0203*x405;
     const double x412 = x401*x4 - x5*x404;
-    stash[68] = x412;
     const double x413 = x412 + 4.8*x408;
     const double x414 = x371 + x337;
     const double x415 = x396*x6 + x399*x7;
     const double x416 = x415 + 0.82*x414;
-    stash[69] = x416;
     const double x417 = x416 + 4.8*x354;
     const double x418 = x191 + x413*x3 + x417*x2;
-    stash[70] = x418;
     const double x419 = -x192 - 0.15005*x418 + x406*x2 - x411*x3;
     const double x420 = x405 + 4.8*x356;
     const double x421 = -x142 + x413*x2 - x417*x3;
@@ -3373,7 +3282,6 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x471 = -x470 + 0.82*x468;
     const double x472 = -x127 - x465*x5 - x471*x4;
     const double x473 = -0.4318*x472;
-    stash[71] = x473;
     const double x474 = 0.0005*x466;
     const double x475 = -x474 + 0.0018*x439 - 0.015579999999999998*x468;
     const double x476 = 0.00010000000000000005*x429;
@@ -3392,133 +3300,23 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part1(const do
     const double x488 = x487 + 0.0003*x485;
     const double x489 = x488 + x486;
     const double x490 = x475 + x483*x7 - x6*x489;
-    stash[72] = x490;
     const double x491 = x161 + 0.015579999999999998*x425 - 0.0018*x86;
     const double x492 = 0.0004*x86 - x480*x67 - x482*x66;
     ((volatile double *)dtau_dq)[27] = x492;
     const double x493 = x491 - x492;
-    stash[73] = x493;
     const double x494 = -x473 + x490*x4 - x493*x5 - x163*x5 - x168*x4;
-    stash[74] = x494;
     const double x495 = x483*x6 + x489*x7;
     ((volatile double *)dtau_dq)[21] = x495;
     const double x496 = x495 - 0.0203*x472;
-    stash[75] = x496;
     const double x497 = x332*x76;
     const double x498 = x334*x429;
     const double x499 = x497 + x498;
     const double x500 = -0.015579999999999998*x499;
     const double x501 = x456*x6 + x463*x7;
     const double x502 = x501 + x500;
-    stash[76] = x502;
     const double x503 = -x143 + x465*x4 - x471*x5;
-    stash[77] = x503;
     const double x504 = x502*x2 + x503*x3;
-    stash[78] = x504;
     const double x505 = -0.15005*x504 + x494*x2 - x496*x3;
-    stash[79] = x505;
-}
-
-/* part 2 of 2 of puma560_inverse_dynamics_derivatives */
-static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part2(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[], double stash[]
-#ifdef puma560_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)q;
-    (void)qdd;
-    (void)p;
-#ifdef puma560_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double x0 = stash[0];
-    const double x1 = stash[1];
-    const double x2 = stash[2];
-    const double x3 = stash[3];
-    const double x4 = stash[4];
-    const double x5 = stash[5];
-    const double x6 = stash[6];
-    const double x7 = stash[7];
-    const double x8 = stash[8];
-    const double x9 = stash[9];
-    const double x10 = stash[10];
-    const double x11 = stash[11];
-    const double x12 = stash[12];
-    const double x13 = stash[13];
-    const double x18 = stash[14];
-    const double x34 = stash[15];
-    const double x35 = stash[16];
-    const double x41 = stash[17];
-    const double x65 = stash[18];
-    const double x66 = stash[19];
-    const double x67 = stash[20];
-    const double x69 = stash[21];
-    const double x72 = stash[22];
-    const double x73 = stash[23];
-    const double x74 = stash[24];
-    const double x75 = stash[25];
-    const double x76 = stash[26];
-    const double x77 = stash[27];
-    const double x78 = stash[28];
-    const double x79 = stash[29];
-    const double x80 = stash[30];
-    const double x81 = stash[31];
-    const double x87 = stash[32];
-    const double x88 = stash[33];
-    const double x93 = stash[34];
-    const double x98 = stash[35];
-    const double x99 = stash[36];
-    const double x100 = stash[37];
-    const double x102 = stash[38];
-    const double x106 = stash[39];
-    const double x108 = stash[40];
-    const double x109 = stash[41];
-    const double x116 = stash[42];
-    const double x124 = stash[43];
-    const double x134 = stash[44];
-    const double x144 = stash[45];
-    const double x148 = stash[46];
-    const double x149 = stash[47];
-    const double x150 = stash[48];
-    const double x155 = stash[49];
-    const double x160 = stash[50];
-    const double x166 = stash[51];
-    const double x169 = stash[52];
-    const double x178 = stash[53];
-    const double x204 = stash[54];
-    const double x237 = stash[55];
-    const double x293 = stash[56];
-    const double x302 = stash[57];
-    const double x308 = stash[58];
-    const double x310 = stash[59];
-    const double x326 = stash[60];
-    const double x330 = stash[61];
-    const double x340 = stash[62];
-    const double x342 = stash[63];
-    const double x346 = stash[64];
-    const double x387 = stash[65];
-    const double x392 = stash[66];
-    const double x408 = stash[67];
-    const double x412 = stash[68];
-    const double x416 = stash[69];
-    const double x418 = stash[70];
-    const double x473 = stash[71];
-    const double x490 = stash[72];
-    const double x493 = stash[73];
-    const double x494 = stash[74];
-    const double x496 = stash[75];
-    const double x502 = stash[76];
-    const double x503 = stash[77];
-    const double x504 = stash[78];
-    const double x505 = stash[79];
     const double x506 = x503*x2 - x3*x502;
     const double x507 = 0.15005*x506 + x473 + x494*x3 + x496*x2;
     const double x508 = x505*x0 + x507*x1;
@@ -4047,21 +3845,33 @@ static puma560_NOINLINE void puma560_inverse_dynamics_derivatives_part2(const do
     ((volatile double *)dtau_dqd)[34] = x979;
 }
 
-/* dtau/dq and dtau/dqd of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (2288 operations: 1279 multiplications, 999 additions, 0 divisions, 10 trigonometric calls, 0 other calls) */
-void puma560_inverse_dynamics_derivatives(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[])
+/* dqdd/dq and dqdd/dqd of qdd = FD(q, qd, tau) = M(q)^-1 (tau - V - G - F), and M(q)^-1 (3654 operations: 2026 multiplications, 1606 additions, 6 divisions, 10 trigonometric calls, 6 other calls) */
+void puma560_forward_dynamics_derivatives(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[])
 {
     (void)p;
-#ifdef puma560_SINCOS_VECTOR
     const double q2 = q[1];
     const double q3 = q[2];
     const double q4 = q[3];
     const double q5 = q[4];
     const double q6 = q[5];
+    const double qd1 = qd[0];
+    const double qd2 = qd[1];
+    const double qd3 = qd[2];
+    const double qd4 = qd[3];
+    const double qd5 = qd[4];
+    const double qd6 = qd[5];
+    const double tau1 = tau[0];
+    const double tau2 = tau[1];
+    const double tau3 = tau[2];
+    const double tau4 = tau[3];
+    const double tau5 = tau[4];
+    const double tau6 = tau[5];
+#ifdef puma560_SINCOS_VECTOR
     const double angle[8] = {
-        q2,
-        q3,
-        q4,
         q5,
+        q3,
+        q2,
+        q4,
         q6,
         0.0,
         0.0,
@@ -4070,66 +3880,6 @@ void puma560_inverse_dynamics_derivatives(const double q[], const double qd[], c
     double sine[8], cosine[8];
     puma560_sincos(5, angle, sine, cosine);
 #endif
-    double stash[80];
-    puma560_inverse_dynamics_derivatives_part1(q, qd, qdd, p, dtau_dq, dtau_dqd, stash
-#ifdef puma560_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-    puma560_inverse_dynamics_derivatives_part2(q, qd, qdd, p, dtau_dq, dtau_dqd, stash
-#ifdef puma560_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-}
-
-/* part 1 of 2 of puma560_forward_dynamics_derivatives */
-static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[], double stash[]
-#ifdef puma560_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)p;
-    (void)dqdd_dqd;
-#ifdef puma560_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double q2 = q[1];
-    (void)q2; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double q3 = q[2];
-    (void)q3; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double q4 = q[3];
-    (void)q4; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double q5 = q[4];
-    (void)q5; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double q6 = q[5];
-    (void)q6; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd1 = qd[0];
-    (void)qd1; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd3 = qd[2];
-    (void)qd3; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double tau1 = tau[0];
-    (void)tau1; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double tau2 = tau[1];
-    (void)tau2; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double tau3 = tau[2];
-    (void)tau3; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double tau4 = tau[3];
-    (void)tau4; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double tau5 = tau[4];
-    (void)tau5; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double tau6 = tau[5];
-    (void)tau6; /* with AVX2, puma560_SIN(k, a) does not read a */
     ((volatile double *)dqdd_dq)[0] = 0.0;
     ((volatile double *)dqdd_dq)[6] = 0.0;
     ((volatile double *)dqdd_dq)[12] = 0.0;
@@ -4137,132 +3887,82 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     ((volatile double *)dqdd_dq)[24] = 0.0;
     ((volatile double *)dqdd_dq)[30] = 0.0;
     const double x0 = puma560_SIN(0, q5);
-    stash[0] = x0;
     const double x1 = puma560_COS(0, q5);
-    stash[1] = x1;
     const double x2 = puma560_COS(1, q3);
-    stash[2] = x2;
     const double x3 = puma560_SIN(1, q3);
-    stash[3] = x3;
     const double x4 = puma560_COS(2, q2);
-    stash[4] = x4;
     const double x5 = qd1*x4;
-    stash[5] = x5;
     const double x6 = x5*x3;
-    stash[6] = x6;
     const double x7 = puma560_SIN(2, q2);
-    stash[7] = x7;
     const double x8 = qd1*x7;
-    stash[8] = x8;
     const double x9 = x8*x2 + x6;
-    stash[9] = x9;
     const double x10 = puma560_COS(3, q4);
-    stash[10] = x10;
     const double x11 = x5*x2;
-    stash[11] = x11;
     const double x12 = x11 - x3*x8;
-    stash[12] = x12;
     const double x13 = x12*x10;
     const double x14 = x13*x1 - x0*x9;
     const double x15 = x14*qd5;
     const double x16 = x5*qd2;
     const double x17 = 0.0028799999999999997*x0;
-    stash[13] = x17;
     const double x18 = puma560_SIN(3, q4);
-    stash[14] = x18;
     const double x19 = x17*x18;
-    stash[15] = x19;
     const double x20 = 0.06767999999999999 + x19;
-    stash[16] = x20;
     const double x21 = 0.3001*x20;
     const double x22 = x17*x10;
     const double x23 = 0.025374999999999998 - x22;
-    stash[17] = x23;
     const double x24 = 0.0028799999999999997*x1;
-    stash[18] = x24;
     const double x25 = 0.015579999999999998 + x24;
-    stash[19] = x25;
     const double x26 = 0.87575 + x25;
-    stash[20] = x26;
     const double x27 = x23*x2 - x26*x3;
     const double x28 = 0.8636*x27;
     const double x29 = -0.0406*x22;
     const double x30 = x0*x0;
-    stash[21] = x30;
     const double x31 = 0.00020216*x30;
     const double x32 = 0.00164 + x31;
     const double x33 = 0.013969400500000005 + x32 + x29;
-    stash[22] = x33;
     const double x34 = 0.8636*x25;
     const double x35 = 0.00263818 - x31;
-    stash[23] = x35;
     const double x36 = -0.00273818 + x35;
     const double x37 = x18*x18;
-    stash[24] = x37;
     const double x38 = x37*x36;
     const double x39 = 0.32353833800000004 + x35 - x38 + x34;
-    stash[25] = x39;
     const double x40 = x39 - x33;
     const double x41 = x2*x3;
-    stash[26] = x41;
     const double x42 = 2.0*x41;
-    stash[27] = x42;
     const double x43 = 0.4318*x22;
     const double x44 = x1*x0;
-    stash[28] = x44;
     const double x45 = 0.00020216*x44;
-    stash[29] = x45;
     const double x46 = x43 + x45*x10;
-    stash[30] = x46;
     const double x47 = -0.010956925000000001 + x46 - 0.0203*x25;
-    stash[31] = x47;
     const double x48 = x3*x3;
-    stash[32] = x48;
     const double x49 = x48*x40 + x47*x42;
     const double x50 = 2.769262117125 + x33 + x49 + x21 + x28;
-    stash[33] = x50;
     const double x51 = x4*x7;
     const double x52 = 2.0*x51;
-    stash[34] = x52;
     const double x53 = 1.1674009151249998 + x39 - x49 + x21;
-    stash[35] = x53;
     const double x54 = x23*x3 + x26*x2;
     const double x55 = 1.0 - 2.0*x48;
-    stash[36] = x55;
     const double x56 = -0.0070992 - 0.4318*x54 + x47*x55 + x41*x40;
-    stash[37] = x56;
     const double x57 = x7*x7;
-    stash[38] = x57;
     const double x58 = x57*(x53 - x50) + x56*x52;
     const double x59 = 0.35 + x50 + x58;
     const double x60 = 0.784029968642 + x59;
     const double x61 = 1.0/x60;
     const double x62 = x10*x18;
-    stash[39] = x62;
     const double x63 = -0.0203*x19 - x62*x36;
-    stash[40] = x63;
     const double x64 = 0.4318*x19 + x45*x18;
     const double x65 = -0.0047376 - x64;
-    stash[41] = x65;
     const double x66 = 0.15005*x27 + x65*x3 - x63*x2;
-    stash[42] = x66;
     const double x67 = -0.6611671195 - x66 - 0.4318*x20;
-    stash[43] = x67;
     const double x68 = x63*x3 + x65*x2;
     const double x69 = -0.023751 + x68 - 0.15005*x54;
-    stash[44] = x69;
     const double x70 = x67*x7 + x69*x4;
     const double x71 = x70*x61;
     const double x72 = 4e-05*x1;
-    stash[45] = x72;
     const double x73 = 4e-05*x0;
-    stash[46] = x73;
     const double x74 = x73*x10;
-    stash[47] = x74;
     const double x75 = -x72*x3 - x74*x2;
-    stash[48] = x75;
     const double x76 = x72*x2 - x74*x3;
-    stash[49] = x76;
     const double x77 = x75*x7 + x76*x4;
     const double x78 = x77*x61;
     const double x79 = 0.3458373425 + x38 + x34 + x29;
@@ -4275,7 +3975,6 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x86 = x83*(x85 - x84*x78);
     const double x87 = 0.576873331938 + x79;
     const double x88 = x68 - 0.15005*x54;
-    stash[50] = x88;
     const double x89 = x88*x4 - x66*x7;
     const double x90 = x89*x61;
     const double x91 = x79 + 0.4318*x27;
@@ -4287,13 +3986,10 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x97 = x94*(x85 - x95*x78 - x96*x86);
     const double x98 = 0.19079062612368 + x32;
     const double x99 = x32 - 0.0203*x22;
-    stash[51] = x99;
     const double x100 = x19*x3;
     const double x101 = -0.15005*x100 + x46*x2 - x99*x3;
-    stash[52] = x101;
     const double x102 = x19*x2;
     const double x103 = -x43 + 0.15005*x102 + x99*x2 + x46*x3;
-    stash[53] = x103;
     const double x104 = x101*x7 + x103*x4;
     const double x105 = x104*x61;
     const double x106 = -x64 + 0.4318*x100;
@@ -4307,18 +4003,13 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x114 = x110*(x72 - x111*x78 - x112*x86 - x113*x97);
     const double x115 = x24*x18;
     const double x116 = 0.0203*x115;
-    stash[54] = x116;
     const double x117 = 0.4318*x115;
     const double x118 = 0.00064216*x18 + x117;
-    stash[55] = x118;
     const double x119 = x24*x10;
-    stash[56] = x119;
     const double x120 = -x119*x3 - x17*x2;
     const double x121 = -0.15005*x120 + x118*x2 + x3*x116;
-    stash[57] = x121;
     const double x122 = x17*x3 - x119*x2;
     const double x123 = 0.15005*x122 - x117 + x118*x3 - x2*x116;
-    stash[58] = x123;
     const double x124 = x121*x7 + x123*x4;
     const double x125 = x124*x61;
     const double x126 = 0.00064216*x10 + 0.4318*x119 - 0.0203*x17;
@@ -4335,10 +4026,8 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x137 = -x78 + x71*x86 - x97*x134 - x114*x135 - x133*x136;
     const double x138 = 0.19410450566800005 - x60*x78*x78 - x82*x86*x86 - x93*x97*x97 - x109*x114*x114 - x131*x133*x133;
     const double x139 = 1.0/x138;
-    stash[59] = x139;
     ((volatile double *)Minv)[35] = x139;
     const double x140 = x137*x139;
-    stash[60] = x140;
     ((volatile double *)Minv)[5] = x140;
     ((volatile double *)Minv)[30] = x140;
     const double x141 = x83*x71;
@@ -4346,28 +4035,23 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x143 = x110*x135;
     const double x144 = x132*x136;
     const double x145 = x61 + x71*x141 + x134*x142 + x135*x143 + x136*x144 + x137*x140;
-    stash[61] = x145;
     ((volatile double *)Minv)[0] = x145;
     const double x146 = -x107 + x92*x108;
     const double x147 = -x128 + x92*x129 - x130*x146;
     const double x148 = -x86 + x92*x97 - x114*x146 - x133*x147;
     const double x149 = -x141 + x146*x143 + x147*x144 + x148*x140 - x92*x142;
-    stash[62] = x149;
     ((volatile double *)Minv)[1] = x149;
     ((volatile double *)Minv)[6] = x149;
     const double x150 = -x129 + x108*x130;
     const double x151 = -x97 + x108*x114 - x133*x150;
     const double x152 = x142 + x150*x144 + x151*x140 - x108*x143;
-    stash[63] = x152;
     ((volatile double *)Minv)[2] = x152;
     ((volatile double *)Minv)[12] = x152;
     const double x153 = -x114 + x130*x133;
     const double x154 = x143 + x153*x140 - x130*x144;
-    stash[64] = x154;
     ((volatile double *)Minv)[3] = x154;
     ((volatile double *)Minv)[18] = x154;
     const double x155 = x144 - x133*x140;
-    stash[65] = x155;
     ((volatile double *)Minv)[4] = x155;
     ((volatile double *)Minv)[24] = x155;
     const double x156 = 0.015000000000000013*x16;
@@ -4385,9 +4069,7 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x168 = x167 + 0.068*x163;
     const double x169 = x156 + 0.13*x16 + 0.10439999999999999*x162 - 3.9585*x168;
     const double x170 = qd2 + qd3;
-    stash[66] = x170;
     const double x171 = x12*x170;
-    stash[67] = x171;
     const double x172 = 0.0735*x171;
     const double x173 = x12*qd3;
     const double x174 = x173 + x2*x16 - x3*x157;
@@ -4411,35 +4093,25 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x192 = x191 + 0.0141*x186 + x185;
     const double x193 = 0.066*x174 + 0.336*x182 - 0.06767999999999999*x192 + x172;
     const double x194 = x9*x10;
-    stash[68] = x194;
     const double x195 = x170*x18;
-    stash[69] = x195;
     const double x196 = x194 - x195;
-    stash[70] = x196;
     const double x197 = x12 + qd4;
-    stash[71] = x197;
     const double x198 = x196*x1 + x197*x0;
-    stash[72] = x198;
     const double x199 = x198*qd5;
     const double x200 = x9*qd3;
     const double x201 = -x200 - x2*x157 - x3*x16;
     const double x202 = -x9*x18 - x170*x10;
-    stash[73] = x202;
     const double x203 = x202*qd4;
     const double x204 = x203 + x174*x10;
     const double x205 = -x199 + x201*x1 - x204*x0;
     const double x206 = 4e-05*x205;
     const double x207 = qd5 - x202;
-    stash[74] = x207;
     const double x208 = 0.00010000000000000005*x207;
-    stash[75] = x208;
     const double x209 = -x198*x208;
     const double x210 = 0.0003*x205 + x209;
     const double x211 = x210 + x206;
     const double x212 = x202*x197;
-    stash[76] = x212;
     const double x213 = 0.0005*x212;
-    stash[77] = x213;
     const double x214 = x212 - x204;
     const double x215 = x9*x12;
     const double x216 = x175 + x183;
@@ -4453,24 +4125,16 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x224 = x223 + 0.019*x214;
     const double x225 = -x213 + 0.0018*x204 - 0.015579999999999998*x224;
     const double x226 = puma560_COS(4, q6);
-    stash[78] = x226;
     const double x227 = puma560_SIN(4, q6);
-    stash[79] = x227;
     const double x228 = x197*x1 - x0*x196;
-    stash[80] = x228;
     const double x229 = x208*x228;
-    stash[81] = x229;
     const double x230 = x228*qd5;
     const double x231 = x230 + x201*x0 + x204*x1;
     const double x232 = 0.0003*x231 + x229;
     const double x233 = -x198*x227 - x207*x226;
-    stash[82] = x233;
     const double x234 = x228 + qd6;
-    stash[83] = x234;
     const double x235 = x233*x234;
-    stash[84] = x235;
     const double x236 = 0.00010999999999999999*x235;
-    stash[85] = x236;
     const double x237 = x233*qd6;
     const double x238 = x196*qd4;
     const double x239 = -x238 - x174*x18;
@@ -4484,11 +4148,8 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x247 = x246 + 0.032*x241;
     const double x248 = -x236 + 0.00015*x240 - 0.0028799999999999997*x247;
     const double x249 = x198*x226;
-    stash[86] = x249;
     const double x250 = x207*x227;
-    stash[87] = x250;
     const double x251 = x249 - x250;
-    stash[88] = x251;
     const double x252 = x251*x234;
     const double x253 = 0.00010999999999999999*x252;
     const double x254 = x251*qd6;
@@ -4572,9 +4233,7 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x332 = x331 - x3*x324;
     const double x333 = x332*x10 + x329;
     const double x334 = -x15 + x327*x1 - x333*x0;
-    stash[89] = x334;
     const double x335 = 4e-05*x334;
-    stash[90] = x335;
     const double x336 = x13*qd4;
     const double x337 = -x336 - x332*x18;
     const double x338 = -x0*x13 - x1*x9;
@@ -4582,7 +4241,6 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x340 = -x328*x226 - x14*x227;
     const double x341 = x340*x234;
     const double x342 = 0.00010999999999999999*x339 + 0.00010999999999999999*x341;
-    stash[91] = x342;
     const double x343 = x340*qd6;
     const double x344 = x338*qd5;
     const double x345 = x327*x0 + x333*x1 + x344;
@@ -4605,20 +4263,17 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x362 = 0.4318*x361;
     const double x363 = x171 - x327;
     const double x364 = -x9*x170;
-    stash[92] = x364;
     const double x365 = x364 + x332;
     const double x366 = 0.0203*x363 + x362 + 0.4318*x365;
     const double x367 = -x360*x18 - x366*x10;
     const double x368 = x360*x10 - x366*x18;
     const double x369 = 2.0*x215;
     const double x370 = 0.0203*x349 - 0.4318*x369;
-    stash[93] = x370;
     const double x371 = x358*x2 - x3*x354;
     const double x372 = x370 + x371;
     const double x373 = x368*x1 + x372*x0;
     const double x374 = x367*x226 - x227*x373;
     const double x375 = x339 + x341;
-    stash[94] = x375;
     const double x376 = x375 - x346;
     const double x377 = x374 + 0.032*x376;
     const double x378 = -x342 + 0.00015*x346 - 0.0028799999999999997*x377;
@@ -4626,45 +4281,33 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x380 = x14*x226 - x227*x328;
     const double x381 = x380*x234;
     const double x382 = 0.00010999999999999999*x379 + 0.00010999999999999999*x381;
-    stash[95] = x382;
     const double x383 = x380*qd6;
-    stash[96] = x383;
     const double x384 = -x383 + x337*x226 - x345*x227;
     const double x385 = x367*x227 + x373*x226;
     const double x386 = x379 + x381;
-    stash[97] = x386;
     const double x387 = x384 + x386;
     const double x388 = x385 + 0.032*x387;
     const double x389 = x382 + 0.0028799999999999997*x388 + 0.00015*x384;
     const double x390 = -0.0004*x337 - x378*x227 - x389*x226;
-    stash[98] = x390;
     const double x391 = 0.00010000000000000005*x328;
     const double x392 = x391*x228 + x208*x338;
-    stash[99] = x392;
     const double x393 = x392 + 0.0003*x345;
     const double x394 = x393 + x378*x226 - x227*x389;
     const double x395 = x391*x198 + x208*x14;
-    stash[100] = x395;
     const double x396 = -x395 + 0.0003*x334;
     const double x397 = x396 + x335;
     const double x398 = 0.0013*x327 + x394*x0 + x397*x1;
-    stash[101] = x398;
     const double x399 = 0.053500000000000006*x348 + 0.053500000000000006*x175;
-    stash[102] = x399;
     const double x400 = 0.07*x349;
-    stash[103] = x400;
     const double x401 = x171 + x327;
     const double x402 = x359 + x400 + 0.0141*x401;
     const double x403 = -x399 - 0.336*x402;
     const double x404 = 2.0*x196;
-    stash[104] = x404;
     const double x405 = x404*x13;
     const double x406 = 2.0*x202;
-    stash[105] = x406;
     const double x407 = x406*x328;
     const double x408 = x405 - x407;
     const double x409 = -0.019*x408;
-    stash[106] = x409;
     const double x410 = x372 + x409;
     const double x411 = 0.09*x388;
     const double x412 = 0.09*x377;
@@ -4672,14 +4315,11 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x414 = x413 + 0.34*x373;
     const double x415 = x372*x1 - x0*x368;
     const double x416 = 2.0*x251;
-    stash[107] = x416;
     const double x417 = x416*x380;
     const double x418 = 2.0*x233;
-    stash[108] = x418;
     const double x419 = x418*x340;
     const double x420 = x417 + x419;
     const double x421 = -0.032*x420;
-    stash[109] = x421;
     const double x422 = x415 + x421;
     const double x423 = 0.09*x422 + 0.34*x415;
     const double x424 = x414*x0 + x423*x1;
@@ -4687,9 +4327,7 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x426 = -x9*x202;
     const double x427 = x328*x197;
     const double x428 = 0.0005*x427 - 0.0005*x426;
-    stash[110] = x428;
     const double x429 = x426 - x427;
-    stash[111] = x429;
     const double x430 = x429 - x333;
     const double x431 = x367 + 0.019*x430;
     const double x432 = x428 + 0.0018*x333 - 0.015579999999999998*x431;
@@ -4697,9 +4335,7 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x434 = -x9*x196;
     const double x435 = x13*x197;
     const double x436 = 0.0005*x434 + 0.0005*x435;
-    stash[112] = x436;
     const double x437 = x434 + x435;
-    stash[113] = x437;
     const double x438 = x337 + x437;
     const double x439 = x368 + 0.019*x438;
     const double x440 = x436 + 0.0018*x337 + 0.015579999999999998*x439;
@@ -4711,7 +4347,6 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x446 = -x445 + 0.82*x431;
     const double x447 = x443*x10 - x18*x446;
     const double x448 = x403 + 0.0203*x425 - 0.4318*x447 - x433*x18 - x441*x10;
-    stash[114] = x448;
     const double x449 = 0.394*x159 - 0.394*x158;
     const double x450 = x164 + 0.068*x351 + 0.006*x355;
     const double x451 = x450 + 0.2275*x353;
@@ -4720,34 +4355,27 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x454 = x449 + 1.1832*x453 - 0.10439999999999999*x451;
     const double x455 = x447 + 4.8*x402;
     const double x456 = -0.07*x369;
-    stash[115] = x456;
     const double x457 = x364 - x332;
     const double x458 = x371 + 0.0141*x457 + x456;
     const double x459 = x425 + 4.8*x458;
     const double x460 = x455*x3 + x459*x2;
     const double x461 = x454 + x448 + 0.4318*x460;
-    stash[116] = x461;
     const double x462 = x189 + 0.15005*x357;
     const double x463 = x148*x139;
-    stash[117] = x463;
     ((volatile double *)Minv)[11] = x463;
     ((volatile double *)Minv)[31] = x463;
     const double x464 = x94*x92;
     const double x465 = x110*x146;
     const double x466 = x132*x147;
     const double x467 = x83 + x92*x464 + x146*x465 + x147*x466 + x148*x463;
-    stash[118] = x467;
     ((volatile double *)Minv)[7] = x467;
     const double x468 = -x464 + x150*x466 + x151*x463 - x108*x465;
-    stash[119] = x468;
     ((volatile double *)Minv)[8] = x468;
     ((volatile double *)Minv)[13] = x468;
     const double x469 = x465 + x153*x463 - x130*x466;
-    stash[120] = x469;
     ((volatile double *)Minv)[9] = x469;
     ((volatile double *)Minv)[19] = x469;
     const double x470 = x466 - x133*x463;
-    stash[121] = x470;
     ((volatile double *)Minv)[10] = x470;
     ((volatile double *)Minv)[25] = x470;
     const double x471 = x313*x149 + x318*x467 + x319*x468 + x320*x469 + x321*x470 + x322*x463;
@@ -4755,22 +4383,17 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x473 = x16 - x324;
     const double x474 = x164 + 0.15005*x473 + 0.4318*x472;
     const double x475 = x462*x2 + x474*x3;
-    stash[122] = x475;
     const double x476 = x151*x139;
-    stash[123] = x476;
     ((volatile double *)Minv)[17] = x476;
     ((volatile double *)Minv)[32] = x476;
     const double x477 = x110*x108;
     const double x478 = x132*x150;
     const double x479 = x94 + x108*x477 + x150*x478 + x151*x476;
-    stash[124] = x479;
     ((volatile double *)Minv)[14] = x479;
     const double x480 = -x477 + x153*x476 - x130*x478;
-    stash[125] = x480;
     ((volatile double *)Minv)[15] = x480;
     ((volatile double *)Minv)[20] = x480;
     const double x481 = x478 - x133*x476;
-    stash[126] = x481;
     ((volatile double *)Minv)[16] = x481;
     ((volatile double *)Minv)[26] = x481;
     const double x482 = x313*x152 + x318*x468 + x319*x479 + x320*x480 + x321*x481 + x322*x476;
@@ -4778,154 +4401,115 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x484 = x215 - x483;
     const double x485 = x217 + x475 + 0.4318*x484;
     const double x486 = x485*x10;
-    stash[127] = x486;
     const double x487 = x157 - x325;
     const double x488 = 0.4318*x487 + x179;
     const double x489 = x3*x324;
     const double x490 = -x489 - x200 + x325*x2;
     const double x491 = x220 - x490;
     const double x492 = x326 + x2*x324;
-    stash[128] = x492;
     const double x493 = x492 + x171;
     const double x494 = x488 + 0.0203*x491 + 0.4318*x493;
     const double x495 = x494*x18;
-    stash[129] = x495;
     const double x496 = x486 - x495;
     const double x497 = x474*x2 - x3*x462;
-    stash[130] = x497;
     const double x498 = x215 + x483;
     const double x499 = x497 + 0.0203*x498 + x243;
     const double x500 = x496*x1 + x499*x0;
-    stash[131] = x500;
     const double x501 = -x485*x18 - x494*x10;
-    stash[132] = x501;
     const double x502 = x500*x226 + x501*x227;
-    stash[133] = x502;
     const double x503 = x203 + x492*x10 - x18*x483;
-    stash[134] = x503;
     const double x504 = x153*x139;
-    stash[135] = x504;
     ((volatile double *)Minv)[23] = x504;
     ((volatile double *)Minv)[33] = x504;
     const double x505 = x132*x130;
     const double x506 = x110 + x130*x505 + x153*x504;
-    stash[136] = x506;
     ((volatile double *)Minv)[21] = x506;
     const double x507 = -x505 - x133*x504;
-    stash[137] = x507;
     ((volatile double *)Minv)[22] = x507;
     ((volatile double *)Minv)[27] = x507;
     const double x508 = x313*x154 + x318*x469 + x319*x480 + x320*x506 + x321*x507 + x322*x504;
     const double x509 = x490 + x508;
-    stash[138] = x509;
     const double x510 = x230 + x1*x503 + x509*x0;
-    stash[139] = x510;
     const double x511 = x133*x139;
-    stash[140] = x511;
     ((volatile double *)Minv)[29] = -x511;
     ((volatile double *)Minv)[34] = -x511;
     const double x512 = x132 + x133*x511;
-    stash[141] = x512;
     ((volatile double *)Minv)[28] = x512;
     const double x513 = x313*x155 + x318*x470 + x319*x481 + x320*x507 + x321*x512 - x322*x511;
     const double x514 = x492*x18 + x483*x10;
-    stash[142] = x514;
     const double x515 = -x514 - x238;
     const double x516 = x513 - x515;
     const double x517 = x510*x227 + x516*x226;
-    stash[143] = x517;
     const double x518 = -x254 - x517;
     const double x519 = x252 + x518;
     const double x520 = x502 + 0.032*x519;
     const double x521 = 0.09*x520;
     const double x522 = x501*x226 - x500*x227;
-    stash[144] = x522;
     const double x523 = x237 + x510*x226 - x227*x516;
-    stash[145] = x523;
     const double x524 = x235 - x523;
     const double x525 = x522 + 0.032*x524;
     const double x526 = 0.09*x525;
     const double x527 = x521*x226 - x526*x227;
-    stash[146] = x527;
     const double x528 = x527 + 0.34*x500;
     const double x529 = x499*x1 - x0*x496;
-    stash[147] = x529;
     const double x530 = 0.34*x529;
-    stash[148] = x530;
     const double x531 = x529 + x277;
     const double x532 = 0.09*x531 + x530;
     const double x533 = x528*x1 - x0*x532;
-    stash[149] = x533;
     const double x534 = x262 + x515;
     const double x535 = x496 + 0.019*x534;
     const double x536 = x533 + 0.82*x535;
     const double x537 = x212 - x503;
     const double x538 = x501 + 0.019*x537;
     const double x539 = x521*x227 + x526*x226;
-    stash[150] = x539;
     const double x540 = -x539 - 0.34*x501;
     const double x541 = -x540 + 0.82*x538;
     const double x542 = x536*x10 - x18*x541;
-    stash[151] = x542;
     const double x543 = x220 + x490;
     const double x544 = x475 + 0.07*x484 + 0.0141*x543;
     const double x545 = x542 + 4.8*x544;
     const double x546 = x171 - x492;
     const double x547 = x497 + 0.0141*x546 + x185;
     const double x548 = x528*x0 + x532*x1;
-    stash[152] = x548;
     const double x549 = x499 + x298;
     const double x550 = x548 + 0.82*x549;
     const double x551 = x550 + 4.8*x547;
     const double x552 = x545*x3 + x551*x2;
-    stash[153] = x552;
     const double x553 = x536*x18 + x541*x10;
-    stash[154] = x553;
     const double x554 = -x236 + 0.00015*x523 - 0.0028799999999999997*x525;
     const double x555 = 0.0028799999999999997*x520 + 0.00015*x518 + x253;
     const double x556 = x554*x226 - x227*x555;
-    stash[155] = x556;
     const double x557 = x229 + 0.0003*x510;
     const double x558 = x556 + x557;
     const double x559 = x0*x503;
-    stash[156] = x559;
     const double x560 = -x559 - x199 + x509*x1;
     const double x561 = 0.0003*x560 + x209;
     const double x562 = x313*x140 + x318*x463 + x319*x476 + x320*x504 + x322*x139 - x321*x511;
     const double x563 = x560 + x562;
     const double x564 = x561 + 4e-05*x563;
     const double x565 = x558*x1 - x0*x564;
-    stash[157] = x565;
     const double x566 = -x213 + 0.0018*x503 - 0.015579999999999998*x538;
     const double x567 = x565 + x566;
-    stash[158] = x567;
     const double x568 = 0.0018*x515 + 0.015579999999999998*x535 + x263;
     const double x569 = x554*x227 + x555*x226;
-    stash[159] = x569;
     const double x570 = -x569 + 0.0004*x516;
     const double x571 = x568 - x570;
-    stash[160] = x571;
     const double x572 = x567*x10 - x18*x571;
-    stash[161] = x572;
     const double x573 = x488 + 0.07*x493 + x178;
     const double x574 = x172 + 0.066*x492 + 0.336*x573 - 0.06767999999999999*x547;
     const double x575 = x572 + x574 - 0.4318*x553;
     const double x576 = 0.06767999999999999*x544 + 0.0125*x490 + x287;
     const double x577 = x558*x0 + x564*x1;
-    stash[162] = x577;
     const double x578 = x577 + 0.0013*x509;
     const double x579 = x576 + x578 + 0.0203*x553;
     const double x580 = x575*x2 - x3*x579;
-    stash[163] = x580;
     const double x581 = x167 + 0.068*x472 + 0.2275*x473;
     const double x582 = x324 + x16;
     const double x583 = 0.068*x487 + 0.006*x582 + x161;
     const double x584 = x156 + 0.13*x324 + 0.10439999999999999*x583 - 3.9585*x581;
     const double x585 = x580 + x584 - 0.15005*x552;
     const double x586 = x545*x2 - x3*x551;
-    stash[164] = x586;
     const double x587 = x575*x3 + x579*x2;
-    stash[165] = x587;
     const double x588 = x163 - x471;
     const double x589 = x306 + 0.006*x588 + 0.2275*x357;
     const double x590 = -x305 + 0.524*x325 + 3.9585*x589 - 1.1832*x583;
@@ -4936,16 +4520,13 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x595 = 0.068*x361 + 0.006*x594;
     const double x596 = 0.13*x325 + 0.10439999999999999*x595 - 3.9585*x453 + x593;
     const double x597 = 0.0735*x364;
-    stash[166] = x597;
     const double x598 = x369 + x347;
     const double x599 = -0.0141*x598;
-    stash[167] = x599;
     const double x600 = 0.07*x365 + x362 + x599;
     const double x601 = 0.066*x332 + 0.336*x600 - 0.06767999999999999*x458 + x597;
     const double x602 = -x443*x18 - x446*x10;
     const double x603 = x601 + 0.4318*x602 + x433*x10 - x18*x441;
     const double x604 = -0.01999999999999999*x171;
-    stash[168] = x604;
     const double x605 = 0.06767999999999999*x402 + 0.0125*x327 + x604;
     const double x606 = x605 + x398 - 0.0203*x602;
     const double x607 = x596 - 0.15005*x460 + x603*x2 - x3*x606;
@@ -4955,237 +4536,21 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part1(const do
     const double x611 = x455*x2 - x3*x459;
     const double x612 = x609 + 0.15005*x611 - 0.4318*x610 + x603*x3 + x606*x2;
     const double x613 = x585*x4 + x607*x7 + x612*x4 - x7*x592;
-    stash[169] = x613;
     const double x614 = -x335*x140 - x390*x155 - x398*x154 - x448*x152 - x461*x149 - x613*x145;
     ((volatile double *)dqdd_dq)[1] = x614;
     const double x615 = x331 - x489;
-    stash[170] = x615;
     const double x616 = x615*x10 + x329;
-    stash[171] = x616;
     const double x617 = -x15 - x1*x492 - x616*x0;
-    stash[172] = x617;
     const double x618 = 4e-05*x617;
-    stash[173] = x618;
     const double x619 = -x336 - x615*x18;
-    stash[174] = x619;
     const double x620 = x344 + x616*x1 - x0*x492;
-    stash[175] = x620;
     const double x621 = x619*x227 + x620*x226 + x343;
-    stash[176] = x621;
     const double x622 = x350 + x497;
     const double x623 = x492 + x171;
     const double x624 = x364 + x615;
-    stash[177] = x624;
     const double x625 = 0.0203*x623 + 0.4318*x624;
     const double x626 = -x622*x18 - x625*x10;
-    stash[178] = x626;
     const double x627 = x622*x10 - x625*x18;
-    stash[179] = x627;
-}
-
-/* part 2 of 2 of puma560_forward_dynamics_derivatives */
-static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part2(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[], double stash[]
-#ifdef puma560_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)q;
-    (void)tau;
-    (void)p;
-    (void)Minv;
-#ifdef puma560_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double x0 = stash[0];
-    const double x1 = stash[1];
-    const double x2 = stash[2];
-    const double x3 = stash[3];
-    const double x4 = stash[4];
-    const double x5 = stash[5];
-    const double x6 = stash[6];
-    const double x7 = stash[7];
-    const double x8 = stash[8];
-    const double x9 = stash[9];
-    const double x10 = stash[10];
-    const double x11 = stash[11];
-    const double x12 = stash[12];
-    const double x17 = stash[13];
-    const double x18 = stash[14];
-    const double x19 = stash[15];
-    const double x20 = stash[16];
-    const double x23 = stash[17];
-    const double x24 = stash[18];
-    const double x25 = stash[19];
-    const double x26 = stash[20];
-    const double x30 = stash[21];
-    const double x33 = stash[22];
-    const double x35 = stash[23];
-    const double x37 = stash[24];
-    const double x39 = stash[25];
-    const double x41 = stash[26];
-    const double x42 = stash[27];
-    const double x44 = stash[28];
-    const double x45 = stash[29];
-    const double x46 = stash[30];
-    const double x47 = stash[31];
-    const double x48 = stash[32];
-    const double x50 = stash[33];
-    const double x52 = stash[34];
-    const double x53 = stash[35];
-    const double x55 = stash[36];
-    const double x56 = stash[37];
-    const double x57 = stash[38];
-    const double x62 = stash[39];
-    const double x63 = stash[40];
-    const double x65 = stash[41];
-    const double x66 = stash[42];
-    const double x67 = stash[43];
-    const double x69 = stash[44];
-    const double x72 = stash[45];
-    const double x73 = stash[46];
-    const double x74 = stash[47];
-    const double x75 = stash[48];
-    const double x76 = stash[49];
-    const double x88 = stash[50];
-    const double x99 = stash[51];
-    const double x101 = stash[52];
-    const double x103 = stash[53];
-    const double x116 = stash[54];
-    const double x118 = stash[55];
-    const double x119 = stash[56];
-    const double x121 = stash[57];
-    const double x123 = stash[58];
-    const double x139 = stash[59];
-    const double x140 = stash[60];
-    const double x145 = stash[61];
-    const double x149 = stash[62];
-    const double x152 = stash[63];
-    const double x154 = stash[64];
-    const double x155 = stash[65];
-    const double x170 = stash[66];
-    const double x171 = stash[67];
-    const double x194 = stash[68];
-    const double x195 = stash[69];
-    const double x196 = stash[70];
-    const double x197 = stash[71];
-    const double x198 = stash[72];
-    const double x202 = stash[73];
-    const double x207 = stash[74];
-    const double x208 = stash[75];
-    const double x212 = stash[76];
-    const double x213 = stash[77];
-    const double x226 = stash[78];
-    const double x227 = stash[79];
-    const double x228 = stash[80];
-    const double x229 = stash[81];
-    const double x233 = stash[82];
-    const double x234 = stash[83];
-    const double x235 = stash[84];
-    const double x236 = stash[85];
-    const double x249 = stash[86];
-    const double x250 = stash[87];
-    const double x251 = stash[88];
-    const double x334 = stash[89];
-    const double x335 = stash[90];
-    const double x342 = stash[91];
-    const double x364 = stash[92];
-    const double x370 = stash[93];
-    const double x375 = stash[94];
-    const double x382 = stash[95];
-    const double x383 = stash[96];
-    const double x386 = stash[97];
-    const double x390 = stash[98];
-    const double x392 = stash[99];
-    const double x395 = stash[100];
-    const double x398 = stash[101];
-    const double x399 = stash[102];
-    const double x400 = stash[103];
-    const double x404 = stash[104];
-    const double x406 = stash[105];
-    const double x409 = stash[106];
-    const double x416 = stash[107];
-    const double x418 = stash[108];
-    const double x421 = stash[109];
-    const double x428 = stash[110];
-    const double x429 = stash[111];
-    const double x436 = stash[112];
-    const double x437 = stash[113];
-    const double x448 = stash[114];
-    const double x456 = stash[115];
-    const double x461 = stash[116];
-    const double x463 = stash[117];
-    const double x467 = stash[118];
-    const double x468 = stash[119];
-    const double x469 = stash[120];
-    const double x470 = stash[121];
-    const double x475 = stash[122];
-    const double x476 = stash[123];
-    const double x479 = stash[124];
-    const double x480 = stash[125];
-    const double x481 = stash[126];
-    const double x486 = stash[127];
-    const double x492 = stash[128];
-    const double x495 = stash[129];
-    const double x497 = stash[130];
-    const double x500 = stash[131];
-    const double x501 = stash[132];
-    const double x502 = stash[133];
-    const double x503 = stash[134];
-    const double x504 = stash[135];
-    const double x506 = stash[136];
-    const double x507 = stash[137];
-    const double x509 = stash[138];
-    const double x510 = stash[139];
-    const double x511 = stash[140];
-    const double x512 = stash[141];
-    const double x514 = stash[142];
-    const double x517 = stash[143];
-    const double x522 = stash[144];
-    const double x523 = stash[145];
-    const double x527 = stash[146];
-    const double x529 = stash[147];
-    const double x530 = stash[148];
-    const double x533 = stash[149];
-    const double x539 = stash[150];
-    const double x542 = stash[151];
-    const double x548 = stash[152];
-    const double x552 = stash[153];
-    const double x553 = stash[154];
-    const double x556 = stash[155];
-    const double x559 = stash[156];
-    const double x565 = stash[157];
-    const double x567 = stash[158];
-    const double x569 = stash[159];
-    const double x571 = stash[160];
-    const double x572 = stash[161];
-    const double x577 = stash[162];
-    const double x580 = stash[163];
-    const double x586 = stash[164];
-    const double x587 = stash[165];
-    const double x597 = stash[166];
-    const double x599 = stash[167];
-    const double x604 = stash[168];
-    const double x613 = stash[169];
-    const double x615 = stash[170];
-    const double x616 = stash[171];
-    const double x617 = stash[172];
-    const double x618 = stash[173];
-    const double x619 = stash[174];
-    const double x620 = stash[175];
-    const double x621 = stash[176];
-    const double x624 = stash[177];
-    const double x626 = stash[178];
-    const double x627 = stash[179];
     const double x628 = x370 - x475;
     const double x629 = x627*x1 + x628*x0;
     const double x630 = x626*x226 - x227*x629;
@@ -5859,42 +5224,6 @@ static puma560_NOINLINE void puma560_forward_dynamics_derivatives_part2(const do
     ((volatile double *)dqdd_dqd)[35] = x1233;
 }
 
-/* dqdd/dq and dqdd/dqd of qdd = FD(q, qd, tau) = M(q)^-1 (tau - V - G - F), and M(q)^-1 (3654 operations: 2026 multiplications, 1606 additions, 6 divisions, 10 trigonometric calls, 6 other calls) */
-void puma560_forward_dynamics_derivatives(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[])
-{
-    (void)p;
-#ifdef puma560_SINCOS_VECTOR
-    const double q2 = q[1];
-    const double q3 = q[2];
-    const double q4 = q[3];
-    const double q5 = q[4];
-    const double q6 = q[5];
-    const double angle[8] = {
-        q5,
-        q3,
-        q2,
-        q4,
-        q6,
-        0.0,
-        0.0,
-        0.0
-    };
-    double sine[8], cosine[8];
-    puma560_sincos(5, angle, sine, cosine);
-#endif
-    double stash[180];
-    puma560_forward_dynamics_derivatives_part1(q, qd, tau, p, dqdd_dq, dqdd_dqd, Minv, stash
-#ifdef puma560_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-    puma560_forward_dynamics_derivatives_part2(q, qd, tau, p, dqdd_dq, dqdd_dqd, Minv, stash
-#ifdef puma560_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-}
-
 /* M(q)^-1 by the unrolled L D L^T factorisation (423 operations: 241 multiplications, 168 additions, 6 divisions, 8 trigonometric calls, 0 other calls) */
 void puma560_mass_matrix_inverse(const double q[], const double p[], double Minv[])
 {
@@ -6117,52 +5446,56 @@ void puma560_mass_matrix_inverse(const double q[], const double p[], double Minv
     ((volatile double *)Minv)[28] = x165;
 }
 
-/* part 1 of 2 of puma560_linearize */
-static puma560_NOINLINE void puma560_linearize_part1(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[], double stash[]
-#ifdef puma560_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
+/* xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1] (3654 operations: 2026 multiplications, 1606 additions, 6 divisions, 10 trigonometric calls, 6 other calls) */
+void puma560_linearize(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[])
 {
     (void)p;
-#ifdef puma560_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
     const double q2 = q[1];
-    (void)q2; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q3 = q[2];
-    (void)q3; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q4 = q[3];
-    (void)q4; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q5 = q[4];
-    (void)q5; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double q6 = q[5];
-    (void)q6; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd1 = qd[0];
-    (void)qd1; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd3 = qd[2];
-    (void)qd3; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double tau1 = tau[0];
-    (void)tau1; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double tau2 = tau[1];
-    (void)tau2; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double tau3 = tau[2];
-    (void)tau3; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double tau4 = tau[3];
-    (void)tau4; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double tau5 = tau[4];
-    (void)tau5; /* with AVX2, puma560_SIN(k, a) does not read a */
     const double tau6 = tau[5];
-    (void)tau6; /* with AVX2, puma560_SIN(k, a) does not read a */
+    /* the runs of zeros of A (the inputs are read), then the rest as it is known */
+    for (int k = 0; k < 6; ++k) A[k] = 0;
+    for (int k = 7; k < 19; ++k) A[k] = 0;
+    for (int k = 20; k < 32; ++k) A[k] = 0;
+    for (int k = 33; k < 45; ++k) A[k] = 0;
+    for (int k = 46; k < 58; ++k) A[k] = 0;
+    for (int k = 59; k < 71; ++k) A[k] = 0;
+    A[72] = 0;
+    A[84] = 0;
+    A[96] = 0;
+    A[108] = 0;
+    A[120] = 0;
+    A[132] = 0;
+    /* the runs of zeros of B (the inputs are read), then the rest as it is known */
+    for (int k = 0; k < 36; ++k) B[k] = 0;
+#ifdef puma560_SINCOS_VECTOR
+    const double angle[8] = {
+        q5,
+        q3,
+        q2,
+        q4,
+        q6,
+        0.0,
+        0.0,
+        0.0
+    };
+    double sine[8], cosine[8];
+    puma560_sincos(5, angle, sine, cosine);
+#endif
     ((volatile double *)A)[6] = 1.0;
     ((volatile double *)A)[19] = 1.0;
     ((volatile double *)A)[32] = 1.0;
@@ -6170,132 +5503,82 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     ((volatile double *)A)[58] = 1.0;
     ((volatile double *)A)[71] = 1.0;
     const double x0 = puma560_SIN(0, q5);
-    stash[0] = x0;
     const double x1 = puma560_COS(0, q5);
-    stash[1] = x1;
     const double x2 = puma560_COS(1, q3);
-    stash[2] = x2;
     const double x3 = puma560_SIN(1, q3);
-    stash[3] = x3;
     const double x4 = puma560_COS(2, q2);
-    stash[4] = x4;
     const double x5 = qd1*x4;
-    stash[5] = x5;
     const double x6 = x5*x3;
-    stash[6] = x6;
     const double x7 = puma560_SIN(2, q2);
-    stash[7] = x7;
     const double x8 = qd1*x7;
-    stash[8] = x8;
     const double x9 = x8*x2 + x6;
-    stash[9] = x9;
     const double x10 = puma560_COS(3, q4);
-    stash[10] = x10;
     const double x11 = x5*x2;
-    stash[11] = x11;
     const double x12 = x11 - x3*x8;
-    stash[12] = x12;
     const double x13 = x12*x10;
     const double x14 = x13*x1 - x0*x9;
     const double x15 = x14*qd5;
     const double x16 = x5*qd2;
     const double x17 = 0.0028799999999999997*x0;
-    stash[13] = x17;
     const double x18 = puma560_SIN(3, q4);
-    stash[14] = x18;
     const double x19 = x17*x18;
-    stash[15] = x19;
     const double x20 = 0.06767999999999999 + x19;
-    stash[16] = x20;
     const double x21 = 0.3001*x20;
     const double x22 = x17*x10;
     const double x23 = 0.025374999999999998 - x22;
-    stash[17] = x23;
     const double x24 = 0.0028799999999999997*x1;
-    stash[18] = x24;
     const double x25 = 0.015579999999999998 + x24;
-    stash[19] = x25;
     const double x26 = 0.87575 + x25;
-    stash[20] = x26;
     const double x27 = x23*x2 - x26*x3;
     const double x28 = 0.8636*x27;
     const double x29 = -0.0406*x22;
     const double x30 = x0*x0;
-    stash[21] = x30;
     const double x31 = 0.00020216*x30;
     const double x32 = 0.00164 + x31;
     const double x33 = 0.013969400500000005 + x32 + x29;
-    stash[22] = x33;
     const double x34 = 0.8636*x25;
     const double x35 = 0.00263818 - x31;
-    stash[23] = x35;
     const double x36 = -0.00273818 + x35;
     const double x37 = x18*x18;
-    stash[24] = x37;
     const double x38 = x37*x36;
     const double x39 = 0.32353833800000004 + x35 - x38 + x34;
-    stash[25] = x39;
     const double x40 = x39 - x33;
     const double x41 = x2*x3;
-    stash[26] = x41;
     const double x42 = 2.0*x41;
-    stash[27] = x42;
     const double x43 = 0.4318*x22;
     const double x44 = x1*x0;
-    stash[28] = x44;
     const double x45 = 0.00020216*x44;
-    stash[29] = x45;
     const double x46 = x43 + x45*x10;
-    stash[30] = x46;
     const double x47 = -0.010956925000000001 + x46 - 0.0203*x25;
-    stash[31] = x47;
     const double x48 = x3*x3;
-    stash[32] = x48;
     const double x49 = x48*x40 + x47*x42;
     const double x50 = 2.769262117125 + x33 + x49 + x21 + x28;
-    stash[33] = x50;
     const double x51 = x4*x7;
     const double x52 = 2.0*x51;
-    stash[34] = x52;
     const double x53 = 1.1674009151249998 + x39 - x49 + x21;
-    stash[35] = x53;
     const double x54 = x23*x3 + x26*x2;
     const double x55 = 1.0 - 2.0*x48;
-    stash[36] = x55;
     const double x56 = -0.0070992 - 0.4318*x54 + x47*x55 + x41*x40;
-    stash[37] = x56;
     const double x57 = x7*x7;
-    stash[38] = x57;
     const double x58 = x57*(x53 - x50) + x56*x52;
     const double x59 = 0.35 + x50 + x58;
     const double x60 = 0.784029968642 + x59;
     const double x61 = 1.0/x60;
     const double x62 = x10*x18;
-    stash[39] = x62;
     const double x63 = -0.0203*x19 - x62*x36;
-    stash[40] = x63;
     const double x64 = 0.4318*x19 + x45*x18;
     const double x65 = -0.0047376 - x64;
-    stash[41] = x65;
     const double x66 = 0.15005*x27 + x65*x3 - x63*x2;
-    stash[42] = x66;
     const double x67 = -0.6611671195 - x66 - 0.4318*x20;
-    stash[43] = x67;
     const double x68 = x63*x3 + x65*x2;
     const double x69 = -0.023751 + x68 - 0.15005*x54;
-    stash[44] = x69;
     const double x70 = x67*x7 + x69*x4;
     const double x71 = x70*x61;
     const double x72 = 4e-05*x1;
-    stash[45] = x72;
     const double x73 = 4e-05*x0;
-    stash[46] = x73;
     const double x74 = x73*x10;
-    stash[47] = x74;
     const double x75 = -x72*x3 - x74*x2;
-    stash[48] = x75;
     const double x76 = x72*x2 - x74*x3;
-    stash[49] = x76;
     const double x77 = x75*x7 + x76*x4;
     const double x78 = x77*x61;
     const double x79 = 0.3458373425 + x38 + x34 + x29;
@@ -6308,7 +5591,6 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x86 = x83*(x85 - x84*x78);
     const double x87 = 0.576873331938 + x79;
     const double x88 = x68 - 0.15005*x54;
-    stash[50] = x88;
     const double x89 = x88*x4 - x66*x7;
     const double x90 = x89*x61;
     const double x91 = x79 + 0.4318*x27;
@@ -6320,13 +5602,10 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x97 = x94*(x85 - x95*x78 - x96*x86);
     const double x98 = 0.19079062612368 + x32;
     const double x99 = x32 - 0.0203*x22;
-    stash[51] = x99;
     const double x100 = x19*x3;
     const double x101 = -0.15005*x100 + x46*x2 - x99*x3;
-    stash[52] = x101;
     const double x102 = x19*x2;
     const double x103 = -x43 + 0.15005*x102 + x99*x2 + x46*x3;
-    stash[53] = x103;
     const double x104 = x101*x7 + x103*x4;
     const double x105 = x104*x61;
     const double x106 = -x64 + 0.4318*x100;
@@ -6340,18 +5619,13 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x114 = x110*(x72 - x111*x78 - x112*x86 - x113*x97);
     const double x115 = x24*x18;
     const double x116 = 0.0203*x115;
-    stash[54] = x116;
     const double x117 = 0.4318*x115;
     const double x118 = 0.00064216*x18 + x117;
-    stash[55] = x118;
     const double x119 = x24*x10;
-    stash[56] = x119;
     const double x120 = -x119*x3 - x17*x2;
     const double x121 = -0.15005*x120 + x118*x2 + x3*x116;
-    stash[57] = x121;
     const double x122 = x17*x3 - x119*x2;
     const double x123 = 0.15005*x122 - x117 + x118*x3 - x2*x116;
-    stash[58] = x123;
     const double x124 = x121*x7 + x123*x4;
     const double x125 = x124*x61;
     const double x126 = 0.00064216*x10 + 0.4318*x119 - 0.0203*x17;
@@ -6368,10 +5642,8 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x137 = -x78 + x71*x86 - x97*x134 - x114*x135 - x133*x136;
     const double x138 = 0.19410450566800005 - x60*x78*x78 - x82*x86*x86 - x93*x97*x97 - x109*x114*x114 - x131*x133*x133;
     const double x139 = 1.0/x138;
-    stash[59] = x139;
     ((volatile double *)B)[71] = x139;
     const double x140 = x137*x139;
-    stash[60] = x140;
     ((volatile double *)B)[41] = x140;
     ((volatile double *)B)[66] = x140;
     const double x141 = x83*x71;
@@ -6379,28 +5651,23 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x143 = x110*x135;
     const double x144 = x132*x136;
     const double x145 = x61 + x71*x141 + x134*x142 + x135*x143 + x136*x144 + x137*x140;
-    stash[61] = x145;
     ((volatile double *)B)[36] = x145;
     const double x146 = -x107 + x92*x108;
     const double x147 = -x128 + x92*x129 - x130*x146;
     const double x148 = -x86 + x92*x97 - x114*x146 - x133*x147;
     const double x149 = -x141 + x146*x143 + x147*x144 + x148*x140 - x92*x142;
-    stash[62] = x149;
     ((volatile double *)B)[37] = x149;
     ((volatile double *)B)[42] = x149;
     const double x150 = -x129 + x108*x130;
     const double x151 = -x97 + x108*x114 - x133*x150;
     const double x152 = x142 + x150*x144 + x151*x140 - x108*x143;
-    stash[63] = x152;
     ((volatile double *)B)[38] = x152;
     ((volatile double *)B)[48] = x152;
     const double x153 = -x114 + x130*x133;
     const double x154 = x143 + x153*x140 - x130*x144;
-    stash[64] = x154;
     ((volatile double *)B)[39] = x154;
     ((volatile double *)B)[54] = x154;
     const double x155 = x144 - x133*x140;
-    stash[65] = x155;
     ((volatile double *)B)[40] = x155;
     ((volatile double *)B)[60] = x155;
     const double x156 = 0.015000000000000013*x16;
@@ -6418,9 +5685,7 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x168 = x167 + 0.068*x163;
     const double x169 = x156 + 0.13*x16 + 0.10439999999999999*x162 - 3.9585*x168;
     const double x170 = qd2 + qd3;
-    stash[66] = x170;
     const double x171 = x12*x170;
-    stash[67] = x171;
     const double x172 = 0.0735*x171;
     const double x173 = x12*qd3;
     const double x174 = x173 + x2*x16 - x3*x157;
@@ -6444,35 +5709,25 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x192 = x191 + 0.0141*x186 + x185;
     const double x193 = 0.066*x174 + 0.336*x182 - 0.06767999999999999*x192 + x172;
     const double x194 = x9*x10;
-    stash[68] = x194;
     const double x195 = x170*x18;
-    stash[69] = x195;
     const double x196 = x194 - x195;
-    stash[70] = x196;
     const double x197 = x12 + qd4;
-    stash[71] = x197;
     const double x198 = x196*x1 + x197*x0;
-    stash[72] = x198;
     const double x199 = x198*qd5;
     const double x200 = x9*qd3;
     const double x201 = -x200 - x2*x157 - x3*x16;
     const double x202 = -x9*x18 - x170*x10;
-    stash[73] = x202;
     const double x203 = x202*qd4;
     const double x204 = x203 + x174*x10;
     const double x205 = -x199 + x201*x1 - x204*x0;
     const double x206 = 4e-05*x205;
     const double x207 = qd5 - x202;
-    stash[74] = x207;
     const double x208 = 0.00010000000000000005*x207;
-    stash[75] = x208;
     const double x209 = -x198*x208;
     const double x210 = 0.0003*x205 + x209;
     const double x211 = x210 + x206;
     const double x212 = x202*x197;
-    stash[76] = x212;
     const double x213 = 0.0005*x212;
-    stash[77] = x213;
     const double x214 = x212 - x204;
     const double x215 = x9*x12;
     const double x216 = x175 + x183;
@@ -6486,24 +5741,16 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x224 = x223 + 0.019*x214;
     const double x225 = -x213 + 0.0018*x204 - 0.015579999999999998*x224;
     const double x226 = puma560_COS(4, q6);
-    stash[78] = x226;
     const double x227 = puma560_SIN(4, q6);
-    stash[79] = x227;
     const double x228 = x197*x1 - x0*x196;
-    stash[80] = x228;
     const double x229 = x208*x228;
-    stash[81] = x229;
     const double x230 = x228*qd5;
     const double x231 = x230 + x201*x0 + x204*x1;
     const double x232 = 0.0003*x231 + x229;
     const double x233 = -x198*x227 - x207*x226;
-    stash[82] = x233;
     const double x234 = x228 + qd6;
-    stash[83] = x234;
     const double x235 = x233*x234;
-    stash[84] = x235;
     const double x236 = 0.00010999999999999999*x235;
-    stash[85] = x236;
     const double x237 = x233*qd6;
     const double x238 = x196*qd4;
     const double x239 = -x238 - x174*x18;
@@ -6517,11 +5764,8 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x247 = x246 + 0.032*x241;
     const double x248 = -x236 + 0.00015*x240 - 0.0028799999999999997*x247;
     const double x249 = x198*x226;
-    stash[86] = x249;
     const double x250 = x207*x227;
-    stash[87] = x250;
     const double x251 = x249 - x250;
-    stash[88] = x251;
     const double x252 = x251*x234;
     const double x253 = 0.00010999999999999999*x252;
     const double x254 = x251*qd6;
@@ -6605,9 +5849,7 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x332 = x331 - x3*x324;
     const double x333 = x332*x10 + x329;
     const double x334 = -x15 + x327*x1 - x333*x0;
-    stash[89] = x334;
     const double x335 = 4e-05*x334;
-    stash[90] = x335;
     const double x336 = x13*qd4;
     const double x337 = -x336 - x332*x18;
     const double x338 = -x0*x13 - x1*x9;
@@ -6615,7 +5857,6 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x340 = -x328*x226 - x14*x227;
     const double x341 = x340*x234;
     const double x342 = 0.00010999999999999999*x339 + 0.00010999999999999999*x341;
-    stash[91] = x342;
     const double x343 = x340*qd6;
     const double x344 = x338*qd5;
     const double x345 = x327*x0 + x333*x1 + x344;
@@ -6638,20 +5879,17 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x362 = 0.4318*x361;
     const double x363 = x171 - x327;
     const double x364 = -x9*x170;
-    stash[92] = x364;
     const double x365 = x364 + x332;
     const double x366 = 0.0203*x363 + x362 + 0.4318*x365;
     const double x367 = -x360*x18 - x366*x10;
     const double x368 = x360*x10 - x366*x18;
     const double x369 = 2.0*x215;
     const double x370 = 0.0203*x349 - 0.4318*x369;
-    stash[93] = x370;
     const double x371 = x358*x2 - x3*x354;
     const double x372 = x370 + x371;
     const double x373 = x368*x1 + x372*x0;
     const double x374 = x367*x226 - x227*x373;
     const double x375 = x339 + x341;
-    stash[94] = x375;
     const double x376 = x375 - x346;
     const double x377 = x374 + 0.032*x376;
     const double x378 = -x342 + 0.00015*x346 - 0.0028799999999999997*x377;
@@ -6659,45 +5897,33 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x380 = x14*x226 - x227*x328;
     const double x381 = x380*x234;
     const double x382 = 0.00010999999999999999*x379 + 0.00010999999999999999*x381;
-    stash[95] = x382;
     const double x383 = x380*qd6;
-    stash[96] = x383;
     const double x384 = -x383 + x337*x226 - x345*x227;
     const double x385 = x367*x227 + x373*x226;
     const double x386 = x379 + x381;
-    stash[97] = x386;
     const double x387 = x384 + x386;
     const double x388 = x385 + 0.032*x387;
     const double x389 = x382 + 0.0028799999999999997*x388 + 0.00015*x384;
     const double x390 = -0.0004*x337 - x378*x227 - x389*x226;
-    stash[98] = x390;
     const double x391 = 0.00010000000000000005*x328;
     const double x392 = x391*x228 + x208*x338;
-    stash[99] = x392;
     const double x393 = x392 + 0.0003*x345;
     const double x394 = x393 + x378*x226 - x227*x389;
     const double x395 = x391*x198 + x208*x14;
-    stash[100] = x395;
     const double x396 = -x395 + 0.0003*x334;
     const double x397 = x396 + x335;
     const double x398 = 0.0013*x327 + x394*x0 + x397*x1;
-    stash[101] = x398;
     const double x399 = 0.053500000000000006*x348 + 0.053500000000000006*x175;
-    stash[102] = x399;
     const double x400 = 0.07*x349;
-    stash[103] = x400;
     const double x401 = x171 + x327;
     const double x402 = x359 + x400 + 0.0141*x401;
     const double x403 = -x399 - 0.336*x402;
     const double x404 = 2.0*x196;
-    stash[104] = x404;
     const double x405 = x404*x13;
     const double x406 = 2.0*x202;
-    stash[105] = x406;
     const double x407 = x406*x328;
     const double x408 = x405 - x407;
     const double x409 = -0.019*x408;
-    stash[106] = x409;
     const double x410 = x372 + x409;
     const double x411 = 0.09*x388;
     const double x412 = 0.09*x377;
@@ -6705,14 +5931,11 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x414 = x413 + 0.34*x373;
     const double x415 = x372*x1 - x0*x368;
     const double x416 = 2.0*x251;
-    stash[107] = x416;
     const double x417 = x416*x380;
     const double x418 = 2.0*x233;
-    stash[108] = x418;
     const double x419 = x418*x340;
     const double x420 = x417 + x419;
     const double x421 = -0.032*x420;
-    stash[109] = x421;
     const double x422 = x415 + x421;
     const double x423 = 0.09*x422 + 0.34*x415;
     const double x424 = x414*x0 + x423*x1;
@@ -6720,9 +5943,7 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x426 = -x9*x202;
     const double x427 = x328*x197;
     const double x428 = 0.0005*x427 - 0.0005*x426;
-    stash[110] = x428;
     const double x429 = x426 - x427;
-    stash[111] = x429;
     const double x430 = x429 - x333;
     const double x431 = x367 + 0.019*x430;
     const double x432 = x428 + 0.0018*x333 - 0.015579999999999998*x431;
@@ -6730,9 +5951,7 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x434 = -x9*x196;
     const double x435 = x13*x197;
     const double x436 = 0.0005*x434 + 0.0005*x435;
-    stash[112] = x436;
     const double x437 = x434 + x435;
-    stash[113] = x437;
     const double x438 = x337 + x437;
     const double x439 = x368 + 0.019*x438;
     const double x440 = x436 + 0.0018*x337 + 0.015579999999999998*x439;
@@ -6744,7 +5963,6 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x446 = -x445 + 0.82*x431;
     const double x447 = x443*x10 - x18*x446;
     const double x448 = x403 + 0.0203*x425 - 0.4318*x447 - x433*x18 - x441*x10;
-    stash[114] = x448;
     const double x449 = 0.394*x159 - 0.394*x158;
     const double x450 = x164 + 0.068*x351 + 0.006*x355;
     const double x451 = x450 + 0.2275*x353;
@@ -6753,34 +5971,27 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x454 = x449 + 1.1832*x453 - 0.10439999999999999*x451;
     const double x455 = x447 + 4.8*x402;
     const double x456 = -0.07*x369;
-    stash[115] = x456;
     const double x457 = x364 - x332;
     const double x458 = x371 + 0.0141*x457 + x456;
     const double x459 = x425 + 4.8*x458;
     const double x460 = x455*x3 + x459*x2;
     const double x461 = x454 + x448 + 0.4318*x460;
-    stash[116] = x461;
     const double x462 = x189 + 0.15005*x357;
     const double x463 = x148*x139;
-    stash[117] = x463;
     ((volatile double *)B)[47] = x463;
     ((volatile double *)B)[67] = x463;
     const double x464 = x94*x92;
     const double x465 = x110*x146;
     const double x466 = x132*x147;
     const double x467 = x83 + x92*x464 + x146*x465 + x147*x466 + x148*x463;
-    stash[118] = x467;
     ((volatile double *)B)[43] = x467;
     const double x468 = -x464 + x150*x466 + x151*x463 - x108*x465;
-    stash[119] = x468;
     ((volatile double *)B)[44] = x468;
     ((volatile double *)B)[49] = x468;
     const double x469 = x465 + x153*x463 - x130*x466;
-    stash[120] = x469;
     ((volatile double *)B)[45] = x469;
     ((volatile double *)B)[55] = x469;
     const double x470 = x466 - x133*x463;
-    stash[121] = x470;
     ((volatile double *)B)[46] = x470;
     ((volatile double *)B)[61] = x470;
     const double x471 = x313*x149 + x318*x467 + x319*x468 + x320*x469 + x321*x470 + x322*x463;
@@ -6788,22 +5999,17 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x473 = x16 - x324;
     const double x474 = x164 + 0.15005*x473 + 0.4318*x472;
     const double x475 = x462*x2 + x474*x3;
-    stash[122] = x475;
     const double x476 = x151*x139;
-    stash[123] = x476;
     ((volatile double *)B)[53] = x476;
     ((volatile double *)B)[68] = x476;
     const double x477 = x110*x108;
     const double x478 = x132*x150;
     const double x479 = x94 + x108*x477 + x150*x478 + x151*x476;
-    stash[124] = x479;
     ((volatile double *)B)[50] = x479;
     const double x480 = -x477 + x153*x476 - x130*x478;
-    stash[125] = x480;
     ((volatile double *)B)[51] = x480;
     ((volatile double *)B)[56] = x480;
     const double x481 = x478 - x133*x476;
-    stash[126] = x481;
     ((volatile double *)B)[52] = x481;
     ((volatile double *)B)[62] = x481;
     const double x482 = x313*x152 + x318*x468 + x319*x479 + x320*x480 + x321*x481 + x322*x476;
@@ -6811,154 +6017,115 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x484 = x215 - x483;
     const double x485 = x217 + x475 + 0.4318*x484;
     const double x486 = x485*x10;
-    stash[127] = x486;
     const double x487 = x157 - x325;
     const double x488 = 0.4318*x487 + x179;
     const double x489 = x3*x324;
     const double x490 = -x489 - x200 + x325*x2;
     const double x491 = x220 - x490;
     const double x492 = x326 + x2*x324;
-    stash[128] = x492;
     const double x493 = x492 + x171;
     const double x494 = x488 + 0.0203*x491 + 0.4318*x493;
     const double x495 = x494*x18;
-    stash[129] = x495;
     const double x496 = x486 - x495;
     const double x497 = x474*x2 - x3*x462;
-    stash[130] = x497;
     const double x498 = x215 + x483;
     const double x499 = x497 + 0.0203*x498 + x243;
     const double x500 = x496*x1 + x499*x0;
-    stash[131] = x500;
     const double x501 = -x485*x18 - x494*x10;
-    stash[132] = x501;
     const double x502 = x500*x226 + x501*x227;
-    stash[133] = x502;
     const double x503 = x203 + x492*x10 - x18*x483;
-    stash[134] = x503;
     const double x504 = x153*x139;
-    stash[135] = x504;
     ((volatile double *)B)[59] = x504;
     ((volatile double *)B)[69] = x504;
     const double x505 = x132*x130;
     const double x506 = x110 + x130*x505 + x153*x504;
-    stash[136] = x506;
     ((volatile double *)B)[57] = x506;
     const double x507 = -x505 - x133*x504;
-    stash[137] = x507;
     ((volatile double *)B)[58] = x507;
     ((volatile double *)B)[63] = x507;
     const double x508 = x313*x154 + x318*x469 + x319*x480 + x320*x506 + x321*x507 + x322*x504;
     const double x509 = x490 + x508;
-    stash[138] = x509;
     const double x510 = x230 + x1*x503 + x509*x0;
-    stash[139] = x510;
     const double x511 = x133*x139;
-    stash[140] = x511;
     ((volatile double *)B)[65] = -x511;
     ((volatile double *)B)[70] = -x511;
     const double x512 = x132 + x133*x511;
-    stash[141] = x512;
     ((volatile double *)B)[64] = x512;
     const double x513 = x313*x155 + x318*x470 + x319*x481 + x320*x507 + x321*x512 - x322*x511;
     const double x514 = x492*x18 + x483*x10;
-    stash[142] = x514;
     const double x515 = -x514 - x238;
     const double x516 = x513 - x515;
     const double x517 = x510*x227 + x516*x226;
-    stash[143] = x517;
     const double x518 = -x254 - x517;
     const double x519 = x252 + x518;
     const double x520 = x502 + 0.032*x519;
     const double x521 = 0.09*x520;
     const double x522 = x501*x226 - x500*x227;
-    stash[144] = x522;
     const double x523 = x237 + x510*x226 - x227*x516;
-    stash[145] = x523;
     const double x524 = x235 - x523;
     const double x525 = x522 + 0.032*x524;
     const double x526 = 0.09*x525;
     const double x527 = x521*x226 - x526*x227;
-    stash[146] = x527;
     const double x528 = x527 + 0.34*x500;
     const double x529 = x499*x1 - x0*x496;
-    stash[147] = x529;
     const double x530 = 0.34*x529;
-    stash[148] = x530;
     const double x531 = x529 + x277;
     const double x532 = 0.09*x531 + x530;
     const double x533 = x528*x1 - x0*x532;
-    stash[149] = x533;
     const double x534 = x262 + x515;
     const double x535 = x496 + 0.019*x534;
     const double x536 = x533 + 0.82*x535;
     const double x537 = x212 - x503;
     const double x538 = x501 + 0.019*x537;
     const double x539 = x521*x227 + x526*x226;
-    stash[150] = x539;
     const double x540 = -x539 - 0.34*x501;
     const double x541 = -x540 + 0.82*x538;
     const double x542 = x536*x10 - x18*x541;
-    stash[151] = x542;
     const double x543 = x220 + x490;
     const double x544 = x475 + 0.07*x484 + 0.0141*x543;
     const double x545 = x542 + 4.8*x544;
     const double x546 = x171 - x492;
     const double x547 = x497 + 0.0141*x546 + x185;
     const double x548 = x528*x0 + x532*x1;
-    stash[152] = x548;
     const double x549 = x499 + x298;
     const double x550 = x548 + 0.82*x549;
     const double x551 = x550 + 4.8*x547;
     const double x552 = x545*x3 + x551*x2;
-    stash[153] = x552;
     const double x553 = x536*x18 + x541*x10;
-    stash[154] = x553;
     const double x554 = -x236 + 0.00015*x523 - 0.0028799999999999997*x525;
     const double x555 = 0.0028799999999999997*x520 + 0.00015*x518 + x253;
     const double x556 = x554*x226 - x227*x555;
-    stash[155] = x556;
     const double x557 = x229 + 0.0003*x510;
     const double x558 = x556 + x557;
     const double x559 = x0*x503;
-    stash[156] = x559;
     const double x560 = -x559 - x199 + x509*x1;
     const double x561 = 0.0003*x560 + x209;
     const double x562 = x313*x140 + x318*x463 + x319*x476 + x320*x504 + x322*x139 - x321*x511;
     const double x563 = x560 + x562;
     const double x564 = x561 + 4e-05*x563;
     const double x565 = x558*x1 - x0*x564;
-    stash[157] = x565;
     const double x566 = -x213 + 0.0018*x503 - 0.015579999999999998*x538;
     const double x567 = x565 + x566;
-    stash[158] = x567;
     const double x568 = 0.0018*x515 + 0.015579999999999998*x535 + x263;
     const double x569 = x554*x227 + x555*x226;
-    stash[159] = x569;
     const double x570 = -x569 + 0.0004*x516;
     const double x571 = x568 - x570;
-    stash[160] = x571;
     const double x572 = x567*x10 - x18*x571;
-    stash[161] = x572;
     const double x573 = x488 + 0.07*x493 + x178;
     const double x574 = x172 + 0.066*x492 + 0.336*x573 - 0.06767999999999999*x547;
     const double x575 = x572 + x574 - 0.4318*x553;
     const double x576 = 0.06767999999999999*x544 + 0.0125*x490 + x287;
     const double x577 = x558*x0 + x564*x1;
-    stash[162] = x577;
     const double x578 = x577 + 0.0013*x509;
     const double x579 = x576 + x578 + 0.0203*x553;
     const double x580 = x575*x2 - x3*x579;
-    stash[163] = x580;
     const double x581 = x167 + 0.068*x472 + 0.2275*x473;
     const double x582 = x324 + x16;
     const double x583 = 0.068*x487 + 0.006*x582 + x161;
     const double x584 = x156 + 0.13*x324 + 0.10439999999999999*x583 - 3.9585*x581;
     const double x585 = x580 + x584 - 0.15005*x552;
     const double x586 = x545*x2 - x3*x551;
-    stash[164] = x586;
     const double x587 = x575*x3 + x579*x2;
-    stash[165] = x587;
     const double x588 = x163 - x471;
     const double x589 = x306 + 0.006*x588 + 0.2275*x357;
     const double x590 = -x305 + 0.524*x325 + 3.9585*x589 - 1.1832*x583;
@@ -6969,16 +6136,13 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x595 = 0.068*x361 + 0.006*x594;
     const double x596 = 0.13*x325 + 0.10439999999999999*x595 - 3.9585*x453 + x593;
     const double x597 = 0.0735*x364;
-    stash[166] = x597;
     const double x598 = x369 + x347;
     const double x599 = -0.0141*x598;
-    stash[167] = x599;
     const double x600 = 0.07*x365 + x362 + x599;
     const double x601 = 0.066*x332 + 0.336*x600 - 0.06767999999999999*x458 + x597;
     const double x602 = -x443*x18 - x446*x10;
     const double x603 = x601 + 0.4318*x602 + x433*x10 - x18*x441;
     const double x604 = -0.01999999999999999*x171;
-    stash[168] = x604;
     const double x605 = 0.06767999999999999*x402 + 0.0125*x327 + x604;
     const double x606 = x605 + x398 - 0.0203*x602;
     const double x607 = x596 - 0.15005*x460 + x603*x2 - x3*x606;
@@ -6988,237 +6152,21 @@ static puma560_NOINLINE void puma560_linearize_part1(const double q[], const dou
     const double x611 = x455*x2 - x3*x459;
     const double x612 = x609 + 0.15005*x611 - 0.4318*x610 + x603*x3 + x606*x2;
     const double x613 = x585*x4 + x607*x7 + x612*x4 - x7*x592;
-    stash[169] = x613;
     const double x614 = -x335*x140 - x390*x155 - x398*x154 - x448*x152 - x461*x149 - x613*x145;
     ((volatile double *)A)[73] = x614;
     const double x615 = x331 - x489;
-    stash[170] = x615;
     const double x616 = x615*x10 + x329;
-    stash[171] = x616;
     const double x617 = -x15 - x1*x492 - x616*x0;
-    stash[172] = x617;
     const double x618 = 4e-05*x617;
-    stash[173] = x618;
     const double x619 = -x336 - x615*x18;
-    stash[174] = x619;
     const double x620 = x344 + x616*x1 - x0*x492;
-    stash[175] = x620;
     const double x621 = x619*x227 + x620*x226 + x343;
-    stash[176] = x621;
     const double x622 = x350 + x497;
     const double x623 = x492 + x171;
     const double x624 = x364 + x615;
-    stash[177] = x624;
     const double x625 = 0.0203*x623 + 0.4318*x624;
     const double x626 = -x622*x18 - x625*x10;
-    stash[178] = x626;
     const double x627 = x622*x10 - x625*x18;
-    stash[179] = x627;
-}
-
-/* part 2 of 2 of puma560_linearize */
-static puma560_NOINLINE void puma560_linearize_part2(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[], double stash[]
-#ifdef puma560_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)q;
-    (void)tau;
-    (void)p;
-    (void)B;
-#ifdef puma560_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, puma560_SIN(k, a) does not read a */
-    const double x0 = stash[0];
-    const double x1 = stash[1];
-    const double x2 = stash[2];
-    const double x3 = stash[3];
-    const double x4 = stash[4];
-    const double x5 = stash[5];
-    const double x6 = stash[6];
-    const double x7 = stash[7];
-    const double x8 = stash[8];
-    const double x9 = stash[9];
-    const double x10 = stash[10];
-    const double x11 = stash[11];
-    const double x12 = stash[12];
-    const double x17 = stash[13];
-    const double x18 = stash[14];
-    const double x19 = stash[15];
-    const double x20 = stash[16];
-    const double x23 = stash[17];
-    const double x24 = stash[18];
-    const double x25 = stash[19];
-    const double x26 = stash[20];
-    const double x30 = stash[21];
-    const double x33 = stash[22];
-    const double x35 = stash[23];
-    const double x37 = stash[24];
-    const double x39 = stash[25];
-    const double x41 = stash[26];
-    const double x42 = stash[27];
-    const double x44 = stash[28];
-    const double x45 = stash[29];
-    const double x46 = stash[30];
-    const double x47 = stash[31];
-    const double x48 = stash[32];
-    const double x50 = stash[33];
-    const double x52 = stash[34];
-    const double x53 = stash[35];
-    const double x55 = stash[36];
-    const double x56 = stash[37];
-    const double x57 = stash[38];
-    const double x62 = stash[39];
-    const double x63 = stash[40];
-    const double x65 = stash[41];
-    const double x66 = stash[42];
-    const double x67 = stash[43];
-    const double x69 = stash[44];
-    const double x72 = stash[45];
-    const double x73 = stash[46];
-    const double x74 = stash[47];
-    const double x75 = stash[48];
-    const double x76 = stash[49];
-    const double x88 = stash[50];
-    const double x99 = stash[51];
-    const double x101 = stash[52];
-    const double x103 = stash[53];
-    const double x116 = stash[54];
-    const double x118 = stash[55];
-    const double x119 = stash[56];
-    const double x121 = stash[57];
-    const double x123 = stash[58];
-    const double x139 = stash[59];
-    const double x140 = stash[60];
-    const double x145 = stash[61];
-    const double x149 = stash[62];
-    const double x152 = stash[63];
-    const double x154 = stash[64];
-    const double x155 = stash[65];
-    const double x170 = stash[66];
-    const double x171 = stash[67];
-    const double x194 = stash[68];
-    const double x195 = stash[69];
-    const double x196 = stash[70];
-    const double x197 = stash[71];
-    const double x198 = stash[72];
-    const double x202 = stash[73];
-    const double x207 = stash[74];
-    const double x208 = stash[75];
-    const double x212 = stash[76];
-    const double x213 = stash[77];
-    const double x226 = stash[78];
-    const double x227 = stash[79];
-    const double x228 = stash[80];
-    const double x229 = stash[81];
-    const double x233 = stash[82];
-    const double x234 = stash[83];
-    const double x235 = stash[84];
-    const double x236 = stash[85];
-    const double x249 = stash[86];
-    const double x250 = stash[87];
-    const double x251 = stash[88];
-    const double x334 = stash[89];
-    const double x335 = stash[90];
-    const double x342 = stash[91];
-    const double x364 = stash[92];
-    const double x370 = stash[93];
-    const double x375 = stash[94];
-    const double x382 = stash[95];
-    const double x383 = stash[96];
-    const double x386 = stash[97];
-    const double x390 = stash[98];
-    const double x392 = stash[99];
-    const double x395 = stash[100];
-    const double x398 = stash[101];
-    const double x399 = stash[102];
-    const double x400 = stash[103];
-    const double x404 = stash[104];
-    const double x406 = stash[105];
-    const double x409 = stash[106];
-    const double x416 = stash[107];
-    const double x418 = stash[108];
-    const double x421 = stash[109];
-    const double x428 = stash[110];
-    const double x429 = stash[111];
-    const double x436 = stash[112];
-    const double x437 = stash[113];
-    const double x448 = stash[114];
-    const double x456 = stash[115];
-    const double x461 = stash[116];
-    const double x463 = stash[117];
-    const double x467 = stash[118];
-    const double x468 = stash[119];
-    const double x469 = stash[120];
-    const double x470 = stash[121];
-    const double x475 = stash[122];
-    const double x476 = stash[123];
-    const double x479 = stash[124];
-    const double x480 = stash[125];
-    const double x481 = stash[126];
-    const double x486 = stash[127];
-    const double x492 = stash[128];
-    const double x495 = stash[129];
-    const double x497 = stash[130];
-    const double x500 = stash[131];
-    const double x501 = stash[132];
-    const double x502 = stash[133];
-    const double x503 = stash[134];
-    const double x504 = stash[135];
-    const double x506 = stash[136];
-    const double x507 = stash[137];
-    const double x509 = stash[138];
-    const double x510 = stash[139];
-    const double x511 = stash[140];
-    const double x512 = stash[141];
-    const double x514 = stash[142];
-    const double x517 = stash[143];
-    const double x522 = stash[144];
-    const double x523 = stash[145];
-    const double x527 = stash[146];
-    const double x529 = stash[147];
-    const double x530 = stash[148];
-    const double x533 = stash[149];
-    const double x539 = stash[150];
-    const double x542 = stash[151];
-    const double x548 = stash[152];
-    const double x552 = stash[153];
-    const double x553 = stash[154];
-    const double x556 = stash[155];
-    const double x559 = stash[156];
-    const double x565 = stash[157];
-    const double x567 = stash[158];
-    const double x569 = stash[159];
-    const double x571 = stash[160];
-    const double x572 = stash[161];
-    const double x577 = stash[162];
-    const double x580 = stash[163];
-    const double x586 = stash[164];
-    const double x587 = stash[165];
-    const double x597 = stash[166];
-    const double x599 = stash[167];
-    const double x604 = stash[168];
-    const double x613 = stash[169];
-    const double x615 = stash[170];
-    const double x616 = stash[171];
-    const double x617 = stash[172];
-    const double x618 = stash[173];
-    const double x619 = stash[174];
-    const double x620 = stash[175];
-    const double x621 = stash[176];
-    const double x624 = stash[177];
-    const double x626 = stash[178];
-    const double x627 = stash[179];
     const double x628 = x370 - x475;
     const double x629 = x627*x1 + x628*x0;
     const double x630 = x626*x226 - x227*x629;
@@ -7890,55 +6838,4 @@ static puma560_NOINLINE void puma560_linearize_part2(const double q[], const dou
     ((volatile double *)A)[142] = x1232;
     const double x1233 = -0.2158232532732*x139 - x1155*x504 - x1165*x476 - x1168*x463 - x1177*x140 + 2.0*x1151*x511;
     ((volatile double *)A)[143] = x1233;
-}
-
-/* xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1] (3654 operations: 2026 multiplications, 1606 additions, 6 divisions, 10 trigonometric calls, 6 other calls) */
-void puma560_linearize(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[])
-{
-    (void)p;
-    /* the runs of zeros of A (the inputs are read), then the rest as it is known */
-    for (int k = 0; k < 6; ++k) A[k] = 0;
-    for (int k = 7; k < 19; ++k) A[k] = 0;
-    for (int k = 20; k < 32; ++k) A[k] = 0;
-    for (int k = 33; k < 45; ++k) A[k] = 0;
-    for (int k = 46; k < 58; ++k) A[k] = 0;
-    for (int k = 59; k < 71; ++k) A[k] = 0;
-    A[72] = 0;
-    A[84] = 0;
-    A[96] = 0;
-    A[108] = 0;
-    A[120] = 0;
-    A[132] = 0;
-    /* the runs of zeros of B (the inputs are read), then the rest as it is known */
-    for (int k = 0; k < 36; ++k) B[k] = 0;
-#ifdef puma560_SINCOS_VECTOR
-    const double q2 = q[1];
-    const double q3 = q[2];
-    const double q4 = q[3];
-    const double q5 = q[4];
-    const double q6 = q[5];
-    const double angle[8] = {
-        q5,
-        q3,
-        q2,
-        q4,
-        q6,
-        0.0,
-        0.0,
-        0.0
-    };
-    double sine[8], cosine[8];
-    puma560_sincos(5, angle, sine, cosine);
-#endif
-    double stash[180];
-    puma560_linearize_part1(q, qd, tau, p, A, B, stash
-#ifdef puma560_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-    puma560_linearize_part2(q, qd, tau, p, A, B, stash
-#ifdef puma560_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
 }

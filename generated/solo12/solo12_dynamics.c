@@ -98,15 +98,6 @@ static void solo12_sincos(int n, const double *restrict x, double *restrict s, d
 #define solo12_COS(k, a) cos(a)
 #endif
 
-/* keeps each part of a large function a function of its own (symdyn.codegen.c.parts) */
-#if defined(__GNUC__)
-#define solo12_NOINLINE __attribute__((noinline))
-#elif defined(_MSC_VER)
-#define solo12_NOINLINE __declspec(noinline)
-#else
-#define solo12_NOINLINE
-#endif
-
 /* tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (948 operations: 516 multiplications, 408 additions, 0 divisions, 24 trigonometric calls, 0 other calls) */
 void solo12_inverse_dynamics(const double q[], const double qd[], const double qdd[], const double p[], double tau[])
 {
@@ -3863,100 +3854,93 @@ void solo12_base_regressor(const double q[], const double qd[], const double qdd
     ((volatile double *)Yb)[1151] = x359;
 }
 
-/* part 1 of 2 of solo12_inverse_dynamics_derivatives */
-static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[], double stash[]
-#ifdef solo12_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
+/* dtau/dq and dtau/dqd of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (3256 operations: 1720 multiplications, 1512 additions, 0 divisions, 24 trigonometric calls, 0 other calls) */
+void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[])
 {
     (void)p;
-    (void)dtau_dqd;
-#ifdef solo12_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
     const double q1 = q[0];
-    (void)q1; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q2 = q[1];
-    (void)q2; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q3 = q[2];
-    (void)q3; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q4 = q[3];
-    (void)q4; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q5 = q[4];
-    (void)q5; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q6 = q[5];
-    (void)q6; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q7 = q[6];
-    (void)q7; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q8 = q[7];
-    (void)q8; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q9 = q[8];
-    (void)q9; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q10 = q[9];
-    (void)q10; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q11 = q[10];
-    (void)q11; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q12 = q[11];
-    (void)q12; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd1 = qd[0];
-    (void)qd1; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd3 = qd[2];
-    (void)qd3; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd7 = qd[6];
-    (void)qd7; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd8 = qd[7];
-    (void)qd8; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd9 = qd[8];
-    (void)qd9; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd10 = qd[9];
-    (void)qd10; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd11 = qd[10];
-    (void)qd11; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd12 = qd[11];
-    (void)qd12; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd1 = qdd[0];
-    (void)qdd1; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd2 = qdd[1];
-    (void)qdd2; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd3 = qdd[2];
-    (void)qdd3; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd4 = qdd[3];
-    (void)qdd4; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd5 = qdd[4];
-    (void)qdd5; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd6 = qdd[5];
-    (void)qdd6; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd7 = qdd[6];
-    (void)qdd7; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd8 = qdd[7];
-    (void)qdd8; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd9 = qdd[8];
-    (void)qdd9; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd10 = qdd[9];
-    (void)qdd10; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd11 = qdd[10];
-    (void)qdd11; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qdd12 = qdd[11];
-    (void)qdd12; /* with AVX2, solo12_SIN(k, a) does not read a */
+    /* the runs of zeros of dtau_dq (the inputs are read), then the rest as it is known */
+    for (int k = 3; k < 12; ++k) dtau_dq[k] = 0;
+    for (int k = 15; k < 24; ++k) dtau_dq[k] = 0;
+    for (int k = 27; k < 39; ++k) dtau_dq[k] = 0;
+    for (int k = 42; k < 51; ++k) dtau_dq[k] = 0;
+    for (int k = 54; k < 63; ++k) dtau_dq[k] = 0;
+    for (int k = 66; k < 78; ++k) dtau_dq[k] = 0;
+    for (int k = 81; k < 90; ++k) dtau_dq[k] = 0;
+    for (int k = 93; k < 102; ++k) dtau_dq[k] = 0;
+    for (int k = 105; k < 117; ++k) dtau_dq[k] = 0;
+    for (int k = 120; k < 129; ++k) dtau_dq[k] = 0;
+    for (int k = 132; k < 141; ++k) dtau_dq[k] = 0;
+    /* the runs of zeros of dtau_dqd (the inputs are read), then the rest as it is known */
+    for (int k = 3; k < 12; ++k) dtau_dqd[k] = 0;
+    for (int k = 15; k < 24; ++k) dtau_dqd[k] = 0;
+    for (int k = 27; k < 39; ++k) dtau_dqd[k] = 0;
+    for (int k = 42; k < 51; ++k) dtau_dqd[k] = 0;
+    for (int k = 54; k < 63; ++k) dtau_dqd[k] = 0;
+    for (int k = 66; k < 78; ++k) dtau_dqd[k] = 0;
+    for (int k = 81; k < 90; ++k) dtau_dqd[k] = 0;
+    for (int k = 93; k < 102; ++k) dtau_dqd[k] = 0;
+    for (int k = 105; k < 117; ++k) dtau_dqd[k] = 0;
+    for (int k = 120; k < 129; ++k) dtau_dqd[k] = 0;
+    for (int k = 132; k < 141; ++k) dtau_dqd[k] = 0;
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q2,
+        q1,
+        q3,
+        q5,
+        q4,
+        q6,
+        q8,
+        q7,
+        q9,
+        q11,
+        q10,
+        q12
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
     const double x0 = solo12_SIN(0, q2);
-    stash[0] = x0;
     const double x1 = solo12_COS(0, q2);
-    stash[1] = x1;
     const double x2 = 9.81*solo12_SIN(1, q1);
     const double x3 = solo12_SIN(2, q3);
-    stash[2] = x3;
     const double x4 = solo12_COS(2, q3);
-    stash[3] = x4;
     const double x5 = x2*x0;
     const double x6 = x2*x1;
     const double x7 = x5*x4 + x6*x3;
@@ -3980,12 +3964,10 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x24 = x9 + 0.014*qdd1;
     const double x25 = x24*x0;
     const double x26 = qd1*x1;
-    stash[4] = x26;
     const double x27 = x26*qd2;
     const double x28 = x27 + qdd1*x0;
     const double x29 = x27 - x28;
     const double x30 = qd1*x0;
-    stash[5] = x30;
     const double x31 = x26*x30;
     const double x32 = x31 + qdd2;
     const double x33 = -x25 + 0.03745*x29 - 0.16*x32;
@@ -4001,16 +3983,13 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x43 = x33*x4 - x3*x42;
     const double x44 = 0.03763607*x43;
     const double x45 = x4*x26 - x3*x30;
-    stash[6] = x45;
     const double x46 = qd2 + qd3;
-    stash[7] = x46;
     const double x47 = x45*x46;
     const double x48 = x45*qd3;
     const double x49 = x48 + x39*x3;
     const double x50 = x49 + x28*x4;
     const double x51 = x47 - x50;
     const double x52 = x3*x26 + x4*x30;
-    stash[8] = x52;
     const double x53 = x52*x45;
     const double x54 = qdd2 + qdd3;
     const double x55 = x53 + x54;
@@ -4067,11 +4046,8 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x106 = x103 + x104 + x105 + 0.0002730308797879413*qdd2 + 8.590521094399056e-05*x28;
     const double x107 = x106 + x99 - 0.03745*x98;
     const double x108 = 3.959544277738894e-08*x30;
-    stash[9] = x108;
     const double x109 = 0.0002730308797879413*x26;
-    stash[10] = x109;
     const double x110 = x108 + x109;
-    stash[11] = x110;
     const double x111 = -x101 + 8.590521094399056e-05*x26;
     const double x112 = -x100 + x111*qd2 - x110*x30;
     const double x113 = x104 + x112 - x105 - 0.001386899962102278*x28;
@@ -4084,9 +4060,7 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x120 = x47 - x119;
     const double x121 = -x117 - 0.0060217712000000005*x118 - 0.0038482516772413004*x120;
     const double x122 = 3.3497340042275575e-05*x45;
-    stash[12] = x122;
     const double x123 = 5.038484487542601e-06*x45;
-    stash[13] = x123;
     const double x124 = -x80 + x123*x46 - x122*x52;
     const double x125 = x34 - x72;
     const double x126 = 0.16*x125;
@@ -4161,7 +4135,6 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x191 = x102*x26 + x88*x30 + x30*x150 - x26*x111;
     const double x192 = x191 + 3.959544277738894e-08*x28 + 2.0453744564999998e-06*x25 + 0.0002730308797879413*x39 + 0.01169101578415*x41;
     const double x193 = 0.0005446477058047094*x52;
-    stash[14] = x193;
     const double x194 = 0.0005396092213171668*x57 + x70*x52 - x193*x52;
     const double x195 = x194 + 3.3497340042275575e-05*x138 - 0.0038482516772413004*x139;
     ((volatile double *)dtau_dq)[25] = x195;
@@ -4172,14 +4145,10 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x198 = x197 - 0.16*x184;
     ((volatile double *)dtau_dq)[14] = x198;
     const double x199 = solo12_SIN(3, q5);
-    stash[15] = x199;
     const double x200 = solo12_COS(3, q5);
-    stash[16] = x200;
     const double x201 = 9.81*solo12_SIN(4, q4);
     const double x202 = solo12_SIN(5, q6);
-    stash[17] = x202;
     const double x203 = solo12_COS(5, q6);
-    stash[18] = x203;
     const double x204 = x201*x199;
     const double x205 = x201*x200;
     const double x206 = x204*x203 + x205*x202;
@@ -4203,12 +4172,10 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x223 = x208 - 0.014*qdd4;
     const double x224 = x223*x199;
     const double x225 = qd4*x200;
-    stash[19] = x225;
     const double x226 = x225*qd5;
     const double x227 = x226 + qdd4*x199;
     const double x228 = x226 - x227;
     const double x229 = qd4*x199;
-    stash[20] = x229;
     const double x230 = x225*x229;
     const double x231 = x230 + qdd5;
     const double x232 = -x224 - 0.03745*x228 - 0.16*x231;
@@ -4223,16 +4190,13 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x241 = x236 + x240 - 0.03745*x239;
     const double x242 = x232*x203 - x202*x241;
     const double x243 = x203*x225 - x202*x229;
-    stash[21] = x243;
     const double x244 = qd5 + qd6;
-    stash[22] = x244;
     const double x245 = x243*x244;
     const double x246 = x243*qd6;
     const double x247 = x246 + x238*x202;
     const double x248 = x247 + x203*x227;
     const double x249 = x245 - x248;
     const double x250 = x202*x225 + x203*x229;
-    stash[23] = x250;
     const double x251 = x250*x243;
     const double x252 = qdd5 + qdd6;
     const double x253 = x251 + x252;
@@ -4291,9 +4255,7 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x306 = -x298 - x300 - x305 + 8.590521094399056e-05*x227 - 0.0002730308797879413*qdd5;
     const double x307 = x306 + x297 + 0.03745*x296;
     const double x308 = 3.959544277738894e-08*x229;
-    stash[24] = x308;
     const double x309 = 0.0002730308797879413*x225;
-    stash[25] = x309;
     const double x310 = x308 - x309;
     const double x311 = x302 + 8.590521094399056e-05*x225;
     const double x312 = x311*qd5 - x229*x310;
@@ -4307,9 +4269,7 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x320 = x245 - x319;
     const double x321 = -x317 - 0.0060217712000000005*x318 - 0.0038482516772413004*x320;
     const double x322 = 3.3497340042275575e-05*x243;
-    stash[26] = x322;
     const double x323 = 5.038484487542601e-06*x243;
-    stash[27] = x323;
     const double x324 = -x278 + x322*x250 + x323*x244;
     const double x325 = x233 - x270;
     const double x326 = 0.16*x325;
@@ -4394,14 +4354,10 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x398 = x397 - 0.16*x385;
     ((volatile double *)dtau_dq)[53] = x398;
     const double x399 = solo12_SIN(6, q8);
-    stash[28] = x399;
     const double x400 = solo12_COS(6, q8);
-    stash[29] = x400;
     const double x401 = 9.81*solo12_SIN(7, q7);
     const double x402 = solo12_SIN(8, q9);
-    stash[30] = x402;
     const double x403 = solo12_COS(8, q9);
-    stash[31] = x403;
     const double x404 = x401*x399;
     const double x405 = x401*x400;
     const double x406 = x404*x403 + x405*x402;
@@ -4425,12 +4381,10 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x423 = x408 + 0.014*qdd7;
     const double x424 = x423*x399;
     const double x425 = qd7*x400;
-    stash[32] = x425;
     const double x426 = x425*qd8;
     const double x427 = x426 + qdd7*x399;
     const double x428 = x426 - x427;
     const double x429 = qd7*x399;
-    stash[33] = x429;
     const double x430 = x425*x429;
     const double x431 = x430 + qdd8;
     const double x432 = -x424 + 0.03745*x428 - 0.16*x431;
@@ -4446,16 +4400,13 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x442 = x432*x403 - x441*x402;
     const double x443 = 0.03763607*x442;
     const double x444 = x403*x425 - x429*x402;
-    stash[34] = x444;
     const double x445 = qd8 + qd9;
-    stash[35] = x445;
     const double x446 = x444*x445;
     const double x447 = x444*qd9;
     const double x448 = x447 + x438*x402;
     const double x449 = x448 + x403*x427;
     const double x450 = x446 - x449;
     const double x451 = x403*x429 + x425*x402;
-    stash[36] = x451;
     const double x452 = x451*x444;
     const double x453 = qdd8 + qdd9;
     const double x454 = x452 + x453;
@@ -4512,11 +4463,8 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x505 = x502 + x503 + x504 + 0.0002730308797879413*qdd8 + 8.590521094399056e-05*x427;
     const double x506 = x505 + x498 - 0.03745*x497;
     const double x507 = 3.959544277738894e-08*x429;
-    stash[37] = x507;
     const double x508 = 0.0002730308797879413*x425;
-    stash[38] = x508;
     const double x509 = x507 + x508;
-    stash[39] = x509;
     const double x510 = -x500 + 8.590521094399056e-05*x425;
     const double x511 = -x499 + x510*qd8 - x429*x509;
     const double x512 = x503 + x511 - x504 - 0.001386899962102278*x427;
@@ -4529,9 +4477,7 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x519 = x446 - x518;
     const double x520 = -x516 - 0.0060217712000000005*x517 - 0.0038482516772413004*x519;
     const double x521 = 3.3497340042275575e-05*x444;
-    stash[40] = x521;
     const double x522 = 5.038484487542601e-06*x444;
-    stash[41] = x522;
     const double x523 = -x479 + x522*x445 - x451*x521;
     const double x524 = x433 - x471;
     const double x525 = 0.16*x524;
@@ -4606,7 +4552,6 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x590 = x501*x425 + x487*x429 + x429*x549 - x425*x510;
     const double x591 = x590 + 3.959544277738894e-08*x427 + 2.0453744564999998e-06*x424 + 0.0002730308797879413*x438 + 0.01169101578415*x440;
     const double x592 = 0.0005446477058047094*x451;
-    stash[42] = x592;
     const double x593 = 0.0005396092213171668*x456 + x469*x451 - x592*x451;
     const double x594 = x593 + 3.3497340042275575e-05*x537 - 0.0038482516772413004*x538;
     ((volatile double *)dtau_dq)[103] = x594;
@@ -4617,21 +4562,13 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x597 = x596 - 0.16*x583;
     ((volatile double *)dtau_dq)[92] = x597;
     const double x598 = solo12_SIN(9, q11);
-    stash[43] = x598;
     const double x599 = solo12_COS(9, q11);
-    stash[44] = x599;
     const double x600 = 9.81*solo12_SIN(10, q10);
-    stash[45] = x600;
     const double x601 = solo12_SIN(11, q12);
-    stash[46] = x601;
     const double x602 = solo12_COS(11, q12);
-    stash[47] = x602;
     const double x603 = x600*x598;
-    stash[48] = x603;
     const double x604 = x600*x599;
-    stash[49] = x604;
     const double x605 = x603*x602 + x604*x601;
-    stash[50] = x605;
     const double x606 = 0.0002972952667644*x605;
     const double x607 = 9.81*solo12_COS(10, q10);
     const double x608 = 0.0028754860404784995*x604 + 0.01169101578415*x607;
@@ -4643,7 +4580,6 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     const double x614 = x608 + 0.0060217712000000005*x607 - 0.03745*x613 + x610*x602 + x601*x606;
     const double x615 = 0.0028754860404784995*x603 - 2.0453744564999998e-06*x607;
     const double x616 = x611*x605 + x612*x609;
-    stash[51] = x616;
     const double x617 = x615 + 0.03745*x616 - x601*x610 + x602*x606;
     const double x618 = x616 + 0.14853845*x603;
     const double x619 = x613 - 0.14853845*x604;
@@ -4652,172 +4588,35 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part1(const doub
     ((volatile double *)dtau_dq)[117] = x621;
     const double x622 = x607 - 0.014*qdd10;
     const double x623 = x622*x598;
-    stash[52] = x623;
     const double x624 = qd10*x599;
-    stash[53] = x624;
     const double x625 = x624*qd11;
-    stash[54] = x625;
     const double x626 = x625 + qdd10*x598;
-    stash[55] = x626;
     const double x627 = x625 - x626;
-    stash[56] = x627;
     const double x628 = qd10*x598;
-    stash[57] = x628;
     const double x629 = x624*x628;
-    stash[58] = x629;
     const double x630 = x629 + qdd11;
-    stash[59] = x630;
     const double x631 = -x623 - 0.03745*x627 - 0.16*x630;
-    stash[60] = x631;
     const double x632 = x624*x624;
-    stash[61] = x632;
     const double x633 = qd11*qd11;
-    stash[62] = x633;
     const double x634 = x632 + x633;
-    stash[63] = x634;
     const double x635 = 0.16*x634;
     const double x636 = x628*qd11;
-    stash[64] = x636;
     const double x637 = -x636 + qdd10*x599;
-    stash[65] = x637;
     const double x638 = x636 + x637;
-    stash[66] = x638;
     const double x639 = x622*x599;
-    stash[67] = x639;
     const double x640 = x635 + x639 - 0.03745*x638;
-    stash[68] = x640;
     const double x641 = x631*x602 - x601*x640;
-    stash[69] = x641;
     const double x642 = x602*x624 - x601*x628;
-    stash[70] = x642;
     const double x643 = qd11 + qd12;
-    stash[71] = x643;
     const double x644 = x642*x643;
-    stash[72] = x644;
     const double x645 = x642*qd12;
     const double x646 = x645 + x637*x601;
-    stash[73] = x646;
     const double x647 = x646 + x602*x626;
-    stash[74] = x647;
     const double x648 = x644 - x647;
-    stash[75] = x648;
     const double x649 = x601*x624 + x602*x628;
-    stash[76] = x649;
     const double x650 = x649*x642;
-    stash[77] = x650;
     const double x651 = qdd11 + qdd12;
-    stash[78] = x651;
     const double x652 = x650 + x651;
-    stash[79] = x652;
-}
-
-/* part 2 of 2 of solo12_inverse_dynamics_derivatives */
-static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part2(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[], double stash[]
-#ifdef solo12_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)q;
-    (void)p;
-#ifdef solo12_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd8 = qd[7];
-    (void)qd8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd10 = qd[9];
-    (void)qd10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd11 = qd[10];
-    (void)qd11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd12 = qd[11];
-    (void)qd12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qdd11 = qdd[10];
-    (void)qdd11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double x0 = stash[0];
-    const double x1 = stash[1];
-    const double x3 = stash[2];
-    const double x4 = stash[3];
-    const double x26 = stash[4];
-    const double x30 = stash[5];
-    const double x45 = stash[6];
-    const double x46 = stash[7];
-    const double x52 = stash[8];
-    const double x108 = stash[9];
-    const double x109 = stash[10];
-    const double x110 = stash[11];
-    const double x122 = stash[12];
-    const double x123 = stash[13];
-    const double x193 = stash[14];
-    const double x199 = stash[15];
-    const double x200 = stash[16];
-    const double x202 = stash[17];
-    const double x203 = stash[18];
-    const double x225 = stash[19];
-    const double x229 = stash[20];
-    const double x243 = stash[21];
-    const double x244 = stash[22];
-    const double x250 = stash[23];
-    const double x308 = stash[24];
-    const double x309 = stash[25];
-    const double x322 = stash[26];
-    const double x323 = stash[27];
-    const double x399 = stash[28];
-    const double x400 = stash[29];
-    const double x402 = stash[30];
-    const double x403 = stash[31];
-    const double x425 = stash[32];
-    const double x429 = stash[33];
-    const double x444 = stash[34];
-    const double x445 = stash[35];
-    const double x451 = stash[36];
-    const double x507 = stash[37];
-    const double x508 = stash[38];
-    const double x509 = stash[39];
-    const double x521 = stash[40];
-    const double x522 = stash[41];
-    const double x592 = stash[42];
-    const double x598 = stash[43];
-    const double x599 = stash[44];
-    const double x600 = stash[45];
-    const double x601 = stash[46];
-    const double x602 = stash[47];
-    const double x603 = stash[48];
-    const double x604 = stash[49];
-    const double x605 = stash[50];
-    const double x616 = stash[51];
-    const double x623 = stash[52];
-    const double x624 = stash[53];
-    const double x625 = stash[54];
-    const double x626 = stash[55];
-    const double x627 = stash[56];
-    const double x628 = stash[57];
-    const double x629 = stash[58];
-    const double x630 = stash[59];
-    const double x631 = stash[60];
-    const double x632 = stash[61];
-    const double x633 = stash[62];
-    const double x634 = stash[63];
-    const double x636 = stash[64];
-    const double x637 = stash[65];
-    const double x638 = stash[66];
-    const double x639 = stash[67];
-    const double x640 = stash[68];
-    const double x641 = stash[69];
-    const double x642 = stash[70];
-    const double x643 = stash[71];
-    const double x644 = stash[72];
-    const double x646 = stash[73];
-    const double x647 = stash[74];
-    const double x648 = stash[75];
-    const double x649 = stash[76];
-    const double x650 = stash[77];
-    const double x651 = stash[78];
-    const double x652 = stash[79];
     const double x653 = 0.03763607*x641 - 0.0002972952667644*x648 - 0.0038482516772413004*x652;
     const double x654 = x642*x642;
     const double x655 = x643*x643;
@@ -5501,35 +5300,10 @@ static solo12_NOINLINE void solo12_inverse_dynamics_derivatives_part2(const doub
     ((volatile double *)dtau_dqd)[143] = x1289;
 }
 
-/* dtau/dq and dtau/dqd of tau = M(q) qdd + V(q, qd) + G(q) + F(qd) (3256 operations: 1720 multiplications, 1512 additions, 0 divisions, 24 trigonometric calls, 0 other calls) */
-void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], const double qdd[], const double p[], double dtau_dq[], double dtau_dqd[])
+/* dqdd/dq and dqdd/dqd of qdd = FD(q, qd, tau) = M(q)^-1 (tau - V - G - F), and M(q)^-1 (4418 operations: 2374 multiplications, 2012 additions, 8 divisions, 24 trigonometric calls, 0 other calls) */
+void solo12_forward_dynamics_derivatives(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[])
 {
     (void)p;
-    /* the runs of zeros of dtau_dq (the inputs are read), then the rest as it is known */
-    for (int k = 3; k < 12; ++k) dtau_dq[k] = 0;
-    for (int k = 15; k < 24; ++k) dtau_dq[k] = 0;
-    for (int k = 27; k < 39; ++k) dtau_dq[k] = 0;
-    for (int k = 42; k < 51; ++k) dtau_dq[k] = 0;
-    for (int k = 54; k < 63; ++k) dtau_dq[k] = 0;
-    for (int k = 66; k < 78; ++k) dtau_dq[k] = 0;
-    for (int k = 81; k < 90; ++k) dtau_dq[k] = 0;
-    for (int k = 93; k < 102; ++k) dtau_dq[k] = 0;
-    for (int k = 105; k < 117; ++k) dtau_dq[k] = 0;
-    for (int k = 120; k < 129; ++k) dtau_dq[k] = 0;
-    for (int k = 132; k < 141; ++k) dtau_dq[k] = 0;
-    /* the runs of zeros of dtau_dqd (the inputs are read), then the rest as it is known */
-    for (int k = 3; k < 12; ++k) dtau_dqd[k] = 0;
-    for (int k = 15; k < 24; ++k) dtau_dqd[k] = 0;
-    for (int k = 27; k < 39; ++k) dtau_dqd[k] = 0;
-    for (int k = 42; k < 51; ++k) dtau_dqd[k] = 0;
-    for (int k = 54; k < 63; ++k) dtau_dqd[k] = 0;
-    for (int k = 66; k < 78; ++k) dtau_dqd[k] = 0;
-    for (int k = 81; k < 90; ++k) dtau_dqd[k] = 0;
-    for (int k = 93; k < 102; ++k) dtau_dqd[k] = 0;
-    for (int k = 105; k < 117; ++k) dtau_dqd[k] = 0;
-    for (int k = 120; k < 129; ++k) dtau_dqd[k] = 0;
-    for (int k = 132; k < 141; ++k) dtau_dqd[k] = 0;
-#ifdef solo12_SINCOS_VECTOR
     const double q1 = q[0];
     const double q2 = q[1];
     const double q3 = q[2];
@@ -5542,113 +5316,90 @@ void solo12_inverse_dynamics_derivatives(const double q[], const double qd[], co
     const double q10 = q[9];
     const double q11 = q[10];
     const double q12 = q[11];
+    const double qd1 = qd[0];
+    const double qd2 = qd[1];
+    const double qd3 = qd[2];
+    const double qd4 = qd[3];
+    const double qd5 = qd[4];
+    const double qd6 = qd[5];
+    const double qd7 = qd[6];
+    const double qd8 = qd[7];
+    const double qd9 = qd[8];
+    const double qd10 = qd[9];
+    const double qd11 = qd[10];
+    const double qd12 = qd[11];
+    const double tau1 = tau[0];
+    const double tau2 = tau[1];
+    const double tau3 = tau[2];
+    const double tau4 = tau[3];
+    const double tau5 = tau[4];
+    const double tau6 = tau[5];
+    const double tau7 = tau[6];
+    const double tau8 = tau[7];
+    const double tau9 = tau[8];
+    const double tau10 = tau[9];
+    const double tau11 = tau[10];
+    const double tau12 = tau[11];
+    /* the runs of zeros of dqdd_dq (the inputs are read), then the rest as it is known */
+    for (int k = 3; k < 12; ++k) dqdd_dq[k] = 0;
+    for (int k = 15; k < 24; ++k) dqdd_dq[k] = 0;
+    for (int k = 27; k < 39; ++k) dqdd_dq[k] = 0;
+    for (int k = 42; k < 51; ++k) dqdd_dq[k] = 0;
+    for (int k = 54; k < 63; ++k) dqdd_dq[k] = 0;
+    for (int k = 66; k < 78; ++k) dqdd_dq[k] = 0;
+    for (int k = 81; k < 90; ++k) dqdd_dq[k] = 0;
+    for (int k = 93; k < 102; ++k) dqdd_dq[k] = 0;
+    for (int k = 105; k < 117; ++k) dqdd_dq[k] = 0;
+    for (int k = 120; k < 129; ++k) dqdd_dq[k] = 0;
+    for (int k = 132; k < 141; ++k) dqdd_dq[k] = 0;
+    /* the runs of zeros of dqdd_dqd (the inputs are read), then the rest as it is known */
+    for (int k = 3; k < 12; ++k) dqdd_dqd[k] = 0;
+    for (int k = 15; k < 24; ++k) dqdd_dqd[k] = 0;
+    for (int k = 27; k < 39; ++k) dqdd_dqd[k] = 0;
+    for (int k = 42; k < 51; ++k) dqdd_dqd[k] = 0;
+    for (int k = 54; k < 63; ++k) dqdd_dqd[k] = 0;
+    for (int k = 66; k < 78; ++k) dqdd_dqd[k] = 0;
+    for (int k = 81; k < 90; ++k) dqdd_dqd[k] = 0;
+    for (int k = 93; k < 102; ++k) dqdd_dqd[k] = 0;
+    for (int k = 105; k < 117; ++k) dqdd_dqd[k] = 0;
+    for (int k = 120; k < 129; ++k) dqdd_dqd[k] = 0;
+    for (int k = 132; k < 141; ++k) dqdd_dqd[k] = 0;
+    /* the runs of zeros of Minv (the inputs are read), then the rest as it is known */
+    for (int k = 3; k < 12; ++k) Minv[k] = 0;
+    for (int k = 15; k < 24; ++k) Minv[k] = 0;
+    for (int k = 27; k < 39; ++k) Minv[k] = 0;
+    for (int k = 42; k < 51; ++k) Minv[k] = 0;
+    for (int k = 54; k < 63; ++k) Minv[k] = 0;
+    for (int k = 66; k < 78; ++k) Minv[k] = 0;
+    for (int k = 81; k < 90; ++k) Minv[k] = 0;
+    for (int k = 93; k < 102; ++k) Minv[k] = 0;
+    for (int k = 105; k < 117; ++k) Minv[k] = 0;
+    for (int k = 120; k < 129; ++k) Minv[k] = 0;
+    for (int k = 132; k < 141; ++k) Minv[k] = 0;
+#ifdef solo12_SINCOS_VECTOR
     const double angle[12] = {
+        q3,
         q2,
         q1,
-        q3,
+        q6,
         q5,
         q4,
-        q6,
+        q9,
         q8,
         q7,
-        q9,
+        q12,
         q11,
-        q10,
-        q12
+        q10
     };
     double sine[12], cosine[12];
     solo12_sincos(12, angle, sine, cosine);
 #endif
-    double stash[80];
-    solo12_inverse_dynamics_derivatives_part1(q, qd, qdd, p, dtau_dq, dtau_dqd, stash
-#ifdef solo12_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-    solo12_inverse_dynamics_derivatives_part2(q, qd, qdd, p, dtau_dq, dtau_dqd, stash
-#ifdef solo12_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-}
-
-/* part 1 of 2 of solo12_forward_dynamics_derivatives */
-static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[], double stash[]
-#ifdef solo12_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)p;
-    (void)dqdd_dqd;
-#ifdef solo12_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double q1 = q[0];
-    (void)q1; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q2 = q[1];
-    (void)q2; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q3 = q[2];
-    (void)q3; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q4 = q[3];
-    (void)q4; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q5 = q[4];
-    (void)q5; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q6 = q[5];
-    (void)q6; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q7 = q[6];
-    (void)q7; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q8 = q[7];
-    (void)q8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q9 = q[8];
-    (void)q9; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd1 = qd[0];
-    (void)qd1; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd3 = qd[2];
-    (void)qd3; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd7 = qd[6];
-    (void)qd7; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd8 = qd[7];
-    (void)qd8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd9 = qd[8];
-    (void)qd9; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau1 = tau[0];
-    (void)tau1; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau2 = tau[1];
-    (void)tau2; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau3 = tau[2];
-    (void)tau3; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau4 = tau[3];
-    (void)tau4; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau5 = tau[4];
-    (void)tau5; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau6 = tau[5];
-    (void)tau6; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau7 = tau[6];
-    (void)tau7; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau8 = tau[7];
-    (void)tau8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau9 = tau[8];
-    (void)tau9; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double x0 = solo12_SIN(0, q3);
-    stash[0] = x0;
     const double x1 = solo12_COS(0, q3);
-    stash[1] = x1;
     const double x2 = solo12_SIN(1, q2);
-    stash[2] = x2;
     const double x3 = 9.81*solo12_SIN(2, q1);
     const double x4 = x3*x2;
     const double x5 = solo12_COS(1, q2);
-    stash[3] = x5;
     const double x6 = x3*x5;
     const double x7 = x4*x1 + x6*x0;
     const double x8 = 0.0038482516772413004*x7;
@@ -5671,32 +5422,21 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x25 = x24*x5 - x2*x23;
     const double x26 = 0.014*x25 - 0.0014853845*x3 + x20*x5 + x22*x2;
     const double x27 = 0.0038482516772413004*x1;
-    stash[4] = x27;
     const double x28 = 0.32*x27;
     const double x29 = x0*x0;
-    stash[5] = x29;
     const double x30 = 0.0005396092213171668*x29;
     const double x31 = 0.0029700831576528162 + x28 - x30;
-    stash[6] = x31;
     const double x32 = x5*x2;
     const double x33 = 2.0*x32;
-    stash[7] = x33;
     const double x34 = 0.0038482516772413004*x0;
-    stash[8] = x34;
     const double x35 = x1*x0;
-    stash[9] = x35;
     const double x36 = 1.609852873477455e-07 - 0.0005396092213171668*x35 - 0.16*x34;
-    stash[10] = x36;
     const double x37 = 0.0001659957931773617 + x30;
-    stash[11] = x37;
     const double x38 = x2*x2;
-    stash[12] = x38;
     const double x39 = x38*(x37 - x31) + x36*x33;
     const double x40 = 0.0002098871105248012 + x31 + x39;
     const double x41 = 0.03745*x34 + 3.3497340042275575e-05*x0;
-    stash[13] = x41;
     const double x42 = 0.03745*x27 + 3.3497340042275575e-05*x1;
-    stash[14] = x42;
     const double x43 = x34*x5 + x27*x2;
     const double x44 = 0.014*x43 + x41*x5 + x42*x2;
     const double x45 = 0.0028381974208050668 + x28;
@@ -5705,45 +5445,32 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x48 = 1.0/x47;
     const double x49 = 1842.9129686423128*x44;
     const double x50 = -3.959544277738894e-08 + x41;
-    stash[15] = x50;
     const double x51 = 0.0005461134539102453 + x42;
-    stash[16] = x51;
     const double x52 = 2.0453744564999998e-06 - x34;
-    stash[17] = x52;
     const double x53 = -0.01771278698415 - x27;
-    stash[18] = x53;
     const double x54 = -x52*x5 - x53*x2;
     const double x55 = 0.014*x54 + x50*x5 + x51*x2;
     const double x56 = x48*(x55 - x46*x49);
     const double x57 = x40 - 1842.9129686423128*x44*x44 - x47*x56*x56;
     const double x58 = 1.0/x57;
-    stash[19] = x58;
     ((volatile double *)Minv)[0] = x58;
     const double x59 = 1842.9129686423128*x46;
     const double x60 = -x49 + x59*x56;
     const double x61 = x60*x58;
-    stash[20] = x61;
     ((volatile double *)Minv)[2] = x61;
     ((volatile double *)Minv)[24] = x61;
     const double x62 = x56*x58;
-    stash[21] = x62;
     ((volatile double *)Minv)[1] = -x62;
     ((volatile double *)Minv)[12] = -x62;
     const double x63 = x62*x14 - x58*x26 + x8*x61;
     ((volatile double *)dqdd_dq)[0] = x63;
     const double x64 = qd1*x5;
-    stash[22] = x64;
     const double x65 = qd1*x2;
-    stash[23] = x65;
     const double x66 = x0*x64 + x1*x65;
-    stash[24] = x66;
     const double x67 = 0.0005446477058047094*x66;
-    stash[25] = x67;
     const double x68 = x1*x64 - x0*x65;
-    stash[26] = x68;
     const double x69 = x68*x68;
     const double x70 = qd2 + qd3;
-    stash[27] = x70;
     const double x71 = 3.3497340042275575e-05*x70 + 5.038484487542601e-06*x66;
     const double x72 = 0.0005396092213171668*x69 + x71*x66 - x67*x66;
     const double x73 = x64*qd2;
@@ -5860,11 +5587,9 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x184 = x73 - x148;
     const double x185 = x48*x59;
     const double x186 = -x185 - x56*x61;
-    stash[28] = x186;
     ((volatile double *)Minv)[14] = x186;
     ((volatile double *)Minv)[25] = x186;
     const double x187 = x48 + x56*x62;
-    stash[29] = x187;
     ((volatile double *)Minv)[13] = x187;
     const double x188 = x145*x187 + x146*x186 - x141*x62;
     const double x189 = x99 + x188;
@@ -5875,7 +5600,6 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x194 = x178 + x1*x148;
     const double x195 = x108 - x194;
     const double x196 = 1842.9129686423128 + x60*x61 + x59*x185;
-    stash[30] = x196;
     ((volatile double *)Minv)[26] = x196;
     const double x197 = x141*x61 + x145*x186 + x146*x196;
     const double x198 = x188 + x197;
@@ -5905,11 +5629,8 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x222 = x128 + x220 + x221 + 0.0002730308797879413*x188 + 8.590521094399056e-05*x148;
     const double x223 = x219 + x222 - 0.03745*x218;
     const double x224 = 3.959544277738894e-08*x65;
-    stash[31] = x224;
     const double x225 = 0.0002730308797879413*x64;
-    stash[32] = x225;
     const double x226 = x224 + x225;
-    stash[33] = x226;
     const double x227 = -x125 + x167*qd2 - x226*x65;
     const double x228 = x227 + x220 - x221 - 0.001386899962102278*x148;
     const double x229 = 2.0*x115;
@@ -5919,9 +5640,7 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x233 = x108 - x179;
     const double x234 = -x231 - 0.0060217712000000005*x232 - 0.0038482516772413004*x233;
     const double x235 = 3.3497340042275575e-05*x68;
-    stash[34] = x235;
     const double x236 = 5.038484487542601e-06*x68;
-    stash[35] = x236;
     const double x237 = -x109 + x236*x70 - x235*x66;
     const double x238 = x237 + 0.0002972952667644*x177 + 0.0005446477058047094*x179 - 0.0006157202683586081*x232;
     const double x239 = 3.3497340042275575e-05*x69 - 0.0005446477058047094*x172 - x97*x66;
@@ -5980,15 +5699,11 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x285 = -x263*x196 - x269*x186 - x278*x61;
     ((volatile double *)dqdd_dq)[26] = x285;
     const double x286 = solo12_SIN(3, q6);
-    stash[36] = x286;
     const double x287 = solo12_COS(3, q6);
-    stash[37] = x287;
     const double x288 = solo12_SIN(4, q5);
-    stash[38] = x288;
     const double x289 = 9.81*solo12_SIN(5, q4);
     const double x290 = x289*x288;
     const double x291 = solo12_COS(4, q5);
-    stash[39] = x291;
     const double x292 = x289*x291;
     const double x293 = x290*x287 + x292*x286;
     const double x294 = 0.0038482516772413004*x293;
@@ -6011,32 +5726,21 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x311 = x310*x291 - x288*x309;
     const double x312 = 0.0014853845*x289 - 0.014*x311 + x306*x291 + x308*x288;
     const double x313 = 0.0038482516772413004*x287;
-    stash[40] = x313;
     const double x314 = 0.32*x313;
     const double x315 = x286*x286;
-    stash[41] = x315;
     const double x316 = 0.0005396092213171668*x315;
     const double x317 = 0.0029700831576528162 + x314 - x316;
-    stash[42] = x317;
     const double x318 = x291*x288;
     const double x319 = 2.0*x318;
-    stash[43] = x319;
     const double x320 = 0.0038482516772413004*x286;
-    stash[44] = x320;
     const double x321 = x287*x286;
-    stash[45] = x321;
     const double x322 = -1.609852873477455e-07 - 0.0005396092213171668*x321 - 0.16*x320;
-    stash[46] = x322;
     const double x323 = 0.0001659957931773617 + x316;
-    stash[47] = x323;
     const double x324 = x288*x288;
-    stash[48] = x324;
     const double x325 = x324*(x323 - x317) + x322*x319;
     const double x326 = 0.0002098871105248012 + x317 + x325;
     const double x327 = 0.03745*x320 + 3.3497340042275575e-05*x286;
-    stash[49] = x327;
     const double x328 = 0.03745*x313 + 3.3497340042275575e-05*x287;
-    stash[50] = x328;
     const double x329 = x320*x291 + x313*x288;
     const double x330 = -0.014*x329 - x327*x291 - x328*x288;
     const double x331 = 0.0028381974208050668 + x314;
@@ -6045,43 +5749,31 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x334 = 1.0/x333;
     const double x335 = 1842.9129686423128*x330;
     const double x336 = -3.959544277738894e-08 - x327;
-    stash[51] = x336;
     const double x337 = -0.0005461134539102453 - x328;
-    stash[52] = x337;
     const double x338 = -2.0453744564999998e-06 - x320;
-    stash[53] = x338;
     const double x339 = -0.01771278698415 - x313;
-    stash[54] = x339;
     const double x340 = -x338*x291 - x339*x288;
     const double x341 = -0.014*x340 + x336*x291 + x337*x288;
     const double x342 = x334*(x341 - x332*x335);
     const double x343 = x326 - 1842.9129686423128*x330*x330 - x333*x342*x342;
     const double x344 = 1.0/x343;
-    stash[55] = x344;
     ((volatile double *)Minv)[39] = x344;
     const double x345 = 1842.9129686423128*x332;
     const double x346 = -x335 + x345*x342;
     const double x347 = x346*x344;
-    stash[56] = x347;
     ((volatile double *)Minv)[41] = x347;
     ((volatile double *)Minv)[63] = x347;
     const double x348 = x342*x344;
-    stash[57] = x348;
     ((volatile double *)Minv)[40] = -x348;
     ((volatile double *)Minv)[51] = -x348;
     const double x349 = x348*x300 - x344*x312 + x294*x347;
     ((volatile double *)dqdd_dq)[39] = x349;
     const double x350 = qd4*x291;
-    stash[58] = x350;
     const double x351 = qd4*x288;
-    stash[59] = x351;
     const double x352 = x286*x350 + x287*x351;
-    stash[60] = x352;
     const double x353 = x287*x350 - x286*x351;
-    stash[61] = x353;
     const double x354 = x353*x353;
     const double x355 = qd5 + qd6;
-    stash[62] = x355;
     const double x356 = 5.038484487542601e-06*x352 - 3.3497340042275575e-05*x355;
     const double x357 = 0.0005446477058047094*x352*x352 - 0.0005396092213171668*x354 - x356*x352;
     const double x358 = x350*qd5;
@@ -6199,11 +5891,9 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x470 = x358 - x434;
     const double x471 = x334*x345;
     const double x472 = -x471 - x342*x347;
-    stash[63] = x472;
     ((volatile double *)Minv)[53] = x472;
     ((volatile double *)Minv)[64] = x472;
     const double x473 = x334 + x342*x348;
-    stash[64] = x473;
     ((volatile double *)Minv)[52] = x473;
     const double x474 = x431*x473 + x432*x472 - x427*x348;
     const double x475 = x384 + x474;
@@ -6213,7 +5903,6 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x479 = x464 + x287*x434;
     const double x480 = x393 - x479;
     const double x481 = 1842.9129686423128 + x346*x347 + x345*x471;
-    stash[65] = x481;
     ((volatile double *)Minv)[65] = x481;
     const double x482 = x427*x347 + x431*x472 + x432*x481;
     const double x483 = x474 + x482;
@@ -6244,9 +5933,7 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x508 = -x505 - x506 - x507 + 8.590521094399056e-05*x434 - 0.0002730308797879413*x474;
     const double x509 = x504 + x508 + 0.03745*x503;
     const double x510 = 3.959544277738894e-08*x351;
-    stash[66] = x510;
     const double x511 = 0.0002730308797879413*x350;
-    stash[67] = x511;
     const double x512 = x510 - x511;
     const double x513 = x453*qd5 - x351*x512;
     const double x514 = x513 + x507 - x506 - 0.001386899962102278*x434;
@@ -6257,9 +5944,7 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x519 = x393 - x465;
     const double x520 = -x517 - 0.0060217712000000005*x518 - 0.0038482516772413004*x519;
     const double x521 = 3.3497340042275575e-05*x353;
-    stash[68] = x521;
     const double x522 = 5.038484487542601e-06*x353;
-    stash[69] = x522;
     const double x523 = -x394 + x521*x352 + x522*x355;
     const double x524 = x523 + 0.0005446477058047094*x465 - 0.0002972952667644*x463 - 0.0006157202683586081*x518;
     const double x525 = -3.3497340042275575e-05*x354 - 0.0005446477058047094*x458 - x382*x352;
@@ -6319,27 +6004,20 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x572 = -x549*x481 - x555*x472 - x565*x347;
     ((volatile double *)dqdd_dq)[65] = x572;
     const double x573 = solo12_SIN(6, q9);
-    stash[70] = x573;
     const double x574 = solo12_COS(6, q9);
-    stash[71] = x574;
     const double x575 = solo12_SIN(7, q8);
-    stash[72] = x575;
     const double x576 = 9.81*solo12_SIN(8, q7);
     const double x577 = x576*x575;
     const double x578 = solo12_COS(7, q8);
-    stash[73] = x578;
     const double x579 = x576*x578;
     const double x580 = x577*x574 + x579*x573;
-    stash[74] = x580;
     const double x581 = 0.0038482516772413004*x580;
-    stash[75] = x581;
     const double x582 = 2.0453744564999998e-06*x579 - 0.01169101578415*x577;
     const double x583 = 0.03763607*x574;
     const double x584 = 0.03763607*x573;
     const double x585 = x577*x573 - x574*x579;
     const double x586 = x583*x580 + x584*x585;
     const double x587 = x582 - x581 - 0.16*x586;
-    stash[76] = x587;
     const double x588 = 0.0002972952667644*x580;
     const double x589 = 9.81*solo12_COS(8, q7);
     const double x590 = 0.01169101578415*x589 - 0.0028754860404784995*x579;
@@ -6352,34 +6030,22 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x597 = x592 - 0.14853845*x579;
     const double x598 = x597*x578 - x575*x596;
     const double x599 = 0.014*x598 - 0.0014853845*x576 + x593*x578 + x595*x575;
-    stash[77] = x599;
     const double x600 = 0.0038482516772413004*x574;
-    stash[78] = x600;
     const double x601 = 0.32*x600;
     const double x602 = x573*x573;
-    stash[79] = x602;
     const double x603 = 0.0005396092213171668*x602;
     const double x604 = 0.0029700831576528162 + x601 - x603;
-    stash[80] = x604;
     const double x605 = x578*x575;
     const double x606 = 2.0*x605;
-    stash[81] = x606;
     const double x607 = 0.0038482516772413004*x573;
-    stash[82] = x607;
     const double x608 = x574*x573;
-    stash[83] = x608;
     const double x609 = 1.609852873477455e-07 - 0.0005396092213171668*x608 - 0.16*x607;
-    stash[84] = x609;
     const double x610 = 0.0001659957931773617 + x603;
-    stash[85] = x610;
     const double x611 = x575*x575;
-    stash[86] = x611;
     const double x612 = x611*(x610 - x604) + x609*x606;
     const double x613 = 0.0002098871105248012 + x604 + x612;
     const double x614 = 0.03745*x607 + 3.3497340042275575e-05*x573;
-    stash[87] = x614;
     const double x615 = 0.03745*x600 + 3.3497340042275575e-05*x574;
-    stash[88] = x615;
     const double x616 = x607*x578 + x600*x575;
     const double x617 = 0.014*x616 + x614*x578 + x615*x575;
     const double x618 = 0.0028381974208050668 + x601;
@@ -6388,54 +6054,38 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x621 = 1.0/x620;
     const double x622 = 1842.9129686423128*x617;
     const double x623 = -3.959544277738894e-08 + x614;
-    stash[89] = x623;
     const double x624 = 0.0005461134539102453 + x615;
-    stash[90] = x624;
     const double x625 = 2.0453744564999998e-06 - x607;
-    stash[91] = x625;
     const double x626 = -0.01771278698415 - x600;
-    stash[92] = x626;
     const double x627 = -x625*x578 - x626*x575;
     const double x628 = 0.014*x627 + x623*x578 + x624*x575;
     const double x629 = x621*(x628 - x619*x622);
     const double x630 = x613 - 1842.9129686423128*x617*x617 - x620*x629*x629;
     const double x631 = 1.0/x630;
-    stash[93] = x631;
     ((volatile double *)Minv)[78] = x631;
     const double x632 = 1842.9129686423128*x619;
     const double x633 = -x622 + x632*x629;
     const double x634 = x633*x631;
-    stash[94] = x634;
     ((volatile double *)Minv)[80] = x634;
     ((volatile double *)Minv)[102] = x634;
     const double x635 = x629*x631;
-    stash[95] = x635;
     ((volatile double *)Minv)[79] = -x635;
     ((volatile double *)Minv)[90] = -x635;
     const double x636 = x635*x587 - x631*x599 + x581*x634;
     ((volatile double *)dqdd_dq)[78] = x636;
     const double x637 = qd7*x578;
-    stash[96] = x637;
     const double x638 = qd7*x575;
-    stash[97] = x638;
     const double x639 = x574*x638 + x637*x573;
-    stash[98] = x639;
     const double x640 = 0.0005446477058047094*x639;
-    stash[99] = x640;
     const double x641 = x574*x637 - x638*x573;
-    stash[100] = x641;
     const double x642 = x641*x641;
-    stash[101] = x642;
     const double x643 = qd8 + qd9;
-    stash[102] = x643;
     const double x644 = 3.3497340042275575e-05*x643 + 5.038484487542601e-06*x639;
     const double x645 = 0.0005396092213171668*x642 + x644*x639 - x640*x639;
-    stash[103] = x645;
     const double x646 = x637*qd8;
     const double x647 = x638*qd8;
     const double x648 = 0.0013320948074879001*qd8 + 0.0002730308797879413*x638 - 3.959544277738894e-08*x637;
     const double x649 = -x648*x638;
-    stash[104] = x649;
     const double x650 = 1.609852873477455e-07*x637;
     const double x651 = x650 + 0.0002730308797879413*qd8 + 8.590521094399056e-05*x638;
     const double x652 = qd7*qd7;
@@ -6457,10 +6107,8 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x668 = -x667 - 0.32*x647;
     const double x669 = -x659 + 0.03763607*x668 - 0.0038482516772413004*x663;
     const double x670 = 3.3497340042275575e-05*x639 + 0.0005426192213171668*x643;
-    stash[105] = x670;
     const double x671 = x644*x643 - x670*x639;
     const double x672 = x637*x638;
-    stash[106] = x672;
     const double x673 = x589*x575;
     const double x674 = -x673 - 0.16*x672;
     const double x675 = qd8*qd8;
@@ -6470,9 +6118,7 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x679 = x678*x574 + x674*x573;
     const double x680 = x671 + 0.0002972952667644*x679 + 0.0005446477058047094*x661 + 0.0038482516772413004*x668;
     const double x681 = x641*x643;
-    stash[107] = x681;
     const double x682 = x670*x641;
-    stash[108] = x682;
     const double x683 = x682 - 0.0005446477058047094*x681;
     const double x684 = x641*qd9;
     const double x685 = x684 + x574*x646 - x647*x573;
@@ -6497,11 +6143,9 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x704 = x702 - 0.03745*x703 + x687*x574 - x680*x573;
     const double x705 = x665 + x675;
     const double x706 = 2.0453744564999998e-06*x705;
-    stash[109] = x706;
     const double x707 = -x706 - 0.14853845*x673 - 0.01169101578415*x672;
     const double x708 = x707 + x703;
     const double x709 = 0.01169101578415*x676;
-    stash[110] = x709;
     const double x710 = x709 + 0.14853845*x655 + 2.0453744564999998e-06*x672;
     const double x711 = x710 + x696;
     const double x712 = x711*x578 - x575*x708;
@@ -6514,342 +6158,97 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part1(const doub
     const double x719 = tau9 - x716;
     const double x720 = x714*x631 + x719*x634 - x718*x635;
     const double x721 = x720*x575 + x646;
-    stash[111] = x721;
     const double x722 = -x639*qd9;
     const double x723 = -x647 + x720*x578;
-    stash[112] = x723;
     const double x724 = x722 + x723*x574;
-    stash[113] = x724;
     const double x725 = x724 - x721*x573;
-    stash[114] = x725;
     const double x726 = x664 - x665;
-    stash[115] = x726;
     const double x727 = 0.16*x726;
     const double x728 = x647 + x723;
-    stash[116] = x728;
     const double x729 = x589 + 0.014*x720;
     const double x730 = x729*x578;
-    stash[117] = x730;
     const double x731 = -x727 - x730 - 0.03745*x728;
     const double x732 = 2.0*x672;
-    stash[118] = x732;
     const double x733 = 0.16*x732;
     const double x734 = x729*x575;
-    stash[119] = x734;
     const double x735 = x646 - x721;
-    stash[120] = x735;
     const double x736 = -x733 - x734 + 0.03745*x735;
     const double x737 = x731*x574 - x736*x573;
-    stash[121] = x737;
     const double x738 = x645 + 3.3497340042275575e-05*x725 - 0.0038482516772413004*x737;
-    stash[122] = x738;
     const double x739 = x650 - 0.001386899962102278*x638;
-    stash[123] = x739;
     const double x740 = -x699 + 8.590521094399056e-05*x637;
     const double x741 = x700*x637 + x651*x638 + x638*x739 - x637*x740;
     const double x742 = x741 + 3.959544277738894e-08*x721 + 2.0453744564999998e-06*x734 + 0.0002730308797879413*x723 + 0.01169101578415*x730;
     const double x743 = x642 - x639*x639;
     const double x744 = -0.0038482516772413004*x743;
-    stash[124] = x744;
     const double x745 = -x639*x643;
-    stash[125] = x745;
     const double x746 = x745 - x725;
     const double x747 = 0.0002972952667644*x746 + 0.03763607*x737 + x744;
-    stash[126] = x747;
     const double x748 = -2.0*x639*x641;
     const double x749 = 0.0038482516772413004*x748;
-    stash[127] = x749;
     const double x750 = x736*x574 + x731*x573;
-    stash[128] = x750;
     const double x751 = x684 + x723*x573;
     const double x752 = -x751 - x574*x721;
-    stash[129] = x752;
     const double x753 = x681 + x752;
     const double x754 = 0.0002972952667644*x753 + 0.03763607*x750 + x749;
-    stash[130] = x754;
     const double x755 = x747*x574 + x754*x573;
-    stash[131] = x755;
     const double x756 = x742 + x738 - 0.16*x755;
-    stash[132] = x756;
     const double x757 = x646 - x721;
-    stash[133] = x757;
     const double x758 = x621*x632;
     const double x759 = -x758 - x629*x634;
-    stash[134] = x759;
     ((volatile double *)Minv)[92] = x759;
     ((volatile double *)Minv)[103] = x759;
     const double x760 = x621 + x629*x635;
-    stash[135] = x760;
     ((volatile double *)Minv)[91] = x760;
     const double x761 = x718*x760 + x719*x759 - x714*x635;
-    stash[136] = x761;
     const double x762 = x672 + x761;
-    stash[137] = x762;
     const double x763 = -x734 + 0.03745*x757 - 0.16*x762;
     const double x764 = x677 + x730 + 0.03745*x728;
     const double x765 = x763*x574 - x764*x573;
     const double x766 = 0.03763607*x765;
-    stash[138] = x766;
     const double x767 = x751 + x574*x721;
-    stash[139] = x767;
     const double x768 = x681 - x767;
     const double x769 = 1842.9129686423128 + x633*x634 + x632*x758;
-    stash[140] = x769;
     ((volatile double *)Minv)[104] = x769;
     const double x770 = x714*x634 + x718*x759 + x719*x769;
     const double x771 = x761 + x770;
     const double x772 = x688 + x771;
     const double x773 = 0.0002972952667644*x768 + x766 - 0.0038482516772413004*x772;
     const double x774 = x764*x574 + x763*x573;
-    stash[141] = x774;
     const double x775 = x721*x573;
-    stash[142] = x775;
     const double x776 = -x660 - x775 + x723*x574;
     const double x777 = x776 + x662;
     const double x778 = x693 + 0.0002972952667644*x777 + 0.03763607*x774;
     const double x779 = x778*x574 - x573*x773;
-    stash[143] = x779;
     const double x780 = x647 - x723;
     const double x781 = -x667 - 0.16*x780;
     const double x782 = x671 + 0.0002972952667644*x774 + 0.0005446477058047094*x776 + 0.0038482516772413004*x781;
     const double x783 = 0.0002972952667644*x765;
-    stash[144] = x783;
     const double x784 = x683 - x783 + 3.3497340042275575e-05*x771 + 5.038484487542601e-06*x767;
     const double x785 = x782*x574 + x784*x573;
-    stash[145] = x785;
     const double x786 = 0.0028754860404784995*x730;
-    stash[146] = x786;
     const double x787 = x654 + x786 + 0.001386899962102278*x723 + 1.609852873477455e-07*x721 - 3.959544277738894e-08*x761;
     const double x788 = x662 - x776;
     const double x789 = -x659 + 0.03763607*x781 - 0.0038482516772413004*x788;
     const double x790 = x785 + x787 + 0.03745*x779 + 0.16*x789;
-    stash[147] = x790;
     const double x791 = x773*x574 + x778*x573;
-    stash[148] = x791;
     const double x792 = x784*x574 - x573*x782;
-    stash[149] = x792;
     const double x793 = 1.609852873477455e-07*x723;
     const double x794 = 0.0028754860404784995*x734;
     const double x795 = x701 + x793 + x794 + 0.0002730308797879413*x761 + 8.590521094399056e-05*x721;
     const double x796 = x792 + x795 - 0.03745*x791;
-    stash[150] = x796;
     const double x797 = 3.959544277738894e-08*x638;
-    stash[151] = x797;
     const double x798 = 0.0002730308797879413*x637;
-    stash[152] = x798;
     const double x799 = x797 + x798;
-    stash[153] = x799;
     const double x800 = -x698 + x740*qd8 - x638*x799;
     const double x801 = x800 + x793 - x794 - 0.001386899962102278*x721;
-    stash[154] = x801;
     const double x802 = 2.0*x688;
     const double x803 = x748 + x802;
     const double x804 = 0.0002972952667644*x803;
-    stash[155] = x804;
     const double x805 = x646 + x721;
-    stash[156] = x805;
     const double x806 = x681 - x752;
     const double x807 = -x804 - 0.0060217712000000005*x805 - 0.0038482516772413004*x806;
-    stash[157] = x807;
     const double x808 = 3.3497340042275575e-05*x641;
-    stash[158] = x808;
-}
-
-/* part 2 of 2 of solo12_forward_dynamics_derivatives */
-static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part2(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[], double stash[]
-#ifdef solo12_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)p;
-#ifdef solo12_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double q10 = q[9];
-    (void)q10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q11 = q[10];
-    (void)q11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q12 = q[11];
-    (void)q12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd8 = qd[7];
-    (void)qd8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd10 = qd[9];
-    (void)qd10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd11 = qd[10];
-    (void)qd11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd12 = qd[11];
-    (void)qd12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau10 = tau[9];
-    (void)tau10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau11 = tau[10];
-    (void)tau11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau12 = tau[11];
-    (void)tau12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double x0 = stash[0];
-    const double x1 = stash[1];
-    const double x2 = stash[2];
-    const double x5 = stash[3];
-    const double x27 = stash[4];
-    const double x29 = stash[5];
-    const double x31 = stash[6];
-    const double x33 = stash[7];
-    const double x34 = stash[8];
-    const double x35 = stash[9];
-    const double x36 = stash[10];
-    const double x37 = stash[11];
-    const double x38 = stash[12];
-    const double x41 = stash[13];
-    const double x42 = stash[14];
-    const double x50 = stash[15];
-    const double x51 = stash[16];
-    const double x52 = stash[17];
-    const double x53 = stash[18];
-    const double x58 = stash[19];
-    const double x61 = stash[20];
-    const double x62 = stash[21];
-    const double x64 = stash[22];
-    const double x65 = stash[23];
-    const double x66 = stash[24];
-    const double x67 = stash[25];
-    const double x68 = stash[26];
-    const double x70 = stash[27];
-    const double x186 = stash[28];
-    const double x187 = stash[29];
-    const double x196 = stash[30];
-    const double x224 = stash[31];
-    const double x225 = stash[32];
-    const double x226 = stash[33];
-    const double x235 = stash[34];
-    const double x236 = stash[35];
-    const double x286 = stash[36];
-    const double x287 = stash[37];
-    const double x288 = stash[38];
-    const double x291 = stash[39];
-    const double x313 = stash[40];
-    const double x315 = stash[41];
-    const double x317 = stash[42];
-    const double x319 = stash[43];
-    const double x320 = stash[44];
-    const double x321 = stash[45];
-    const double x322 = stash[46];
-    const double x323 = stash[47];
-    const double x324 = stash[48];
-    const double x327 = stash[49];
-    const double x328 = stash[50];
-    const double x336 = stash[51];
-    const double x337 = stash[52];
-    const double x338 = stash[53];
-    const double x339 = stash[54];
-    const double x344 = stash[55];
-    const double x347 = stash[56];
-    const double x348 = stash[57];
-    const double x350 = stash[58];
-    const double x351 = stash[59];
-    const double x352 = stash[60];
-    const double x353 = stash[61];
-    const double x355 = stash[62];
-    const double x472 = stash[63];
-    const double x473 = stash[64];
-    const double x481 = stash[65];
-    const double x510 = stash[66];
-    const double x511 = stash[67];
-    const double x521 = stash[68];
-    const double x522 = stash[69];
-    const double x573 = stash[70];
-    const double x574 = stash[71];
-    const double x575 = stash[72];
-    const double x578 = stash[73];
-    const double x580 = stash[74];
-    const double x581 = stash[75];
-    const double x587 = stash[76];
-    const double x599 = stash[77];
-    const double x600 = stash[78];
-    const double x602 = stash[79];
-    const double x604 = stash[80];
-    const double x606 = stash[81];
-    const double x607 = stash[82];
-    const double x608 = stash[83];
-    const double x609 = stash[84];
-    const double x610 = stash[85];
-    const double x611 = stash[86];
-    const double x614 = stash[87];
-    const double x615 = stash[88];
-    const double x623 = stash[89];
-    const double x624 = stash[90];
-    const double x625 = stash[91];
-    const double x626 = stash[92];
-    const double x631 = stash[93];
-    const double x634 = stash[94];
-    const double x635 = stash[95];
-    const double x637 = stash[96];
-    const double x638 = stash[97];
-    const double x639 = stash[98];
-    const double x640 = stash[99];
-    const double x641 = stash[100];
-    const double x642 = stash[101];
-    const double x643 = stash[102];
-    const double x645 = stash[103];
-    const double x649 = stash[104];
-    const double x670 = stash[105];
-    const double x672 = stash[106];
-    const double x681 = stash[107];
-    const double x682 = stash[108];
-    const double x706 = stash[109];
-    const double x709 = stash[110];
-    const double x721 = stash[111];
-    const double x723 = stash[112];
-    const double x724 = stash[113];
-    const double x725 = stash[114];
-    const double x726 = stash[115];
-    const double x728 = stash[116];
-    const double x730 = stash[117];
-    const double x732 = stash[118];
-    const double x734 = stash[119];
-    const double x735 = stash[120];
-    const double x737 = stash[121];
-    const double x738 = stash[122];
-    const double x739 = stash[123];
-    const double x744 = stash[124];
-    const double x745 = stash[125];
-    const double x747 = stash[126];
-    const double x749 = stash[127];
-    const double x750 = stash[128];
-    const double x752 = stash[129];
-    const double x754 = stash[130];
-    const double x755 = stash[131];
-    const double x756 = stash[132];
-    const double x757 = stash[133];
-    const double x759 = stash[134];
-    const double x760 = stash[135];
-    const double x761 = stash[136];
-    const double x762 = stash[137];
-    const double x766 = stash[138];
-    const double x767 = stash[139];
-    const double x769 = stash[140];
-    const double x774 = stash[141];
-    const double x775 = stash[142];
-    const double x779 = stash[143];
-    const double x783 = stash[144];
-    const double x785 = stash[145];
-    const double x786 = stash[146];
-    const double x790 = stash[147];
-    const double x791 = stash[148];
-    const double x792 = stash[149];
-    const double x796 = stash[150];
-    const double x797 = stash[151];
-    const double x798 = stash[152];
-    const double x799 = stash[153];
-    const double x801 = stash[154];
-    const double x804 = stash[155];
-    const double x805 = stash[156];
-    const double x807 = stash[157];
-    const double x808 = stash[158];
     const double x809 = 5.038484487542601e-06*x641;
     const double x810 = -x682 + x809*x643 - x639*x808;
     const double x811 = x810 + 0.0002972952667644*x750 + 0.0005446477058047094*x752 - 0.0006157202683586081*x805;
@@ -7707,89 +7106,6 @@ static solo12_NOINLINE void solo12_forward_dynamics_derivatives_part2(const doub
     ((volatile double *)dqdd_dqd)[143] = x1601;
 }
 
-/* dqdd/dq and dqdd/dqd of qdd = FD(q, qd, tau) = M(q)^-1 (tau - V - G - F), and M(q)^-1 (4418 operations: 2374 multiplications, 2012 additions, 8 divisions, 24 trigonometric calls, 0 other calls) */
-void solo12_forward_dynamics_derivatives(const double q[], const double qd[], const double tau[], const double p[], double dqdd_dq[], double dqdd_dqd[], double Minv[])
-{
-    (void)p;
-    /* the runs of zeros of dqdd_dq (the inputs are read), then the rest as it is known */
-    for (int k = 3; k < 12; ++k) dqdd_dq[k] = 0;
-    for (int k = 15; k < 24; ++k) dqdd_dq[k] = 0;
-    for (int k = 27; k < 39; ++k) dqdd_dq[k] = 0;
-    for (int k = 42; k < 51; ++k) dqdd_dq[k] = 0;
-    for (int k = 54; k < 63; ++k) dqdd_dq[k] = 0;
-    for (int k = 66; k < 78; ++k) dqdd_dq[k] = 0;
-    for (int k = 81; k < 90; ++k) dqdd_dq[k] = 0;
-    for (int k = 93; k < 102; ++k) dqdd_dq[k] = 0;
-    for (int k = 105; k < 117; ++k) dqdd_dq[k] = 0;
-    for (int k = 120; k < 129; ++k) dqdd_dq[k] = 0;
-    for (int k = 132; k < 141; ++k) dqdd_dq[k] = 0;
-    /* the runs of zeros of dqdd_dqd (the inputs are read), then the rest as it is known */
-    for (int k = 3; k < 12; ++k) dqdd_dqd[k] = 0;
-    for (int k = 15; k < 24; ++k) dqdd_dqd[k] = 0;
-    for (int k = 27; k < 39; ++k) dqdd_dqd[k] = 0;
-    for (int k = 42; k < 51; ++k) dqdd_dqd[k] = 0;
-    for (int k = 54; k < 63; ++k) dqdd_dqd[k] = 0;
-    for (int k = 66; k < 78; ++k) dqdd_dqd[k] = 0;
-    for (int k = 81; k < 90; ++k) dqdd_dqd[k] = 0;
-    for (int k = 93; k < 102; ++k) dqdd_dqd[k] = 0;
-    for (int k = 105; k < 117; ++k) dqdd_dqd[k] = 0;
-    for (int k = 120; k < 129; ++k) dqdd_dqd[k] = 0;
-    for (int k = 132; k < 141; ++k) dqdd_dqd[k] = 0;
-    /* the runs of zeros of Minv (the inputs are read), then the rest as it is known */
-    for (int k = 3; k < 12; ++k) Minv[k] = 0;
-    for (int k = 15; k < 24; ++k) Minv[k] = 0;
-    for (int k = 27; k < 39; ++k) Minv[k] = 0;
-    for (int k = 42; k < 51; ++k) Minv[k] = 0;
-    for (int k = 54; k < 63; ++k) Minv[k] = 0;
-    for (int k = 66; k < 78; ++k) Minv[k] = 0;
-    for (int k = 81; k < 90; ++k) Minv[k] = 0;
-    for (int k = 93; k < 102; ++k) Minv[k] = 0;
-    for (int k = 105; k < 117; ++k) Minv[k] = 0;
-    for (int k = 120; k < 129; ++k) Minv[k] = 0;
-    for (int k = 132; k < 141; ++k) Minv[k] = 0;
-#ifdef solo12_SINCOS_VECTOR
-    const double q1 = q[0];
-    const double q2 = q[1];
-    const double q3 = q[2];
-    const double q4 = q[3];
-    const double q5 = q[4];
-    const double q6 = q[5];
-    const double q7 = q[6];
-    const double q8 = q[7];
-    const double q9 = q[8];
-    const double q10 = q[9];
-    const double q11 = q[10];
-    const double q12 = q[11];
-    const double angle[12] = {
-        q3,
-        q2,
-        q1,
-        q6,
-        q5,
-        q4,
-        q9,
-        q8,
-        q7,
-        q12,
-        q11,
-        q10
-    };
-    double sine[12], cosine[12];
-    solo12_sincos(12, angle, sine, cosine);
-#endif
-    double stash[159];
-    solo12_forward_dynamics_derivatives_part1(q, qd, tau, p, dqdd_dq, dqdd_dqd, Minv, stash
-#ifdef solo12_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-    solo12_forward_dynamics_derivatives_part2(q, qd, tau, p, dqdd_dq, dqdd_dqd, Minv, stash
-#ifdef solo12_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-}
-
 /* M(q)^-1 by the unrolled L D L^T factorisation (336 operations: 184 multiplications, 128 additions, 8 divisions, 16 trigonometric calls, 0 other calls) */
 void solo12_mass_matrix_inverse(const double q[], const double p[], double Minv[])
 {
@@ -8042,54 +7358,113 @@ void solo12_mass_matrix_inverse(const double q[], const double p[], double Minv[
     ((volatile double *)Minv)[143] = x175;
 }
 
-/* part 1 of 2 of solo12_linearize */
-static solo12_NOINLINE void solo12_linearize_part1(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[], double stash[]
-#ifdef solo12_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
+/* xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1] (4418 operations: 2374 multiplications, 2012 additions, 8 divisions, 24 trigonometric calls, 0 other calls) */
+void solo12_linearize(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[])
 {
     (void)p;
-#ifdef solo12_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
     const double q1 = q[0];
-    (void)q1; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q2 = q[1];
-    (void)q2; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q3 = q[2];
-    (void)q3; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q4 = q[3];
-    (void)q4; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q5 = q[4];
-    (void)q5; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double q6 = q[5];
-    (void)q6; /* with AVX2, solo12_SIN(k, a) does not read a */
+    const double q7 = q[6];
+    const double q8 = q[7];
+    const double q9 = q[8];
+    const double q10 = q[9];
+    const double q11 = q[10];
+    const double q12 = q[11];
     const double qd1 = qd[0];
-    (void)qd1; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd2 = qd[1];
-    (void)qd2; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd3 = qd[2];
-    (void)qd3; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd4 = qd[3];
-    (void)qd4; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd5 = qd[4];
-    (void)qd5; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double qd6 = qd[5];
-    (void)qd6; /* with AVX2, solo12_SIN(k, a) does not read a */
+    const double qd7 = qd[6];
+    const double qd8 = qd[7];
+    const double qd9 = qd[8];
+    const double qd10 = qd[9];
+    const double qd11 = qd[10];
+    const double qd12 = qd[11];
     const double tau1 = tau[0];
-    (void)tau1; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double tau2 = tau[1];
-    (void)tau2; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double tau3 = tau[2];
-    (void)tau3; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double tau4 = tau[3];
-    (void)tau4; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double tau5 = tau[4];
-    (void)tau5; /* with AVX2, solo12_SIN(k, a) does not read a */
     const double tau6 = tau[5];
-    (void)tau6; /* with AVX2, solo12_SIN(k, a) does not read a */
+    const double tau7 = tau[6];
+    const double tau8 = tau[7];
+    const double tau9 = tau[8];
+    const double tau10 = tau[9];
+    const double tau11 = tau[10];
+    const double tau12 = tau[11];
+    /* the runs of zeros of A (the inputs are read), then the rest as it is known */
+    for (int k = 0; k < 12; ++k) A[k] = 0;
+    for (int k = 13; k < 37; ++k) A[k] = 0;
+    for (int k = 38; k < 62; ++k) A[k] = 0;
+    for (int k = 63; k < 87; ++k) A[k] = 0;
+    for (int k = 88; k < 112; ++k) A[k] = 0;
+    for (int k = 113; k < 137; ++k) A[k] = 0;
+    for (int k = 138; k < 162; ++k) A[k] = 0;
+    for (int k = 163; k < 187; ++k) A[k] = 0;
+    for (int k = 188; k < 212; ++k) A[k] = 0;
+    for (int k = 213; k < 237; ++k) A[k] = 0;
+    for (int k = 238; k < 262; ++k) A[k] = 0;
+    for (int k = 263; k < 287; ++k) A[k] = 0;
+    for (int k = 291; k < 300; ++k) A[k] = 0;
+    for (int k = 303; k < 312; ++k) A[k] = 0;
+    for (int k = 315; k < 324; ++k) A[k] = 0;
+    for (int k = 327; k < 336; ++k) A[k] = 0;
+    for (int k = 339; k < 348; ++k) A[k] = 0;
+    for (int k = 351; k < 363; ++k) A[k] = 0;
+    for (int k = 366; k < 375; ++k) A[k] = 0;
+    for (int k = 378; k < 387; ++k) A[k] = 0;
+    for (int k = 390; k < 399; ++k) A[k] = 0;
+    for (int k = 402; k < 411; ++k) A[k] = 0;
+    for (int k = 414; k < 423; ++k) A[k] = 0;
+    for (int k = 426; k < 438; ++k) A[k] = 0;
+    for (int k = 441; k < 450; ++k) A[k] = 0;
+    for (int k = 453; k < 462; ++k) A[k] = 0;
+    for (int k = 465; k < 474; ++k) A[k] = 0;
+    for (int k = 477; k < 486; ++k) A[k] = 0;
+    for (int k = 489; k < 498; ++k) A[k] = 0;
+    for (int k = 501; k < 513; ++k) A[k] = 0;
+    for (int k = 516; k < 525; ++k) A[k] = 0;
+    for (int k = 528; k < 537; ++k) A[k] = 0;
+    for (int k = 540; k < 549; ++k) A[k] = 0;
+    for (int k = 552; k < 561; ++k) A[k] = 0;
+    for (int k = 564; k < 573; ++k) A[k] = 0;
+    /* the runs of zeros of B (the inputs are read), then the rest as it is known */
+    for (int k = 0; k < 144; ++k) B[k] = 0;
+    for (int k = 147; k < 156; ++k) B[k] = 0;
+    for (int k = 159; k < 168; ++k) B[k] = 0;
+    for (int k = 171; k < 183; ++k) B[k] = 0;
+    for (int k = 186; k < 195; ++k) B[k] = 0;
+    for (int k = 198; k < 207; ++k) B[k] = 0;
+    for (int k = 210; k < 222; ++k) B[k] = 0;
+    for (int k = 225; k < 234; ++k) B[k] = 0;
+    for (int k = 237; k < 246; ++k) B[k] = 0;
+    for (int k = 249; k < 261; ++k) B[k] = 0;
+    for (int k = 264; k < 273; ++k) B[k] = 0;
+    for (int k = 276; k < 285; ++k) B[k] = 0;
+#ifdef solo12_SINCOS_VECTOR
+    const double angle[12] = {
+        q3,
+        q2,
+        q1,
+        q6,
+        q5,
+        q4,
+        q9,
+        q8,
+        q7,
+        q12,
+        q11,
+        q10
+    };
+    double sine[12], cosine[12];
+    solo12_sincos(12, angle, sine, cosine);
+#endif
     ((volatile double *)A)[12] = 1.0;
     ((volatile double *)A)[37] = 1.0;
     ((volatile double *)A)[62] = 1.0;
@@ -8591,7 +7966,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x458 = 1842.9129686423128*x445;
     const double x459 = -x448 + x458*x455;
     const double x460 = x459*x457;
-    stash[0] = x460;
     ((volatile double *)B)[185] = x460;
     ((volatile double *)B)[207] = x460;
     const double x461 = x455*x457;
@@ -8722,7 +8096,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x583 = x471 - x547;
     const double x584 = x447*x458;
     const double x585 = -x584 - x455*x460;
-    stash[1] = x585;
     ((volatile double *)B)[197] = x585;
     ((volatile double *)B)[208] = x585;
     const double x586 = x447 + x455*x461;
@@ -8735,7 +8108,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x592 = x577 + x400*x547;
     const double x593 = x506 - x592;
     const double x594 = 1842.9129686423128 + x459*x460 + x458*x584;
-    stash[2] = x594;
     ((volatile double *)B)[209] = x594;
     const double x595 = x540*x460 + x544*x585 + x545*x594;
     const double x596 = x587 + x595;
@@ -8843,7 +8215,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x696 = x694*x400 - x688*x399;
     const double x697 = x695*x404 + x696*x401;
     const double x698 = 2.0*x697;
-    stash[3] = x698;
     const double x699 = 0.0030108856000000002*x463 + 0.0019241258386206502*x466;
     const double x700 = 0.005845507892075*x463 - 1.0226872282499999e-06*x464;
     const double x701 = x700 + x699;
@@ -8873,7 +8244,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x725 = x437*(x724 - x717) + x721*x432;
     const double x726 = x725 + x717 - 0.028*x701;
     const double x727 = 2.0*x726;
-    stash[4] = x727;
     const double x728 = 0.03745*x720;
     const double x729 = 8.049264367387275e-08*x463;
     const double x730 = 0.0014377430202392497*x680 - 0.00013651543989397065*qd5;
@@ -8907,7 +8277,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x757 = x634 - x708;
     const double x758 = x757 + x433*x680 + x440*x464 - x426*x682 - x441*x463;
     const double x759 = 2.0*x758;
-    stash[5] = x759;
     const double x760 = x733 + x732 - 0.004582252128742899*x680 + x435*x463 - x430*x464;
     const double x761 = x741 - x742 + 0.004582252128742899*x682 + x436*x463 - x435*x464;
     const double x762 = x748 + x747 + 0.004582252128742899*x463 + 0.18617451999999998*x682;
@@ -8915,7 +8284,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x764 = x763*x404 - x762*x401;
     const double x765 = -0.014*x764 + x760*x404 + x761*x401;
     const double x766 = 2.0*x765;
-    stash[6] = x766;
     const double x767 = x624 + x710 - x623 - x722;
     const double x768 = x767 + x757 + x706;
     const double x769 = x768 + x450*x463 + x452*x682 - x449*x464 - x451*x680;
@@ -8923,7 +8291,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     ((volatile double *)A)[376] = x770;
     const double x771 = x757 + x708 - x634;
     const double x772 = 2.0*x771;
-    stash[7] = x772;
     const double x773 = x687 + x686 - 0.0002972952667644*x684 - 0.0005446477058047094*x465;
     const double x774 = x692 - x693 + x635 - 0.0002972952667644*x689;
     const double x775 = 2.0*x704 + 0.0002972952667644*x466 - 0.03763607*x689;
@@ -8935,7 +8302,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x781 = x777*x404 - x779*x401;
     const double x782 = -0.014*x781 + x778*x404 + x780*x401;
     const double x783 = 2.0*x782;
-    stash[8] = x783;
     const double x784 = x771 - 0.16*x779;
     const double x785 = -x772*x460 - x783*x457 + 2.0*x784*x461;
     ((volatile double *)A)[377] = x785;
@@ -8946,15 +8312,12 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     const double x788 = x678*x461 - x662*x585 - x668*x586;
     ((volatile double *)A)[389] = x788;
     const double x789 = 2.0*x755;
-    stash[9] = x789;
     const double x790 = -x698*x585 - x789*x586 + 2.0*x726*x461;
     ((volatile double *)A)[399] = x790;
     const double x791 = 2.0*x769;
-    stash[10] = x791;
     const double x792 = -x759*x585 - x791*x586 + 2.0*x765*x461;
     ((volatile double *)A)[400] = x792;
     const double x793 = 2.0*x784;
-    stash[11] = x793;
     const double x794 = -x772*x585 - x793*x586 + 2.0*x782*x461;
     ((volatile double *)A)[401] = x794;
     const double x795 = -x585*x413 - x460*x425 + 0.0038482516772413004*x594*x406;
@@ -8963,68 +8326,6 @@ static solo12_NOINLINE void solo12_linearize_part1(const double q[], const doubl
     ((volatile double *)A)[412] = x796;
     const double x797 = -x662*x594 - x668*x585 - x678*x460;
     ((volatile double *)A)[413] = x797;
-}
-
-/* part 2 of 2 of solo12_linearize */
-static solo12_NOINLINE void solo12_linearize_part2(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[], double stash[]
-#ifdef solo12_SINCOS_VECTOR
-    , const double sine[], const double cosine[]
-#endif
-)
-{
-    (void)p;
-#ifdef solo12_SINCOS_VECTOR
-    (void)sine;
-    (void)cosine;
-#endif
-    const double q7 = q[6];
-    (void)q7; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q8 = q[7];
-    (void)q8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q9 = q[8];
-    (void)q9; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q10 = q[9];
-    (void)q10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q11 = q[10];
-    (void)q11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double q12 = q[11];
-    (void)q12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd7 = qd[6];
-    (void)qd7; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd8 = qd[7];
-    (void)qd8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd9 = qd[8];
-    (void)qd9; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd10 = qd[9];
-    (void)qd10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd11 = qd[10];
-    (void)qd11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double qd12 = qd[11];
-    (void)qd12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau7 = tau[6];
-    (void)tau7; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau8 = tau[7];
-    (void)tau8; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau9 = tau[8];
-    (void)tau9; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau10 = tau[9];
-    (void)tau10; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau11 = tau[10];
-    (void)tau11; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double tau12 = tau[11];
-    (void)tau12; /* with AVX2, solo12_SIN(k, a) does not read a */
-    const double x460 = stash[0];
-    const double x585 = stash[1];
-    const double x594 = stash[2];
-    const double x698 = stash[3];
-    const double x727 = stash[4];
-    const double x759 = stash[5];
-    const double x766 = stash[6];
-    const double x772 = stash[7];
-    const double x783 = stash[8];
-    const double x789 = stash[9];
-    const double x791 = stash[10];
-    const double x793 = stash[11];
     const double x798 = -x698*x594 - x727*x460 - x789*x585;
     ((volatile double *)A)[423] = x798;
     const double x799 = -x759*x594 - x766*x460 - x791*x585;
@@ -9886,100 +9187,4 @@ static solo12_NOINLINE void solo12_linearize_part2(const double q[], const doubl
     ((volatile double *)A)[574] = x1600;
     const double x1601 = -x1573*x1395 - x1584*x1261 - x1594*x1386;
     ((volatile double *)A)[575] = x1601;
-}
-
-/* xd = f(x, tau) linearised at x = (q, qd): A = [[0, I], [dqdd/dq, dqdd/dqd]], B = [0; M^-1] (4418 operations: 2374 multiplications, 2012 additions, 8 divisions, 24 trigonometric calls, 0 other calls) */
-void solo12_linearize(const double q[], const double qd[], const double tau[], const double p[], double A[], double B[])
-{
-    (void)p;
-    /* the runs of zeros of A (the inputs are read), then the rest as it is known */
-    for (int k = 0; k < 12; ++k) A[k] = 0;
-    for (int k = 13; k < 37; ++k) A[k] = 0;
-    for (int k = 38; k < 62; ++k) A[k] = 0;
-    for (int k = 63; k < 87; ++k) A[k] = 0;
-    for (int k = 88; k < 112; ++k) A[k] = 0;
-    for (int k = 113; k < 137; ++k) A[k] = 0;
-    for (int k = 138; k < 162; ++k) A[k] = 0;
-    for (int k = 163; k < 187; ++k) A[k] = 0;
-    for (int k = 188; k < 212; ++k) A[k] = 0;
-    for (int k = 213; k < 237; ++k) A[k] = 0;
-    for (int k = 238; k < 262; ++k) A[k] = 0;
-    for (int k = 263; k < 287; ++k) A[k] = 0;
-    for (int k = 291; k < 300; ++k) A[k] = 0;
-    for (int k = 303; k < 312; ++k) A[k] = 0;
-    for (int k = 315; k < 324; ++k) A[k] = 0;
-    for (int k = 327; k < 336; ++k) A[k] = 0;
-    for (int k = 339; k < 348; ++k) A[k] = 0;
-    for (int k = 351; k < 363; ++k) A[k] = 0;
-    for (int k = 366; k < 375; ++k) A[k] = 0;
-    for (int k = 378; k < 387; ++k) A[k] = 0;
-    for (int k = 390; k < 399; ++k) A[k] = 0;
-    for (int k = 402; k < 411; ++k) A[k] = 0;
-    for (int k = 414; k < 423; ++k) A[k] = 0;
-    for (int k = 426; k < 438; ++k) A[k] = 0;
-    for (int k = 441; k < 450; ++k) A[k] = 0;
-    for (int k = 453; k < 462; ++k) A[k] = 0;
-    for (int k = 465; k < 474; ++k) A[k] = 0;
-    for (int k = 477; k < 486; ++k) A[k] = 0;
-    for (int k = 489; k < 498; ++k) A[k] = 0;
-    for (int k = 501; k < 513; ++k) A[k] = 0;
-    for (int k = 516; k < 525; ++k) A[k] = 0;
-    for (int k = 528; k < 537; ++k) A[k] = 0;
-    for (int k = 540; k < 549; ++k) A[k] = 0;
-    for (int k = 552; k < 561; ++k) A[k] = 0;
-    for (int k = 564; k < 573; ++k) A[k] = 0;
-    /* the runs of zeros of B (the inputs are read), then the rest as it is known */
-    for (int k = 0; k < 144; ++k) B[k] = 0;
-    for (int k = 147; k < 156; ++k) B[k] = 0;
-    for (int k = 159; k < 168; ++k) B[k] = 0;
-    for (int k = 171; k < 183; ++k) B[k] = 0;
-    for (int k = 186; k < 195; ++k) B[k] = 0;
-    for (int k = 198; k < 207; ++k) B[k] = 0;
-    for (int k = 210; k < 222; ++k) B[k] = 0;
-    for (int k = 225; k < 234; ++k) B[k] = 0;
-    for (int k = 237; k < 246; ++k) B[k] = 0;
-    for (int k = 249; k < 261; ++k) B[k] = 0;
-    for (int k = 264; k < 273; ++k) B[k] = 0;
-    for (int k = 276; k < 285; ++k) B[k] = 0;
-#ifdef solo12_SINCOS_VECTOR
-    const double q1 = q[0];
-    const double q2 = q[1];
-    const double q3 = q[2];
-    const double q4 = q[3];
-    const double q5 = q[4];
-    const double q6 = q[5];
-    const double q7 = q[6];
-    const double q8 = q[7];
-    const double q9 = q[8];
-    const double q10 = q[9];
-    const double q11 = q[10];
-    const double q12 = q[11];
-    const double angle[12] = {
-        q3,
-        q2,
-        q1,
-        q6,
-        q5,
-        q4,
-        q9,
-        q8,
-        q7,
-        q12,
-        q11,
-        q10
-    };
-    double sine[12], cosine[12];
-    solo12_sincos(12, angle, sine, cosine);
-#endif
-    double stash[12];
-    solo12_linearize_part1(q, qd, tau, p, A, B, stash
-#ifdef solo12_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
-    solo12_linearize_part2(q, qd, tau, p, A, B, stash
-#ifdef solo12_SINCOS_VECTOR
-        , sine, cosine
-#endif
-        );
 }
