@@ -193,7 +193,7 @@ def measure_parts(label: str, ctx) -> None:
     with tempfile.TemporaryDirectory(prefix="symdyn-compile-time-") as tmp:
         files = render(ctx, False)
         b = build(ctx, files, Path(tmp, "parts"))
-        print(f"\n{label}: {ctx.robot.n} joints, largest function {largest(render(ctx, True))}")
+        print(f"\n{label}: {ctx.robot.n} joints")
         print(f"{b['size'] / 1000:.0f} KB of C in {b['files']} files, all at once {b['parallel']:.1f} s wall")
         for name, cpu in b["serial"].items():
             print(f"  {name}: {len(files[name].encode()) / 1000:.0f} KB, gcc -O2 {cpu:.1f} s of CPU")

@@ -32,6 +32,7 @@ def _split(monkeypatch, ctx, statements: int, file_bytes: int) -> dict[str, str]
     """The C of `ctx` rendered with parts of at most `statements` statements and files of about
     `file_bytes` bytes of statements."""
     with monkeypatch.context() as m:
+        m.setattr(parts, "PART_ABOVE", statements)
         m.setattr(parts, "PART_STATEMENTS", statements)
         m.setattr(parts, "SPLIT_BYTES", file_bytes)
         return c_target.render(ctx)
@@ -128,6 +129,7 @@ def test_stash_slots_are_reused_once_read():
         ("store", "tau[1]", "x0"),
     ]
     with pytest.MonkeyPatch.context() as m:
+        m.setattr(parts, "PART_ABOVE", 2)
         m.setattr(parts, "PART_STATEMENTS", 2)
         split = parts.split_body(body, [("q1", "q", "0")], "f", ["q", "tau"])
     first, second, third = split["parts"]

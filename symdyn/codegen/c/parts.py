@@ -6,7 +6,7 @@ builds every function's statements, templates/c/*.j2 spell them.
 Parts. gcc's time on straight-line code grows faster than the code: most of a -O2 build of a large
 function goes to register allocation (LRA's hard register assignment, half of the time of the
 Panda's 143 KB forward-dynamics derivatives), which looks at every value live at once. A function of
-more than PART_STATEMENTS statements is cut into parts of about that many consecutive statements
+more than PART_ABOVE statements is cut into parts of about PART_STATEMENTS consecutive statements
 (as many parts as needed, each cut within a quarter of a part of the even cut where the fewest
 temporaries are alive); part k is a static function NAME_FUNCTION_partk with the
 function's own arguments, called in order by the function, never inlined (NAME_NOINLINE). A
@@ -26,10 +26,20 @@ from __future__ import annotations
 import re
 from math import ceil
 
-__all__ = ["PART_STATEMENTS", "SPLIT_BYTES", "split_body", "reads_in", "file_groups", "source_file_name"]
+__all__ = [
+    "PART_ABOVE",
+    "PART_STATEMENTS",
+    "SPLIT_BYTES",
+    "split_body",
+    "reads_in",
+    "file_groups",
+    "source_file_name",
+]
 
-#: a function with more statements (temporaries and output stores) than this is cut into parts
-PART_STATEMENTS = 4000
+#: a function with more statements (temporaries and output stores) than this is cut into parts ...
+PART_ABOVE = 4000
+#: ... of about this many statements each
+PART_STATEMENTS = 1500
 
 #: C text of about this many bytes per source file, when the whole is larger
 SPLIT_BYTES = 1_000_000
@@ -55,7 +65,7 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
     reads), "unused" (the arguments it neither reads nor writes, and the stash's name "" when it
     neither loads nor saves)}.
     """
-    if len(body) <= PART_STATEMENTS:
+    if len(body) <= max(PART_ABOVE, PART_STATEMENTS):
         return None
     chunks = [body[a:b] for a, b in _cuts(body)]
     defined_in = {s[1]: c for c, chunk in enumerate(chunks) for s in chunk if s[0] == "let"}
