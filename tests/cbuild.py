@@ -41,6 +41,7 @@ __all__ = [
     "compile_program",
     "header_macros",
     "CDynamics",
+    "source_files",
     "build_dynamics",
     "load_c_and_numpy",
 ]
@@ -207,6 +208,12 @@ class CDynamics:
         return self.call("forward_dynamics", q, qd, tau, p)
 
 
+def source_files(files: Mapping[str, str | bytes], directory: str | os.PathLike, name: str) -> list[Path]:
+    """The C target's source files among `files`, in `directory`: NAME_dynamics.c, NAME_dynamics_2.c ..."""
+    pattern = re.compile(re.escape(name) + r"_dynamics(_[0-9]+)?\.c\Z")
+    return [Path(directory) / k for k in sorted(files) if pattern.match(k)]
+
+
 def build_dynamics(
     files: Mapping[str, str | bytes],
     directory: str | os.PathLike,
@@ -216,14 +223,13 @@ def build_dynamics(
     opt: str = TEST_OPT,
     extra: Sequence[str] = (),
 ) -> CDynamics:
-    """Write the C target's files, compile NAME_dynamics.c to a shared library and load it
-    (`extra`: more compiler flags, e.g. -mavx2)."""
+    """Write the C target's files, compile NAME_dynamics.c (and a large robot's NAME_dynamics_2.c
+    ...: `source_files`) to a shared library and load it (`extra`: more compiler flags, e.g. -mavx2)."""
     out = Path(directory)
-    write_files({k: v for k, v in files.items() if k.startswith(f"{name}_dynamics.")}, out)
+    write_files({k: v for k, v in files.items() if k.startswith(f"{name}_dynamics")}, out)
     macros = header_macros((out / f"{name}_dynamics.h").read_text())
-    lib = compile_shared(
-        [out / f"{name}_dynamics.c"], out / f"lib{name}_{precision}_{compiler}.so", compiler, opt, extra=extra
-    )
+    library = out / f"lib{name}_{precision}_{compiler}.so"
+    lib = compile_shared(source_files(files, out, name), library, compiler, opt, extra=extra)
     return CDynamics(lib, name, int(macros[f"{name}_NDOF"]), int(macros[f"{name}_NPARAM"]), precision)
 
 
@@ -232,7 +238,7 @@ def load_c_and_numpy(files: Mapping[str, str | bytes], directory: str | os.PathL
     written to `directory`, the C compiled with the strict flags."""
     out = Path(directory)
     write_files(files, out)
-    lib = ctypes.CDLL(str(compile_shared([out / f"{name}_dynamics.c"], out / f"lib{name}.so")))
+    lib = ctypes.CDLL(str(compile_shared(source_files(files, out, name), out / f"lib{name}.so")))
     module = types.ModuleType(f"{name}_numpy")
     exec(
         compile(files[f"{name}_numpy.py"], f"{name}_numpy.py", "exec"), module.__dict__

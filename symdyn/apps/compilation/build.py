@@ -130,6 +130,7 @@ def compile_library(
     size = sum(len(text.encode()) for name, text in sources.items() if name.endswith(".c"))
     count = sum(name.endswith(".c") for name in sources)
     label = f"compiling {Path(target).name}: {size / 1000:.0f} KB of C in {count} files"
+    label += f", {min(count, os.cpu_count() or 1)} at once" if count > 1 else ""
     label += f" ({compile_estimate(size)})"
     with (
         progress_stage(label),
@@ -150,26 +151,49 @@ def compile_library(
         except OSError as exc:
             raise SymdynError(f"cannot run the C compiler {compiler[0]}: {exc}") from exc
         if failed:
-            raise SymdynError(f"the C compiler failed ({shlex.join(failed[0])}):\n{failed[1].strip()}")
+            raise SymdynError(_failure(failed, count))
     return Path(target)
 
 
 def _compile_objects(compiler: list[str], c_files: list[str], arch: Sequence[str], folder: str):
-    """Compile every file of `c_files` to its .o at once; (command, messages) of the first that
-    failed, or None."""
+    """Compile every file of `c_files` to its .o, at most os.cpu_count() at once, the largest first
+    (the large generated files dominate; a large robot's C is in several, symdyn.codegen.c.parts);
+    (command, messages) of the first that failed, or None. After a failure no further file starts."""
     import subprocess  # here, not at the top: a cached run (find_compiler only) does not need it
 
     flags = [f for f in COMPILE_FLAGS if f != "-shared"]
-    commands = [[*compiler, *flags, *arch, "-c", name, "-o", name[:-2] + ".o"] for name in c_files]
-    running = [
-        subprocess.Popen(cmd, cwd=folder, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        for cmd in commands
-    ]
-    errors = [proc.communicate()[1] for proc in running]
-    return next(
-        ((cmd, err) for cmd, err, proc in zip(commands, errors, running, strict=True) if proc.returncode),
-        None,
-    )
+    order = sorted(c_files, key=lambda name: (-Path(folder, name).stat().st_size, name))
+    waiting = [[*compiler, *flags, *arch, "-c", name, "-o", name[:-2] + ".o"] for name in order]
+    running: list = []
+    failed = None
+    while waiting or running:
+        while waiting and len(running) < (os.cpu_count() or 1) and failed is None:
+            cmd = waiting.pop(0)
+            running.append(
+                (
+                    cmd,
+                    subprocess.Popen(
+                        cmd, cwd=folder, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+                    ),
+                )
+            )
+        if failed is not None and not running:
+            break
+        cmd, proc = running.pop(0)
+        errors = proc.communicate()[1]
+        if proc.returncode and failed is None:
+            failed = (cmd, errors)
+    return failed
+
+
+def _failure(failed: tuple[list[str], str], count: int) -> str:
+    """One line for a failed build: the command, its first error message and how many lines follow."""
+    cmd, messages = failed
+    lines = [line.strip() for line in messages.strip().splitlines() if line.strip()]
+    first = next((line for line in lines if "error" in line), lines[0] if lines else "no message")
+    more = f" (and {len(lines) - 1} more lines)" if len(lines) > 1 else ""
+    where = f"{cmd[cmd.index('-c') + 1]}, one of {count} files; " if "-c" in cmd and count > 1 else ""
+    return f"the C compiler failed ({where}{shlex.join(cmd)}): {first}{more}"
 
 
 def _run(cmd: list[str], folder: str):

@@ -116,6 +116,9 @@ class CNames:
     # them for an array of angles), the macros "sin", "cos" (reading them) and "vector" (defined
     # when the helper is used), the locals "angle", "sine" and "cosine" (the arrays)
     sincos: dict[str, str]
+    # the parts of a large function (symdyn.codegen.c.parts): the macro "noinline" (keeps each part a
+    # function of its own) and the local array "stash" (the temporaries passed between parts)
+    parts: dict[str, str]
 
 
 def _aliases(written: list[str], taken: set[str]) -> tuple[tuple[str, str], ...]:
@@ -177,7 +180,8 @@ def c_names(ctx: RenderContext) -> CNames:
         + ([f"{name}_NACT", f"{name}_NPAS"] if "loop_newton_step" in functions else [])
         + ([f"{name}_NCONTACT", f"{name}_NLAMBDA"] if "contact_jacobian" in functions else [])
     )
-    taken = set(written) | set(functions.values()) | {guard} | set(sincos.values())
+    parts = {"noinline": f"{name}_NOINLINE"}
+    taken = set(written) | set(functions.values()) | {guard} | set(sincos.values()) | set(parts.values())
     aliases = _aliases(written, taken)
 
     joint_symbols = _joint_symbols(ctx)
@@ -200,6 +204,7 @@ def c_names(ctx: RenderContext) -> CNames:
         used.add(local_names[p])
     for array in ("angle", "sine", "cosine"):
         sincos[array] = free_name(array, reserved | used, TEMPORARY)
+    parts["stash"] = free_name("stash", reserved | used, TEMPORARY)
     param_macro = {p: m for p, (m, _) in zip(params, param_macros, strict=True)}
     return CNames(
         header_file=f"{name}_dynamics.h",
@@ -231,4 +236,5 @@ def c_names(ctx: RenderContext) -> CNames:
             "nv": nv or str(ctx.robot.nv),
         },
         sincos=sincos,
+        parts=parts,
     )

@@ -25,6 +25,7 @@ from ..loop_solve import loop_solve_context
 from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
+from .parts import file_groups, reads_in, source_file_name, split_body
 from .printer import CPrinter
 from .sincos import BLOCK, FREESTANDING_ERROR, gather
 
@@ -43,7 +44,11 @@ FILL_ZEROS = 16
 
 #: The tools each file's bytes depend on besides symdyn (SymPy builds every expression; the
 #: CMakeLists.txt header carries the operation counts).
-TOOLS = {"_dynamics.h": ("sympy",), "_dynamics.c": ("sympy",), "CMakeLists.txt": ("sympy",)}
+TOOLS = {
+    "_dynamics.h": ("sympy",),
+    ".c": ("sympy",),
+    "CMakeLists.txt": ("sympy",),
+}  # .c: NAME_dynamics.c, NAME_dynamics_2.c, ...
 
 #: the build file written beside the C files (templates/c/CMakeLists.txt.j2)
 CMAKE_FILE = "CMakeLists.txt"
@@ -145,8 +150,14 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
             }
         )
     printed = [(sym.name, printer.doprint(expr)) for sym, expr in temporaries]
+    body = _body(spec, temporaries, printed, outputs)
+    arguments = [inp["name"] for inp in inputs] + [out["name"] for out in outputs]
+    parts = split_body(body, reads, names.functions[spec.name], arguments)
     return {
-        "body": _body(spec, temporaries, printed, outputs),
+        "body": body,
+        "parts": parts,
+        # with parts, the function itself reads only the inputs of its angles (symdyn.codegen.c.parts)
+        "angle_reads": reads_in(sincos["angles"], reads) if parts and sincos else [],
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
@@ -232,6 +243,7 @@ def render_context(ctx: RenderContext) -> dict:
         "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
         "freestanding": ctx.freestanding,
         "sincos_error": FREESTANDING_ERROR[ctx.precision],
+        "parts": names.parts if any(f["parts"] for f in functions) else None,
         "loops": _loops_view(ctx, names),
         "contacts": _contacts_view(ctx, names),
     }
@@ -296,13 +308,23 @@ def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
 
 def render(ctx: RenderContext) -> dict[str, str]:
     """NAME_dynamics.h, NAME_dynamics.c and CMakeLists.txt (a static library of every .c file
-    written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`."""
+    written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`; a
+    large robot's functions go into NAME_dynamics.c, NAME_dynamics_2.c, ...
+    (symdyn.codegen.c.parts.file_groups decides)."""
     values = render_context(ctx)
     env = environment()
-    files = {
-        values["header_file"]: env.get_template("c/dynamics.h.j2").render(values),
-        values["source_file"]: env.get_template("c/dynamics.c.j2").render(values),
-    }
+    files = {values["header_file"]: env.get_template("c/dynamics.h.j2").render(values)}
+    functions = values["functions"]
+    groups = file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
+    for k, group in enumerate(groups):
+        chosen = [functions[i] for i in group]
+        files[source_file_name(ctx.name, k)] = env.get_template("c/dynamics.c.j2").render(
+            values,
+            functions=chosen,
+            sincos=values["sincos"] if any(f["sincos"] for f in chosen) else None,
+            parts=values["parts"] if any(f["parts"] for f in chosen) else None,
+            loops=values["loops"] if k == 0 else None,
+        )
     sources = sorted(name for name in files if name.endswith(".c"))
     files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render({**values, "sources": sources})
     return files

@@ -1,0 +1,186 @@
+"""The C target's layout: large function bodies cut into parts, large outputs into several files.
+
+This module alone decides how the generated C is laid out for the compiler; symdyn.codegen.c.target
+builds every function's statements, templates/c/*.j2 spell them.
+
+Parts. gcc's time on straight-line code grows faster than the code: most of a -O2 build of a large
+function goes to register allocation (LRA's hard register assignment, half of the time of the
+Panda's 143 KB forward-dynamics derivatives), which looks at every value live at once. A function of
+more than PART_ABOVE statements is cut into parts of about PART_STATEMENTS consecutive statements
+(as many parts as needed, each cut within a quarter of a part of the even cut where the fewest
+temporaries are alive); part k is a static function NAME_FUNCTION_partk with the
+function's own arguments, called in order by the function, never inlined (NAME_NOINLINE). A
+temporary read by a later part than the one that computes it goes through the function's local
+array `stash`: stored right after it is computed, loaded at the start of each part that reads it;
+a slot is reused after the last part that reads its value (a greedy colouring of the intervals
+[defining part, last reading part]). Each part reads the inputs it needs from the input
+arrays itself.
+
+Files. `file_groups` puts the functions into the source files: one NAME_dynamics.c while the whole C
+is below SPLIT_BYTES, else consecutive functions in files of about SPLIT_BYTES each (NAME_dynamics.c,
+NAME_dynamics_2.c, ...; a function's parts stay with it), which a build compiles in parallel.
+"""
+
+from __future__ import annotations
+
+import re
+from math import ceil
+
+__all__ = [
+    "PART_ABOVE",
+    "PART_STATEMENTS",
+    "SPLIT_BYTES",
+    "split_body",
+    "reads_in",
+    "file_groups",
+    "source_file_name",
+]
+
+#: a function with more statements (temporaries and output stores) than this is cut into parts ...
+PART_ABOVE = 4000
+#: ... of about this many statements each
+PART_STATEMENTS = 1500
+
+#: C text of about this many bytes per source file, when the whole is larger
+SPLIT_BYTES = 1_000_000
+
+_IDENTIFIER = re.compile(r"\b[A-Za-z_]\w*")
+
+
+def _names_read(text: str, known: set[str]) -> set[str]:
+    """The identifiers of `known` that the printed C expression `text` reads."""
+    return {word for word in _IDENTIFIER.findall(text) if word in known}
+
+
+def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> dict | None:
+    """{"parts", "slots": the size of the array `stash`} of a function whose `body` (("let", name,
+    value) and ("store", target, value) in order, symdyn.codegen.c.target) has more than
+    PART_STATEMENTS statements; None when it has not.
+
+    `reads` are the function's (local, input, index): each input value it copies into a local;
+    `arguments` the names of its inputs and outputs, which each part takes too.
+    Each part is {"name", "reads" (the reads it needs), "loads" ((name, slot): the temporaries of
+    earlier parts it reads), "body" (its statements, ("load", name, slot) before the first that
+    reads a temporary of an earlier part, ("save", slot, name) after a temporary a later part
+    reads), "unused" (the arguments it neither reads nor writes, and the stash's name "" when it
+    neither loads nor saves)}.
+    """
+    if len(body) <= max(PART_ABOVE, PART_STATEMENTS):
+        return None
+    chunks = [body[a:b] for a, b in _cuts(body)]
+    defined_in = {s[1]: c for c, chunk in enumerate(chunks) for s in chunk if s[0] == "let"}
+    inputs = {local for local, _, _ in reads}
+    known = set(defined_in) | inputs
+    used = [set().union(*(_names_read(s[2], known) for s in chunk)) for chunk in chunks]
+    # the temporaries each part loads from an earlier one, and the last part that loads each
+    loads = [
+        sorted((n for n in names if n in defined_in and defined_in[n] < c), key=_number)
+        for c, names in enumerate(used)
+    ]
+    last = {n: c for c, names in enumerate(loads) for n in names}
+    slot_of: dict[str, int] = {}
+    free: list[int] = []
+    slots = 0
+    parts = []
+    for c, chunk in enumerate(chunks):
+        statements = []
+        part_loads = [(n, slot_of[n]) for n in loads[c]]
+        pending = dict(part_loads)
+        for s in chunk:
+            # each temporary of an earlier part loaded right before its first use: a load at the
+            # part's start could not move past the stores to the outputs (they may alias the
+            # stash), and the value would stay alive, in a register or spilled, through the part
+            for n in sorted(_names_read(s[2], set(pending)), key=_number):
+                statements.append(("load", n, str(pending.pop(n))))
+            statements.append(s)
+            if s[0] == "let" and s[1] in last:
+                slot = free.pop() if free else slots
+                slots = max(slots, slot + 1)
+                slot_of[s[1]] = slot
+                statements.append(("save", str(slot), s[1]))
+        # a slot is free again after the last part that reads its value (it loads it where it first reads it)
+        free.extend(slot for n, slot in part_loads if last[n] == c)
+        free.sort(reverse=True)
+        part_reads = [r for r in reads if r[0] in used[c]]
+        touched = {r[1] for r in part_reads}
+        touched |= set().union(*(_names_read(s[1], set(arguments)) for s in chunk if s[0] == "store"))
+        stashed = bool(part_loads) or any(s[0] == "save" for s in statements)
+        parts.append(
+            {
+                "name": f"{c_name}_part{c + 1}",
+                "reads": part_reads,
+                "loads": part_loads,
+                "body": statements,
+                "unused": [a for a in arguments if a not in touched] + ([] if stashed else [""]),
+            }
+        )
+    return {"parts": parts, "slots": slots}
+
+
+def _cuts(body: list) -> list[tuple[int, int]]:
+    """The parts' [start, end) in `body`: as many as PART_STATEMENTS asks, each cut placed, within a
+    quarter of a part's length of the even cut, where the fewest temporaries are alive (computed
+    before it, read after it): every such value costs a store and a load per later part reading it."""
+    n = len(body)
+    count = ceil(n / PART_STATEMENTS)
+    size = n / count
+    defined = {s[1]: k for k, s in enumerate(body) if s[0] == "let"}
+    last: dict[str, int] = {}
+    for k, s in enumerate(body):
+        for name in _names_read(s[2], set(defined)):
+            last[name] = k
+    # alive[i]: the temporaries alive across a cut before statement i (defined before i, read at i or later)
+    change = [0] * (n + 2)
+    for name, k in defined.items():
+        if name in last:
+            change[k + 1] += 1
+            change[last[name] + 1] -= 1
+    alive, running = [], 0
+    for i in range(n + 1):
+        running += change[i]
+        alive.append(running)
+    cuts, start = [], 0
+    for part in range(1, count):
+        even = round(part * size)
+        window = range(max(start + 1, even - int(size) // 4), min(n, even + int(size) // 4) + 1)
+        cut = min(window, key=lambda i: (alive[i], abs(i - even), i))
+        cuts.append((start, cut))
+        start = cut
+    return [*cuts, (start, n)]
+
+
+def reads_in(texts: list[str], reads: list) -> list:
+    """The (local, input, index) of `reads` whose local the printed C expressions `texts` read."""
+    known = {local for local, _, _ in reads}
+    used = set().union(*(_names_read(text, known) for text in texts))
+    return [r for r in reads if r[0] in used]
+
+
+def _number(name: str) -> tuple[int, str]:
+    """Temporaries x12 in their numeric order."""
+    digits = name[1:]
+    return (int(digits), name) if digits.isdigit() else (0, name)
+
+
+def file_groups(sizes: list[int]) -> list[list[int]]:
+    """The functions of each source file, as indices into `sizes` (each function's bytes of C):
+    all in one file while the sum is at most SPLIT_BYTES, else consecutive functions in about
+    sum / SPLIT_BYTES files of balanced size."""
+    total = sum(sizes)
+    if total <= SPLIT_BYTES or len(sizes) < 2:
+        return [list(range(len(sizes)))]
+    count = min(len(sizes), ceil(total / SPLIT_BYTES))
+    groups: list[list[int]] = [[]]
+    done = 0
+    for k, size in enumerate(sizes):
+        # a new file when this function's middle lies past the current file's share of the whole
+        if groups[-1] and len(groups) < count and done + size / 2 > total * len(groups) / count:
+            groups.append([])
+        groups[-1].append(k)
+        done += size
+    return groups
+
+
+def source_file_name(name: str, index: int) -> str:
+    """NAME_dynamics.c for the first file (index 0), NAME_dynamics_2.c ... for the others."""
+    return f"{name}_dynamics.c" if index == 0 else f"{name}_dynamics_{index + 1}.c"
