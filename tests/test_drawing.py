@@ -181,23 +181,17 @@ def test_a_closed_loop_is_drawn_dashed_and_masses_are_sized():
 
 
 def test_contacts_are_drawn_as_frames_of_their_own_style():
-    """A robot with `contacts` (another module adds them to the model) shows each as a marker."""
-
-    class Contact:
-        name, link = "toe", 1
-        point = (0.1, 0.0, 0.0)
+    """A robot's contacts (Robot.contacts) are markers of kind contact at their frames' origins: the
+    oracle's poses of those frames."""
+    from symdyn.model.contacts import Contact
 
     robot = _quiet(example, "puma560")
-    object.__setattr__(robot, "contacts", (Contact(),))
+    robot = replace(robot, contacts=(Contact("toe", "link2", "point"), Contact("hand", "link6", "6d")))
     q = np.full(6, 0.3)
-    try:
-        origins = _origins(draw(robot, q))
-    finally:
-        object.__delattr__(robot, "contacts")
-    pose = frame_state(robot, "link2", q).pose
-    body = pose @ np.linalg.inv(np.array(robot.links[1].frame.matrix(), dtype=float))
-    assert origins["toe"][0] == "contact"
-    np.testing.assert_allclose(origins["toe"][1], body[:3, :3] @ [0.1, 0, 0] + body[:3, 3], atol=TOL)
+    origins = _origins(draw(robot, q))
+    for name, frame in (("toe", "link2"), ("hand", "link6")):
+        assert origins[name][0] == "contact"
+        np.testing.assert_allclose(origins[name][1], frame_state(robot, frame, q).pose[:3, 3], atol=TOL)
 
 
 def test_drawings_are_deterministic_and_every_view_works(tmp_path):

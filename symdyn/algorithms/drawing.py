@@ -59,19 +59,12 @@ def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 def _contacts(robot) -> list[tuple[str, int, np.ndarray]]:
-    """(name, link, k_T_C) of each contact the model has (Robot.contacts: a name, a link index and
-    a placement Transform or a point in the link's body frame)."""
+    """(name, link, k_T_C) of each contact (Robot.contacts): the pose of its frame, a link's
+    convention frame or a named frame (Robot.frame), on link k (-1: the base)."""
     out = []
-    for c in getattr(robot, "contacts", ()) or ():
-        name = str(getattr(c, "name", "contact"))
-        link = int(getattr(c, "link", -1))
-        placement = getattr(c, "placement", None)
-        if placement is not None:
-            H = _homogeneous(placement, f"contact '{name}' placement")
-        else:
-            H = np.eye(4)
-            H[:3, 3] = _array(getattr(c, "point", (0, 0, 0)), (3,), f"contact '{name}' point")
-        out.append((name, link, H))
+    for c in robot.contacts:
+        f = robot.frame(c.frame, f"contact '{c.name}'")
+        out.append((c.name, f.link, _homogeneous(f.placement, f"contact '{c.name}' frame")))
     return out
 
 
@@ -99,7 +92,7 @@ class _Geometry:
         self.mass = [float(_array(lk.mass, (), f"link '{lk.name}' mass")) for lk in links]
         self.com = [_array(lk.com, (3,), f"link '{lk.name}' com") for lk in links]
         self.frames = [(f.name, f.link, _homogeneous(f.placement, f"frame '{f.name}'")) for f in r.frames]
-        self.contacts = _contacts(robot)
+        self.contacts = _contacts(r)
         self.loops = [
             (lp.link, _array(lp.point, (3,), f"loop '{lp.name}'"), lp.to, _array(lp.to_point, (3,), "loop"))
             for lp in r.loops
