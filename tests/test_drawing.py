@@ -10,6 +10,7 @@ screenshot shows the robot. Hostile names are escaped everywhere.
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 import subprocess
@@ -17,6 +18,7 @@ import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import replace
 from pathlib import Path
+from urllib.parse import unquote
 
 import numpy as np
 import pytest
@@ -231,6 +233,9 @@ def test_hostile_names_are_escaped_in_svg_and_html():
     body = html.split('id="symdyn-data">', 1)[1].split("</script>", 1)[0]
     assert "<" not in body and ">" not in body  # the names cannot close the data element
     assert html.count("<script") == 4  # the error hook, the import map, the data, the page's module
+    script = html.split('<script type="module">', 1)[1]  # labels and table cells: textContent only
+    html_sinks = r"innerHTML|outerHTML|insertAdjacentHTML|document\.write|createContextualFragment"
+    assert not re.search(html_sinks, script)
 
 
 def test_bad_input_is_refused_in_one_line(tmp_path, capsys):
@@ -299,7 +304,8 @@ def _chromium() -> str | None:
 @pytest.fixture(scope="module")
 def browser_run(tmp_path_factory):
     """One Chromium start: a page holding the drawing (HTML of a robot with hostile names) and
-    the animation of a simulation in two frames side by side; its console and screenshot."""
+    the animation of a simulation (opened at its last step) in two frames side by side; its
+    console and screenshot."""
     exe = _chromium()
     if exe is None:
         if IN_CI:
@@ -313,8 +319,8 @@ def browser_run(tmp_path_factory):
     (folder / "both.html").write_text(
         '<!DOCTYPE html><html><body style="margin:0;background:#fff;overflow:hidden">'
         '<iframe src="draw.html" style="position:absolute;left:0;top:0;border:0;width:980px;height:800px">'
-        '</iframe><iframe src="anim.html" style="position:absolute;left:980px;top:0;border:0;width:980px;'
-        'height:800px"></iframe></body></html>'
+        '</iframe><iframe src="anim.html#step=19" style="position:absolute;left:980px;top:0;border:0;'
+        'width:980px;height:800px"></iframe></body></html>'
     )
     shot = folder / "shot.png"
     cmd = [exe, *CHROMIUM_FLAGS, f"--user-data-dir={folder / 'profile'}", "--window-size=1960,800"]
@@ -333,8 +339,62 @@ def test_the_html_pages_open_in_chromium_without_console_errors(browser_run):
     drawn = [line for line in console if "symdyn: drawn" in line]
     assert len(drawn) == 2, run.stderr[-3000:]
     noise = ("GL Driver Message", "GPU stall")
-    errors = [line for line in console if "symdyn: drawn" not in line and not any(n in line for n in noise)]
+    ours = ('"symdyn: drawn ', '"symdyn: labels ')  # the pages' own lines
+    errors = [line for line in console if not any(n in line for n in (*ours, *noise))]
     assert not errors, errors
+
+
+def _shown(run) -> list[dict]:
+    """What each page printed it shows as text (page.js, "symdyn: labels"), read from its DOM."""
+    found = re.findall(r"symdyn: labels (\S+?)\"", run.stderr)
+    return [json.loads(unquote(text)) for text in found]
+
+
+_DH_TEXT = re.compile(r"([adαθ])(\d+) = (-?[0-9.e+-]+)(°?)")
+
+
+def _check_dh_labels(page: dict, s) -> None:
+    """The page's DH labels and table hold the scene's rows (read back from the frames, checked
+    against the file by test_the_dh_parameters_on_the_picture_are_the_files_rows), to the
+    figures' 4 digits and 0.1 degree."""
+    rows = {r.index: r for r in s.dh}
+    dh = [text for kind, _, text in page["labels"] if kind == "label dh"]
+    assert len(dh) >= len(rows), dh
+    for text in dh:
+        name, i, value, deg = _DH_TEXT.fullmatch(text).groups()
+        row = rows[int(i) + (name in "aα" and s.dh[0].convention == "modified")]
+        want = {"a": row.a, "d": row.d, "α": row.alpha, "θ": row.theta}[name]
+        if deg:
+            diff = np.angle(np.exp(1j * (np.radians(float(value)) - want)))
+            assert abs(diff) <= np.radians(0.051), (text, want)
+        else:
+            assert abs(float(value) - want) <= 5e-4 * abs(want), (text, want)
+    table = page["table"]
+    assert [r[0] for r in table[1:]] == [str(i) for i in rows]
+    for cells, row in zip(table[1:], s.dh, strict=True):
+        np.testing.assert_allclose([float(c) for c in cells[1:3]], [row.a, row.d], rtol=5e-4, atol=1e-12)
+
+
+def test_the_labels_are_in_the_pages_with_the_scenes_text(browser_run):
+    """The axis labels (x_i, z_i), the named frames' names and the DH parameters are elements of
+    each page, their text read back from the DOM (the animation's at its last step: the labels
+    follow the motion); hostile names are text, no element."""
+    run, _ = browser_run
+    pages = _shown(run)
+    assert len(pages) == 2, run.stderr[-3000:]
+    drawing = next(p for p in pages if any(f == HOSTILE for _, f, _ in p["labels"]))
+    anim = next(p for p in pages if p is not drawing)
+    last = np.full(6, np.sin(2.0))  # the animation's q at t = 1
+    for page, robot, q in ((drawing, _hostile_robot(), [0.2, 0.4]), (anim, _quiet(example, "puma560"), last)):
+        s = scene(robot, q)
+        axes = [f for f in s.frames if f.kind in ("link", "base")]
+        want = [("label axis", f.name, a + f.label) for f in axes for a in "xz"]
+        want += [(f"label {f.kind}", f.name, f.label) for f in s.frames if f.kind in ("frame", "contact")]
+        got = [tuple(x) for x in page["labels"] if x[0] != "label dh"]
+        assert sorted(got) == sorted(want)
+        assert page["foreign"] == 0 and page["scripts"] == 4
+        _check_dh_labels(page, s)
+    assert "tip<svg onload=alert(3)>" in [text for _, _, text in drawing["labels"]]
 
 
 def test_the_screenshot_shows_both_robots(browser_run):
@@ -357,8 +417,6 @@ def test_the_animation_page_holds_the_frames_and_the_tool_path(tmp_path):
     q = np.outer(t, np.ones(6))
     page = animate(robot, t, q, tmp_path / "a.html", frames=4).decode()
     data = page.split('id="symdyn-data">', 1)[1].split("</script>", 1)[0]
-    import json
-
     d = json.loads(data)
     assert len(d["steps"]) == 4 and d["times"] == [0.0, 0.3, 0.7, 1.0]
     want = [frame_state(robot, "link6", x).pose[:3, 3] for x in q]
@@ -366,6 +424,12 @@ def test_the_animation_page_holds_the_frames_and_the_tool_path(tmp_path):
     assert Path(tmp_path / "a.html").read_bytes() == page.encode()
     assert not re.search(r"""(src|href)\s*=\s*["']?(https?:|//)""", page)  # nothing from the network
     assert '"three":"data:text/javascript;base64,' in page.replace(" ", "")
+    for step, k in zip(d["steps"], (0, 3, 7, 10), strict=True):  # the DH labels follow the motion
+        thetas = [float(sub.split(" = ")[1][:-1]) for text, sub, *_ in step["dh"] if text == "θ"]
+        rows = scene(robot, q[k]).dh
+        want = [np.degrees(r.theta) for r in rows if abs(r.theta) > 1e-9]
+        np.testing.assert_allclose(thetas, want, atol=0.051)
+        assert [c[0][0] for c in step["table"][1:]] == [str(r.index) for r in rows]
 
 
 # --------------------------------------------------------------------------- the documentation's pictures

@@ -4,7 +4,7 @@ import * as THREE from "three";
 
 const D = JSON.parse(document.getElementById("symdyn-data").textContent);
 const COLORS = { x: 0xd62728, y: 0x2ca02c, z: 0x1f77b4, link: 0x555555, loop: 0x8c564b,
-  joint: 0xff7f0e, mass: 0x7f7f7f, contact: 0xe377c2, trace: 0x17becf, force: 0xbcbd22 };
+  joint: 0xff7f0e, mass: 0x7f7f7f, contact: 0xe377c2, trace: 0x17becf, force: 0xbcbd22, dh: 0x9467bd };
 const view = document.getElementById("view");
 const W = view.clientWidth, H = view.clientHeight;
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -75,12 +75,17 @@ const balls = D.masses.map((m) => {
   return s;
 });
 const labels = document.getElementById("labels");
-function label(text, sub, color) {
-  const e = document.createElement("span");
-  e.className = "label";
-  e.style.color = "#" + color.toString(16).padStart(6, "0");
+// Text with a subscript ("x" with "1": x_1), user text through textContent only.
+function write(e, text, sub) {
   e.textContent = text;
   if (sub) { const s = document.createElement("sub"); s.textContent = sub; e.appendChild(s); }
+}
+function label(text, sub, color, kind, frame) {
+  const e = document.createElement("span");
+  e.className = "label " + kind;
+  e.style.color = "#" + color.toString(16).padStart(6, "0");
+  if (frame !== undefined) e.dataset.frame = frame;
+  write(e, text, sub);
   labels.appendChild(e);
   return e;
 }
@@ -92,15 +97,53 @@ D.frames.forEach((f) => {
     const a = new THREE.ArrowHelper(up, new THREE.Vector3(), len, COLORS[axis], 0.25 * len, 0.12 * len);
     scene.add(a);
     arrows.push({ a, k, len });
-    if (!named && axis !== "y") tags.push({ e: label(axis, f.label, COLORS[axis]), frame: arrows.length - 1 });
+    if (!named && axis !== "y") tags.push({ e: label(axis, f.label, COLORS[axis], "axis", f.name), frame: arrows.length - 1 });
   });
-  if (named) tags.push({ e: label(f.label, "", f.kind === "contact" ? COLORS.contact : 0x333333), origin: arrows.length - 1 });
+  if (named) {
+    const color = f.kind === "contact" ? COLORS.contact : 0x333333;
+    tags.push({ e: label(f.label, "", color, f.kind, f.name), origin: arrows.length - 1 });
+  }
 });
 if (D.trace.length > 1) {
   const g = new THREE.BufferGeometry().setFromPoints(D.trace.map(v3));
   scene.add(new THREE.Line(g, new THREE.LineBasicMaterial({ color: COLORS.trace })));
 }
 const forceArrows = [];
+// A DH robot's parameters at the shown step: labels beside their points, d and a along dashed
+// lines (the SVG's marks, symdyn.apps.drawing.sketch.dh_texts), and the table in the corner.
+const dhTags = [], dhLines = [], table = document.getElementById("dh-table");
+const dashed = new THREE.LineDashedMaterial({ color: COLORS.dh, dashSize: 0.1 * L, gapSize: 0.07 * L });
+function showDH(s) {
+  dhTags.forEach((t) => { t.e.style.display = "none"; t.point = null; });
+  dhLines.forEach((l) => { l.visible = false; });
+  let n = 0;
+  (s.dh || []).forEach(([text, sub, at, shift, span]) => {
+    const k = dhTags.length;
+    if (k <= n) dhTags.push({ e: label("", "", COLORS.dh, "dh") });
+    const t = dhTags[n++];
+    write(t.e, text, sub);
+    t.e.style.display = "";
+    t.point = v3(at);
+    t.shift = shift;
+    if (span) {
+      const i = dhLines.findIndex((l) => !l.visible);
+      const line = i >= 0 ? dhLines[i] : new THREE.Line(new THREE.BufferGeometry(), dashed);
+      if (i < 0) { dhLines.push(line); scene.add(line); }
+      line.geometry.setFromPoints(span.map(v3));
+      line.computeLineDistances();
+      line.visible = true;
+    }
+  });
+  table.replaceChildren();
+  (s.table || []).forEach((row, r) => {
+    const tr = table.insertRow();
+    row.forEach(([text, sub]) => {
+      const cell = document.createElement(r === 0 ? "th" : "td");
+      write(cell, text, sub);
+      tr.appendChild(cell);
+    });
+  });
+}
 
 function show(k) {
   const s = D.steps[k];
@@ -129,6 +172,7 @@ function show(k) {
       forceArrows[i].setLength(len, 0.3 * L, 0.15 * L);
     }
   });
+  showDH(s);
   document.getElementById("time").textContent = D.times.length > 1 ? `t = ${D.times[k].toFixed(3)} s` : "";
   render();
 }
@@ -144,6 +188,12 @@ function render() {
     p.project(camera);
     t.e.style.left = `${((p.x + 1) / 2) * W}px`;
     t.e.style.top = `${((1 - p.y) / 2) * H}px`;
+  });
+  dhTags.forEach((t) => {
+    if (!t.point) return;
+    const p = t.point.clone().project(camera);
+    t.e.style.left = `${((p.x + 1) / 2) * W + t.shift[0]}px`;
+    t.e.style.top = `${((1 - p.y) / 2) * H + t.shift[1]}px`;
   });
 }
 
@@ -171,6 +221,18 @@ window.addEventListener("pointermove", (e) => {
   placeCamera();
   render();
 });
-show(0);
+// The step shown first: 0, or K of a link to the page ending in #step=K.
+const asked = /^#step=(\d+)$/.exec(location.hash);
+slider.value = String(asked ? Math.min(Number(asked[1]), D.steps.length - 1) : 0);
+show(Number(slider.value));
 document.body.dataset.status = "drawn";
 console.log(`symdyn: drawn ${D.frames.length} frames`);
+// What the page shows as text, read back from the DOM (for tests): each label's class and text,
+// the table's cells, and the count of elements no name may create.
+const shown = [...document.querySelectorAll("#labels .label")].filter((e) => e.style.display !== "none");
+console.log("symdyn: labels " + encodeURIComponent(JSON.stringify({
+  labels: shown.map((e) => [e.className, e.dataset.frame || "", e.textContent]),
+  table: [...table.rows].map((r) => [...r.cells].map((c) => c.textContent)),
+  foreign: document.querySelectorAll("img, svg, iframe, object, embed, b").length,
+  scripts: document.scripts.length,
+})));

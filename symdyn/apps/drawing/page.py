@@ -6,6 +6,11 @@ in an import map, so the page loads nothing from the network; the page's own scr
 page.js beside this module. The scenes go in as JSON inside <script type="application/json">,
 with <, > and & written as \\u escapes, so no name can close the element; the script puts user
 text into the page only through textContent. World frame, metres.
+
+The labels are the SVG's (symdyn.apps.drawing.sketch): each link frame's x_i and z_i, the named
+frames' and contacts' names, and a DH robot's parameters (sketch.dh_texts, with their dashed
+lines, and sketch.dh_table in the corner), HTML elements placed each time the view is drawn at
+their 3-D points projected by the camera, so they follow dragging and the animation's steps.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ...model.scene import Scene
+from .sketch import dh_table, dh_texts
 
 __all__ = ["html_page", "THREE_VERSION"]
 
@@ -29,6 +35,8 @@ _STYLE = (
     "body{margin:0;font-family:sans-serif;background:#fff}#view{position:relative;width:960px;"
     "height:720px;overflow:hidden}#labels{position:absolute;left:0;top:0;pointer-events:none}"
     ".label{position:absolute;font-size:13px;transform:translate(-50%,-50%);white-space:pre}"
+    ".label.dh{font-size:12px;transform:translate(0,-80%)}#dh-table{position:absolute;left:8px;top:4px;"
+    "color:#9467bd;font-size:12px;border-collapse:collapse}#dh-table td{padding:0 12px 0 0}"
     "#controls{padding:6px 10px}#slider{width:600px;vertical-align:middle}h1{font-size:16px;"
     "margin:8px 10px}"
 )
@@ -53,6 +61,11 @@ def _step(s: Scene, forces=None) -> dict:
             [_r(j.origin - 0.6 * s.scale * j.axis), _r(j.origin + 0.6 * s.scale * j.axis)] for j in s.joints
         ],
         "masses": [_r(m.position) for m in s.masses],
+        "dh": [
+            [t.text, t.sub, _r(t.at), list(t.shift), None if t.span is None else [_r(p) for p in t.span]]
+            for t in dh_texts(s)
+        ],
+        "table": dh_table(s),
     }
     if forces:
         out["forces"] = [[_r(p), _r(f)] for p, f in forces]
@@ -113,7 +126,7 @@ def html_page(
             f'<script type="importmap">{imports}</script>',
             "</head><body>",
             f"<h1>{heading}</h1>",
-            '<div id="view"><div id="labels"></div></div>',
+            '<div id="view"><div id="labels"></div><table id="dh-table"></table></div>',
             '<div id="controls"><button id="play" type="button">play</button> '
             '<input id="slider" type="range" min="0" max="0" step="1" value="0"> '
             '<span id="time"></span></div>',

@@ -30,6 +30,9 @@ __all__ = [
     "pixel_map",
     "view_basis",
     "COLORS",
+    "DHText",
+    "dh_texts",
+    "dh_table",
 ]
 
 #: The views of --view: name -> (right, up) unit vectors of the picture plane, world frame.
@@ -212,38 +215,71 @@ def _masses(scene: Scene, px: _Pixels) -> Group:
     return Group("masses", tuple(items))
 
 
-def _dh(scene: Scene, px: _Pixels) -> Group:
-    """Each row's d and a as dashed lines with their values, alpha and theta beside them, and the
-    table in the top left corner. A modified row i holds Craig's a_{i-1} and alpha_{i-1}."""
-    c = COLORS["dh"]
-    items = []
+@dataclass(frozen=True)
+class DHText:
+    """One DH parameter as a picture writes it: `text` with the subscript `sub` ("d" with
+    "2 = 0.15"), beside the world point `at`, moved by `shift` pixels (right, down); a length
+    has `span`, the two world points of its dashed line (`at` is their midpoint)."""
+
+    text: str
+    sub: str
+    at: np.ndarray
+    shift: tuple[float, float]
+    span: tuple[np.ndarray, np.ndarray] | None = None
+
+
+def dh_texts(scene: Scene) -> list[DHText]:
+    """Each DH row's d and a (non-zero) along their dashed lines, theta beside the foot and alpha
+    beside the frame it turns (the SVG's marks, the HTML page's labels). A modified row i holds
+    Craig's a_{i-1} and alpha_{i-1}."""
+    out = []
     for row in scene.dh:
         i = str(row.index)
         standard = row.convention == "standard"
         before = i if standard else str(row.index - 1)  # the subscript of a and alpha
         d_span = (row.start, row.foot) if standard else (row.foot, row.end)
         a_span = (row.foot, row.end) if standard else (row.start, row.foot)
-        for name, sub, (p, q), value in (("d", i, d_span, row.d), ("a", before, a_span, row.a)):
+        for name, sub, span, value in (("d", i, d_span, row.d), ("a", before, a_span, row.a)):
             if abs(value) > 1e-9:
-                (x1, y1), (x2, y2) = px(p), px(q)
-                items.append(Line(x1, y1, x2, y2, c, 1.5, dash="4 3"))
-                items.append(
-                    Label((x1 + x2) / 2 + 6, (y1 + y2) / 2 - 6, name, f"{sub} = {_number(value)}", c, 12)
-                )
+                mid = (np.asarray(span[0]) + np.asarray(span[1])) / 2
+                out.append(DHText(name, f"{sub} = {_number(value)}", mid, (6.0, -6.0), span))
         if abs(row.theta) > 1e-9:
-            x, y = px(row.foot)
-            items.append(Label(x + 8, y + 16, "θ", f"{i} = {_degrees(row.theta)}°", c, 12))
+            out.append(DHText("θ", f"{i} = {_degrees(row.theta)}°", row.foot, (8.0, 16.0)))
         if abs(row.alpha) > 1e-9:
-            x, y = px(row.end if standard else row.foot)
-            items.append(Label(x + 8, y + 30, "α", f"{before} = {_degrees(row.alpha)}°", c, 12))
+            at = row.end if standard else row.foot
+            out.append(DHText("α", f"{before} = {_degrees(row.alpha)}°", at, (8.0, 30.0)))
+    return out
+
+
+def dh_table(scene: Scene) -> list[list[tuple[str, str]]]:
+    """A DH robot's table at q as (text, subscript) cells: the header (i, a, d, alpha, theta),
+    then one row per joint (lengths in m, angles in degrees); [] for another robot."""
+    if not scene.dh:
+        return []
     before = "i" if scene.dh[0].convention == "standard" else "i-1"
-    header = [("i", ""), ("a", before), ("d", "i"), ("α", before), ("θ", "i")]
-    for j, (text, sub) in enumerate(header):  # the table, in the top left corner
-        items.append(Label(10 + 70 * j, 18, text, sub, c, 12))
-    for k, r in enumerate(scene.dh, 1):
+    rows = [[("i", ""), ("a", before), ("d", "i"), ("α", before), ("θ", "i")]]
+    for r in scene.dh:
         cells = (str(r.index), _number(r.a), _number(r.d), _degrees(r.alpha) + "°", _degrees(r.theta) + "°")
-        for j, text in enumerate(cells):
-            items.append(Label(10 + 70 * j, 18 + 16 * k, text, "", c, 12))
+        rows.append([(text, "") for text in cells])
+    return rows
+
+
+def _dh(scene: Scene, px: _Pixels) -> Group:
+    """Each row's d and a as dashed lines with their values, alpha and theta beside them
+    (dh_texts), and the table (dh_table) in the top left corner."""
+    c = COLORS["dh"]
+    items = []
+    for t in dh_texts(scene):
+        if t.span is not None:
+            (x1, y1), (x2, y2) = px(t.span[0]), px(t.span[1])
+            items.append(Line(x1, y1, x2, y2, c, 1.5, dash="4 3"))
+            x, y = (x1 + x2) / 2, (y1 + y2) / 2
+        else:
+            x, y = px(t.at)
+        items.append(Label(x + t.shift[0], y + t.shift[1], t.text, t.sub, c, 12))
+    for k, row in enumerate(dh_table(scene)):  # the table, in the top left corner
+        for j, (text, sub) in enumerate(row):
+            items.append(Label(10 + 70 * j, 18 + 16 * k, text, sub, c, 12))
     return Group("dh", tuple(items), (("data-convention", scene.dh[0].convention),))
 
 
