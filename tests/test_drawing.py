@@ -361,7 +361,9 @@ def _check_dh_labels(page: dict, s) -> None:
     dh = [text for kind, _, text in page["labels"] if kind == "label dh"]
     assert len(dh) >= len(rows), dh
     for text in dh:
-        name, i, value, deg = _DH_TEXT.fullmatch(text).groups()
+        match = _DH_TEXT.fullmatch(text)
+        assert match, text
+        name, i, value, deg = match.groups()
         row = rows[int(i) + (name in "aα" and s.dh[0].convention == "modified")]
         want = {"a": row.a, "d": row.d, "α": row.alpha, "θ": row.theta}[name]
         if deg:
