@@ -121,15 +121,15 @@ def floating_effort_jacobians(
     the base twist, so the fixed base's 2 C shortcut is not used); tau includes friction, whose
     Coulomb term contributes zero.
     """
-    nv = len(qd)
+    nv, m = len(qd), len(tau)  # m = nv for tau; any outputs of the configuration work the same way
     dquat = jacobian(program, tau, q[3:7], "Dr")
     ux, uy, uz, w = q[3:7]
     # dp/de_k for k = x, y, z: ((w e_k + u x e_k) / 2, -u_k / 2)
     P = sp.Matrix([[w, -uz, uy], [uz, w, -ux], [-uy, ux, w], [-ux, -uy, -uz]]) / 2
-    rotation = sp.Matrix(nv, 3, lambda i, k: program.let(sum(dquat[i, j] * P[j, k] for j in range(4)), "Dr"))
-    dq = sp.zeros(nv, 3).row_join(rotation).row_join(jacobian(program, tau, q[7:], "Dq"))
+    rotation = sp.Matrix(m, 3, lambda i, k: program.let(sum(dquat[i, j] * P[j, k] for j in range(4)), "Dr"))
+    dq = sp.zeros(m, 3).row_join(rotation).row_join(jacobian(program, tau, q[7:], "Dq"))
     dv = jacobian(program, tau, qd, "Dv")
-    return dq, sp.Matrix(nv, nv, lambda i, j: program.let(dv[i, j], "Dv"))
+    return dq, sp.Matrix(m, nv, lambda i, j: program.let(dv[i, j], "Dv"))
 
 
 def substitute(program: Program, outputs: Sequence[sp.Expr], values: dict, hint: str) -> list[sp.Expr]:

@@ -5,7 +5,14 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["add_robot_argument", "load_robot_argument", "xacro_arguments", "METHODS", "FLOATING_COMMANDS"]
+__all__ = [
+    "add_robot_argument",
+    "add_contacts_argument",
+    "load_robot_argument",
+    "xacro_arguments",
+    "METHODS",
+    "FLOATING_COMMANDS",
+]
 
 #: symdyn.dynamics.METHODS, spelled here so that building the parser imports no SymPy
 #: (tests/test_cli.py checks that the two agree).
@@ -24,7 +31,14 @@ def load_robot_argument(args: argparse.Namespace):
 
     floating = getattr(args, "floating", False)
     with progress_stage(f"loading {args.robot}"):
-        robot = load(args.robot, base=args.base, tip=args.tip, floating=floating, **xacro_arguments(args))
+        robot = load(
+            args.robot,
+            base=args.base,
+            tip=args.tip,
+            floating=floating,
+            contacts=getattr(args, "contacts", None),
+            **xacro_arguments(args),
+        )
     command = getattr(args, "command", None)
     if robot.floating and command not in FLOATING_COMMANDS:
         raise SymdynError(
@@ -87,4 +101,16 @@ def add_robot_argument(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="no progress reports on stderr (a command that runs for a second or more reports its "
         "stages and their time)",
+    )
+
+
+def add_contacts_argument(parser: argparse.ArgumentParser) -> None:
+    """--contacts FRAME[:point|6d] ...: the robot's contacts with the world (docs/contacts.md)."""
+    parser.add_argument(
+        "--contacts",
+        nargs="+",
+        metavar="FRAME[:point|6d]",
+        help="contacts with the world at these frames, in place of the robot file's (each named after "
+        "its frame; point: 3 rows, world-aligned, the default; 6d: 6 rows in the frame's axes; "
+        "docs/contacts.md)",
     )

@@ -22,7 +22,7 @@ from ..progress import quiet as progress_quiet
 from ..progress import restart as progress_restart
 from ..progress import stage as progress_stage
 from .apps import COMMANDS as APPLICATIONS
-from .common import METHODS, add_robot_argument, load_robot_argument
+from .common import METHODS, add_contacts_argument, add_robot_argument, load_robot_argument
 from .draw import COMMANDS as DRAWING
 from .identification import COMMANDS as IDENTIFICATION
 
@@ -201,6 +201,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 def _derive_arguments(d: argparse.ArgumentParser) -> None:
     add_robot_argument(d)
+    add_contacts_argument(d)
     d.add_argument("--method", choices=METHODS, default="newton-euler")
     d.add_argument("--format", choices=("text", "latex", "json"), default="text")
     d.add_argument(
@@ -244,6 +245,7 @@ def _derive_arguments(d: argparse.ArgumentParser) -> None:
 
 def _generate_arguments(g: argparse.ArgumentParser) -> None:
     add_robot_argument(g)
+    add_contacts_argument(g)
     g.add_argument(
         "--target",
         action="append",
@@ -265,14 +267,17 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
             "operational_space",
             "configuration",
             "centroidal",
+            "contacts",
+            "contact_derivatives",
             "all",
         ),
         default=["dynamics"],
         help="the groups of functions to build (default: dynamics, the seven of tau = M qdd + V + G + F "
         "and forward dynamics); regressor, tip_wrench (product-of-exponentials robots), derivatives, "
         "kinematics and operational_space (per frame, see --frames); configuration (a floating robot's "
-        "integrate and difference), centroidal (momentum matrix, its drift, com, total mass); all: "
-        "every group",
+        "integrate and difference), centroidal (momentum matrix, its drift, com, total mass), contacts "
+        "(a robot with contacts: Jc, drift, constrained and impulse dynamics; docs/contacts.md), "
+        "contact_derivatives (their derivatives); all: every group",
     )
     g.add_argument(
         "--frames",

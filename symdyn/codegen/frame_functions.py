@@ -121,7 +121,7 @@ def _entries(*matrices: sp.Matrix) -> tuple[sp.Expr, ...]:
     return tuple(m[i, j] for m in matrices for i in range(m.rows) for j in range(m.cols))
 
 
-def _frames_of(dyn: Dynamics, x: Inputs, prog) -> tuple:
+def frames_of(dyn: Dynamics, x: Inputs, prog) -> tuple:
     """(frame quantities, q, qd, columns of a Jacobian, their size name) over `prog`: on a
     floating robot FloatingFrames over q (NQ) and v (NV), else FrameKinematics over the joints."""
     robot = dyn.robot
@@ -139,7 +139,7 @@ def kinematics_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     with the base's columns (symdyn.algorithms.floating_frames)."""
     prog = dyn.program.copy("K")
     first = len(prog.assignments)
-    fk, q, qd, n, cols = _frames_of(dyn, x, prog)
+    fk, q, qd, n, cols = frames_of(dyn, x, prog)
     rows: list[tuple] = []
     for name, ident, link in x.frames.frames:
         on = f"of frame {comment_text(name)} on {link}"
@@ -202,7 +202,7 @@ def operational_space_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     c = dyn.compact
     prog = dyn.program.copy("O")
     first = len(prog.assignments)
-    fk, _, _, n, _ = _frames_of(dyn, x, prog)
+    fk, _, _, n, _ = frames_of(dyn, x, prog)
     chain = dyn.robot.is_chain and not dyn.robot.floating
     keep = list(x.frames.rows)
     k = len(keep)

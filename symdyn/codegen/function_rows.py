@@ -41,10 +41,27 @@ class Input:
 #: for the state x = (q, qd), "3", "4", "6" fixed sizes, "k" the task axes of the
 #: operational-space functions (symdyn.codegen.frame_functions), "nact" and "npas" the actuated
 #: and passive coordinates of a robot with loops (symdyn.codegen.loop_functions), "nq" and "nv" a
-#: floating robot's configuration and velocity sizes (symdyn.codegen.configuration_functions); a
+#: floating robot's configuration and velocity sizes (symdyn.codegen.configuration_functions),
+#: "ncontact" and "nlambda" the contacts and their rows (symdyn.codegen.contact_functions); a
 #: target spells each as its own expression (C: a macro), and a family of functions that needs
 #: another size adds the name and every target's spelling.
-DIMS = ("1", "n", "2n", "nstd", "nbase", "3", "4", "6", "k", "nact", "npas", "nq", "nv")
+DIMS = (
+    "1",
+    "n",
+    "2n",
+    "nstd",
+    "nbase",
+    "3",
+    "4",
+    "6",
+    "k",
+    "nact",
+    "npas",
+    "nq",
+    "nv",
+    "ncontact",
+    "nlambda",
+)
 
 
 @dataclass(frozen=True)

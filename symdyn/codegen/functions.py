@@ -49,6 +49,7 @@ from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .centroidal_functions import centroidal_rows
 from .configuration_functions import configuration_rows
+from .contact_functions import CONTACT_FUNCTIONS, contact_derivative_rows, contact_rows_of
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
 from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
 from .function_rows import (
@@ -227,6 +228,8 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     loop_rows,
     configuration_rows,
     centroidal_rows,
+    contact_rows_of,
+    contact_derivative_rows,
 )
 
 
@@ -235,11 +238,16 @@ INVERTING: dict[Callable[[Dynamics, Inputs], list[FunctionRow]], tuple[str, ...]
     forward_dynamics_rows: ("forward_dynamics",),
     derivative_rows: DERIVATIVE_FUNCTION_NAMES[1:],
     operational_space_rows: ("operational_space_inertia", "operational_space_bias"),
+    contact_rows_of: CONTACT_FUNCTIONS[2:4],
+    contact_derivative_rows: CONTACT_FUNCTIONS[4:],
 }
 
 
 def _warn_singular(dyn: Dynamics, families) -> None:
     """One SymdynWarning: M is singular (which joints, why) and the functions left out."""
+    families = [
+        f for f in families if f not in (contact_rows_of, contact_derivative_rows) or dyn.robot.contacts
+    ]
     left_out = [name for family in families for name in INVERTING.get(family, ())]
     if not dyn.singular_joints or not left_out:
         return
@@ -262,6 +270,8 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
     "operational_space": (operational_space_rows,),
     "configuration": (configuration_rows,),
     "centroidal": (centroidal_rows,),
+    "contacts": (contact_rows_of,),
+    "contact_derivatives": (contact_derivative_rows,),
 }
 
 #: The groups built per frame (symdyn.codegen.frame_functions): only when named, never by default.
@@ -278,7 +288,7 @@ def _first(rows: list[FunctionRow], name: str) -> FunctionRow:
 
 #: the groups a floating robot gets by default (every group is generated for it when named:
 #: docs/floating-base.md, docs/centroidal.md)
-FLOATING_DEFAULT = ("dynamics", "configuration")
+FLOATING_DEFAULT = ("dynamics", "configuration", "contacts")
 
 
 def build_functions(

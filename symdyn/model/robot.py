@@ -35,6 +35,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from .contacts import Contact, check_contacts
 from .frames import Frame, check_frame_names, unknown_frame
 from .free_flyer import NQ_BASE, NV_BASE, BaseBody
 from .friction import Friction
@@ -54,6 +55,7 @@ __all__ = [
     "Frame",
     "BaseBody",
     "Tendon",
+    "Contact",
     "JOINT_TYPES",
     "DEFAULT_GRAVITY",
 ]
@@ -181,6 +183,8 @@ class Robot:
     base_body: BaseBody = field(default_factory=BaseBody)
     #: fixed tendons and joint springs (symdyn.model.tendons): couplings with constant coefficients
     tendons: tuple[Tendon, ...] = ()
+    #: contacts with the world at named frames (symdyn.model.contacts), rows in this order
+    contacts: tuple[Contact, ...] = ()
 
     def __post_init__(self) -> None:
         problem = check_parents(self.parents)
@@ -201,6 +205,7 @@ class Robot:
                 "position and orientation are coordinates): give 'base: floating' without a placement"
             )
         self._check_tendons()
+        self._check_contacts()
         for i, link in enumerate(self.links):
             m = link.mimic
             if m is None:
@@ -228,6 +233,23 @@ class Robot:
                 f"robot '{self.name}': fixed tendons and joint springs ('{self.tendons[0].name}') on a "
                 "floating base are not handled yet: fix the base, or remove the tendon's armature, "
                 "damping, frictionloss and stiffness",
+                file=self.source,
+            )
+
+    def _check_contacts(self) -> None:
+        """Contacts at existing frames, with unique identifier names; none beside closed loops."""
+        if not isinstance(self.contacts, tuple):
+            raise SymdynError(f"robot '{self.name}': contacts must be a tuple of Contact", file=self.source)
+        if not self.contacts:
+            return
+        try:
+            check_contacts(self.name, self.contacts, self.frame_names, "contacts")
+        except SymdynError as e:
+            raise SymdynError(e.reason, file=self.source) from None
+        if self.loops:
+            raise SymdynError(
+                f"robot '{self.name}': contacts (field 'contacts') on a robot with closed loops are not "
+                "handled yet: the contact functions are derived for a tree",
                 file=self.source,
             )
 

@@ -9,6 +9,7 @@ from collections.abc import Mapping
 from dataclasses import replace
 
 from ..errors import SymdynError
+from ..model.contacts import with_contacts
 from ..model.robot import Robot
 from ..spatial.transform import Transform
 from .mjcf import mjcf_from_bytes
@@ -25,6 +26,7 @@ def load_robot(
     base: str | None = None,
     tip: str | None = None,
     floating: bool = False,
+    contacts: object = None,
     **xacro: Mapping[str, str] | None,
 ) -> Robot:
     """Read a robot file (YAML or JSON), a URDF (or xacro) or an MJCF file, recognised by its content.
@@ -38,7 +40,9 @@ def load_robot(
     inertial data. floating=True: the robot's base floats, joined to the world by a free flyer
     (docs/floating-base.md): a URDF's base link (`load_urdf`), an MJCF's root body (a free joint
     there makes it floating anyway: `load_mjcf`), a robot file's base frame with a massless base
-    body (write `base: floating` in the file to give the base a mass).
+    body (write `base: floating` in the file to give the base a mass). contacts: the robot's
+    contacts with the world in place of the file's (symdyn.model.contacts: Contact objects,
+    {name, frame, type} mappings or 'FRAME[:point|6d]' strings; docs/contacts.md).
     """
     unknown = sorted(set(xacro) - {"xacro_args", "package_dirs"})
     if unknown:
@@ -49,11 +53,13 @@ def load_robot(
         root = parse_xml(raw, file)
         if root.tag == "mujoco":
             _urdf_only(base, tip, xacro, file, "an MJCF file")
-            return mjcf_from_bytes(raw, file, digest, floating=floating)
-        return urdf_from_root(root, file, digest, base, tip, floating=floating, **xacro)
+            return with_contacts(mjcf_from_bytes(raw, file, digest, floating=floating), contacts)
+        return with_contacts(
+            urdf_from_root(root, file, digest, base, tip, floating=floating, **xacro), contacts
+        )
     _urdf_only(base, tip, xacro, file, "a robot file")
     robot = robot_from_bytes(raw, file, digest)
-    return _floated(robot, file) if floating and not robot.floating else robot
+    return with_contacts(_floated(robot, file) if floating and not robot.floating else robot, contacts)
 
 
 def _floated(robot: Robot, file: str) -> Robot:

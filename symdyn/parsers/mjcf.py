@@ -56,6 +56,7 @@ from typing import Any
 import sympy as sp
 
 from ..errors import SymdynError, SymdynWarning
+from ..model.contacts import with_contacts
 from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import BaseBody, Friction, Link, Motor, Robot
@@ -97,7 +98,7 @@ class _Walk:
     dof_link: dict[int, int] = field(default_factory=dict)
 
 
-def load_mjcf(path: str | os.PathLike, floating: bool = False) -> Robot:
+def load_mjcf(path: str | os.PathLike, floating: bool = False, contacts: object = None) -> Robot:
     """Read an MJCF (MuJoCo XML) file and return its robot on a fixed base.
 
     The file is compiled by MuJoCo (the `mujoco` package: pip install 'symdyn[mjcf]') and read
@@ -105,10 +106,11 @@ def load_mjcf(path: str | os.PathLike, floating: bool = False) -> Robot:
     naming the file (and the body and joint) for bad input, with MuJoCo's message for a file its
     compiler rejects; warns with SymdynWarning for what is ignored and for implausible inertias.
     `symdyn.load_robot` reads MJCF too (it recognises the top element <mujoco>). A free joint on
-    the root body makes a floating robot (floating=True: the file must have one).
+    the root body makes a floating robot (floating=True: the file must have one). contacts: the
+    robot's contacts with the world (symdyn.model.contacts; docs/contacts.md).
     """
     file, raw, digest = read_source(path, "MJCF file")
-    return mjcf_from_bytes(raw, file, digest, floating=floating)
+    return with_contacts(mjcf_from_bytes(raw, file, digest, floating=floating), contacts)
 
 
 def _free_body(model: Any, file: str, body_names: list[str], joint_names: list[str]) -> int | None:

@@ -37,6 +37,7 @@ POE_TOP_KEYS = (
     "frames",
     "loops",
     "actuated",
+    "contacts",
 )
 POE_LINK_KEYS = ("name", "frame", "spatial_inertia", "screw", "limits")
 FRAME_KEYS = ("position", "rotation")

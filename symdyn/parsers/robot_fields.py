@@ -19,6 +19,7 @@ import sympy as sp
 
 from ..errors import SymdynError, link_fields
 from ..model.angles import snap_angle
+from ..model.contacts import Contact, contacts_from
 from ..model.expressions import check_parameter_name, is_c_identifier, parse_expression_names
 from ..model.limits import check_limits
 from ..model.robot import JOINT_TYPES
@@ -39,7 +40,18 @@ __all__ = [
     "RobotFileReader",
 ]
 
-TOP_KEYS = ("name", "convention", "gravity", "base", "parameters", "links", "frames", "loops", "actuated")
+TOP_KEYS = (
+    "name",
+    "convention",
+    "gravity",
+    "base",
+    "parameters",
+    "links",
+    "frames",
+    "loops",
+    "actuated",
+    "contacts",
+)
 LINK_KEYS = (
     "name",
     "parent",
@@ -114,6 +126,7 @@ class RobotFileReader:
         self.frames: list[FrameData] = []
         self.loops: list[LoopData] = []
         self.actuated: tuple[str, ...] | None = None
+        self.contacts: tuple[Contact, ...] = ()
 
     # -- helpers
     def error(self, message: str, *, link: LinkData | None = None, field: str | None = None):
@@ -237,6 +250,14 @@ class RobotFileReader:
 
     def _read_actuated(self, value: object) -> None:
         self.actuated = read_actuated(self, value, _LINK_NAME)
+
+    def _read_contacts(self, value: object) -> None:
+        """`contacts:` a list of {name, frame, type: point | 6d} (symdyn.model.contacts); the frames
+        are checked against the robot's when it is built."""
+        try:
+            self.contacts = contacts_from(value)
+        except SymdynError as e:
+            raise self.error(e.reason) from None
 
     def _read_parameters(self, value: object) -> None:
         if value is None:

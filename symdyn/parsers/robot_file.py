@@ -220,6 +220,7 @@ def _build(data: object, file: str | None, digest: str | None) -> Robot:
         actuated=model_actuated(reader, reader.actuated, links),
         floating=reader.base_body is not None,
         base_body=_base_body(reader, subs),
+        contacts=reader.contacts,
     )
 
 

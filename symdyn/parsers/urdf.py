@@ -85,6 +85,7 @@ from collections.abc import Mapping
 import sympy as sp
 
 from ..errors import SymdynError, SymdynWarning, location
+from ..model.contacts import with_contacts
 from ..model.frames import Frame
 from ..model.inertia import check_inertia
 from ..model.robot import DEFAULT_GRAVITY, BaseBody, Friction, Link, Mimic, Robot
@@ -310,6 +311,7 @@ def load_urdf(
     xacro_args: Mapping[str, str] | None = None,
     package_dirs: Mapping[str, str] | None = None,
     floating: bool = False,
+    contacts: object = None,
 ) -> Robot:
     """Read a URDF file and return the tree below `base`, or the chain from `base` to `tip`, as a `Robot`.
 
@@ -326,12 +328,14 @@ def load_urdf(
     ROS_PACKAGE_PATH): symdyn.parsers.xacro_expand. Raises SymdynError naming file,
     link and field for bad input; warns with SymdynWarning for implausible inertial
     data of the links used. The robot's name is the URDF name made a C identifier.
-    `symdyn.load_robot` reads a URDF too (it recognises one by its content).
+    `symdyn.load_robot` reads a URDF too (it recognises one by its content). contacts: the robot's
+    contacts with the world (symdyn.model.contacts; docs/contacts.md).
     """
     file, raw, digest = read_source(path, "URDF file")
-    return urdf_from_bytes(
+    robot = urdf_from_bytes(
         raw, file, digest, base, tip, xacro_args=xacro_args, package_dirs=package_dirs, floating=floating
     )
+    return with_contacts(robot, contacts)
 
 
 def urdf_from_bytes(

@@ -165,6 +165,7 @@ def c_names(ctx: RenderContext) -> CNames:
         + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
         + ([f"{name}_NFRAMES"] if ctx.frames else [])
         + ([f"{name}_NACT", f"{name}_NPAS"] if "loop_newton_step" in functions else [])
+        + ([f"{name}_NCONTACT", f"{name}_NLAMBDA"] if "contact_jacobian" in functions else [])
     )
     taken = set(written) | set(functions.values()) | {guard} | set(sincos.values())
     aliases = _aliases(written, taken)
@@ -214,6 +215,8 @@ def c_names(ctx: RenderContext) -> CNames:
             "k": str(_task_size(ctx)),
             "nact": f"{name}_NACT",
             "npas": f"{name}_NPAS",
+            "ncontact": f"{name}_NCONTACT",
+            "nlambda": f"{name}_NLAMBDA",
             "nq": nq or str(ctx.robot.nq),
             "nv": nv or str(ctx.robot.nv),
         },

@@ -92,6 +92,7 @@ def function_inputs(names: CNames, spec: FunctionSpec) -> tuple[list, list, list
         used = [s for s in inp.symbols if s in used_symbols]
         size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
         size = names.dims["nact"] if inp.name in ACTUATED_INPUTS else size
+        size = names.dims["ncontact"] if inp.name == "active" else size
         if inp.name == "q" and names.nq is not None:
             size = names.nq
         inputs.append({"name": inp.name, "read": bool(used), "size": size})
@@ -222,6 +223,21 @@ def render_context(ctx: RenderContext) -> dict:
         "frames": [(comment_text(name), ident, link) for name, ident, link in ctx.frames],
         "sincos": {**names.sincos, "block": BLOCK} if any(f["sincos"] for f in functions) else None,
         "loops": _loops_view(ctx, names),
+        "contacts": _contacts_view(ctx, names),
+    }
+
+
+def _contacts_view(ctx: RenderContext, names: CNames) -> dict | None:
+    """The contacts' macros and table (templates/c/dynamics.h.j2) when the contact functions are built."""
+    if not any(f.name == "contact_jacobian" for f in ctx.functions):
+        return None
+    contacts = ctx.robot.contacts
+    return {
+        "ncontact": names.dims["ncontact"],
+        "nlambda": names.dims["nlambda"],
+        "count": len(contacts),
+        "rows": sum(c.rows for c in contacts),
+        "table": [(c.name, comment_text(c.frame), c.kind, c.rows) for c in contacts],
     }
 
 

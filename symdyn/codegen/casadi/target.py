@@ -28,6 +28,7 @@ from pathlib import Path
 from ...errors import SymdynError
 from ...generated_modules import load_module
 from ...leftovers import sweep_folders
+from ..contact_functions import contacts_of
 from ..functions import FunctionSpec
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
@@ -103,6 +104,7 @@ def render_module(ctx: RenderContext) -> str:
         functions=views,
         uses_math=uses_math,
         loops=loop_solve_context(ctx, "double"),
+        contacts=contacts_of(ctx),
     )
 
 

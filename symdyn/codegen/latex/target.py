@@ -34,6 +34,7 @@ from ...model.names import comment_text, latex_text
 from ...symbolic.simplify import eliminate
 from ..render import RenderContext, environment, header_lines
 from .base_parameters import base_parameters_latex
+from .contacts import contacts_latex
 from .frames import frames_latex
 from .loops import loops_latex
 from .notation import MATRIX_WIDTH, Notation, width
@@ -180,6 +181,7 @@ def render(ctx: RenderContext) -> dict[str, str]:
         body += base_parameters_latex(ctx.dynamics)
     body += frames_latex(ctx)
     body += loops_latex(ctx)
+    body += contacts_latex(ctx)
     text = (
         environment()
         .get_template("latex/dynamics.tex.j2")

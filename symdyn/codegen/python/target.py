@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import weakref
 
+from ..contact_functions import contacts_of
 from ..functions import FunctionSpec
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
@@ -121,6 +122,7 @@ def render_module(ctx: RenderContext, template: str, namespace: str) -> str:
             dtype=dtype(ctx.precision),
             functions=[_in_namespace(view, namespace) for view in _printed_views(ctx)],
             loops=loop_solve_context(ctx),
+            contacts=contacts_of(ctx),
         )
     )
 

@@ -1,0 +1,198 @@
+"""Constrained (contact) and impulse dynamics, and their derivatives, as straight-line programs.
+
+With M the NV x NV mass matrix, b = V + G + F the bias, Jc (NLAMBDA x NV) and gamma the
+contact Jacobian and drift (symdyn.algorithms.contacts), the constrained forward dynamics solve
+the KKT system (Pinocchio's constraintDynamics; lambda the force on the robot):
+
+    M qdd + b = tau + Jc^T lambda,    Jc qdd + gamma = 0.
+
+No branch: with a_r in {0, 1} the activity of row r's contact (the run-time mask) and A0 =
+Jc M^-1 Jc^T the Delassus matrix, the solve is
+
+    A lambda = -a * (gamma + Jc M^-1 (tau - b)),  A_rs = a_r a_s A0_rs + (1 - a_r + mu) delta_rs,
+    qdd = M^-1 (tau - b + Jc^T lambda),
+
+so an inactive row decouples (A's row and column are those of (1 + mu) I, its right-hand side 0)
+and its lambda is exactly 0. mu = DAMPING (1e-10) regularises a redundant or singular set of
+active rows (more rows than the robot can satisfy independently: two point contacts on one
+frame, a point and a 6d contact there): the solve is then the damped (proximal) one, finite,
+with lambda of the minimum-norm kind; on a regular set it changes lambda by about mu |A0^-1|
+relative. Both solves use M's unrolled L D L^T factorisation M = P^T L D L^T P (P the
+elimination order of forward dynamics, symdyn.algorithms.derivatives.elimination_order):
+W = L^-1 P Jc^T, A0 = W^T D^-1 W, Jc M^-1 x = W^T D^-1 L^-1 P x, M^-1 (x + Jc^T lambda) =
+P^T L^-T D^-1 (L^-1 P x + W lambda); A by the same unrolled L D L^T.
+
+Impulse dynamics (Pinocchio's impulseDynamics, restitution e):
+
+    M (qd_plus - qd) = Jc^T impulse,   Jc qd_plus = -e Jc qd  (active rows),
+    A impulse = -(1 + e) a * (Jc qd),   qd_plus = qd + M^-1 Jc^T impulse.
+
+Derivatives (Carpentier and Mansard, RSS 2018, for the contact case as Pinocchio's
+computeConstraintDynamicsDerivatives): differentiating the KKT system at the solution,
+
+    M dqdd - Jc^T dlambda = -r1,   Jc dqdd = -r2,
+    r1 = d/dx (ID(q, qd, qdd) - Jc^T lambda),  r2 = d/dx (Jc qdd + gamma)   (qdd, lambda held),
+
+    dlambda = A^-1 a * (Jc M^-1 r1 - r2),   dqdd = M^-1 (Jc^T a * dlambda - r1),
+
+and for tau, r1 = -I, r2 = 0. For the impulse, with qd_plus and the impulse held,
+r1 = -d/dx (Jc^T impulse) (M's own derivative times qd_plus - qd enters through
+d/dx (M (qd_plus - qd)), computed as d/dx ID(q, 0, qd_plus - qd) without gravity: the
+inertia part of the RNEA), r2 = d/dx (Jc (qd_plus + e qd)). The derivatives by q are taken in
+the tangent space on a floating base (symdyn.algorithms.derivatives.floating_effort_jacobians).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..symbolic.program import Program
+from .derivatives import ldlt_factor
+
+__all__ = ["DAMPING", "FactoredMass", "KKT", "masked_delassus"]
+
+#: mu, the damping added to the Delassus matrix's diagonal (module docstring)
+DAMPING = sp.Float("1e-10")
+
+
+def _sum(terms) -> sp.Expr:
+    return sp.Add(*[t for t in terms if t != 0])
+
+
+@dataclass
+class FactoredMass:
+    """M = P^T L D L^T P, unrolled (module docstring), with the solves that reuse it."""
+
+    L: sp.Matrix
+    D: list[sp.Expr]
+    Dinv: list[sp.Expr]
+    order: list[int]
+    program: Program
+
+    @classmethod
+    def of(cls, M: sp.Matrix, order: Sequence[int], program: Program, hint: str) -> FactoredMass:
+        order = list(order)
+        L, D = ldlt_factor(M.extract(order, order), program, hint)
+        return cls(L, D, [program.let(1 / d, f"{hint}r") for d in D], order, program)
+
+    def forward(self, x: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
+        """y = L^-1 P x (x in the natural order)."""
+        n, L = len(self.order), self.L
+        y: list[sp.Expr] = []
+        for i in range(n):
+            s = x[self.order[i]] - _sum(L[i, k] * y[k] for k in range(i) if L[i, k] != 0 and y[k] != 0)
+            y.append(self.program.let(s, hint) if s != 0 else sp.S.Zero)
+        return y
+
+    def backward(self, y: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
+        """P^T L^-T D^-1 y: M^-1 x for y = forward(x), in the natural order."""
+        n, L = len(self.order), self.L
+        z: list[sp.Expr] = [sp.S.Zero] * n
+        for i in reversed(range(n)):
+            s = y[i] * self.Dinv[i] - _sum(L[k, i] * z[k] for k in range(i + 1, n) if L[k, i] != 0)
+            z[i] = self.program.let(s, hint) if s != 0 else sp.S.Zero
+        out: list[sp.Expr] = [sp.S.Zero] * n
+        for i, j in enumerate(self.order):
+            out[j] = z[i]
+        return out
+
+    def weighted(self, u: Sequence[sp.Expr], w: Sequence[sp.Expr]) -> sp.Expr:
+        """u^T D^-1 w of two forward() results."""
+        return _sum(a * d * b for a, d, b in zip(u, self.Dinv, w, strict=True) if a != 0 and b != 0)
+
+
+def masked_delassus(A0: sp.Matrix, active: Sequence[sp.Expr], program: Program, hint: str) -> sp.Matrix:
+    """A_rs = a_r a_s A0_rs + (1 - a_r + mu) delta_rs (module docstring), entries named."""
+    m = A0.rows
+    A = sp.zeros(m, m)
+    for r in range(m):
+        for s in range(r, m):
+            e = active[r] * active[s] * A0[r, s] if r != s else active[r] * A0[r, r] + 1 - active[r] + DAMPING
+            A[r, s] = A[s, r] = program.let(e, hint) if A0[r, s] != 0 or r == s else sp.S.Zero
+    return A
+
+
+def spd_solve(A: sp.Matrix, b: Sequence[sp.Expr], program: Program, hint: str) -> list[sp.Expr]:
+    """x solving A x = b by A's unrolled L D L^T (A symmetric positive definite, small and dense)."""
+    F = FactoredMass.of(A, range(A.rows), program, hint)
+    return F.backward(F.forward(list(b), hint), hint)
+
+
+@dataclass
+class KKT:
+    """The masked contact system of one robot state (module docstring), over one Program.
+
+    Args:
+        M: the NV x NV mass matrix; Jc: NLAMBDA x NV; active: per row, its contact's activity a_r.
+        order: M's elimination order; program: receives the intermediates.
+    """
+
+    M: sp.Matrix
+    Jc: sp.Matrix
+    active: list[sp.Expr]
+    order: list[int]
+    program: Program
+
+    def __post_init__(self) -> None:
+        prog = self.program
+        self.mass = FactoredMass.of(self.M, self.order, prog, "kD")
+        m = self.Jc.rows
+        self.W = [self.mass.forward(list(self.Jc[r, :]), "kW") for r in range(m)]  # L^-1 P Jc_r^T
+        A0 = sp.zeros(m, m)
+        for r in range(m):
+            for s in range(r, m):
+                A0[r, s] = A0[s, r] = self.mass.weighted(self.W[r], self.W[s])
+        self.A = masked_delassus(A0, self.active, prog, "kA")
+        self.factor = FactoredMass.of(self.A, range(m), prog, "kL")
+
+    def solve_rows(self, rhs: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
+        """x solving A x = a * rhs (an inactive row's x is 0)."""
+        b = [
+            self.program.let(a * r, hint) if r != 0 else sp.S.Zero
+            for a, r in zip(self.active, rhs, strict=True)
+        ]
+        return self.factor.backward(self.factor.forward(b, hint), hint)
+
+    def forward_dynamics(self, force: Sequence[sp.Expr], gamma: Sequence[sp.Expr]) -> tuple[list, list]:
+        """(qdd, lambda) solving M qdd = force + Jc^T lambda, Jc qdd + gamma = 0 (force = tau - b)."""
+        u = self.mass.forward(list(force), "ku")
+        rhs = [-(g + self.mass.weighted(w, u)) for g, w in zip(gamma, self.W, strict=True)]
+        lam = self.solve_rows(rhs, "kl")
+        return self._accelerate(u, lam, "kq"), lam
+
+    def impulse(self, qd: Sequence[sp.Expr], restitution: sp.Expr) -> tuple[list, list]:
+        """(qd_plus, impulse): M (qd_plus - qd) = Jc^T impulse, Jc qd_plus = -e Jc qd."""
+        vel = [
+            _sum(self.Jc[r, j] * qd[j] for j in range(self.Jc.cols) if self.Jc[r, j] != 0)
+            for r in range(self.Jc.rows)
+        ]
+        rhs = [-(1 + restitution) * self.program.let(v, "kv") for v in vel]
+        imp = self.solve_rows(rhs, "ki")
+        dv = self._accelerate([sp.S.Zero] * len(self.order), imp, "kp")
+        return [self.program.let(q + d, "kp") for q, d in zip(qd, dv, strict=True)], imp
+
+    def _accelerate(self, u: Sequence[sp.Expr], lam: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
+        """M^-1 (x + Jc^T lam) for u = L^-1 P x."""
+        y = [
+            _sum([u[i], *(self.W[r][i] * lam[r] for r in range(len(lam)) if self.W[r][i] != 0)])
+            for i in range(len(u))
+        ]
+        return self.mass.backward(y, hint)
+
+    def sensitivities(self, r1: sp.Matrix, r2: sp.Matrix, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
+        """(dqdd, dlambda) = (M^-1 (Jc^T dlambda - r1), A^-1 a * (Jc M^-1 r1 - r2)) column by column
+        (module docstring); r1 NV x k, r2 NLAMBDA x k. Jc^T dlambda needs no mask: an inactive
+        row's dlambda is 0."""
+        cols_q, cols_l = [], []
+        for j in range(r1.cols):
+            u = self.mass.forward([-x for x in r1[:, j]], f"{hint}u")  # L^-1 P (-r1)
+            rhs = [-(self.mass.weighted(w, u) + r2[r, j]) for r, w in enumerate(self.W)]
+            dl = self.solve_rows(rhs, f"{hint}l")
+            cols_q.append(self._accelerate(u, dl, f"{hint}q"))
+            cols_l.append(dl)
+        dq = sp.Matrix(r1.rows, r1.cols, lambda i, j: cols_q[j][i])
+        dl = sp.Matrix(r2.rows, r1.cols, lambda i, j: cols_l[j][i])
+        return dq, dl
