@@ -106,12 +106,7 @@ def make_states(robot, rng) -> tuple[np.ndarray, np.ndarray]:
 def pinocchio_model_text(robot, Q, V) -> str:
     """MODEL.txt of bench/pinocchio_centroidal.cpp: the joints (pin_harness), the `floating` line
     of the base body (bench/pinocchio_model.hpp), the states."""
-    zeros = {x: np.zeros((NSTATES, robot.n)) for x in ("q", "qd", "qdd", "tau")}
-    lines = pin_harness.model_and_states_lines(robot, zeros)[: 2 + robot.n]
-    b = robot.numeric().base_body
-    I = np.array(b.inertia, dtype=float)
-    base = [float(b.mass), *np.array(b.com, dtype=float).ravel(), *I[np.triu_indices(3)]]
-    lines.insert(2, "floating " + " ".join(repr(float(x)) for x in base))
+    lines = pin_harness.floating_model_lines(robot)
     lines.append(f"nstates {NSTATES}")
     lines += [" ".join(repr(float(x)) for x in np.r_[q, v]) for q, v in zip(Q, V, strict=True)]
     return "\n".join(lines) + "\n"

@@ -29,7 +29,14 @@ from machine import BENCH, CXX_COMPILER, CXX_EXTRA, FLAGS, compiler_version, log
 from row import Row
 from states import CHECK_TOL, NCHECK, NSTATES
 
-__all__ = ["prepare", "check_pinocchio", "pinocchio_model_text", "model_and_states_lines", "MIMIC_NOTE"]
+__all__ = [
+    "prepare",
+    "check_pinocchio",
+    "pinocchio_model_text",
+    "model_and_states_lines",
+    "floating_model_lines",
+    "MIMIC_NOTE",
+]
 
 MIMIC_NOTE = (
     "mimic joints: Pinocchio not run (bench/pinocchio_harness.cpp gives every link an independent "
@@ -176,6 +183,19 @@ def model_and_states_lines(robot, states) -> list[str]:
     for k in range(NSTATES):
         vec = np.concatenate([states[x][k] for x in ("q", "qd", "qdd", "tau")])
         lines.append(" ".join(repr(float(v)) for v in vec))
+    return lines
+
+
+def floating_model_lines(robot) -> list[str]:
+    """The model lines of MODEL.txt for a floating robot: the joints (model_and_states_lines) and
+    the `floating MASS CX CY CZ IXX IXY IXZ IYY IYZ IZZ` line of the base body after `gravity`
+    (bench/pinocchio_model.hpp puts a free flyer ahead of the joints); no states."""
+    zeros = {x: np.zeros((NSTATES, robot.n)) for x in ("q", "qd", "qdd", "tau")}
+    lines = model_and_states_lines(robot, zeros)[: 2 + robot.n]
+    b = robot.numeric().base_body
+    inertia = np.array(b.inertia, dtype=float)
+    base = [float(b.mass), *np.array(b.com, dtype=float).ravel(), *inertia[np.triu_indices(3)]]
+    lines.insert(2, "floating " + " ".join(repr(float(x)) for x in base))
     return lines
 
 
