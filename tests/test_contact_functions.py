@@ -68,6 +68,16 @@ ROBOTS = {
 }
 
 
+def numpy_module(ctx, directory):
+    """The NumPy target's module of `ctx`, written to `directory` and imported."""
+    ((file, text),) = numpy_target.render(ctx).items()
+    (directory / file).write_text(text)
+    spec = importlib.util.spec_from_file_location(f"contacts_{ctx.name}", directory / file)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 class Generated:
     """One robot's generated contact functions in NumPy and C: call(target, name, *inputs)."""
 
@@ -79,11 +89,7 @@ class Generated:
             self.ctx = context(self.robot, functions=groups)
         self.path, self.floating = FOLDER / path, floating
         self.specs = {f.name: f for f in self.ctx.functions}
-        ((file, text),) = numpy_target.render(self.ctx).items()
-        (directory / file).write_text(text)
-        spec = importlib.util.spec_from_file_location(f"contacts_{key}", directory / file)
-        self.numpy = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(self.numpy)
+        self.numpy = numpy_module(self.ctx, directory)
         self.lib = None
         if c and compilers():
             paths = write_files(c_target.render(self.ctx), directory)
@@ -339,12 +345,7 @@ contacts:
 
 def test_floating_derivatives_equal_differences_of_the_generated_functions(tmp_path):
     robot = symdyn.robot_from_data(__import__("yaml").safe_load(FLYER2))
-    ctx = context(robot, functions=("contacts", "contact_derivatives"))
-    ((file, text),) = numpy_target.render(ctx).items()
-    (tmp_path / file).write_text(text)
-    spec = importlib.util.spec_from_file_location("flyer2_contacts", tmp_path / file)
-    g = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(g)
+    g = numpy_module(context(robot, functions=("contacts", "contact_derivatives")), tmp_path)
     rng = np.random.default_rng(3)
     quat = rng.normal(size=4)
     q = np.r_[rng.normal(size=3), quat / np.linalg.norm(quat), rng.normal(size=1)]

@@ -22,23 +22,12 @@ import sympy as sp
 
 from ..spatial.transform import Transform
 from .poe import PoeLink, poe_links
-from .robot_fields import LINK_NAME, LinkData, RobotFileReader
+from .robot_fields import LINK_NAME, TOP_KEYS, LinkData, RobotFileReader
 
 __all__ = ["POE_TOP_KEYS", "POE_LINK_KEYS", "FRAME_KEYS", "PoeFileReader"]
 
-POE_TOP_KEYS = (
-    "name",
-    "convention",
-    "gravity",
-    "base",
-    "parameters",
-    "links",
-    "end_effector",
-    "frames",
-    "loops",
-    "actuated",
-    "contacts",
-)
+#: a robot file's keys, with the end-effector frame after the links
+POE_TOP_KEYS = (*TOP_KEYS[:6], "end_effector", *TOP_KEYS[6:])
 POE_LINK_KEYS = ("name", "frame", "spatial_inertia", "screw", "limits")
 FRAME_KEYS = ("position", "rotation")
 
