@@ -59,11 +59,16 @@ def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
 
 
 def _contacts(robot) -> list[tuple[str, int, np.ndarray]]:
-    """(name, link, k_T_C) of each contact the model has (Robot.contacts: a name, a link index and
-    a placement Transform or a point in the link's body frame)."""
+    """(name, link, k_T_C) of each contact the model has: a Robot.contacts entry at a named frame
+    (symdyn.model.contacts.Contact: Robot.frame gives its link and placement), or an object with a
+    link index and a placement Transform or a point in the link's body frame."""
     out = []
     for c in getattr(robot, "contacts", ()) or ():
         name = str(getattr(c, "name", "contact"))
+        if isinstance(getattr(c, "frame", None), str):
+            f = robot.frame(c.frame, f"contact '{name}'")
+            out.append((name, f.link, _homogeneous(f.placement, f"contact '{name}' frame")))
+            continue
         link = int(getattr(c, "link", -1))
         placement = getattr(c, "placement", None)
         if placement is not None:
@@ -99,7 +104,7 @@ class _Geometry:
         self.mass = [float(_array(lk.mass, (), f"link '{lk.name}' mass")) for lk in links]
         self.com = [_array(lk.com, (3,), f"link '{lk.name}' com") for lk in links]
         self.frames = [(f.name, f.link, _homogeneous(f.placement, f"frame '{f.name}'")) for f in r.frames]
-        self.contacts = _contacts(robot)
+        self.contacts = _contacts(r)
         self.loops = [
             (lp.link, _array(lp.point, (3,), f"loop '{lp.name}'"), lp.to, _array(lp.to_point, (3,), "loop"))
             for lp in r.loops

@@ -68,8 +68,10 @@ def initial_configuration(nq: int) -> np.ndarray:
     return q
 
 
-def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_at) -> tuple:
-    """(Q (N+1, NQ), V (N+1, NV), U (N+1, NV)) from one state; tau_at(row, t, q, v) -> (NV,)."""
+def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_at, accel=None) -> tuple:
+    """(Q (N+1, NQ), V (N+1, NV), U (N+1, NV)) from one state; tau_at(row, t, q, v) -> (NV,);
+    accel(q, v, tau) -> a: the accelerations (default plant.forward_dynamics; the constrained
+    dynamics of symdyn.apps.simulation.contact_simulate)."""
     if scheme not in FLOATING_SCHEMES:
         raise SymdynError(
             f"robot '{plant.robot.name}' has a floating base: integrator '{scheme}' does not apply "
@@ -83,6 +85,7 @@ def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_a
     Q[0], V[0] = q0, v0
     q, v = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)
     one = np.ones(1)
+    accel = plant.forward_dynamics if accel is None else accel
 
     def step_to(q, xi):
         return plant.integrate(q, xi, one)
@@ -91,13 +94,13 @@ def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_a
         for k in range(steps):
             hk, tk = h[k], t[k]
             U[k] = tau_at(3 * k, tk, q, v)
-            a1 = plant.forward_dynamics(q, v, U[k])
+            a1 = accel(q, v, U[k])
             if scheme == "rk4":
                 K, A, theta, vel = [v], [a1], v * 0.0, v
                 for i, (c, row) in enumerate(((0.5, 1), (0.5, 1), (1.0, 2))):
                     theta, vel = c * hk * K[i], v + c * hk * A[i]
                     qi = step_to(q, theta)
-                    A.append(plant.forward_dynamics(qi, vel, tau_at(3 * k + row, tk + c * hk, qi, vel)))
+                    A.append(accel(qi, vel, tau_at(3 * k + row, tk + c * hk, qi, vel)))
                     K.append(dexp_inverse(theta, vel))
                 q = step_to(q, hk / 6.0 * (K[0] + 2 * K[1] + 2 * K[2] + K[3]))
                 v = v + hk / 6.0 * (A[0] + 2 * A[1] + 2 * A[2] + A[3])
