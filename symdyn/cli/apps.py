@@ -170,11 +170,13 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from ..apps.simulation.simulate import simulate
     from ..apps.simulation.trajectory import plot_trajectory
     from .animation import check_animation, write_animation
+    from .contact_options import check_contact_options
 
     check_output(args.out, "--out")
     _check_plot_path(args.plot)
     check_animation(args)
     params = _assignments(args.params, "--params")
+    check_contact_options(args)
     if args.contacts is not None:
         return _simulate_contacts(args, params)
     if args.track is not None and args.tau is not None:
@@ -280,15 +282,15 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
     """simulate --contacts: the constrained dynamics (symdyn.apps.simulation.contact_simulate), the
     contact forces in the CSV, --plot drawing them, --animate their arrows."""
+    from ..apps.compilation.compiled import compiled_dynamics
     from ..apps.output import write_atomic
     from ..apps.simulation.contact_simulate import plot_contact_forces, simulate_contacts
     from ..apps.simulation.floating_stepping import floating_sizes, initial_configuration
     from .animation import write_animation
-    from .contact_options import check_contact_options, pd_torque
+    from .contact_options import pd_torque
 
-    check_contact_options(args)
     robot = _with_params(load_robot_argument(args), params)
-    plant = cached_plant(args, lambda: robot, params=params, contacts=list(args.contacts))
+    plant = compiled_dynamics(robot)  # cached by the robot's content (it is loaded anyway: its contacts)
     sizes = floating_sizes(plant)
     nq, nv = sizes if sizes is not None else (plant.n, plant.n)
     q0 = _vector(args.q0, nq, "--q0", default=initial_configuration(nq) if sizes else np.zeros(nq))

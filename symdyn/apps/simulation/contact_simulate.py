@@ -62,13 +62,15 @@ class ContactTrajectory(Trajectory):
     """A Trajectory in contact: `lam` (N, NLAMBDA) the contact forces in the rows' axes (a point's
     world-aligned force, a 6d frame's force and moment in its own axes), `active` (N, NCONTACT) the
     mask at each sample, `impulse` (NLAMBDA,) the touchdown's (None without one) at `impulse_time`,
-    `poses` (N, NCONTACT, 4, 4) the contact frames' world poses."""
+    where qd jumped from `qd_before` to qd[k], `poses` (N, NCONTACT, 4, 4) the contact frames'
+    world poses."""
 
     lam: np.ndarray | None = None
     active: np.ndarray | None = None
     impulse: np.ndarray | None = None
     impulse_time: float | None = None
     poses: np.ndarray | None = None
+    qd_before: np.ndarray | None = None
 
     @property
     def contact_forces(self) -> np.ndarray:
@@ -153,8 +155,7 @@ class _FixedBase:
     """A fixed-base plant seen by floating_stepping.run_floating: integrate(q, xi) = q + xi."""
 
     def __init__(self, plant) -> None:
-        self.robot, self.functions = plant.robot, ("forward_dynamics", "integrate")
-        self.forward_dynamics = plant.forward_dynamics
+        self.robot, self.functions = plant.robot, ("integrate",)
 
     @staticmethod
     def integrate(q, xi, scale):
@@ -232,10 +233,11 @@ def simulate_contacts(
     start = 0 if impulse_at is None else int(np.searchsorted(t, impulse_at - 1e-12 * max(1.0, duration)))
     segments = [(0, start, np.zeros(ncontact)), (start, len(h), np.ones(ncontact))]
     Q, V, U = np.empty((len(t), nq)), np.empty((len(t), nv)), np.empty((len(t), nv))
-    impulse, active_rows = None, np.zeros((len(t), ncontact))
+    impulse, before, active_rows = None, None, np.zeros((len(t), ncontact))
     anchored = np.empty((len(t), ncontact, 4, 4))
     for first, last, active in segments:
         if first == start and impulse_at is not None:
+            before = v
             v, impulse = plant.impulse_dynamics(q, v, active, np.array([e]))
         anchors = geometry.poses(q)
         accel = _constrained(plant, geometry, active, anchors, kp, kd)
@@ -266,6 +268,7 @@ def simulate_contacts(
         robot, t, Q, V, U, scheme, plant=plant, qdd=A if sizes is not None else None, lam=lam,
         active=active_rows, impulse=impulse, impulse_time=None if impulse_at is None else float(t[start]),
         poses=poses,
+        qd_before=before,
     )  # fmt: skip
 
 

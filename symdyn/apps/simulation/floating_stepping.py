@@ -77,7 +77,8 @@ def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_a
             f"robot '{plant.robot.name}' has a floating base: integrator '{scheme}' does not apply "
             f"(one of {', '.join(FLOATING_SCHEMES)})"
         )
-    missing = [f for f in ("forward_dynamics", "integrate") if f not in plant.functions]
+    needed = ("forward_dynamics", "integrate") if accel is None else ("integrate",)
+    missing = [f for f in needed if f not in plant.functions]
     if missing:
         raise SymdynError(f"robot '{plant.robot.name}': no {missing[0]} function, cannot simulate")
     steps = len(h)
