@@ -184,7 +184,7 @@ def simulate_contacts(
     restitution in [0, 1]; baumgarte: (Kp, Kd) >= 0. Raises SymdynError for bad input and when
     the state stops being finite.
     """
-    from .simulate import _state, _torque_table, torque_function
+    from .simulate import initial_state, torque_function, torque_table
 
     if not robot.contacts:
         raise SymdynError(f"robot '{robot.name}' has no contacts (give --contacts FRAME ...)")
@@ -216,15 +216,15 @@ def simulate_contacts(
     )
     sizes = floating_sizes(plant)
     nq, nv = sizes if sizes is not None else (robot.n, robot.n)
-    q = _state(q0, nq, "q0")
-    v = np.zeros(nv) if qd0 is None else _state(qd0, nv, "qd0")
+    q = initial_state(q0, nq, "q0")
+    v = np.zeros(nv) if qd0 is None else initial_state(qd0, nv, "qd0")
     if q.ndim != 1 or v.ndim != 1:
         raise SymdynError("a simulation with contacts starts from one state")
     if sizes is not None:
         check_quaternions(q, "q0")
         q[3:7] /= quaternion_norms(q)
     t, h = sample_times(duration, dt)
-    table = _torque_table(tau, nv, torque_rows(t, h))
+    table = torque_table(tau, nv, torque_rows(t, h))
     torque = torque_function(tau, nv) if table is None else None
     geometry = _Geometry(robot, params)
     ncontact = len(robot.contacts)
