@@ -31,23 +31,13 @@ from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import mass_matrix
 
 sys.path.insert(0, str(Path(__file__).parent))
+from test_contact_functions import FLYER2  # noqa: E402
 from timebound import refused, within  # noqa: E402
 
 FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
 
-ROBOT = """name: hopper
-base: {floating: true, mass: 3, com: [0.02, -0.01, 0.05],
-       inertia: {ixx: 0.05, iyy: 0.06, izz: 0.07, ixy: 0.004}}
-links:
-  - {name: l1, joint: revolute, a: 0.4, alpha: 0.7, d: 0.1, mass: 1, com: [-0.2, 0.01, 0.02],
-     inertia: {ixx: 0.002, iyy: 0.01, izz: 0.01}, friction: {viscous: 0.3}}
-frames:
-  - {name: foot, link: base, xyz: [0.1, 0.2, -0.3], rpy: [0.3, -0.2, 0.1]}
-  - {name: hand, link: l1, xyz: [0.05, 0, 0.02], rpy: [0, 0.5, 0]}
-contacts:
-  - {name: foot, frame: foot}
-  - {name: hand, frame: hand}
-"""
+# test_contact_functions' small floating robot with its point foot (on the base) and hand (on l1)
+ROBOT = FLYER2.replace("flyer2", "hopper").replace("  - {name: grip, frame: hand, type: 6d}\n", "")
 Q0 = np.r_[0.1, -0.2, 0.5, 0.1, 0.2, -0.1, 0.97, 0.4]
 
 
