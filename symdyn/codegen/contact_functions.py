@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..algorithms.contact_dynamics import KKT
+from ..algorithms.contact_dynamics import DAMPING, KKT
 from ..algorithms.contacts import ContactKinematics
 from ..algorithms.derivatives import elimination_order, floating_effort_jacobians, jacobian, substitute
 from ..dynamics import Dynamics
@@ -52,6 +52,10 @@ CONTACT_FUNCTIONS = (
     "contact_forward_dynamics_derivatives",
     "impulse_dynamics_derivatives",
 )
+
+
+#: the damping of the Delassus matrix as the functions' comments state it
+MU_TEXT = f"{float(DAMPING):.0e}"
 
 
 def contact_inputs(ncontact: int) -> tuple[Input, Input]:
@@ -146,7 +150,7 @@ def contact_rows_of(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (
                 "contact_forward_dynamics",
                 "qdd and lam solving M qdd + V + G + F = tau + Jc^T lam, Jc qdd + gamma = 0 for the "
-                "active contacts (masked, damped KKT solve)",
+                f"active contacts (masked KKT solve, Delassus matrix damped by mu = {MU_TEXT})",
                 (x.q, qd_in, x.tau, active, x.p),
                 (out("qdd", nv, (cols, "1"), "accelerations"), out("lam", m, ("nlambda", "1"), lam_doc)),
                 (*qdd, *lam),
@@ -154,7 +158,7 @@ def contact_rows_of(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
             (
                 "impulse_dynamics",
                 "qd_plus and impulse solving M (qd_plus - qd) = Jc^T impulse, Jc qd_plus = -e Jc qd "
-                "for the active contacts",
+                f"for the active contacts (Delassus matrix damped by mu = {MU_TEXT})",
                 (x.q, qd_in, active, e, x.p),
                 (
                     out("qd_plus", nv, (cols, "1"), "velocities after the impact"),
@@ -220,7 +224,8 @@ def _derivative_rows(dyn, x, prog, kkt: KKT, Jc, gamma, solved, inputs, cols) ->
         (
             "contact_forward_dynamics_derivatives",
             "dqdd/dq, dqdd/dqd, dqdd/dtau, dlam/dq, dlam/dqd, dlam/dtau of contact_forward_dynamics "
-            "(the KKT system differentiated; by q in the tangent space on a floating base)",
+            f"(the KKT system with mu = {MU_TEXT} differentiated; by q in the tangent space on a floating "
+            "base)",
             (x.q, qd_in, x.tau, active, x.p),
             (
                 square("dqdd_dq", "dqdd_i/dq_j"),
