@@ -12,9 +12,10 @@ NCHECK states, then times them on NSTATES random states (each call on the next s
 derivatives after the dynamics they differentiate, as a user calls them; the thread's CPU time).
 
 symdyn's column: the robot with `Robot.contacts` (symdyn.model.contacts.Contact) compiled by
-`symdyn.compile(robot, functions=("contacts", "contact_derivatives"))` (the time of
-that first compile, in a cache of its own, is the generation time reported), its methods contact_forward_dynamics,
-impulse_dynamics, contact_forward_dynamics_derivatives and impulse_dynamics_derivatives called
+`symdyn.compile(robot, functions=("contacts", "contact_derivatives"))` (its time is reported: with
+SYMDYN_CACHE_DIR an empty folder, the derivation, generation and C compilation), its methods
+contact_forward_dynamics, impulse_dynamics, contact_forward_dynamics_derivatives and
+impulse_dynamics_derivatives (the restitution e = 0) called
 on the same NSTATES states as one batch (one thread; the thread's CPU time of the call over
 NSTATES: the generated C plus the batch call's share of Python's overhead), checked against the
 oracle first. Where symdyn has no such functions yet, or they fail, the column says "n/a" and the
