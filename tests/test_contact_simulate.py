@@ -199,3 +199,23 @@ def test_simulate_contacts_refuses_bad_arguments(hopper):
     ):
         with pytest.raises(SymdynError, match=message):
             simulate_contacts(plant, robot, Q0, **({"duration": 1.0, "dt": 0.1} | kwargs))
+
+
+def test_a_fixed_base_arm_holds_its_tip_with_rk4(tmp_path):
+    """planar_3r with a point contact at its last link (the z row is empty: the damped solve):
+    the samples solve the stabilised KKT system of the oracle, q integrated in a vector space."""
+    robot = symdyn.load_robot(Path(__file__).parent.parent / "examples/planar_3r.yaml", contacts=["link3"])
+    plant = symdyn.compile(robot, functions=("dynamics", "contacts"))
+    kp, kd = 100.0, 20.0
+    traj = simulate_contacts(
+        plant, robot, [0.3, 0.5, 0.4], [0.2, -0.1, 0.3], duration=0.2, dt=1e-3, tau=[1, 0, 0],
+        integrator="rk4", baumgarte=(kp, kd),
+    )  # fmt: skip
+    anchor = _positions(robot, traj.q[0])
+    for k in (0, 100, 200):
+        q, v, a, lam = traj.q[k], traj.qd[k], traj.qdd[k], traj.lam[k]
+        Jc = contact_jacobian(robot, None, q)
+        assert np.allclose(symdyn.rnea(robot, q, v, a) - Jc.T @ lam, traj.tau[k], atol=1e-8)
+        error = (_positions(robot, q) - anchor).reshape(-1)
+        assert np.allclose(Jc @ a + contact_drift(robot, None, q, v), -kd * Jc @ v - kp * error, atol=1e-6)
+    assert traj.q.shape == (201, 3) and lam[2] == 0.0

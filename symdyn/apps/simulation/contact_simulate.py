@@ -214,6 +214,10 @@ def simulate_contacts(
         _check_number(g, name)
         for g, name in zip(baumgarte, ("Baumgarte's Kp", "Baumgarte's Kd"), strict=True)
     )
+    if (kp or kd) and "mass_matrix" not in plant.functions:
+        raise SymdynError(
+            f"robot '{robot.name}': Baumgarte's gains need the mass_matrix function (group dynamics)"
+        )
     sizes = floating_sizes(plant)
     nq, nv = sizes if sizes is not None else (robot.n, robot.n)
     q = initial_state(q0, nq, "q0")
@@ -250,7 +254,7 @@ def simulate_contacts(
 
         if last > first:
             Qs, Vs, Us = run_floating(
-                stepper, scheme, q, v, h[first:last], t[first : last + 1], tau_at, accel
+                stepper, scheme, q, v, h[first:last], t[first : last + 1], tau_at, accel, sizes is None
             )
             Q[first : last + 1], V[first : last + 1], U[first:last] = Qs, Vs, Us[:-1]
             q, v = Qs[-1], Vs[-1]
@@ -265,11 +269,21 @@ def simulate_contacts(
         accel = _constrained(plant, geometry, active_rows[k], anchored[k], kp, kd)
         A[k], lam[k] = accel(Q[k], V[k], U[k], forces=True)
     return ContactTrajectory(
-        robot, t, Q, V, U, scheme, plant=plant, qdd=A if sizes is not None else None, lam=lam,
-        active=active_rows, impulse=impulse, impulse_time=None if impulse_at is None else float(t[start]),
+        robot,
+        t,
+        Q,
+        V,
+        U,
+        scheme,
+        plant=plant,
+        qdd=A,
+        lam=lam,
+        active=active_rows,
+        impulse=impulse,
+        impulse_time=None if impulse_at is None else float(t[start]),
         poses=poses,
         qd_before=before,
-    )  # fmt: skip
+    )
 
 
 def _constrained(plant, geometry: _Geometry, active: np.ndarray, anchors: np.ndarray, kp: float, kd: float):

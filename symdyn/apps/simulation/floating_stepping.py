@@ -68,10 +68,13 @@ def initial_configuration(nq: int) -> np.ndarray:
     return q
 
 
-def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_at, accel=None) -> tuple:
+def run_floating(
+    plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_at, accel=None, flat: bool = False
+) -> tuple:
     """(Q (N+1, NQ), V (N+1, NV), U (N+1, NV)) from one state; tau_at(row, t, q, v) -> (NV,);
     accel(q, v, tau) -> a: the accelerations (default plant.forward_dynamics; the constrained
-    dynamics of symdyn.apps.simulation.contact_simulate)."""
+    dynamics of symdyn.apps.simulation.contact_simulate); flat: q lives in a vector space (a fixed
+    base, plant.integrate adds), where dexp^-1 is the identity."""
     if scheme not in FLOATING_SCHEMES:
         raise SymdynError(
             f"robot '{plant.robot.name}' has a floating base: integrator '{scheme}' does not apply "
@@ -102,7 +105,7 @@ def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_a
                     theta, vel = c * hk * K[i], v + c * hk * A[i]
                     qi = step_to(q, theta)
                     A.append(accel(qi, vel, tau_at(3 * k + row, tk + c * hk, qi, vel)))
-                    K.append(dexp_inverse(theta, vel))
+                    K.append(vel if flat else dexp_inverse(theta, vel))
                 q = step_to(q, hk / 6.0 * (K[0] + 2 * K[1] + 2 * K[2] + K[3]))
                 v = v + hk / 6.0 * (A[0] + 2 * A[1] + 2 * A[2] + A[3])
             elif scheme == "euler":
