@@ -12,8 +12,10 @@ NCHECK states, then times them on NSTATES random states (each call on the next s
 derivatives after the dynamics they differentiate, as a user calls them; the thread's CPU time).
 
 symdyn's column: the robot with `Robot.contacts` (symdyn.model.contacts.Contact) compiled by
-`symdyn.compile(robot, functions=("contacts",))`, its methods contact_forward_dynamics,
-impulse_dynamics, contact_forward_dynamics_derivatives and impulse_dynamics_derivatives called
+`symdyn.compile(robot, functions=("contacts", "contact_derivatives"))` (its time is reported: with
+SYMDYN_CACHE_DIR an empty folder, the derivation, generation and C compilation), its methods
+contact_forward_dynamics, impulse_dynamics, contact_forward_dynamics_derivatives and
+impulse_dynamics_derivatives (the restitution e = 0) called
 on the same NSTATES states as one batch (one thread; the thread's CPU time of the call over
 NSTATES: the generated C plus the batch call's share of Python's overhead), checked against the
 oracle first. Where symdyn has no such functions yet, or they fail, the column says "n/a" and the
@@ -135,7 +137,7 @@ def symdyn_methods(robot, contacts) -> tuple[dict, str]:
             robot, contacts=tuple(Contact(f, f, kind) for f, kind in contacts)
         )
         t0 = time.perf_counter()
-        compiled = symdyn.compile(with_contacts, functions=("contacts",))
+        compiled = symdyn.compile(with_contacts, functions=("contacts", "contact_derivatives"))
         seconds = time.perf_counter() - t0
     except Exception as exc:  # noqa: BLE001 - whatever fails, the column says so and why
         return {}, f"symdyn.compile with contacts failed: {type(exc).__name__}: {exc}"
@@ -151,11 +153,12 @@ def symdyn_batches(methods: dict, robot, contacts, st, refs: list[dict]) -> tupl
     """Per method: the batch call (a closure), the worst relative error against the oracle at the
     first NCHECK states, and notes for the methods that fail."""
     active = np.ones((NSTATES, len(contacts)))
+    e = np.zeros((NSTATES, 1))  # the restitution, an input of its own (0: the contacts stick)
     args = {
         "contact_forward_dynamics": (st["q"], st["v"], st["tau"], active),
         "contact_forward_dynamics_derivatives": (st["q"], st["v"], st["tau"], active),
-        "impulse_dynamics": (st["q"], st["v"], active),
-        "impulse_dynamics_derivatives": (st["q"], st["v"], active),
+        "impulse_dynamics": (st["q"], st["v"], active, e),
+        "impulse_dynamics_derivatives": (st["q"], st["v"], active, e),
     }
     outputs = {
         "contact_forward_dynamics": ("qdd", "lambda"),

@@ -170,11 +170,15 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from ..apps.simulation.simulate import simulate
     from ..apps.simulation.trajectory import plot_trajectory
     from .animation import check_animation, write_animation
+    from .contact_options import check_contact_options
 
     check_output(args.out, "--out")
     _check_plot_path(args.plot)
     check_animation(args)
     params = _assignments(args.params, "--params")
+    check_contact_options(args)
+    if args.contacts is not None:
+        return _simulate_contacts(args, params)
     if args.track is not None and args.tau is not None:
         raise SymdynError("--tau and --track exclude each other (--track computes the torque)")
     if args.track is None:
@@ -270,6 +274,56 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             + "; maximum over the last half "
             + ", ".join(f"{x:.3g}" for x in err[len(err) // 2 :].max(axis=0))
         )
+    if args.plot:
+        print(args.plot)
+    return 0
+
+
+def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
+    """simulate --contacts: the constrained dynamics (symdyn.apps.simulation.contact_simulate), the
+    contact forces in the CSV, --plot drawing them, --animate their arrows."""
+    from ..apps.compilation.compiled import compiled_dynamics
+    from ..apps.output import write_atomic
+    from ..apps.simulation.contact_simulate import plot_contact_forces, simulate_contacts
+    from ..apps.simulation.floating_stepping import floating_sizes, initial_configuration
+    from .animation import write_animation
+    from .contact_options import pd_torque
+
+    robot = _with_params(load_robot_argument(args), params)
+    plant = compiled_dynamics(robot)  # cached by the robot's content (it is loaded anyway: its contacts)
+    sizes = floating_sizes(plant)
+    nq, nv = sizes if sizes is not None else (plant.n, plant.n)
+    q0 = _vector(args.q0, nq, "--q0", default=initial_configuration(nq) if sizes else np.zeros(nq))
+    qd0 = _vector(args.qd0, nv, "--qd0", default=np.zeros(nv))
+    tau = pd_torque(args, q0, nv) or (None if args.tau is None else _torques(args.tau, nv))
+    traj = simulate_contacts(
+        plant,
+        robot,
+        q0,
+        qd0,
+        duration=args.duration,
+        dt=args.dt,
+        tau=tau,
+        integrator=args.integrator,
+        impulse_at=args.impulse_at,
+        restitution=args.restitution or 0.0,
+        baumgarte=tuple(args.baumgarte or (0.0, 0.0)),
+    )
+    image = plot_contact_forces(traj) if args.plot else None
+    write_atomic(args.out, traj.csv_bytes())
+    if image is not None:
+        write_atomic(args.plot, image)
+    if args.animate:
+        write_animation(args, robot, traj, lambda: robot)
+    total = traj.contact_forces[-1].sum(axis=0)
+    print(
+        f"{args.out}: {len(traj.t)} samples, t = 0 .. {traj.t[-1]:g} s, dt = {args.dt:g} s, "
+        f"integrator {traj.integrator}, contacts {', '.join(c.name for c in robot.contacts)}"
+    )
+    print(
+        f"contact forces at t = {traj.t[-1]:g} s: sum {' '.join(f'{x:.6g}' for x in total)} N (world axes)"
+        + ("" if traj.impulse_time is None else f"; touchdown at t = {traj.impulse_time:g} s")
+    )
     if args.plot:
         print(args.plot)
     return 0
@@ -404,6 +458,7 @@ _VECTOR = {"nargs": "+", "metavar": "V"}
 def _simulate_arguments(s: argparse.ArgumentParser) -> None:
     from ..apps.simulation.stepping import INTEGRATORS
     from .animation import animation_arguments
+    from .contact_options import contact_arguments
 
     vec = _VECTOR
     s.description = (
@@ -457,6 +512,7 @@ def _simulate_arguments(s: argparse.ArgumentParser) -> None:
         "--progress", action="store_true", help="show a progress bar even when stderr is not a terminal"
     )
     animation_arguments(s)
+    contact_arguments(s)
     s.set_defaults(func=cmd_simulate)
 
 

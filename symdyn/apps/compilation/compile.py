@@ -41,6 +41,7 @@ from . import cache
 from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
 from .configuration_check import quaternion_checked
+from .contact_check import contact_checked
 from .entry import build_options, entry_builder, loaded_files
 from .parameter_binding import RobotInfo, bind_parameters
 from .robot_key import robot_digest
@@ -187,7 +188,7 @@ class CompiledDynamics(FrameMethods):
         if self._library is None:
             _warn_fallback()
             for f in meta["functions"]:
-                method = quaternion_checked(f, _numpy_method(self, f["name"]), self.n)
+                method = quaternion_checked(f, contact_checked(f, _numpy_method(self, f["name"])), self.n)
                 setattr(self, f["name"], guarded(self, f["name"], method))
         return self
 
@@ -201,7 +202,7 @@ class CompiledDynamics(FrameMethods):
         ffi, lib, _ = self._loaded()
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
-            method = quaternion_checked(f, c_method(ffi, lib, f, p_ptr, self), self.n)
+            method = quaternion_checked(f, contact_checked(f, c_method(ffi, lib, f, p_ptr, self)), self.n)
             setattr(self, f["name"], guarded(self, f["name"], method))
         return self.__dict__[name]
 

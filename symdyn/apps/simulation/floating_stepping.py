@@ -68,14 +68,20 @@ def initial_configuration(nq: int) -> np.ndarray:
     return q
 
 
-def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_at) -> tuple:
-    """(Q (N+1, NQ), V (N+1, NV), U (N+1, NV)) from one state; tau_at(row, t, q, v) -> (NV,)."""
+def run_floating(
+    plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_at, accel=None, flat: bool = False
+) -> tuple:
+    """(Q (N+1, NQ), V (N+1, NV), U (N+1, NV)) from one state; tau_at(row, t, q, v) -> (NV,);
+    accel(q, v, tau) -> a: the accelerations (default plant.forward_dynamics; the constrained
+    dynamics of symdyn.apps.simulation.contact_simulate); flat: q lives in a vector space (a fixed
+    base, plant.integrate adds), where dexp^-1 is the identity."""
     if scheme not in FLOATING_SCHEMES:
         raise SymdynError(
             f"robot '{plant.robot.name}' has a floating base: integrator '{scheme}' does not apply "
             f"(one of {', '.join(FLOATING_SCHEMES)})"
         )
-    missing = [f for f in ("forward_dynamics", "integrate") if f not in plant.functions]
+    needed = ("forward_dynamics", "integrate") if accel is None else ("integrate",)
+    missing = [f for f in needed if f not in plant.functions]
     if missing:
         raise SymdynError(f"robot '{plant.robot.name}': no {missing[0]} function, cannot simulate")
     steps = len(h)
@@ -83,6 +89,7 @@ def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_a
     Q[0], V[0] = q0, v0
     q, v = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)
     one = np.ones(1)
+    accel = plant.forward_dynamics if accel is None else accel
 
     def step_to(q, xi):
         return plant.integrate(q, xi, one)
@@ -91,14 +98,14 @@ def run_floating(plant, scheme: str, q0, v0, h: np.ndarray, t: np.ndarray, tau_a
         for k in range(steps):
             hk, tk = h[k], t[k]
             U[k] = tau_at(3 * k, tk, q, v)
-            a1 = plant.forward_dynamics(q, v, U[k])
+            a1 = accel(q, v, U[k])
             if scheme == "rk4":
                 K, A, theta, vel = [v], [a1], v * 0.0, v
                 for i, (c, row) in enumerate(((0.5, 1), (0.5, 1), (1.0, 2))):
                     theta, vel = c * hk * K[i], v + c * hk * A[i]
                     qi = step_to(q, theta)
-                    A.append(plant.forward_dynamics(qi, vel, tau_at(3 * k + row, tk + c * hk, qi, vel)))
-                    K.append(dexp_inverse(theta, vel))
+                    A.append(accel(qi, vel, tau_at(3 * k + row, tk + c * hk, qi, vel)))
+                    K.append(vel if flat else dexp_inverse(theta, vel))
                 q = step_to(q, hk / 6.0 * (K[0] + 2 * K[1] + 2 * K[2] + K[3]))
                 v = v + hk / 6.0 * (A[0] + 2 * A[1] + 2 * A[2] + A[3])
             elif scheme == "euler":

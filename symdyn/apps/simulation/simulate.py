@@ -64,6 +64,8 @@ __all__ = [
     "time_expressions",
     "lambdify_time",
     "torque_function",
+    "torque_table",
+    "initial_state",
     "simulate",
     "write_atomic",
     "plot_trajectory",
@@ -187,7 +189,8 @@ def torque_function(tau, n: int) -> Callable:
 # --------------------------------------------------------------------------- integration
 
 
-def _state(x, n: int, name: str) -> np.ndarray:
+def initial_state(x, n: int, name: str) -> np.ndarray:
+    """`x` as a finite float array of one state (n,) or a batch (B, n); else SymdynError naming `name`."""
     try:
         a = np.array(x, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -199,7 +202,7 @@ def _state(x, n: int, name: str) -> np.ndarray:
     return a
 
 
-def _torque_table(tau, n: int, rows: np.ndarray) -> np.ndarray | None:
+def torque_table(tau, n: int, rows: np.ndarray) -> np.ndarray | None:
     """The torque at the table's times (3 per step, symdyn.apps.simulation.stepping), or None for a
     Python callable."""
     if callable(tau):
@@ -218,7 +221,7 @@ def _torque_table(tau, n: int, rows: np.ndarray) -> np.ndarray | None:
 def _in_c(plant, scheme, q, qd, t, h, tau, tau_at, bar):
     """(Q, QD, U) of the whole run with the stepping loop in C, or None when it cannot run there."""
     rows = torque_rows(t, h)
-    table, controller, reference = _torque_table(tau, plant.n, rows), None, None
+    table, controller, reference = torque_table(tau, plant.n, rows), None, None
     if table is None:
         law = getattr(tau, "tracking", None)  # a computed-torque law (symdyn.apps.simulation.control)
         if law is None:
@@ -308,14 +311,14 @@ def _adaptive(plant, method, q, qd, t, tau_at, rtol, atol):
 def _floating(plant, sizes, q0, v0, duration, dt, tau, integrator) -> Trajectory:
     """A floating robot's run (symdyn.apps.simulation.floating_stepping): q0 of NQ, v0 of NV, one state."""
     nq, nv = sizes
-    q = _state(q0, nq, "q0")
-    v = np.zeros(nv) if v0 is None else _state(v0, nv, "qd0")
+    q = initial_state(q0, nq, "q0")
+    v = np.zeros(nv) if v0 is None else initial_state(v0, nv, "qd0")
     if q.ndim != 1 or v.ndim != 1:
         raise SymdynError(f"robot '{plant.robot.name}' has a floating base: give one initial state")
     check_quaternions(q, "q0")  # then a unit quaternion: the one the run's integrate keeps
     q[3:7] /= quaternion_norms(q)
     t, h = sample_times(duration, dt)
-    table = _torque_table(tau, nv, torque_rows(t, h))
+    table = torque_table(tau, nv, torque_rows(t, h))
     torque = torque_function(tau, nv) if table is None else None
 
     def tau_at(row, tk, q, v):
@@ -379,8 +382,8 @@ def simulate(
     sizes = floating_sizes(plant)
     if sizes is not None:
         return _floating(plant, sizes, q0, qd0, duration, dt, tau, integrator)
-    q = _state(q0, n, "q0")
-    qd = np.zeros_like(q) if qd0 is None else _state(qd0, n, "qd0")
+    q = initial_state(q0, n, "q0")
+    qd = np.zeros_like(q) if qd0 is None else initial_state(qd0, n, "qd0")
     q, qd = np.broadcast_arrays(q, qd)
     q, qd = q.copy(), qd.copy()
     torque = torque_function(tau, n)
