@@ -880,7 +880,11 @@ def test_cli_derive_and_generate(tmp_path, capsys):
     assert capsys.readouterr().out.startswith("# branch: 2 joints")
     out_dir = tmp_path / "out"
     assert main(["generate", str(DATA / "rpy_chain.urdf"), "--target", "c", "--out", str(out_dir)]) == 0
-    assert sorted(p.name for p in out_dir.iterdir()) == ["rpy_chain_dynamics.c", "rpy_chain_dynamics.h"]
+    assert sorted(p.name for p in out_dir.iterdir()) == [
+        "CMakeLists.txt",
+        "rpy_chain_dynamics.c",
+        "rpy_chain_dynamics.h",
+    ]
 
 
 def test_cli_errors(tmp_path, capsys):
