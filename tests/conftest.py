@@ -38,6 +38,31 @@ IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
 os.environ["SYMDYN_QUIET"] = "1"
 
 
+#: The test files that take longest (measured with --durations: each about 20 s of CPU or more),
+#: run first: pytest-xdist hands whole files to the workers in collection order (--dist loadfile),
+#: so a long file collected last leaves one worker running it alone while the other idles.
+SLOW_FIRST = (
+    "test_docs.py",
+    "test_c_sincos.py",
+    "test_tree.py",
+    "test_embedded.py",
+    "test_configuration_space.py",
+    "test_frame_functions.py",
+    "test_compile.py",
+    "test_tree_codegen.py",
+    "test_contact_functions.py",
+    "test_contact_simulate.py",
+    "test_drawing.py",
+)
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The files of SLOW_FIRST first, in that order; every other file after them in collection
+    order (a stable sort: the tests of one file keep theirs)."""
+    rank = {name: k for k, name in enumerate(SLOW_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(SLOW_FIRST)))
+
+
 def pytest_configure(config):
     config.addinivalue_line("markers", "accelerator: needs a GPU; skips without one, under CI as well")
 
