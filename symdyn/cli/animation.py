@@ -7,6 +7,7 @@ import argparse
 from collections.abc import Callable
 
 from ..errors import SymdynError
+from .common import whole_number
 
 __all__ = ["check_animation", "write_animation", "animation_arguments", "VIEWS"]
 
@@ -53,5 +54,5 @@ def animation_arguments(s: argparse.ArgumentParser) -> None:
         help="also write the motion as a self-contained HTML page (.html: three.js, a time slider, "
         "play/pause) or an animated GIF (.gif), with the tool frame's path",
     )
-    s.add_argument("--frames", type=int, help="--animate: the number of pictures (default 60)")
+    s.add_argument("--frames", type=whole_number, help="--animate: the number of pictures (default 60)")
     s.add_argument("--view", choices=VIEWS, help="--animate: the view (default iso)")

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import SymdynError
 from .cache import CACHE_HELP, cache_arguments, cached_plant
-from .common import METHODS, add_robot_argument, load_robot_argument
+from .common import METHODS, add_robot_argument, load_robot_argument, whole_number
 
 #: A plain decimal number, read with float() instead of the expression parser (no SymPy needed).
 _PLAIN = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
@@ -433,22 +433,6 @@ def _positive(text: str) -> float:
     if not np.isfinite(v) or v <= 0:
         raise argparse.ArgumentTypeError(f"expected a positive number, got '{text}'")
     return v
-
-
-def whole_number(text: str) -> int:
-    """An integer option's value: a whole number, also written as a float ("1e6", "100.0"), so
-    that its range is checked (and named) by the command rather than refused as a spelling."""
-    try:
-        return int(text)
-    except ValueError:
-        pass
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
-    if not (np.isfinite(v) and v == int(v)):
-        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'")
-    return int(v)
 
 
 #: The options of a vector: values separated by spaces (or commas, split by _words).

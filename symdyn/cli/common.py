@@ -4,6 +4,7 @@ and its loader."""
 from __future__ import annotations
 
 import argparse
+import math
 
 __all__ = [
     "add_robot_argument",
@@ -12,6 +13,7 @@ __all__ = [
     "xacro_arguments",
     "METHODS",
     "FLOATING_COMMANDS",
+    "whole_number",
 ]
 
 #: symdyn.dynamics.METHODS, spelled here so that building the parser imports no SymPy
@@ -114,3 +116,19 @@ def add_contacts_argument(parser: argparse.ArgumentParser) -> None:
         "its frame; point: 3 rows, world-aligned, the default; 6d: 6 rows in the frame's axes; "
         "docs/contacts.md)",
     )
+
+
+def whole_number(text: str) -> int:
+    """An integer option's value: a whole number, also written as a float ("1e6", "100.0"), so
+    that its range is checked (and named) by the command rather than refused as a spelling."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
+    if not (math.isfinite(v) and v == int(v)):
+        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'")
+    return int(v)
