@@ -276,6 +276,7 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
             "centroidal",
             "contacts",
             "contact_derivatives",
+            "contact_baumgarte",
             "all",
         ),
         default=["dynamics"],
@@ -284,7 +285,8 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
         "kinematics and operational_space (per frame, see --frames); configuration (a floating robot's "
         "integrate and difference), centroidal (momentum matrix, its drift, com, total mass), contacts "
         "(a robot with contacts: Jc, drift, constrained and impulse dynamics; docs/contacts.md), "
-        "contact_derivatives (their derivatives); all: every group",
+        "contact_derivatives (their derivatives), contact_baumgarte (the contacts' position errors and "
+        "the Baumgarte-stabilised constrained dynamics, named only); all: every group",
     )
     g.add_argument(
         "--frames",

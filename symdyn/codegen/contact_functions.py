@@ -38,6 +38,9 @@ from .function_rows import FunctionRow, Input, Inputs, Output
 
 __all__ = [
     "CONTACT_FUNCTIONS",
+    "carried_rows",
+    "contact_setup",
+    "kkt_of",
     "contact_rows_of",
     "contact_derivative_rows",
     "contact_inputs",
@@ -79,8 +82,9 @@ def _tangent(
     return jacobian(prog, outputs, q, f"{hint}q"), jacobian(prog, outputs, qd, f"{hint}v")
 
 
-def _setup(dyn: Dynamics, x: Inputs, tag: str):
-    """The program copy, its first new step, the inputs, Jc, gamma, the row activities and sizes."""
+def contact_setup(dyn: Dynamics, x: Inputs, tag: str):
+    """The program copy, its first new step, the inputs, Jc, gamma, the row activities, sizes and
+    the contacts' kinematics (whose `frames` give the contact frames' poses)."""
     robot = dyn.robot
     prog = dyn.program.copy(tag)
     first = len(prog.assignments)
@@ -93,21 +97,26 @@ def _setup(dyn: Dynamics, x: Inputs, tag: str):
     kin = ContactKinematics(fk, robot.contacts, qd, prog)
     Jc, gamma = kin.jacobian(), kin.drift()
     row_active = [active.symbols[k] for k in kin.row_contacts()]
-    return prog, first, (Input("qd", tuple(qd)), active, e), Jc, gamma, row_active, nv, cols
+    return prog, first, (Input("qd", tuple(qd)), active, e), Jc, gamma, row_active, nv, cols, kin
+
+
+def kkt_of(dyn: Dynamics, x: Inputs, prog, Jc, row_active) -> tuple[KKT, list]:
+    """The masked KKT system of the robot over `prog` and the force tau - b it is driven by."""
+    robot, c = dyn.robot, dyn.compact
+    order = elimination_order(Jc.cols, robot.is_chain and not robot.floating)
+    kkt = KKT(sp.Matrix(c["M"]), Jc, row_active, order, prog)
+    return kkt, [prog.let(t - b, "cf") for t, b in zip(x.tau.symbols, c["bias"], strict=True)]
 
 
 def _solved(dyn: Dynamics, x: Inputs, prog, Jc, gamma, row_active, e) -> tuple:
     """The KKT system and (qdd, lam, qd_plus, impulse) over `prog`."""
-    robot, c = dyn.robot, dyn.compact
-    order = elimination_order(Jc.cols, robot.is_chain and not robot.floating)
-    kkt = KKT(sp.Matrix(c["M"]), Jc, row_active, order, prog)
-    force = [prog.let(t - b, "cf") for t, b in zip(x.tau.symbols, c["bias"], strict=True)]
+    kkt, force = kkt_of(dyn, x, prog, Jc, row_active)
     qdd, lam = kkt.forward_dynamics(force, list(gamma))
     qd_plus, imp = kkt.impulse(list(dyn.qd), e.symbols[0])
     return kkt, (qdd, lam, qd_plus, imp)
 
 
-def _carried(rows: list[tuple], prog, first: int, cse: str) -> list[FunctionRow]:
+def carried_rows(rows: list[tuple], prog, first: int, cse: str) -> list[FunctionRow]:
     new = {s for s, _ in prog.assignments[first:]}
     steps = tuple(a for a in prog.needed([v for row in rows for v in row[4]]) if a[0] in new)
     carried = [steps] + [()] * (len(rows) - 1)
@@ -120,7 +129,7 @@ def contact_rows_of(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     robot = dyn.robot
     if not robot.contacts:
         return []
-    prog, first, (qd_in, active, e), Jc, gamma, row_active, nv, cols = _setup(dyn, x, "c")
+    prog, first, (qd_in, active, e), Jc, gamma, row_active, nv, cols, _ = contact_setup(dyn, x, "c")
     m = Jc.rows
 
     def out(name, rows, dims, doc):
@@ -169,7 +178,7 @@ def contact_rows_of(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
                 (*qd_plus, *imp),
             ),
         ]
-    return _carried(rows, prog, first, "contacts")
+    return carried_rows(rows, prog, first, "contacts")
 
 
 def contact_derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
@@ -178,10 +187,10 @@ def contact_derivative_rows(dyn: Dynamics, x: Inputs) -> list[FunctionRow]:
     robot = dyn.robot
     if not robot.contacts or dyn.singular_joints:
         return []
-    prog, first, inputs, Jc, gamma, row_active, _, cols = _setup(dyn, x, "C")
+    prog, first, inputs, Jc, gamma, row_active, _, cols, _ = contact_setup(dyn, x, "C")
     kkt, solved = _solved(dyn, x, prog, Jc, gamma, row_active, inputs[2])
     rows = _derivative_rows(dyn, x, prog, kkt, Jc, gamma, solved, inputs, cols)
-    return _carried(rows, prog, first, "contact_derivatives")
+    return carried_rows(rows, prog, first, "contact_derivatives")
 
 
 def _derivative_rows(dyn, x, prog, kkt: KKT, Jc, gamma, solved, inputs, cols) -> list[tuple]:
@@ -254,6 +263,8 @@ def _derivative_rows(dyn, x, prog, kkt: KKT, Jc, gamma, solved, inputs, cols) ->
 
 
 def contacts_of(ctx) -> tuple:
-    """The robot's contacts when a RenderContext's functions include the contact functions, else ()
-    (the targets' NCONTACT, NLAMBDA and CONTACT_NAMES constants)."""
-    return ctx.robot.contacts if any(f.name == "contact_jacobian" for f in ctx.functions) else ()
+    """The robot's contacts when a RenderContext's functions include the contact functions (group
+    contacts or contact_baumgarte), else () (the targets' NCONTACT, NLAMBDA and CONTACT_NAMES
+    constants)."""
+    marks = ("contact_jacobian", "contact_error")
+    return ctx.robot.contacts if any(f.name in marks for f in ctx.functions) else ()

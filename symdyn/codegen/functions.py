@@ -49,6 +49,7 @@ from ..symbolic.program import Program
 from ..symbolic.simplify import eliminate_many
 from .centroidal_functions import centroidal_rows
 from .configuration_functions import configuration_rows
+from .contact_baumgarte import BAUMGARTE_FUNCTIONS, baumgarte_rows
 from .contact_functions import CONTACT_FUNCTIONS, contact_derivative_rows, contact_rows_of
 from .derivative_functions import DERIVATIVE_FUNCTION_NAMES, derivative_rows
 from .frame_functions import choose_frames, kinematics_rows, operational_space_rows
@@ -230,6 +231,7 @@ FAMILIES: tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...] = (
     centroidal_rows,
     contact_rows_of,
     contact_derivative_rows,
+    baumgarte_rows,
 )
 
 
@@ -240,13 +242,16 @@ INVERTING: dict[Callable[[Dynamics, Inputs], list[FunctionRow]], tuple[str, ...]
     operational_space_rows: ("operational_space_inertia", "operational_space_bias"),
     contact_rows_of: CONTACT_FUNCTIONS[2:4],
     contact_derivative_rows: CONTACT_FUNCTIONS[4:],
+    baumgarte_rows: BAUMGARTE_FUNCTIONS[1:],
 }
 
 
 def _warn_singular(dyn: Dynamics, families) -> None:
     """One SymdynWarning: M is singular (which joints, why) and the functions left out."""
     families = [
-        f for f in families if f not in (contact_rows_of, contact_derivative_rows) or dyn.robot.contacts
+        f
+        for f in families
+        if f not in (contact_rows_of, contact_derivative_rows, baumgarte_rows) or dyn.robot.contacts
     ]
     left_out = [name for family in families for name in INVERTING.get(family, ())]
     if not dyn.singular_joints or not left_out:
@@ -272,12 +277,13 @@ GROUPS: dict[str, tuple[Callable[[Dynamics, Inputs], list[FunctionRow]], ...]] =
     "centroidal": (centroidal_rows,),
     "contacts": (contact_rows_of,),
     "contact_derivatives": (contact_derivative_rows,),
+    "contact_baumgarte": (baumgarte_rows,),
 }
 
 #: The groups built per frame (symdyn.codegen.frame_functions): only when named, never by default.
 FRAME_GROUPS = ("kinematics", "operational_space")
-#: The groups built only when named (the frame groups and the centroidal functions).
-NAMED_ONLY = (*FRAME_GROUPS, "centroidal")
+#: The groups built only when named (the frame groups, the centroidal functions and Baumgarte's).
+NAMED_ONLY = (*FRAME_GROUPS, "centroidal", "contact_baumgarte")
 #: Functions two groups both have (com: kinematics and centroidal): built once, by the first.
 SHARED_FUNCTIONS = ("com",)
 

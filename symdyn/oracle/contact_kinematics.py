@@ -39,7 +39,7 @@ from .floating import base_rotation
 from .inputs import body_positions, body_rates, numeric_model
 from .spatial import joint_poses
 
-__all__ = ["KINDS", "ContactRows", "contact_rows", "contact_kinematics", "shown"]
+__all__ = ["KINDS", "ContactRows", "contact_rows", "contact_kinematics", "contact_poses", "shown"]
 
 
 #: the rows of each kind of contact
@@ -193,3 +193,17 @@ def contact_kinematics(robot, rows: ContactRows, Q: np.ndarray, QD: np.ndarray, 
         gamma[:, start : start + 3] = np.einsum("nij,nj->ni", RT, spatial)
         gamma[:, start + 3 : start + 6] = np.einsum("nij,nj->ni", RT, wd[:, nv])
     return J, gamma
+
+
+def contact_poses(robot, rows: ContactRows, Q: np.ndarray, params=None) -> np.ndarray:
+    """(N, NCONTACT, 4, 4): the contact frames' world poses world_T_F at N checked states Q."""
+    mdl = numeric_model(robot, params)
+    bodies = _bodies(robot, mdl, Q, np.zeros((len(Q), 1, robot.nv)))
+    out = np.zeros((len(Q), len(rows.frames), 4, 4))
+    for j, name in enumerate(rows.frames):
+        f = mdl.frame_names.index(name)
+        R, o = bodies[int(mdl.frame_link[f])][:2]
+        out[:, j, :3, :3] = R @ mdl.frame_R[f]
+        out[:, j, :3, 3] = o + np.einsum("nij,j->ni", R, mdl.frame_p[f])
+        out[:, j, 3, 3] = 1.0
+    return out

@@ -17,6 +17,7 @@ import sympy as sp
 
 from ...errors import SymdynError
 from ...model.expressions import C_KEYWORDS
+from ..contact_functions import contacts_of
 from ..printing import free_name
 from ..render import PRECISIONS, RenderContext
 
@@ -178,7 +179,8 @@ def c_names(ctx: RenderContext) -> CNames:
         + [f"{name}_{d.upper()}" for d in ("nstd", "nbase") if d in column_dims]
         + ([f"{name}_NFRAMES"] if ctx.frames else [])
         + ([f"{name}_NACT", f"{name}_NPAS"] if "loop_newton_step" in functions else [])
-        + ([f"{name}_NCONTACT", f"{name}_NLAMBDA"] if "contact_jacobian" in functions else [])
+        + ([f"{name}_NCONTACT", f"{name}_NLAMBDA"] if contacts_of(ctx) else [])
+        + ([f"{name}_NANCHOR"] if "contact_error" in functions else [])
     )
     parts = {"noinline": f"{name}_NOINLINE"}
     taken = set(written) | set(functions.values()) | {guard} | set(sincos.values()) | set(parts.values())
@@ -232,6 +234,7 @@ def c_names(ctx: RenderContext) -> CNames:
             "npas": f"{name}_NPAS",
             "ncontact": f"{name}_NCONTACT",
             "nlambda": f"{name}_NLAMBDA",
+            "nanchor": f"{name}_NANCHOR",
             "nq": nq or str(ctx.robot.nq),
             "nv": nv or str(ctx.robot.nv),
         },

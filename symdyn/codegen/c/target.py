@@ -19,6 +19,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ...errors import SymdynError
+from ..contact_functions import contacts_of
 from ..frame_functions import comment_text
 from ..functions import FunctionSpec
 from ..loop_solve import loop_solve_context
@@ -106,6 +107,7 @@ def function_inputs(names: CNames, spec: FunctionSpec) -> tuple[list, list, list
         size = names.ndof if inp.name in JOINT_INPUTS else str(len(inp.symbols))
         size = names.dims["nact"] if inp.name in ACTUATED_INPUTS else size
         size = names.dims["ncontact"] if inp.name == "active" else size
+        size = names.dims["nanchor"] if inp.name == "anchor" else size
         if inp.name == "q" and names.nq is not None:
             size = names.nq
         inputs.append({"name": inp.name, "read": bool(used), "size": size})
@@ -251,12 +253,13 @@ def render_context(ctx: RenderContext) -> dict:
 
 def _contacts_view(ctx: RenderContext, names: CNames) -> dict | None:
     """The contacts' macros and table (templates/c/dynamics.h.j2) when the contact functions are built."""
-    if not any(f.name == "contact_jacobian" for f in ctx.functions):
+    contacts = contacts_of(ctx)
+    if not contacts:
         return None
-    contacts = ctx.robot.contacts
     return {
         "ncontact": names.dims["ncontact"],
         "nlambda": names.dims["nlambda"],
+        "nanchor": names.dims["nanchor"] if any(f.name == "contact_error" for f in ctx.functions) else None,
         "count": len(contacts),
         "rows": sum(c.rows for c in contacts),
         "table": [(c.name, comment_text(c.frame), c.kind, c.rows) for c in contacts],
