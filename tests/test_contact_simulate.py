@@ -46,7 +46,11 @@ def hopper(tmp_path_factory):
     path = tmp_path_factory.mktemp("hopper") / "hopper.yaml"
     path.write_text(ROBOT)
     robot = symdyn.load_robot(path)
-    return path, robot, symdyn.compile(robot)
+    return (
+        path,
+        robot,
+        symdyn.compile(robot, functions=("dynamics", "configuration", "contacts", "contact_baumgarte")),
+    )
 
 
 def _positions(robot, q) -> np.ndarray:
@@ -205,7 +209,7 @@ def test_a_fixed_base_arm_holds_its_tip_with_rk4(tmp_path):
     """planar_3r with a point contact at its last link (the z row is empty: the damped solve):
     the samples solve the stabilised KKT system of the oracle, q integrated in a vector space."""
     robot = symdyn.load_robot(Path(__file__).parent.parent / "examples/planar_3r.yaml", contacts=["link3"])
-    plant = symdyn.compile(robot, functions=("dynamics", "contacts"))
+    plant = symdyn.compile(robot, functions=("dynamics", "contacts", "contact_baumgarte"))
     kp, kd = 100.0, 20.0
     traj = simulate_contacts(
         plant, robot, [0.3, 0.5, 0.4], [0.2, -0.1, 0.3], duration=0.2, dt=1e-3, tau=[1, 0, 0],

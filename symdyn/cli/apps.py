@@ -282,6 +282,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
     """simulate --contacts: the constrained dynamics (symdyn.apps.simulation.contact_simulate), the
     contact forces in the CSV, --plot drawing them, --animate their arrows."""
+    from ..apps.compilation.compile import compile as compile_robot
     from ..apps.compilation.compiled import compiled_dynamics
     from ..apps.output import write_atomic
     from ..apps.simulation.contact_simulate import plot_contact_forces, simulate_contacts
@@ -290,7 +291,11 @@ def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
     from .contact_options import pd_torque
 
     robot = _with_params(load_robot_argument(args), params)
-    plant = compiled_dynamics(robot)  # cached by the robot's content (it is loaded anyway: its contacts)
+    if any(args.baumgarte or ()):  # the stabilised dynamics are generated only when named
+        groups = ("dynamics", "configuration") if robot.floating else ("dynamics",)
+        plant = compile_robot(robot, functions=(*groups, "contacts", "contact_baumgarte"))
+    else:
+        plant = compiled_dynamics(robot)  # cached by the robot's content (loaded anyway: its contacts)
     sizes = floating_sizes(plant)
     nq, nv = sizes if sizes is not None else (plant.n, plant.n)
     q0 = _vector(args.q0, nq, "--q0", default=initial_configuration(nq) if sizes else np.zeros(nq))
@@ -308,6 +313,7 @@ def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
         impulse_at=args.impulse_at,
         restitution=args.restitution or 0.0,
         baumgarte=tuple(args.baumgarte or (0.0, 0.0)),
+        stance=args.stance,
     )
     image = plot_contact_forces(traj) if args.plot else None
     write_atomic(args.out, traj.csv_bytes())
@@ -322,7 +328,9 @@ def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
     )
     print(
         f"contact forces at t = {traj.t[-1]:g} s: sum {' '.join(f'{x:.6g}' for x in total)} N (world axes)"
-        + ("" if traj.impulse_time is None else f"; touchdown at t = {traj.impulse_time:g} s")
+        + ("; touchdown at t = " if traj.touchdowns else "")
+        + ", ".join(f"{time:g}" for time, _, _ in traj.touchdowns)
+        + (" s" if traj.touchdowns else "")
     )
     if args.plot:
         print(args.plot)

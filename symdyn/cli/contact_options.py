@@ -1,5 +1,6 @@
-"""simulate's options of a robot in contact with the world (--contacts, --impulse-at, --restitution,
---baumgarte, --pd) and the run they ask for (symdyn.apps.simulation.contact_simulate; docs/contacts.md)."""
+"""simulate's options of a robot in contact with the world (--contacts, --impulse-at, --stance,
+--restitution, --baumgarte, --pd) and the run they ask for (symdyn.apps.simulation.contact_simulate;
+docs/contacts.md)."""
 
 from __future__ import annotations
 
@@ -11,10 +12,10 @@ import numpy as np
 from ..errors import SymdynError
 from .common import add_contacts_argument
 
-__all__ = ["contact_arguments", "check_contact_options", "pd_torque", "CONTACT_ONLY"]
+__all__ = ["contact_arguments", "check_contact_options", "pd_torque", "stance_entries", "CONTACT_ONLY"]
 
 #: the options that apply with --contacts only
-CONTACT_ONLY = ("impulse_at", "restitution", "baumgarte", "pd")
+CONTACT_ONLY = ("impulse_at", "stance", "restitution", "baumgarte", "pd")
 
 
 def contact_arguments(s) -> None:
@@ -27,10 +28,19 @@ def contact_arguments(s) -> None:
         help="--contacts: free before T (s), then a touchdown impulse (impulse dynamics) and held",
     )
     s.add_argument(
+        "--stance",
+        nargs="+",
+        metavar="T=NAME,NAME",
+        help="--contacts: the contacts that hold from time T (s) on, the others free (T= : none); "
+        "before the first T every contact holds; a contact that starts to hold gets a touchdown "
+        "impulse",
+    )
+    s.add_argument(
         "--restitution",
         type=float,
         metavar="E",
-        help="--impulse-at: the restitution in [0, 1] (default 0: the contacts stop)",
+        help="--impulse-at, --stance: the restitution of a touchdown in [0, 1] (default 0: the "
+        "contacts stop)",
     )
     s.add_argument(
         "--baumgarte",
@@ -68,9 +78,15 @@ def check_contact_options(args: argparse.Namespace) -> None:
             raise SymdynError(
                 f"--{opt}: the gains must be finite numbers >= 0, got {' '.join(map(str, values))}"
             )
+    if args.stance is not None:
+        if args.impulse_at is not None:
+            raise SymdynError(
+                "--impulse-at and --stance exclude each other (--impulse-at T is --stance 0= T=ALL)"
+            )
+        args.stance = stance_entries(args.stance, args.duration)
     if args.restitution is not None:
-        if args.impulse_at is None:
-            raise SymdynError("--restitution applies with --impulse-at only")
+        if args.impulse_at is None and args.stance is None:
+            raise SymdynError("--restitution applies with --impulse-at or --stance only")
         if not 0.0 <= args.restitution <= 1.0:
             raise SymdynError(f"--restitution {args.restitution}: must be in [0, 1]")
     if args.impulse_at is not None and not 0.0 < args.impulse_at <= args.duration:
@@ -84,3 +100,24 @@ def pd_torque(args: argparse.Namespace, q0: np.ndarray, nv: int):
     from ..apps.simulation.contact_simulate import joint_pd
 
     return None if args.pd is None else joint_pd(q0, args.pd[0], args.pd[1], nv)
+
+
+def stance_entries(values: list[str], duration: float) -> list[tuple[float, tuple[str, ...]]]:
+    """--stance T=NAME,NAME ... as [(T, names)]: T a finite number in [0, duration], increasing;
+    the names are checked against the contacts by the simulation. SymdynError otherwise."""
+    out: list[tuple[float, tuple[str, ...]]] = []
+    for text in values:
+        time, sep, names = text.partition("=")
+        try:
+            t = float(time) if sep else math.nan
+        except ValueError:
+            t = math.nan
+        if not math.isfinite(t):
+            shown = text if len(text) <= 40 else text[:37] + "..."
+            raise SymdynError(f"--stance {shown!r}: expected T=NAME,NAME,... (T in s, a number)")
+        if not 0.0 <= t <= duration:
+            raise SymdynError(f"--stance {t:g}: the time must lie in [0, {duration:g}] s, the run's time")
+        if out and not t > out[-1][0]:
+            raise SymdynError(f"--stance: the times must increase ({t:g} s after {out[-1][0]:g} s)")
+        out.append((t, tuple(n for n in names.split(",") if n)))
+    return out

@@ -7,21 +7,21 @@ the generated C (symdyn.compile's contact_forward_dynamics):
 
 with Baumgarte's stabilisation on the right (velocity gain Kd in 1/s, position gain Kp in 1/s^2,
 default 0: the exact constraint Jc qdd + gamma = 0). e(q) is each held contact's position error
-against its anchor, the pose of its frame when the contact began to hold: a point's origin less
-the anchor's (world-aligned), a 6d frame's R^T (p - p_anchor) and log(R_anchor^T R) (its own
-axes). The generated function solves the system without the gains; their term is added here by
-linearity: with A = Jc M^-1 Jc^T + mu I over the held rows (mu = the generated damping),
+against its anchor, the pose of its frame when the contact began to hold
+(symdyn.algorithms.contact_error). With a gain not zero the generated
+contact_forward_dynamics_baumgarte solves the stabilised system (the plant needs the group
+contact_baumgarte); with both zero, contact_forward_dynamics the exact one.
 
-    lambda += dl,  qdd += M^-1 Jc^T dl,  dl = -A^-1 (Kd Jc qd + Kp e(q)).
-
-A touchdown at t_i (`impulse_at`): the contacts are free before it (the robot flies), at the first
-sample t_k >= t_i the velocity jumps by the generated impulse_dynamics with every contact held
-(restitution e, default 0: the contacts stop), then they hold to the end. The configuration is
-integrated as in symdyn.apps.simulation.floating_stepping (its schemes, on SE(3) x R^n for a
-floating base; q + h qd on a fixed one). The stepping loop runs in Python around the compiled C
-functions (one call of contact_forward_dynamics per stage, a few microseconds each): the loop of
-symdyn.apps.simulation.stepping in C does not handle the mask, the gains and the impulse.
-The contact forces at every sample are those of the constrained dynamics there.
+The stance may change (`stance`, symdyn.apps.simulation.stance): at the first sample t_k >= T of
+each change, the contacts that start to hold get the generated impulse_dynamics (the new stance
+held, restitution e, default 0: they stop) and are anchored where they are; the contacts that stop
+holding are released. A touchdown `impulse_at` T is the stance "free, then every contact from T".
+The configuration is integrated as in symdyn.apps.simulation.floating_stepping (its schemes, on
+SE(3) x R^n for a floating base; q + h qd on a fixed one). The stepping loop runs in Python
+around the compiled C functions (one call of the constrained dynamics per stage, a few
+microseconds each): the loop of symdyn.apps.simulation.stepping in C does not handle the mask,
+the anchors and the impulses. The contact forces at every sample are those of the constrained
+dynamics there.
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ import numpy as np
 from ...errors import SymdynError
 from ...model.quaternion_norm import check_quaternions, quaternion_norms
 from .floating_stepping import FLOATING_SCHEMES, floating_sizes, run_floating
+from .stance import stance_schedule
 from .stepping import sample_times, torque_rows
 from .trajectory import Trajectory
 
@@ -47,7 +48,8 @@ __all__ = [
 ]
 
 #: the damping mu of the generated KKT solve (symdyn.algorithms.contact_dynamics.DAMPING), spelled
-#: here so that a cached robot simulates without SymPy; tests/test_contact_simulate.py checks it
+#: here so that a cached robot's results can be checked without SymPy; tests/test_contact_simulate.py
+#: checks it
 DAMPING = 1e-10
 _AXES = ("fx", "fy", "fz", "mx", "my", "mz")
 
@@ -61,9 +63,9 @@ def contact_columns(contacts) -> list[str]:
 class ContactTrajectory(Trajectory):
     """A Trajectory in contact: `lam` (N, NLAMBDA) the contact forces in the rows' axes (a point's
     world-aligned force, a 6d frame's force and moment in its own axes), `active` (N, NCONTACT) the
-    mask at each sample, `impulse` (NLAMBDA,) the touchdown's (None without one) at `impulse_time`,
-    where qd jumped from `qd_before` to qd[k], `poses` (N, NCONTACT, 4, 4) the contact frames'
-    world poses."""
+    mask at each sample, `impulse` (NLAMBDA,) the first touchdown's (None without one) at
+    `impulse_time`, where qd jumped from `qd_before` to qd[k], `touchdowns` every touchdown as
+    (time, impulse, qd_before), `poses` (N, NCONTACT, 4, 4) the contact frames' world poses."""
 
     lam: np.ndarray | None = None
     active: np.ndarray | None = None
@@ -71,6 +73,7 @@ class ContactTrajectory(Trajectory):
     impulse_time: float | None = None
     poses: np.ndarray | None = None
     qd_before: np.ndarray | None = None
+    touchdowns: tuple = ()
 
     @property
     def contact_forces(self) -> np.ndarray:
@@ -115,15 +118,13 @@ def _check_number(value, name: str, low: float = 0.0, high: float = math.inf) ->
 
 
 class _Geometry:
-    """The contact frames' world poses at q (symdyn.algorithms.drawing's numeric kinematics) and
-    Baumgarte's position error against the anchors."""
+    """The contact frames' world poses at q (symdyn.algorithms.drawing's numeric kinematics)."""
 
     def __init__(self, robot, params) -> None:
         from ...algorithms.drawing import scene_function
 
         self.scene = scene_function(robot, params)
         self.names = [c.name for c in robot.contacts]
-        self.kinds = [c.kind for c in robot.contacts]
 
     def poses(self, q) -> np.ndarray:
         frames = {f.name: f for f in self.scene(q).frames if f.kind == "contact"}
@@ -132,23 +133,11 @@ class _Geometry:
             out[j, :3, :3], out[j, :3, 3], out[j, 3, 3] = frames[name].axes, frames[name].origin, 1.0
         return out
 
-    def error(self, q, anchors: np.ndarray) -> np.ndarray:
-        rows = []
-        for kind, T, A in zip(self.kinds, self.poses(q), anchors, strict=True):
-            if kind == "point":
-                rows.append(T[:3, 3] - A[:3, 3])
-            else:
-                R = T[:3, :3]
-                rows += [R.T @ (T[:3, 3] - A[:3, 3]), _log3(A[:3, :3].T @ R)]
-        return np.concatenate(rows)
 
-
-def _log3(R: np.ndarray) -> np.ndarray:
-    """The rotation vector of R (angle below pi)."""
-    c = min(1.0, max(-1.0, 0.5 * (np.trace(R) - 1.0)))
-    w = 0.5 * np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    angle = math.acos(c)
-    return w if angle < 1e-9 else w * (angle / math.sin(angle))
+def anchor_numbers(poses: np.ndarray) -> np.ndarray:
+    """The generated functions' anchor (NCONTACT * 12) of the poses (NCONTACT, 4, 4): per contact
+    its origin, then its rotation row-major."""
+    return np.concatenate([np.r_[T[:3, 3], T[:3, :3].reshape(-1)] for T in poses])
 
 
 class _FixedBase:
@@ -175,14 +164,17 @@ def simulate_contacts(
     restitution: float = 0.0,
     baumgarte: tuple[float, float] = (0.0, 0.0),
     params=None,
+    stance=None,
 ) -> ContactTrajectory:
     """Integrate the constrained dynamics of `plant` (symdyn.compile of `robot`, a Robot with
     contacts, its group `contacts` built) from (q0, qd0) over [0, duration] with step dt.
 
     tau: None, NV numbers or expressions of t, or a callable tau(t, q, qd) -> (NV,) (joint_pd).
     impulse_at: the touchdown time in (0, duration] (None: the contacts hold from t = 0);
-    restitution in [0, 1]; baumgarte: (Kp, Kd) >= 0. Raises SymdynError for bad input and when
-    the state stops being finite.
+    stance: [(T, contact names), ...], the contacts that hold from T on (symdyn.apps.simulation.
+    stance; not with impulse_at); restitution in [0, 1], of every touchdown; baumgarte: (Kp, Kd)
+    >= 0, a gain not zero needs the plant's group contact_baumgarte. Raises SymdynError for bad
+    input and when the state stops being finite.
     """
     from .simulate import initial_state, torque_function, torque_table
 
@@ -214,9 +206,11 @@ def simulate_contacts(
         _check_number(g, name)
         for g, name in zip(baumgarte, ("Baumgarte's Kp", "Baumgarte's Kd"), strict=True)
     )
-    if (kp or kd) and "mass_matrix" not in plant.functions:
+    stabilised = kp != 0.0 or kd != 0.0
+    if stabilised and "contact_forward_dynamics_baumgarte" not in plant.functions:
         raise SymdynError(
-            f"robot '{robot.name}': Baumgarte's gains need the mass_matrix function (group dynamics)"
+            f"robot '{robot.name}': Baumgarte's gains need contact_forward_dynamics_baumgarte (compile "
+            "with the group contact_baumgarte)"
         )
     sizes = floating_sizes(plant)
     nq, nv = sizes if sizes is not None else (robot.n, robot.n)
@@ -228,23 +222,29 @@ def simulate_contacts(
         check_quaternions(q, "q0")
         q[3:7] /= quaternion_norms(q)
     t, h = sample_times(duration, dt)
+    schedule = stance_schedule(robot, t, duration, stance, impulse_at)
     table = torque_table(tau, nv, torque_rows(t, h))
     torque = torque_function(tau, nv) if table is None else None
     geometry = _Geometry(robot, params)
     ncontact = len(robot.contacts)
     scheme = "euler" if integrator == "lecture" else integrator
     stepper = plant if sizes is not None else _FixedBase(plant)
-    start = 0 if impulse_at is None else int(np.searchsorted(t, impulse_at - 1e-12 * max(1.0, duration)))
-    segments = [(0, start, np.zeros(ncontact)), (start, len(h), np.ones(ncontact))]
+    gains = (kp, kd) if stabilised else None
     Q, V, U = np.empty((len(t), nq)), np.empty((len(t), nv)), np.empty((len(t), nv))
-    impulse, before, active_rows = None, None, np.zeros((len(t), ncontact))
-    anchored = np.empty((len(t), ncontact, 4, 4))
-    for first, last, active in segments:
-        if first == start and impulse_at is not None:
+    active_rows, anchored = np.zeros((len(t), ncontact)), np.empty((len(t), ncontact, 12))
+    touchdowns, held, anchors = [], np.zeros(ncontact), anchor_numbers(geometry.poses(q))
+    ends = [k for k, _ in schedule[1:]] + [len(h)]
+    for (first, active), last in zip(schedule, ends, strict=True):
+        new = (active > 0) & ~(held > 0)
+        if first > 0 and new.any():
             before = v
             v, impulse = plant.impulse_dynamics(q, v, active, np.array([e]))
-        anchors = geometry.poses(q)
-        accel = _constrained(plant, geometry, active, anchors, kp, kd)
+            touchdowns.append((float(t[first]), impulse, before))
+        if new.any():  # the contacts that start to hold are anchored where they are
+            fresh = anchor_numbers(geometry.poses(q)).reshape(ncontact, 12)
+            anchors = np.where(new[:, None], fresh, anchors.reshape(ncontact, 12)).reshape(-1)
+        held = active
+        accel = _constrained(plant, active, anchors, gains)
         offset = 3 * first
 
         def tau_at(row, tk, qk, vk, offset=offset):
@@ -260,14 +260,15 @@ def simulate_contacts(
             q, v = Qs[-1], Vs[-1]
         else:
             Q[first], V[first] = q, v
-        active_rows[first : last + 1], anchored[first : last + 1] = active, anchors
+        active_rows[first : last + 1], anchored[first : last + 1] = active, anchors.reshape(ncontact, 12)
         U[last] = tau_at(3 * (last - first), t[last], q, v)
     poses = np.array([geometry.poses(x) for x in Q])
     lam = np.empty((len(t), sum(c.rows for c in robot.contacts)))
     A = np.empty((len(t), nv))
     for k in range(len(t)):
-        accel = _constrained(plant, geometry, active_rows[k], anchored[k], kp, kd)
+        accel = _constrained(plant, active_rows[k], anchored[k].reshape(-1), gains)
         A[k], lam[k] = accel(Q[k], V[k], U[k], forces=True)
+    first = touchdowns[0] if touchdowns else (None, None, None)
     return ContactTrajectory(
         robot,
         t,
@@ -279,38 +280,33 @@ def simulate_contacts(
         qdd=A,
         lam=lam,
         active=active_rows,
-        impulse=impulse,
-        impulse_time=None if impulse_at is None else float(t[start]),
+        impulse=first[1],
+        impulse_time=first[0],
         poses=poses,
-        qd_before=before,
+        qd_before=first[2],
+        touchdowns=tuple(touchdowns),
     )
 
 
-def _constrained(plant, geometry: _Geometry, active: np.ndarray, anchors: np.ndarray, kp: float, kd: float):
-    """accel(q, v, tau, forces=False) -> qdd (and lambda): the constrained dynamics with Baumgarte's
-    term (the module docstring) when a gain is not zero."""
-    fd = plant.contact_forward_dynamics
-    rows = np.concatenate([np.full(c_rows, a > 0) for a, c_rows in zip(active, _rows(geometry), strict=True)])
-    stabilised = (kp != 0.0 or kd != 0.0) and rows.any()
+def _constrained(plant, active: np.ndarray, anchors: np.ndarray, gains: tuple[float, float] | None):
+    """accel(q, v, tau, forces=False) -> qdd (and lambda): the generated constrained dynamics, with
+    Baumgarte's term (the module docstring) when `gains` (Kp, Kd) are given."""
+    if gains is None:
+        fd = plant.contact_forward_dynamics
+
+        def solve(q, v, tau):
+            return fd(q, v, tau, active)
+    else:
+        fd, k = plant.contact_forward_dynamics_baumgarte, np.array(gains, dtype=float)
+
+        def solve(q, v, tau):
+            return fd(q, v, tau, active, anchors, k)
 
     def accel(q, v, tau, forces: bool = False):
-        qdd, lam = fd(q, v, tau, active)
-        if stabilised:
-            Jc = plant.contact_jacobian(q)[rows]
-            M = plant.mass_matrix(q)
-            rhs = kd * (Jc @ v) + kp * geometry.error(q, anchors)[rows]
-            MiJt = np.linalg.solve(M, Jc.T)
-            dl = -np.linalg.solve(Jc @ MiJt + DAMPING * np.eye(len(rhs)), rhs)
-            qdd = qdd + MiJt @ dl
-            lam = lam.copy()
-            lam[rows] += dl
+        qdd, lam = solve(q, v, tau)
         return (qdd, lam) if forces else qdd
 
     return accel
-
-
-def _rows(geometry: _Geometry) -> list[int]:
-    return [3 if k == "point" else 6 for k in geometry.kinds]
 
 
 def plot_contact_forces(traj: ContactTrajectory, path=None) -> bytes:
@@ -330,9 +326,10 @@ def plot_contact_forces(traj: ContactTrajectory, path=None) -> bytes:
         ax.set_ylabel(f"f{name} (N)")
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize="small", ncol=3)
-    if traj.impulse_time is not None:
+    changes = np.flatnonzero(np.any(np.diff(traj.active, axis=0) != 0, axis=1)) + 1  # the stance's
+    for k in changes:
         for ax in axes:
-            ax.axvline(traj.impulse_time, color="0.5", lw=0.8)
+            ax.axvline(traj.t[k], color="0.5", lw=0.8)
     axes[0].set_title(f"{traj.robot.name}: contact forces on the robot, world axes ({traj.integrator})")
     axes[-1].set_xlabel("t (s)")
     data = figure_bytes(fig, fmt)
