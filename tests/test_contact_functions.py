@@ -12,6 +12,10 @@ computeImpulseDynamicsDerivatives) and identities:
 - a redundant set on the UR5's tool0 (two point contacts and a 6d one: 12 rows for 6 joints):
   finite values (the damped solve), the same accelerations and total wrench as the 6d contact
   alone;
+- Baumgarte's functions (group contact_baumgarte) on the xArm 7 (6d) and Solo-12 (points): the
+  position error and the stabilised dynamics against the oracle's own (symdyn.oracle.
+  contact_baumgarte), gains 0 giving contact_forward_dynamics, the stabilised constraint on the
+  active rows and lam 0 on the free ones;
 - a small floating robot's derivatives (point contacts on its base and its hand, or a 6d one at
   the hand) against central differences of its own generated functions, q perturbed on the
   manifold (q (+) dq).
@@ -37,6 +41,8 @@ from symdyn.algorithms.contact_dynamics import DAMPING
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
 from symdyn.codegen import python as numpy_target
+from symdyn.oracle.contact_baumgarte import contact_error, contact_forward_dynamics_baumgarte
+from symdyn.oracle.contact_kinematics import contact_poses, contact_rows
 from symdyn.oracle.derivatives import integrate
 from symdyn.regenerate import example_robot_data_folder
 
@@ -51,13 +57,13 @@ ROBOTS = {
         "xarm_description/urdf/xarm7.urdf",
         False,
         ("link_eef:6d",),
-        ("contacts", "contact_derivatives"),
+        ("contacts", "contact_derivatives", "contact_baumgarte"),
     ),
     "solo": (
         "solo_description/robots/solo12.urdf",
         True,
         ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"),
-        ("contacts",),
+        ("contacts", "contact_baumgarte"),
     ),
     "ur5": (
         "ur_description/urdf/ur5_robot.urdf",
@@ -325,6 +331,56 @@ def test_a_redundant_set_is_solved_damped_and_finite(built):
         _close(Jc.T @ lam, Jc[6:].T @ data.lambda_c, f"{target} J^T lam", 1e-5)
         qd_plus, imp = g.call(target, "impulse_dynamics", q, q - q[::-1], [1.0, 1.0, 1.0], [0.0])
         assert np.all(np.isfinite(imp)) and np.abs(qd_plus).max() < 1e-6
+
+
+def _anchors(g: Generated, q, rng) -> np.ndarray:
+    """Anchors near the contacts' poses at q (moved by up to 2 cm, turned by up to 0.2 rad), flat."""
+    poses = contact_poses(g.robot, contact_rows(g.robot, g.robot.contacts), np.asarray(q)[None])[0]
+    out = []
+    for T in poses:
+        w = 0.1 * rng.normal(size=3)
+        K = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+        turn = np.eye(3) + np.sin(np.linalg.norm(w)) / np.linalg.norm(w) * K
+        turn += (1 - np.cos(np.linalg.norm(w))) / np.linalg.norm(w) ** 2 * K @ K  # Rodrigues
+        out.append(np.r_[T[:3, 3] + 0.01 * rng.normal(size=3), (T[:3, :3] @ turn).reshape(-1)])
+    return np.concatenate(out)
+
+
+@pytest.mark.parametrize("key, masks", [("xarm7", [(1,), (0,)]), ("solo", [(1, 1, 1, 1), (0, 1, 1, 0)])])
+def test_baumgarte_functions_agree_with_the_oracle(built, key, masks):
+    g = built(key)
+    rng = np.random.default_rng(11)
+    for target in g.targets():
+        q, v, tau = _state(g, 7)
+        anchor = _anchors(g, q, rng)
+        err = contact_error(g.robot, None, q, anchor)
+        assert 1e-4 < np.abs(err).max() < 0.3
+        _close(g.call(target, "contact_error", q, anchor)[0], err, f"{target} err", 1e-12)
+        Jc, gamma = _kinematics(g, q, v)
+        for active in masks:
+            mask, rows = np.array(active, dtype=float), _rows(g.robot.contacts, active)
+            free = np.setdiff1d(np.arange(len(gamma)), rows)
+            exact = g.call(target, "contact_forward_dynamics", q, v, tau, mask)
+            zero = g.call(target, "contact_forward_dynamics_baumgarte", q, v, tau, mask, anchor, [0.0, 0.0])
+            for got, want, name in zip(zero, exact, ("qdd", "lam"), strict=True):
+                _close(got, want, f"{target} {active} gains 0 {name}", 1e-12)
+            kp, kd = 400.0, 40.0
+            qdd, lam = g.call(target, "contact_forward_dynamics_baumgarte", q, v, tau, mask, anchor, [kp, kd])
+            want = contact_forward_dynamics_baumgarte(
+                g.robot, None, q, v, tau, mask, anchor, (kp, kd), damping=MU
+            )
+            _close(qdd, want[0], f"{target} {active} qdd")
+            _close(lam, want[1], f"{target} {active} lam")
+            assert np.all(lam[free] == 0)
+            # the stabilised constraint on the active rows (Pinocchio's Jc and gamma; mu lam: the damping)
+            lhs = (Jc @ qdd + gamma + MU * lam)[rows]
+            if len(rows):
+                _close(lhs, (-kd * Jc @ v - kp * err)[rows], f"{target} {active} constraint", 1e-9)
+            if len(rows) and len(free):  # the free rows' error changes nothing
+                moved = anchor.copy()
+                moved[12 * int(np.flatnonzero(mask == 0)[0])] += 1.0
+                again = g.call(target, "contact_forward_dynamics_baumgarte", q, v, tau, mask, moved, [kp, kd])
+                assert np.array_equal(again[0], qdd) and np.array_equal(again[1], lam)
 
 
 FLYER2 = """name: flyer2

@@ -26,6 +26,7 @@ from symdyn.algorithms.drawing import scene_function
 from symdyn.apps.simulation.contact_simulate import DAMPING, joint_pd, simulate_contacts
 from symdyn.cli.main import main
 from symdyn.errors import SymdynError
+from symdyn.oracle.contact_kinematics import contact_poses, contact_rows
 from symdyn.oracle.contacts import contact_drift, contact_jacobian, impulse_dynamics
 from symdyn.regenerate import example_robot_data_folder
 from symdyn.rnea import mass_matrix
@@ -60,7 +61,10 @@ def _positions(robot, q) -> np.ndarray:
     return np.array([next(f.origin for f in frames if f.name == c.name) for c in robot.contacts])
 
 
-def test_solo12_stands_on_its_four_feet_under_a_joint_pd_controller():
+@pytest.fixture(scope="module")
+def solo():
+    """Solo-12 with its four feet, its SRDF's standing pose and its plant (compiled once, with the
+    group contact_baumgarte: the standing and the stance tests share it)."""
     folder = example_robot_data_folder()
     if folder is None:
         pytest.skip("example-robot-data is not installed")
@@ -69,7 +73,12 @@ def test_solo12_stands_on_its_four_feet_under_a_joint_pd_controller():
     pose = next(s for s in srdf.iter("group_state") if s.get("name") == "standing")
     values = {j.get("name"): [float(x) for x in j.get("value").split()] for j in pose.iter("joint")}
     q0 = np.r_[values["root_joint"], [values[link.joint_name][0] for link in robot.links]]
-    plant = symdyn.compile(robot, functions=("configuration", "contacts"))
+    plant = symdyn.compile(robot, functions=("configuration", "contacts", "contact_baumgarte"))
+    return folder, robot, q0, plant
+
+
+def test_solo12_stands_on_its_four_feet_under_a_joint_pd_controller(solo):
+    folder, robot, q0, plant = solo
     with within(60):
         traj = simulate_contacts(
             plant, robot, q0, duration=5.0, dt=0.004, tau=joint_pd(q0, 5.0, 0.2, robot.nv)
@@ -93,6 +102,42 @@ def test_solo12_stands_on_its_four_feet_under_a_joint_pd_controller():
     assert abs(total[2] - weight) < 0.01 * weight and np.abs(total[:2]).max() < 0.01 * weight
     assert np.abs(traj.qd[-1]).max() < 1e-3  # at rest
     assert traj.lam.shape == (len(traj.t), 12) and np.all(traj.active == 1)
+
+
+def test_solo12_lifts_a_foot_and_puts_it_down(solo):
+    """--stance: four feet, then three (FL lifted by its hip), then four again with a touchdown
+    impulse; Baumgarte's gains on. The held feet stay within 1 mm, the lifted foot moves, and the
+    touchdown is the oracle's impulse, which stops the foot."""
+    _, robot, q0, plant = solo
+    hold = joint_pd(q0, 5.0, 0.2, robot.nv)
+    hip = 7  # FL_HFE's velocity row (the base's six, then FL_HAA)
+
+    def tau(t, q, v):
+        out = hold(t, q, v)
+        out[hip] += 0.3 if 0.04 <= t < 0.12 else 0.0  # lift the free foot
+        return out
+
+    three = ("FR_FOOT", "HL_FOOT", "HR_FOOT")
+    stance = [(0.04, three), (0.16, FEET)]
+    with within(20):
+        traj = simulate_contacts(
+            plant, robot, q0, duration=0.24, dt=0.002, tau=tau, stance=stance, baumgarte=(100.0, 20.0)
+        )
+    k1, k2 = 20, 80  # the samples of the changes
+    assert (
+        np.all(traj.active[:k1] == 1) and np.all(traj.active[k1:k2, 0] == 0) and np.all(traj.active[k2:] == 1)
+    )
+    feet = contact_poses(robot, contact_rows(robot, robot.contacts), traj.q)[:, :, :3, 3]  # the oracle's
+    assert np.abs(feet[:, 1:] - feet[0, 1:]).max() < 1e-3  # the held feet
+    assert np.linalg.norm(feet[k2, 0] - feet[k1, 0]) > 0.02  # the lifted one moved
+    assert np.abs(feet[k2:, 0] - feet[k2, 0]).max() < 1e-3  # and holds where it touched down
+    assert np.all(traj.lam[k1 + 1 : k2, :3] == 0)  # free while lifted
+    ((time, impulse, before),) = traj.touchdowns
+    assert time == pytest.approx(0.16) and traj.impulse_time == time
+    want_v, want_p = impulse_dynamics(robot, None, traj.q[k2], before, restitution=0.0, damping=DAMPING)
+    assert np.allclose(traj.qd[k2], want_v, atol=1e-9) and np.allclose(impulse, want_p, atol=1e-9)
+    Jc = contact_jacobian(robot, None, traj.q[k2])
+    assert np.linalg.norm(Jc[:3] @ before) > 1e-2 and np.abs(Jc @ traj.qd[k2]).max() < 1e-9
 
 
 def test_the_samples_solve_the_stabilised_kkt_system_of_the_oracle(hopper):

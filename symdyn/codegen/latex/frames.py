@@ -28,11 +28,11 @@ def frames_latex(ctx: RenderContext) -> str:
     return environment().get_template("latex/frames.tex.j2").render(blocks=blocks, frames=frames)
 
 
-def function_blocks(ctx: RenderContext, names: list[str]) -> list[dict]:
+def function_blocks(ctx: RenderContext, names: list[str], extra: dict | None = None) -> list[dict]:
     """One block per generated function of `names`: its name, doc and align rows (the
-    definitions x_k, then every output entry)."""
+    definitions x_k, then every output entry); `extra` names more input symbols (symbol -> LaTeX)."""
     dyn = ctx.dynamics
-    symbols = {}
+    symbols = dict(extra or {})
     for head, v in (("q", dyn.q), ("\\dot{q}", dyn.qd)):
         symbols.update({s: f"{head}_{{{i + 1}}}" for i, s in enumerate(v)})
     blocks = []
