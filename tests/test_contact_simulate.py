@@ -16,6 +16,7 @@ from __future__ import annotations
 import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -192,6 +193,28 @@ def test_simulate_contacts_cli_writes_forces_plot_and_animation(hopper, tmp_path
     assert "contact forces at t = 0.05 s" in capsys.readouterr().out
 
 
+def test_simulate_cli_changes_the_stance(hopper, tmp_path, capsys):
+    path, robot, _ = hopper
+    out = tmp_path / "run.csv"
+    args = ["simulate", path, "--contacts", "foot", "hand", "--duration", "0.05", "--dt", "0.01"]
+    more = [
+        "--stance",
+        "0=hand",
+        "0.02=foot,hand",
+        "0.04=",
+        "--restitution",
+        "0.5",
+        "--baumgarte",
+        "100",
+        "20",
+    ]
+    with within(60):
+        assert main([str(a) for a in [*args, *more, "--out", out]]) == 0
+    assert "touchdown at t = 0.02 s" in capsys.readouterr().out
+    rows = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.all(rows[:2, -6:-3] == 0) and np.any(rows[2:4, -6:-3] != 0) and np.all(rows[4:, -6:] == 0)
+
+
 @pytest.mark.parametrize(
     "extra, message",
     [
@@ -206,6 +229,15 @@ def test_simulate_contacts_cli_writes_forces_plot_and_animation(hopper, tmp_path
         (["--contacts", "foot", "--pd", "1", "1", "--tau", "0"], "--pd and --tau"),
         (["--impulse-at", "0.5"], "--contacts"),
         (["--contacts", "foot:7d"], "7d"),
+        (["--contacts", "foot", "--stance", "x"], "--stance 'x'"),
+        (["--contacts", "foot", "--stance", "nan=foot"], "--stance"),
+        (["--contacts", "foot", "--stance", "2=foot"], "--stance 2"),
+        (["--contacts", "foot", "--stance", "0.5=foot", "0.2="], "must increase"),
+        (["--contacts", "foot", "--stance", "0.5=nose"], "no contact is named 'nose'"),
+        (["--contacts", "foot", "--stance", "0.5=\x1b[2J"], "no contact is named"),
+        (["--contacts", "foot", "--stance", "0.51=foot", "0.55="], "changes twice"),
+        (["--contacts", "foot", "--stance", "0.5=foot", "--impulse-at", "0.5"], "exclude each other"),
+        (["--stance", "0.5=foot"], "--contacts"),
     ],
 )
 def test_simulate_refuses_bad_contact_options(hopper, tmp_path, capsys, extra, message):
@@ -236,8 +268,46 @@ def test_compiled_contact_functions_check_active_and_restitution(hopper):
         )
 
 
+def test_compiled_baumgarte_functions_check_anchor_and_gains(hopper):
+    _, robot, plant = hopper
+    q, v = Q0, np.zeros(7)
+    poses = contact_poses(robot, contact_rows(robot, robot.contacts), Q0[None])[0]
+    anchor = np.concatenate([np.r_[T[:3, 3], T[:3, :3].reshape(-1)] for T in poses])
+    flat = plant.contact_forward_dynamics_baumgarte(q, v, v, [1, 1], anchor, [10.0, 2.0])
+    shaped = plant.contact_forward_dynamics_baumgarte(q, v, v, [1, 1], anchor.reshape(2, 12), [10.0, 2.0])
+    assert all(np.array_equal(a, b) for a, b in zip(flat, shaped, strict=True))
+    assert np.abs(plant.contact_error(q, anchor)).max() < 1e-12  # at its anchors
+    scaled, mirrored, skewed = anchor.copy(), anchor.copy(), anchor.copy()
+    scaled[3:12] *= 1.001
+    mirrored[15:24] = -mirrored[15:24]  # det -1
+    skewed[4] += 1e-5
+    for bad, message in (
+        (anchor[:12], "anchor must be 2 x 12"),
+        (np.r_[anchor, 0.0], "anchor must be 2 x 12"),
+        (np.where(np.arange(24) == 5, np.nan, anchor), "not finite"),
+        (np.where(np.arange(24) == 0, np.inf, anchor), "not finite"),
+        (scaled, "contact 0 is not a rotation"),
+        (mirrored, "contact 1 is not a rotation"),
+        (skewed, "contact 0 is not a rotation"),
+        ("ab", "anchor must be"),
+        (None, "anchor must be"),
+    ):
+        for call in (
+            lambda a: plant.contact_error(q, a),
+            lambda a: plant.contact_forward_dynamics_baumgarte(q, v, v, [1, 1], a, [1.0, 1.0]),
+        ):
+            with pytest.raises(SymdynError, match=message) as info:
+                call(bad)
+            assert "\n" not in str(info.value)
+    for gains in ([-1.0, 0.0], [np.nan, 1.0], [1.0, np.inf], [1.0], [1.0, 2.0, 3.0], "ab", [[1.0, -2.0]] * 2):
+        with pytest.raises(SymdynError, match="gains") as info:
+            plant.contact_forward_dynamics_baumgarte(q, v, v, [1, 1], anchor, gains)
+        assert "\n" not in str(info.value)
+
+
 def test_simulate_contacts_refuses_bad_arguments(hopper):
     _, robot, plant = hopper
+    unstabilised = SimpleNamespace(functions=("contact_forward_dynamics", "impulse_dynamics"))
     for kwargs, message in (
         ({"baumgarte": (np.nan, 1.0)}, "Kp"),
         ({"baumgarte": (1.0, -1.0)}, "Kd"),
@@ -245,9 +315,21 @@ def test_simulate_contacts_refuses_bad_arguments(hopper):
         ({"restitution": 1.5}, "restitution"),
         ({"integrator": "rk45"}, "integrator"),
         ({"dt": 2.0}, "dt"),
+        ({"stance": "foot"}, "stance must be a non-empty list"),
+        ({"stance": []}, "stance must be a non-empty list"),
+        ({"stance": [(0.5,)]}, "stance entry 0 must be a pair"),
+        ({"stance": [(True, ["foot"])]}, "the time must be a number"),
+        ({"stance": [(0.5, "foot")]}, "a list of names"),
+        ({"stance": [(0.5, ["foot"]), (0.5, [])]}, "must increase"),
+        ({"stance": [(-0.1, ["foot"])]}, r"\[0, 1\]"),
+        ({"stance": [(0.5, [3])]}, "no contact is named 3"),
+        ({"stance": [(0.5, ["foot"])], "impulse_at": 0.5}, "not both"),
+        ({"baumgarte": (1.0, 1.0), "plant": "unstabilised"}, "contact_baumgarte"),
     ):
-        with pytest.raises(SymdynError, match=message):
-            simulate_contacts(plant, robot, Q0, **({"duration": 1.0, "dt": 0.1} | kwargs))
+        given = plant if kwargs.pop("plant", None) is None else unstabilised
+        with pytest.raises(SymdynError, match=message) as info:
+            simulate_contacts(given, robot, Q0, **({"duration": 1.0, "dt": 0.1} | kwargs))
+        assert "\n" not in str(info.value)
 
 
 def test_a_fixed_base_arm_holds_its_tip_with_rk4(tmp_path):

@@ -287,10 +287,14 @@ def _simulate_contacts(args: argparse.Namespace, params: dict) -> int:
     from ..apps.output import write_atomic
     from ..apps.simulation.contact_simulate import plot_contact_forces, simulate_contacts
     from ..apps.simulation.floating_stepping import floating_sizes, initial_configuration
+    from ..apps.simulation.stance import stance_schedule
+    from ..apps.simulation.stepping import sample_times
     from .animation import write_animation
     from .contact_options import pd_torque
 
     robot = _with_params(load_robot_argument(args), params)
+    if args.stance is not None:  # checked against the contacts before the compile
+        stance_schedule(robot, sample_times(args.duration, args.dt)[0], args.duration, args.stance)
     if any(args.baumgarte or ()):  # the stabilised dynamics are generated only when named
         groups = ("dynamics", "configuration") if robot.floating else ("dynamics",)
         plant = compile_robot(robot, functions=(*groups, "contacts", "contact_baumgarte"))
