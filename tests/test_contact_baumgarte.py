@@ -22,6 +22,7 @@ import symdyn
 from symdyn.algorithms.contact_dynamics import DAMPING
 from symdyn.cli.main import main
 from symdyn.codegen import context, render
+from symdyn.errors import SymdynError
 from symdyn.oracle.contact_baumgarte import contact_error, contact_forward_dynamics_baumgarte
 from symdyn.oracle.contact_kinematics import contact_poses, contact_rows
 
@@ -105,3 +106,27 @@ def test_the_group_is_named_only(two, tmp_path, capsys):
     assert main([*args, "--functions", "contacts", "contact_baumgarte", "--target", "c"]) == 0
     header = (tmp_path / "o" / "two_dynamics.h").read_text()
     assert "void two_contact_error(" in header and "#define two_NANCHOR (two_NCONTACT*12)" in header
+
+
+def test_the_oracle_refuses_bad_anchors_and_gains(two):
+    robot, _ = two
+    q = np.zeros(2)
+    good = np.tile(np.r_[np.zeros(3), np.eye(3).reshape(-1)], 2)
+    assert np.array_equal(
+        contact_error(robot, None, q, good), contact_error(robot, None, q, good.reshape(2, 12))
+    )
+    for anchor, message in (
+        (good[:12], "anchor must be 2 x 12"),
+        (good.reshape(4, 6), "anchor must be 2 x 12"),
+        (np.where(np.arange(24) == 3, np.nan, good), "not finite"),
+        ("ab", "anchor must hold numbers"),
+    ):
+        with pytest.raises(SymdynError, match=message):
+            contact_error(robot, None, q, anchor)
+    for gains, message in (
+        ((-1.0, 0.0), "Kp must be in"),
+        ((1.0, np.nan), "Kd must be"),
+        ((1.0,), "gains must be"),
+    ):
+        with pytest.raises(SymdynError, match=message):
+            contact_forward_dynamics_baumgarte(robot, None, q, q, q, [0, 1], good, gains)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import SymdynError
 from .contact_kinematics import ContactRows, contact_kinematics, contact_poses, contact_rows, shown
-from .contact_solve import checked_mask, checked_number, checked_state, kkt_solve
+from .contact_solve import checked_mask, checked_number, checked_state, float_array, kkt_solve
 from .rnea import mass_matrix, rnea
 
 __all__ = ["ANCHOR", "contact_error", "contact_forward_dynamics_baumgarte"]
@@ -38,12 +38,7 @@ def _rows(robot, contacts, where: str) -> ContactRows:
 def _anchors(robot, rows: ContactRows, anchor, where: str) -> np.ndarray:
     """The anchors as (NCONTACT, 12) finite numbers (given so or flat)."""
     count = len(rows.frames)
-    try:
-        a = np.asarray(anchor, dtype=float)
-    except (TypeError, ValueError):
-        raise SymdynError(
-            f"{where}: robot '{robot.name}': anchor must hold numbers, got {shown(anchor)}"
-        ) from None
+    a = float_array(robot, anchor, "anchor", where)
     if a.size != ANCHOR * count or a.ndim not in (1, 2) or (a.ndim == 2 and a.shape != (count, ANCHOR)):
         raise SymdynError(
             f"{where}: robot '{robot.name}': anchor must be {count} x {ANCHOR} numbers, got shape {a.shape}"

@@ -22,6 +22,7 @@ __all__ = [
     "checked_state",
     "checked_mask",
     "checked_number",
+    "float_array",
     "kkt_solve",
     "constrained",
     "impulse",
@@ -48,17 +49,22 @@ def checked_state(where: str, robot, params, **vectors) -> list[np.ndarray]:
     return [a[0] for a in out]
 
 
+def float_array(robot, value, name: str, where: str) -> np.ndarray:
+    """`value` as an array of floats, or SymdynError: `name` must hold numbers."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise SymdynError(
+            f"{where}: robot '{robot.name}': {name} must hold numbers, got {shown(value)}"
+        ) from None
+
+
 def checked_mask(robot, rows: ContactRows, active, where: str) -> np.ndarray:
     """The mask as NCONTACT booleans (None: every contact active)."""
     count = len(rows.frames)
     if active is None:
         return np.ones(count, dtype=bool)
-    try:
-        a = np.asarray(active, dtype=float)
-    except (TypeError, ValueError):
-        raise SymdynError(
-            f"{where}: robot '{robot.name}': active must hold numbers, got {shown(active)}"
-        ) from None
+    a = float_array(robot, active, "active", where)
     if a.shape != (count,) or not np.all((a == 0) | (a == 1)):
         raise SymdynError(
             f"{where}: robot '{robot.name}': active must be {count} entries of 0 or 1 (one per contact), "
