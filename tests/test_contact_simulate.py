@@ -64,8 +64,8 @@ def _positions(robot, q) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def solo():
-    """Solo-12 with its four feet, its SRDF's standing pose and its plant (compiled once, with the
-    group contact_baumgarte: the standing and the stance tests share it)."""
+    """Solo-12 with its four feet, its SRDF's standing pose and its plant (compiled once: the
+    standing and the stance tests share it)."""
     folder = example_robot_data_folder()
     if folder is None:
         pytest.skip("example-robot-data is not installed")
@@ -74,7 +74,7 @@ def solo():
     pose = next(s for s in srdf.iter("group_state") if s.get("name") == "standing")
     values = {j.get("name"): [float(x) for x in j.get("value").split()] for j in pose.iter("joint")}
     q0 = np.r_[values["root_joint"], [values[link.joint_name][0] for link in robot.links]]
-    plant = symdyn.compile(robot, functions=("configuration", "contacts", "contact_baumgarte"))
+    plant = symdyn.compile(robot, functions=("configuration", "contacts"))
     return folder, robot, q0, plant
 
 
@@ -107,7 +107,7 @@ def test_solo12_stands_on_its_four_feet_under_a_joint_pd_controller(solo):
 
 def test_solo12_lifts_a_foot_and_puts_it_down(solo):
     """--stance: four feet, then three (FL lifted by its hip), then four again with a touchdown
-    impulse; Baumgarte's gains on. The held feet stay within 1 mm, the lifted foot moves, and the
+    impulse. The held feet stay within 1 mm, the lifted foot moves, and the
     touchdown is the oracle's impulse, which stops the foot."""
     _, robot, q0, plant = solo
     hold = joint_pd(q0, 5.0, 0.2, robot.nv)
@@ -121,9 +121,7 @@ def test_solo12_lifts_a_foot_and_puts_it_down(solo):
     three = ("FR_FOOT", "HL_FOOT", "HR_FOOT")
     stance = [(0.04, three), (0.16, FEET)]
     with within(20):
-        traj = simulate_contacts(
-            plant, robot, q0, duration=0.24, dt=0.002, tau=tau, stance=stance, baumgarte=(100.0, 20.0)
-        )
+        traj = simulate_contacts(plant, robot, q0, duration=0.24, dt=0.002, tau=tau, stance=stance)
     k1, k2 = 20, 80  # the samples of the changes
     assert (
         np.all(traj.active[:k1] == 1) and np.all(traj.active[k1:k2, 0] == 0) and np.all(traj.active[k2:] == 1)
