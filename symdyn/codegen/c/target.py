@@ -168,7 +168,9 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         "body": body,
         "parts": parts,
         # with parts, the function itself reads only the inputs of its angles (symdyn.codegen.c.parts)
-        "angle_reads": reads_in(sincos["angles"], reads) if parts and sincos and not sincos["pointer"] else [],
+        "angle_reads": (
+            reads_in(sincos["angles"], reads) if parts and sincos and not sincos["pointer"] else []
+        ),
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
