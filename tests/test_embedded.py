@@ -353,3 +353,64 @@ def test_inverse_dynamics_is_branch_free_and_its_count_is_qemus(rendered, tmp_pa
     calls = {"inverse_dynamics": "panda_inverse_dynamics(in, in + 7, in + 14, NULL, out)"}
     measured = instructions(folder, objects, "panda_dynamics.h", calls, x, tmp_path / "t")
     assert abs(measured["inverse_dynamics"] - count) <= COUNT_MARGIN, (count, measured)
+
+
+# --------------------------------------------------------------------------- --precision both
+
+APP_BOTH = r"""
+#include <stdio.h>
+#include "roger_arm_values_dynamics.h"
+int main(void)
+{
+    const roger_arm_values_real q[2] = {(roger_arm_values_real)0.3, (roger_arm_values_real)-0.7};
+    roger_arm_values_real M[4];
+    roger_arm_values_mass_matrix(q, NULL, M);
+    printf("%d %.17g %.17g %.17g %.17g\n", (int)sizeof M[0], (double)M[0], (double)M[1], (double)M[2],
+           (double)M[3]);
+    return 0;
+}
+"""
+
+
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="cmake is not installed")
+def test_cmake_switches_the_precision(tmp_path):
+    """--precision both: one set of files that CMake's NAME_PRECISION compiles in float or in
+    double (host gcc, the strict flags with -Wdouble-promotion and -Wconversion), each M the
+    oracle's to its precision; the float build also cross-compiles for the M4F with the embedded
+    flags and no double arithmetic."""
+    robot = _robot_file("roger_arm_values")
+    symdyn.generate(robot, targets=("c",), out_dir=tmp_path / "dyn", precision="both")
+    (tmp_path / "main.c").write_text(APP_BOTH)
+    (tmp_path / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.13)\nproject(app C)\nadd_subdirectory(dyn)\n"
+        "add_executable(app main.c)\ntarget_link_libraries(app PRIVATE roger_arm_values_dynamics)\n"
+    )
+    flags = "-DCMAKE_C_FLAGS=" + " ".join((*STRICT_FLAGS[1:], "-Wdouble-promotion", "-Wconversion"))
+    want = mass_matrix(robot, [0.3, -0.7]).ravel()
+    for precision, size, rtol in (("float", 4, 1e-6), ("double", 8, 1e-13)):
+        build = tmp_path / precision
+        define = f"-Droger_arm_values_PRECISION={precision}"
+        subprocess.run(
+            ["cmake", "-S", str(tmp_path), "-B", str(build), flags, define], check=True, capture_output=True
+        )
+        proc = subprocess.run(["cmake", "--build", str(build)], capture_output=True, text=True)
+        assert proc.returncode == 0 and "warning" not in proc.stdout + proc.stderr, proc.stdout + proc.stderr
+        out = subprocess.run([str(build / "app")], check=True, capture_output=True, text=True).stdout.split()
+        assert int(out[0]) == size
+        np.testing.assert_allclose(np.array(out[1:], dtype=float), want, rtol=rtol)
+    objects = cross_compile(
+        tmp_path / "dyn", "m4f", "-Os", tmp_path / "arm", extra=("-Droger_arm_values_USE_FLOAT",)
+    )
+    _check_object(objects, "float")
+    wrong = ["cmake", "-S", str(tmp_path), "-B", str(tmp_path / "b2"), "-Droger_arm_values_PRECISION=half"]
+    proc = subprocess.run(wrong, capture_output=True, text=True)
+    assert proc.returncode != 0 and "float or double" in proc.stderr
+
+
+def test_precision_both_is_the_c_targets(capsys, tmp_path):
+    """--precision both with another target than C is one line of error and no file."""
+    robot = Path(__file__).resolve().parents[1] / "examples" / "roger_arm.yaml"
+    for targets in (("--target", "casadi"), ()):
+        line = refused(capsys, "generate", robot, *targets, "--precision", "both", "--out", tmp_path / "a")
+        assert "--precision both" in line and "--target c" in line
+    assert not (tmp_path / "a").exists()

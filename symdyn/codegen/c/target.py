@@ -328,16 +328,18 @@ def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
     return list(sizes.values())
 
 
-def render(ctx: RenderContext) -> dict[str, str]:
+def render(ctx: RenderContext, groups: list[list[int]] | None = None) -> dict[str, str]:
     """NAME_dynamics.h, NAME_dynamics.c and CMakeLists.txt (a static library of every .c file
     written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`; a
     large robot's functions go into NAME_dynamics.c, NAME_dynamics_2.c, ...
-    (symdyn.codegen.c.parts.file_groups decides)."""
+    (symdyn.codegen.c.parts.file_groups decides, unless `groups` gives the functions of each file:
+    symdyn.codegen.c.both renders both precisions into the same files)."""
     values = render_context(ctx)
     env = environment()
     files = {values["header_file"]: env.get_template("c/dynamics.h.j2").render(values)}
     functions = values["functions"]
-    groups = file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
+    if groups is None:
+        groups = file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
     for k, group in enumerate(groups):
         chosen = [functions[i] for i in group]
         files[source_file_name(ctx.name, k)] = env.get_template("c/dynamics.c.j2").render(
@@ -348,5 +350,13 @@ def render(ctx: RenderContext) -> dict[str, str]:
             loops=values["loops"] if k == 0 else None,
         )
     sources = sorted(name for name in files if name.endswith(".c"))
-    files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render({**values, "sources": sources})
+    files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render(
+        {**values, "sources": sources, "switch": None}
+    )
     return files
+
+
+def file_groups_of(ctx: RenderContext) -> list[list[int]]:
+    """The functions of each source file `render` writes for `ctx` (indices into ctx.functions)."""
+    functions = render_context(ctx)["functions"]
+    return file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
