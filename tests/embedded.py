@@ -469,23 +469,51 @@ def static_count(obj: str | os.PathLike, function: str) -> tuple[int, list[str],
     return len(code) - len(skipped), callees, broken
 
 
+def _target(ins: Instruction) -> int | None:
+    """The address a branch goes to."""
+    m = re.match(r"([0-9a-f]+)", ins.operands)
+    return int(m.group(1), 16) if m else None
+
+
 def loop_count(obj: str | os.PathLike, function: str, trips: int) -> int:
-    """The instructions one call of `function` runs when its one loop (a backward conditional
-    branch) goes round `trips` times and no forward branch is taken (the freestanding NAME_sincos
-    of n >= 1 angles: `trips` = n)."""
+    """The instructions one call of `function` runs when its one loop (the one branch back, taken
+    or fallen through at its end: the freestanding NAME_sincos over n >= 1 angles, `trips` = n)
+    runs `trips` times: the length of the paths through its code from its entry to its return
+    that pass the branch back `trips` times (every conditional branch both ways; they must
+    agree). A function with no branch back (an unrolled loop) is straight-line code."""
     code = disassembly(obj, function)
-    back = [
-        (k, int(m.group(1), 16))
-        for k, ins in enumerate(code)
-        if _branch_kind(ins) == "conditional"
-        and (m := re.match(r"([0-9a-f]+)", ins.operands))
-        and int(m.group(1), 16) <= ins.address
-    ]
+    where = {ins.address: k for k, ins in enumerate(code)}
+    branches = {k for k, ins in enumerate(code) if _branch_kind(ins) in ("conditional", "jump")}
+    back = [k for k in branches if (_target(code[k]) or 0) <= code[k].address]
+    if not back:
+        count, _, broken = static_count(obj, function)
+        if broken:
+            raise RuntimeError(f"{function}: no loop, and branches {broken}")
+        return count
     if len(back) != 1:
-        raise RuntimeError(f"{function}: {len(back)} backward branches, one loop expected")
-    end, start = back[0]
-    body = sum(1 for ins in code[: end + 1] if ins.address >= start)
-    return len(code) - body + trips * body
+        raise RuntimeError(f"{function}: {len(back)} branches back, one loop expected")
+    lengths, paths = set(), [(0, 0, 0)]  # (instruction, times past the branch back, instructions run)
+    while paths:
+        k, passed, run = paths.pop()
+        while passed <= trips:
+            ins, run = code[k], run + 1
+            passed += k == back[0]
+            kind = _branch_kind(ins)
+            if kind == "return":
+                if passed == trips:
+                    lengths.add(run)
+                break
+            if k in branches:
+                if _target(ins) not in where:
+                    raise RuntimeError(f"{function}: a branch out of the function at {ins.address:x}")
+                if kind == "conditional":
+                    paths.append((k + 1, passed, run))
+                k = where[_target(ins)]
+                continue
+            k += 1
+    if len(lengths) != 1:
+        raise RuntimeError(f"{function}: {sorted(lengths)} instructions by different paths")
+    return lengths.pop()
 
 
 def timing_source(header: str, calls: dict[str, str], nin: int, prelude: str = "") -> str:
