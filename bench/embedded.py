@@ -173,7 +173,7 @@ def static_total(obj: Path, folder: Path, name: str, f: str, trig: dict[str, int
     c_name = f"{name}_{f}"
     count, callees, broken = static_count(obj, c_name)
     if broken:
-        return None, f"branches: {', '.join(broken)}"
+        return None, f"not branch-free: {len(broken)} branch{'es' * (len(broken) > 1)}"
     text = _function_text(folder, c_name)
     local = dict(re.findall(r"const float (\w+) = q\[(\d+)\];", text))
     libm = [(c, local.get(a)) for c, a in re.findall(r"\b(sinf|cosf)\((\w+)\)", text)]
@@ -187,7 +187,7 @@ def static_total(obj: Path, folder: Path, name: str, f: str, trig: dict[str, int
             libm.remove((callee, matching[0]))
             count += trig[f"{callee}{matching[0]}"]
         else:
-            return None, f"a call of {callee}"
+            return None, f"calls {callee}"
     return count, ""
 
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 import shutil
 import subprocess
 import warnings
@@ -414,3 +415,16 @@ def test_precision_both_is_the_c_targets(capsys, tmp_path):
         line = refused(capsys, "generate", robot, *targets, "--precision", "both", "--out", tmp_path / "a")
         assert "--precision both" in line and "--target c" in line
     assert not (tmp_path / "a").exists()
+
+
+def test_precision_both_macros_are_no_parameters_name(tmp_path):
+    """A free parameter named as a macro of --precision both (NAME_real, NAME_USE_FLOAT) gets
+    another local name, so that the macro cannot replace it: the files compile in float and double."""
+    text = (Path(__file__).resolve().parents[1] / "examples" / "roger_arm.yaml").read_text()
+    text = re.sub(r"\bg\b", "roger_arm_real", re.sub(r"\bm1\b", "roger_arm_USE_FLOAT", text))
+    (tmp_path / "roger_arm.yaml").write_text(text)
+    symdyn.generate(tmp_path / "roger_arm.yaml", targets=("c",), out_dir=tmp_path / "dyn", precision="both")
+    source = (tmp_path / "dyn" / "roger_arm_dynamics.c").read_text()
+    assert "const float roger_arm_real " not in source and "const float roger_arm_real_ " in source
+    for define in ((), ("-Droger_arm_USE_FLOAT",)):
+        cross_compile(tmp_path / "dyn", "m4f", "-Os", tmp_path / "o", extra=define)  # a warning fails
