@@ -437,7 +437,11 @@ def _branch_kind(ins: Instruction) -> str:
     base = ins.mnemonic.split(".")[0]
     if base in ("bl", "blx"):
         return "call"
-    if (base == "bx" and ins.operands == "lr") or (base == "pop" and "pc" in ins.operands):
+    if (
+        (base == "bx" and ins.operands == "lr")
+        or (base == "pop" and "pc" in ins.operands)
+        or (base == "ldr" and ins.operands.startswith("pc, [sp]"))  # pop {pc} of one register
+    ):
         return "return"
     if base in ("cbz", "cbnz") or (base[:1] == "b" and base[1:] in _CONDITIONS):
         return "conditional"
