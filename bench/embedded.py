@@ -54,15 +54,16 @@ from embedded import (  # noqa: E402
     CC,
     CPUS,
     FUNCTIONS,
-    LINKER_SCRIPT,
     QEMU,
-    STARTUP,
     cross_compile,
     host_results,
+    instructions,
     link_harness,
+    loop_count,
     random_states,
     relative_errors,
     run_harness,
+    static_count,
 )
 
 import symdyn  # noqa: E402
@@ -72,9 +73,11 @@ from symdyn.regenerate import example_robot_data_folder  # noqa: E402
 
 RESULTS = BENCH / "results" / "embedded.md"
 CPU = "m4f"
+#: the builds measured: the -O level and the flags added to it, the same for symdyn's C and the
+#: CasADi route's; -ffp-contract=fast lets gcc fuse a*b + c into one vfma (C99 mode's default is
+#: off), which the Cortex-M4F's FPU has
 OPTS = ("-Os", "-O2")
-#: -icount shift: 2^7 ns of virtual time per instruction (the SysTick runs at 25 MHz: 3.2 ticks each)
-SHIFT = 7
+CONTRACT = ("-ffp-contract=fast",)
 CASADI_FUNCTIONS = ("inverse_dynamics", "mass_matrix", "gravity")
 
 
@@ -88,10 +91,14 @@ def load(name: str) -> symdyn.Robot:
         return symdyn.load_robot(BENCH.parent / "examples" / f"{name}.yaml")
 
 
-def float_errors(robot: symdyn.Robot, folder: Path, name: str, build: Path, k: int) -> dict[str, tuple]:
-    """function -> (max, 99th percentile) of the float error over k states, and cond(M)."""
-    objects = cross_compile(folder, CPU, "-Os", build / "err")
-    elf = link_harness(folder, objects, CPU, name, "float", robot.nq, robot.nv, build / "err")
+def float_errors(
+    robot: symdyn.Robot, folder: Path, name: str, build: Path, k: int, extra: tuple[str, ...] = ()
+) -> dict[str, tuple]:
+    """function -> (max, 99th percentile) of the float error over k states, and cond(M) (at -Os,
+    with the `extra` flags)."""
+    out = build / f"err{len(extra)}"
+    objects = cross_compile(folder, CPU, "-Os", out, extra=extra)
+    elf = link_harness(folder, objects, CPU, name, "float", robot.nq, robot.nv, out)
     x = random_states(robot, k)
     got = run_harness(elf, CPU, x, "float", robot.nv, seconds=3600)
     want = host_results(robot, x)
@@ -140,97 +147,48 @@ def stack_usage(folder: Path) -> dict[str, int]:
     return usage
 
 
-def _timing_main(header: str, calls: dict[str, str], nin: int) -> str:
-    """main.c that times each call (SysTick under -icount) on in.bin's first state, after 10,000 nops
-    and an empty window for calibration, and writes the tick counts to ticks.bin."""
-    body = []
-    for fname, call in calls.items():
-        body.append(
-            f"    SYST_CVR = 0; (void)SYST_CVR; a = SYST_CVR; {call}; b = SYST_CVR;"
-            f" ticks[n++] = a - b; /* {fname} */"
-        )
-    return f"""\
-#include <fcntl.h>
-#include <stddef.h>
-#include <unistd.h>
-#include "{header}"
-#define SYST_CSR (*(volatile unsigned int *)0xE000E010u)
-#define SYST_RVR (*(volatile unsigned int *)0xE000E014u)
-#define SYST_CVR (*(volatile unsigned int *)0xE000E018u)
-static float in[{nin}];
-static float out[4096];
-static unsigned int ticks[64];
-__attribute__((noinline)) static void nops(void) {{ __asm__ volatile(".rept 10000\\n\\tnop\\n\\t.endr"); }}
-__attribute__((noinline)) static void empty(void) {{ __asm__ volatile(""); }}
-int main(void)
-{{
-    unsigned int a, b;
-    int n = 0, fd = open("in.bin", O_RDONLY);
-    if (fd < 0 || read(fd, in, sizeof in) != (int)sizeof in) {{
-        return 1;
-    }}
-    close(fd);
-    SYST_RVR = 0xFFFFFFu;
-    SYST_CSR = 5u;
-    SYST_CVR = 0; (void)SYST_CVR; a = SYST_CVR; nops(); b = SYST_CVR; ticks[n++] = a - b;
-    SYST_CVR = 0; (void)SYST_CVR; a = SYST_CVR; empty(); b = SYST_CVR; ticks[n++] = a - b;
-{chr(10).join(body)}
-    fd = open("ticks.bin", O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd < 0 || write(fd, ticks, sizeof(unsigned int) * (unsigned int)n) < 0) {{
-        return 1;
-    }}
-    close(fd);
-    return 0;
-}}
+#: timed beside the functions: newlib's sinf and cosf of each q, and a call of the same shape
+#: that runs one instruction (its return), to take the harness's part out of their counts
+TRIG_PRELUDE = """\
+#include <math.h>
+static volatile float sink;
+__attribute__((noinline)) static float ident(float x) { __asm__ volatile("" : "+t"(x)); return x; }
 """
 
 
-def instructions(
-    folder: Path, objects: list[Path], header: str, calls: dict[str, str], x: np.ndarray, build: Path
-) -> dict:
-    """function -> instructions of one call at the state x (SysTick ticks under -icount, calibrated)."""
-    build.mkdir(parents=True, exist_ok=True)
-    (build / "startup.c").write_text(STARTUP)
-    (build / "link.ld").write_text(LINKER_SCRIPT)
-    (build / "main.c").write_text(_timing_main(header, calls, x.size))
-    elf = build / "timing.elf"
-    cmd = [
-        CC,
-        "-std=c99",
-        *CPUS[CPU][1],
-        "-O2",
-        f"-I{folder}",
-        "--specs=rdimon.specs",
-        "-T",
-        str(build / "link.ld"),
-    ]
-    subprocess.run(
-        [*cmd, str(build / "startup.c"), str(build / "main.c"), *map(str, objects), "-lm", "-o", str(elf)],
-        check=True,
-    )
-    with tempfile.TemporaryDirectory() as tmp:
-        np.asarray(x, dtype=np.float32).tofile(Path(tmp) / "in.bin")
-        qemu = [
-            QEMU,
-            "-M",
-            CPUS[CPU][0],
-            "-nographic",
-            "-monitor",
-            "none",
-            "-serial",
-            "none",
-            "-icount",
-            f"shift={SHIFT}",
-        ]
-        subprocess.run(
-            [*qemu, "-semihosting-config", "enable=on,target=native", "-kernel", str(elf)],
-            cwd=tmp,
-            check=True,
-            timeout=600,
-        )
-        ticks = np.fromfile(Path(tmp) / "ticks.bin", dtype=np.uint32).astype(float)
-    per_insn = (ticks[0] - ticks[1]) / 10000.0
-    return {f: round((t - ticks[1]) / per_insn) for f, t in zip(calls, ticks[2:], strict=True)}
+def _function_text(folder: Path, c_name: str) -> str:
+    """The body of a generated function in the folder's C files."""
+    for source in sorted(folder.glob("*.c")):
+        m = re.search(rf"\nvoid {c_name}\(.*?\n\}}\n", source.read_text(), re.S)
+        if m:
+            return m.group(0)
+    raise KeyError(c_name)
+
+
+def static_total(obj: Path, folder: Path, name: str, f: str, trig: dict[str, int]) -> tuple[int | None, str]:
+    """The static count of one call of NAME_f: its own instructions (branch-free: each runs once)
+    plus its calls' instructions, NAME_sincos's from its disassembly (its one loop n times) and
+    newlib's sinf and cosf as measured once at the same angle (`trig`: "sinf3" -> count); and
+    a note naming what breaks the count (a branch, a call it cannot price), else ""."""
+    c_name = f"{name}_{f}"
+    count, callees, broken = static_count(obj, c_name)
+    if broken:
+        return None, f"not branch-free: {len(broken)} branch{'es' * (len(broken) > 1)}"
+    text = _function_text(folder, c_name)
+    local = dict(re.findall(r"const float (\w+) = q\[(\d+)\];", text))
+    libm = [(c, local.get(a)) for c, a in re.findall(r"\b(sinf|cosf)\((\w+)\)", text)]
+    for callee in callees:
+        if callee.startswith(f"{name}_sincos"):
+            count += loop_count(obj, callee, int(re.search(rf"{name}_sincos\((\d+),", text).group(1)))
+        elif callee in ("sinf", "cosf"):
+            matching = [k for c, k in libm if c == callee and k is not None]
+            if not matching:
+                return None, f"a call of {callee} at an angle that is no q"
+            libm.remove((callee, matching[0]))
+            count += trig[f"{callee}{matching[0]}"]
+        else:
+            return None, f"calls {callee}"
+    return count, ""
 
 
 def symdyn_row(robot, ctx, freestanding: bool, opt: str, build: Path, x: np.ndarray) -> dict:
@@ -244,17 +202,35 @@ def symdyn_row(robot, ctx, freestanding: bool, opt: str, build: Path, x: np.ndar
             c_backend.render(dataclasses.replace(ctx, precision="float", freestanding=freestanding)), folder
         )
     name = ctx.name
-    objects = cross_compile(folder, CPU, opt, build / f"o{opt}{freestanding}", extra=("-fstack-usage",))
+    level, *more = opt.split()
+    tag = f"{opt.replace(' ', '').replace('=', '')}{freestanding}"
+    objects = cross_compile(folder, CPU, level, build / f"o{tag}", extra=(*more, "-fstack-usage"))
     sizes = symbol_sizes(objects[0])
     helper = sizes.get(f"{name}_sincos", 0)
-    stack = stack_usage(build / f"o{opt}{freestanding}")
+    stack = stack_usage(build / f"o{tag}")
     calls = {f: f"{name}_{f}({_args(args, robot)}, out)" for f, (args, _) in FUNCTIONS.items()}
-    counts = instructions(folder, objects, f"{name}_dynamics.h", calls, x, build / f"t{opt}{freestanding}")
+    for k in range(robot.nq):
+        # the volatile asm statements pin each call inside its window (gcc may otherwise move a
+        # call of sinf, which only sets errno, across the SysTick reads)
+        calls |= {
+            f"{t}{k}": f'{{ float v = in[{k}]; __asm__ volatile("" : "+t"(v)); v = {t}(v); '
+            f'__asm__ volatile("" : "+t"(v)); sink = v; }}'
+            for t in ("sinf", "cosf", "ident")
+        }
+    counts = instructions(
+        folder, objects, f"{name}_dynamics.h", calls, x, build / f"t{tag}", CPU, TRIG_PRELUDE
+    )
+    trig = {
+        f"{t}{k}": counts[f"{t}{k}"] - counts[f"ident{k}"] + 1
+        for t in ("sinf", "cosf")
+        for k in range(robot.nq)
+    }
     return {
         "flash": {f: sizes[f"{name}_{f}"] + helper for f in FUNCTIONS},
         "file": section_size(objects),
         "stack": {f: stack.get(f"{name}_{f}", -1) for f in FUNCTIONS},
-        "insns": counts,
+        "insns": {f: counts[f] for f in FUNCTIONS},
+        "static": {f: static_total(objects[0], folder, name, f, trig) for f in FUNCTIONS},
     }
 
 
@@ -279,11 +255,12 @@ def casadi_row(robot, opt: str, build: Path, x: np.ndarray) -> dict:
         path = folder / f"cr_{f}.c"
         text = re.sub(r"\b(sin|cos)\(", r"\1f(", path.read_text())
         path.write_text(text)
-    flags = ("-std=c99", *CPUS[CPU][1], opt, "-fstack-usage")
+    flags = ("-std=c99", *CPUS[CPU][1], *opt.split(), "-fstack-usage")
+    tag = opt.replace(" ", "").replace("=", "")
     row = {"flash": {}, "stack": {}, "insns": {}}
     objects = []
     for f in fns:
-        obj = build / f"cr_{f}{opt}.o"
+        obj = build / f"cr_{f}{tag}.o"
         subprocess.run(
             [CC, *flags, "-c", str(folder / f"cr_{f}.c"), "-o", str(obj)], check=True, capture_output=True
         )
@@ -302,8 +279,33 @@ def casadi_row(robot, opt: str, build: Path, x: np.ndarray) -> dict:
         )
     headers = "".join(f'#include "cr_{f}.h"\n' for f in fns)
     (folder / "cr_all.h").write_text(headers)
-    row["insns"] = instructions(folder, objects, "cr_all.h", calls, x[: 3 * n + n], build / f"tc{opt}")
+    row["insns"] = instructions(folder, objects, "cr_all.h", calls, x[: 3 * n + n], build / f"tc{tag}")
     return row
+
+
+def _static_cells(static: tuple[int | None, str], measured: int) -> str:
+    """static | QEMU | difference, or the reason there is no static count."""
+    count, note = static
+    if count is None:
+        return f"({note}) | {measured} | "
+    return f"{count} | {measured} | {measured - count:+d}"
+
+
+def _goal_lines(opt: str, libm: dict, free: dict, cas: dict) -> list[str]:
+    """The Panda's goals of issue 38 at one build: instructions against the CasADi route, flash."""
+    lines = []
+    for f in ("inverse_dynamics", "mass_matrix"):
+        c = cas["insns"][f]
+        ratio = {k: row["insns"][f] / c for k, row in (("libm", libm), ("free", free))}
+        verdict = {k: "holds" if r <= 0.5 else "MISSED" for k, r in ratio.items()}
+        lines.append(
+            f"- Panda {f} {opt}: CasADi {c} instructions; symdyn {libm['insns'][f]} with "
+            f"newlib's sinf and cosf as CasADi's (ratio {ratio['libm']:.3f}, goal <= 0.5: "
+            f"{verdict['libm']}), {free['insns'][f]} freestanding (ratio {ratio['free']:.3f}: "
+            f"{verdict['free']}); flash {libm['flash'][f]} B against {cas['flash'][f]} B "
+            f"({'holds' if libm['flash'][f] <= cas['flash'][f] else 'MISSED'})"
+        )
+    return lines
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -332,7 +334,7 @@ def main(argv: list[str] | None = None) -> int:
         "| CasADi flash B | CasADi instructions | float error max | p99 | cond(M) median / max |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|",
     ]
-    goals = []
+    goals, static_lines, contract_lines = [], [], []
     with tempfile.TemporaryDirectory(prefix="symdyn-embedded-bench-") as tmp:
         for rname in args.robots:
             robot = load(rname)
@@ -346,7 +348,8 @@ def main(argv: list[str] | None = None) -> int:
 
             write_files(c_backend.render(dataclasses.replace(ctx, precision="float")), err_folder)
             errors = float_errors(robot, err_folder, ctx.name, build, args.states)
-            for opt in OPTS if (args.all_opts or not robot.floating) else ("-Os",):
+            opts = OPTS if (args.all_opts or not robot.floating) else ("-Os",)
+            for opt in opts:
                 libm = symdyn_row(robot, ctx, False, opt, build, x)
                 free = symdyn_row(robot, ctx, True, opt, build, x)
                 cas = None if robot.floating else casadi_row(robot, opt, build, x)
@@ -364,26 +367,56 @@ def main(argv: list[str] | None = None) -> int:
                         f"{libm['stack'][f]} | {libm['insns'][f]} / {free['insns'][f]} | {cf} | {ci} | "
                         f"{e[0]:.2g} | {e[1]:.2g} | {cond} |"
                     )
+                    static_lines.append(
+                        f"| {rname} | {f} | {opt} | "
+                        + " | ".join(_static_cells(row["static"][f], row["insns"][f]) for row in (libm, free))
+                        + " |"
+                    )
                 if rname == "panda" and cas:
-                    for f in ("inverse_dynamics", "mass_matrix"):
-                        c = cas["insns"][f]
-                        ratio = {k: row["insns"][f] / c for k, row in (("libm", libm), ("free", free))}
-                        verdict = {k: "holds" if r <= 0.5 else "MISSED" for k, r in ratio.items()}
-                        goals.append(
-                            f"- Panda {f} {opt}: CasADi {c} instructions; symdyn {libm['insns'][f]} with "
-                            f"newlib's sinf and cosf as CasADi's (ratio {ratio['libm']:.2f}, goal <= 0.5: "
-                            f"{verdict['libm']}), {free['insns'][f]} freestanding "
-                            f"(ratio {ratio['free']:.2f}: "
-                            f"{verdict['free']}); flash {libm['flash'][f]} B against {cas['flash'][f]} B "
-                            f"({'holds' if libm['flash'][f] <= cas['flash'][f] else 'MISSED'})"
-                        )
+                    goals += _goal_lines(opt, libm, free, cas)
+            if robot.floating:
+                continue
+            for opt in (f"{o} {' '.join(CONTRACT)}" for o in opts):
+                libm = symdyn_row(robot, ctx, False, opt, build, x)
+                free = symdyn_row(robot, ctx, True, opt, build, x)
+                cas = casadi_row(robot, opt, build, x)
+                for f in CASADI_FUNCTIONS:
+                    c = cas["insns"][f]
+                    contract_lines.append(
+                        f"| {rname} | {f} | {opt} | {libm['insns'][f]} / {free['insns'][f]} | {c} | "
+                        f"{libm['insns'][f] / c:.3f} / {free['insns'][f] / c:.3f} |"
+                    )
+                if rname == "panda":
+                    goals += _goal_lines(opt, libm, free, cas)
             if rname == "panda":
                 p99 = errors["inverse_dynamics"][1]
+                fused = float_errors(robot, err_folder, ctx.name, build, args.states, CONTRACT)
                 goals.append(
-                    f"- Panda inverse dynamics float error p99 {p99:.2g} "
-                    f"(goal <= 1e-5: {'holds' if p99 <= 1e-5 else 'MISSED'})"
+                    f"- Panda inverse dynamics float error p99 {p99:.2g} (goal <= 1e-5: "
+                    f"{'holds' if p99 <= 1e-5 else 'MISSED'}); {fused['inverse_dynamics'][1]:.2g} built "
+                    f"with {' '.join(CONTRACT)} (max {fused['inverse_dynamics'][0]:.2g})"
                 )
             print(f"{rname} done", file=sys.stderr)
+    lines += [
+        "",
+        f"**With {' '.join(CONTRACT)}** (gcc fuses a*b + c into one vfma; the same flags for both "
+        "routes' C; instructions per call under QEMU as above):",
+        "",
+        "| robot | function | flags | symdyn instructions (libm / free) | CasADi instructions "
+        "| ratio (libm / free) |",
+        "|---|---|---|---:|---:|---:|",
+        *contract_lines,
+        "",
+        "**Static counts against QEMU's** (instructions of one call: the function's own from "
+        "arm-none-eabi-objdump -d, each run once as the function has no branch but its calls and its "
+        "return; plus NAME_sincos's from its disassembly, its one loop once per angle, or newlib's "
+        "sinf and cosf as counted under QEMU at the same angle; difference = QEMU - static, the "
+        "harness's argument set-up and call):",
+        "",
+        "| robot | function | -O | libm: static | QEMU | difference | free: static | QEMU | difference |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|",
+        *static_lines,
+    ]
     lines += ["", "**Goals** (issue 38):", "", *goals, ""]
     text = "\n".join(lines)
     RESULTS.write_text(text)

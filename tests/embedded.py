@@ -24,11 +24,13 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import tempfile
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
@@ -50,9 +52,18 @@ __all__ = [
     "random_states",
     "host_results",
     "relative_errors",
+    "disassembly",
+    "static_count",
+    "loop_count",
+    "timing_source",
+    "instructions",
 ]
 
 CC, NM, QEMU = "arm-none-eabi-gcc", "arm-none-eabi-nm", "qemu-system-arm"
+OBJDUMP = "arm-none-eabi-objdump"
+#: -icount shift of the timing programs: 2^7 ns of virtual time per instruction (the SysTick runs
+#: at 25 MHz: 3.2 ticks each)
+SHIFT = 7
 
 #: core -> (QEMU's machine, the compiler's flags for it)
 CPUS = {
@@ -368,3 +379,229 @@ def relative_errors(robot, states: np.ndarray, got: np.ndarray, want: dict) -> d
         scale = np.max(np.abs(want[f]), axis=1)
         errors[f] = np.max(np.abs(out[f] - want[f]), axis=1) / np.where(scale > 0, scale, 1.0)
     return errors
+
+
+# --------------------------------------------------------------------------- instructions per call
+
+
+@dataclass(frozen=True)
+class Instruction:
+    """One instruction of a disassembled function: its address, mnemonic, operands and the
+    symbol a call's relocation names (or the <symbol> objdump resolved), else ""."""
+
+    address: int
+    mnemonic: str
+    operands: str
+    callee: str = ""
+
+
+_LINE = re.compile(r"^\s*([0-9a-f]+):\t([^\t]+)\t?(.*)$")
+_RELOC = re.compile(r"^\s*([0-9a-f]+): R_ARM_THM_(?:CALL|JUMP24)\t(\S+)")
+#: data in a function's literal pool, not instructions
+_DATA = (".word", ".short", ".byte")
+_CONDITIONS = ["eq", "ne", "cs", "hs", "cc", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt", "le"]
+
+
+def disassembly(obj: str | os.PathLike, function: str) -> list[Instruction]:
+    """The instructions of `function` in the object (arm-none-eabi-objdump -dr), literal-pool data
+    left out; a call's callee from its relocation (or objdump's <symbol> for a call within the
+    object)."""
+    out = _run([OBJDUMP, "-dr", "--no-show-raw-insn", str(obj)]).stdout
+    lines, inside = [], False
+    for line in out.splitlines():
+        if line.endswith(">:"):
+            inside = line.split("<", 1)[1][:-2] == function
+            continue
+        if inside:
+            lines.append(line)
+    relocs = {int(m.group(1), 16): m.group(2) for m in map(_RELOC.match, lines) if m}
+    result = []
+    for line in lines:
+        m = _LINE.match(line)
+        if not m or "R_ARM_" in line or m.group(2).strip() in _DATA:
+            continue
+        address, mnemonic, operands = int(m.group(1), 16), m.group(2).strip(), m.group(3).strip()
+        callee = ""
+        if mnemonic in ("bl", "blx"):
+            named = re.search(r"<([^>+]+)", operands)
+            callee = relocs.get(address) or (named.group(1) if named else "")
+        result.append(Instruction(address, mnemonic, operands, callee))
+    if not result:
+        raise RuntimeError(f"{obj}: no function {function}")
+    return result
+
+
+def _branch_kind(ins: Instruction) -> str:
+    """ "" for an instruction that is no branch; else call, return, jump (unconditional) or
+    conditional."""
+    base = ins.mnemonic.split(".")[0]
+    if base in ("bl", "blx"):
+        return "call"
+    if (
+        (base == "bx" and ins.operands == "lr")
+        or (base == "pop" and "pc" in ins.operands)
+        or (base == "ldr" and ins.operands.startswith("pc, [sp]"))  # pop {pc} of one register
+    ):
+        return "return"
+    if base in ("cbz", "cbnz") or (base[:1] == "b" and base[1:] in _CONDITIONS):
+        return "conditional"
+    if base in ("b", "bx", "tbb", "tbh") or ("pc" in ins.operands.split("[")[0] and base in ("ldr", "mov")):
+        return "jump"
+    return ""
+
+
+def static_count(obj: str | os.PathLike, function: str) -> tuple[int, list[str], list[str]]:
+    """(instructions, callees, branches) of a branch-free function: its instruction count (each
+    runs once per call), the symbols it calls (one entry per call) and the branches that break the
+    property (a conditional branch, or a jump anywhere but over a literal pool: its padding nop and
+    data, which do not run). IT-predicated instructions run (and count) whatever their condition."""
+    code = disassembly(obj, function)
+    callees, broken, skipped = [], [], set()
+    for k, ins in enumerate(code):
+        kind = _branch_kind(ins)
+        if kind == "call":
+            callees.append(ins.callee)
+        elif kind == "conditional":
+            broken.append(f"{ins.address:x}: {ins.mnemonic} {ins.operands}")
+        elif kind == "jump":
+            target = re.match(r"([0-9a-f]+)", ins.operands)
+            over = [i for i in code[k + 1 :] if target and i.address < int(target.group(1), 16)]
+            lands = target and any(i.address == int(target.group(1), 16) for i in code)
+            if not lands or any(i.mnemonic != "nop" for i in over):
+                broken.append(f"{ins.address:x}: {ins.mnemonic} {ins.operands}")
+            skipped |= {i.address for i in over}
+    return len(code) - len(skipped), callees, broken
+
+
+def _target(ins: Instruction) -> int | None:
+    """The address a branch goes to."""
+    m = re.match(r"([0-9a-f]+)", ins.operands)
+    return int(m.group(1), 16) if m else None
+
+
+def loop_count(obj: str | os.PathLike, function: str, trips: int) -> int:
+    """The instructions one call of `function` runs when its one loop (the one branch back, taken
+    or fallen through at its end: the freestanding NAME_sincos over n >= 1 angles, `trips` = n)
+    runs `trips` times: the length of the paths through its code from its entry to its return
+    that pass the branch back `trips` times (every conditional branch both ways; they must
+    agree). A function with no branch back (an unrolled loop) is straight-line code."""
+    code = disassembly(obj, function)
+    where = {ins.address: k for k, ins in enumerate(code)}
+    branches = {k for k, ins in enumerate(code) if _branch_kind(ins) in ("conditional", "jump")}
+    back = [k for k in branches if (_target(code[k]) or 0) <= code[k].address]
+    if not back:
+        count, _, broken = static_count(obj, function)
+        if broken:
+            raise RuntimeError(f"{function}: no loop, and branches {broken}")
+        return count
+    if len(back) != 1:
+        raise RuntimeError(f"{function}: {len(back)} branches back, one loop expected")
+    lengths, paths = set(), [(0, 0, 0)]  # (instruction, times past the branch back, instructions run)
+    while paths:
+        k, passed, run = paths.pop()
+        while passed <= trips:
+            ins, run = code[k], run + 1
+            passed += k == back[0]
+            kind = _branch_kind(ins)
+            if kind == "return":
+                if passed == trips:
+                    lengths.add(run)
+                break
+            if k in branches:
+                if _target(ins) not in where:
+                    raise RuntimeError(f"{function}: a branch out of the function at {ins.address:x}")
+                if kind == "conditional":
+                    paths.append((k + 1, passed, run))
+                k = where[_target(ins)]
+                continue
+            k += 1
+    if len(lengths) != 1:
+        raise RuntimeError(f"{function}: {sorted(lengths)} instructions by different paths")
+    return lengths.pop()
+
+
+def timing_source(header: str, calls: dict[str, str], nin: int, prelude: str = "") -> str:
+    """main.c that times each call (SysTick under -icount) on in.bin's first state, after 10,000
+    nops and an empty window for calibration, and writes the tick counts to ticks.bin."""
+    body = []
+    for fname, call in calls.items():
+        body.append(
+            f"    SYST_CVR = 0; (void)SYST_CVR; a = SYST_CVR; {call}; b = SYST_CVR;"
+            f" ticks[n++] = a - b; /* {fname} */"
+        )
+    return f"""\
+#include <fcntl.h>
+#include <stddef.h>
+#include <unistd.h>
+#include "{header}"
+#define SYST_CSR (*(volatile unsigned int *)0xE000E010u)
+#define SYST_RVR (*(volatile unsigned int *)0xE000E014u)
+#define SYST_CVR (*(volatile unsigned int *)0xE000E018u)
+static float in[{nin}];
+static float out[4096];
+static unsigned int ticks[256];
+__attribute__((noinline)) static void nops(void) {{ __asm__ volatile(".rept 10000\\n\\tnop\\n\\t.endr"); }}
+__attribute__((noinline)) static void empty(void) {{ __asm__ volatile(""); }}
+{prelude}
+int main(void)
+{{
+    unsigned int a, b;
+    int n = 0, fd = open("in.bin", O_RDONLY);
+    if (fd < 0 || read(fd, in, sizeof in) != (int)sizeof in) {{
+        return 1;
+    }}
+    close(fd);
+    SYST_RVR = 0xFFFFFFu;
+    SYST_CSR = 5u;
+    SYST_CVR = 0; (void)SYST_CVR; a = SYST_CVR; nops(); b = SYST_CVR; ticks[n++] = a - b;
+    SYST_CVR = 0; (void)SYST_CVR; a = SYST_CVR; empty(); b = SYST_CVR; ticks[n++] = a - b;
+{chr(10).join(body)}
+    fd = open("ticks.bin", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0 || write(fd, ticks, sizeof(unsigned int) * (unsigned int)n) < 0) {{
+        return 1;
+    }}
+    close(fd);
+    return 0;
+}}
+"""
+
+
+def instructions(
+    folder: Path,
+    objects: list[Path],
+    header: str,
+    calls: dict[str, str],
+    x: np.ndarray,
+    build: Path,
+    cpu: str = "m4f",
+    prelude: str = "",
+) -> dict[str, int]:
+    """call name -> the instructions of one call at the state x, counted under QEMU with -icount
+    (SysTick ticks around the call, less the empty window, over the ticks of one instruction from
+    a run of 10,000 nops)."""
+    build.mkdir(parents=True, exist_ok=True)
+    (build / "startup.c").write_text(STARTUP)
+    (build / "link.ld").write_text(LINKER_SCRIPT)
+    (build / "main.c").write_text(timing_source(header, calls, x.size, prelude))
+    elf = build / "timing.elf"
+    cmd = [CC, "-std=c99", *CPUS[cpu][1], "-O2", f"-I{folder}", "--specs=rdimon.specs", "-T"]
+    _run(
+        [
+            *cmd,
+            str(build / "link.ld"),
+            str(build / "startup.c"),
+            str(build / "main.c"),
+            *map(str, objects),
+            "-lm",
+            "-o",
+            str(elf),
+        ]
+    )
+    with tempfile.TemporaryDirectory(prefix="symdyn-qemu-") as tmp:
+        np.asarray(x, dtype=np.float32).tofile(Path(tmp) / "in.bin")
+        qemu = [QEMU, "-M", CPUS[cpu][0], "-nographic", "-monitor", "none", "-serial", "none"]
+        qemu += ["-icount", f"shift={SHIFT}", "-semihosting-config", "enable=on,target=native"]
+        subprocess.run([*qemu, "-kernel", str(elf)], cwd=tmp, check=True, timeout=600, capture_output=True)
+        ticks = np.fromfile(Path(tmp) / "ticks.bin", dtype=np.uint32).astype(float)
+    per_insn = (ticks[0] - ticks[1]) / 10000.0
+    return {f: round((t - ticks[1]) / per_insn) for f, t in zip(calls, ticks[2:], strict=True)}

@@ -254,7 +254,13 @@ def _generate_arguments(g: argparse.ArgumentParser) -> None:
         help="target language; repeat for several (default: c and casadi)",
     )
     g.add_argument("--out", required=True, help="output folder")
-    g.add_argument("--precision", choices=("double", "float"), default="double")
+    g.add_argument(
+        "--precision",
+        choices=("double", "float", "both"),
+        default="double",
+        help="the C type of the code (both: C target only, files that compile in float or double, "
+        "chosen by NAME_USE_FLOAT / CMake's NAME_PRECISION; docs/embedded.md)",
+    )
     g.add_argument(
         "--freestanding",
         action="store_true",

@@ -148,11 +148,19 @@ def render(
     modules = [_target_module(t) for t in dict.fromkeys(targets)]
     if freestanding and "c" not in targets:
         raise SymdynError("--freestanding is an option of the C target: add --target c")
-    ctx = context(robot, precision, method, prune, functions, frames, task_axes, freestanding)
+    both = precision == "both"  # symdyn.codegen.c.both
+    if both and set(targets) != {"c"}:
+        raise SymdynError(
+            "--precision both is the C target's (files that compile in float or double): "
+            "generate with --target c alone"
+        )
+    ctx = context(
+        robot, "double" if both else precision, method, prune, functions, frames, task_axes, freestanding
+    )
     files: dict[str, str | bytes] = {}
     for target, module in zip(dict.fromkeys(targets), modules, strict=True):
         with progress_stage(f"rendering {target} ({len(ctx.functions)} functions)"):
-            files.update(module.render(ctx))
+            files.update(module.render_both(ctx) if both else module.render(ctx))
     return files
 
 

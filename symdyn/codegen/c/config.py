@@ -196,7 +196,9 @@ def c_names(ctx: RenderContext) -> CNames:
     arguments = {r.name for f in ctx.functions for r in f.results} | {
         inp.name for f in ctx.functions for inp in f.inputs
     }
-    reserved = C_RESERVED | taken | {a for a, _ in aliases} | arguments
+    # the macros of a file in both precisions (symdyn.codegen.c.both) are taken in every file
+    both = {f"{name}_real", f"{name}_USE_FLOAT"}
+    reserved = C_RESERVED | taken | {a for a, _ in aliases} | arguments | both
     used = {str(s) for s in joint_symbols}
     local_names: dict[sp.Symbol, str] = {s: str(s) for s in joint_symbols}
     for s in joint_symbols:

@@ -42,6 +42,18 @@ class SinCos:
     angles: tuple[sp.Expr, ...]  # the distinct arguments, over the inputs only
     calls: dict[sp.Expr, tuple[int, int]]  # sin(a) or cos(a) -> (0 for sine or 1 for cosine, index)
     live: frozenset[sp.Symbol]  # the temporaries still read once the calls read the arrays
+    inputs: frozenset[sp.Symbol]  # the input symbols still read outside the calls
+
+    def contiguous(self, inputs: Sequence) -> tuple[str, int] | None:
+        """(input, start) when the angles are entries start, start + 1, ... of one input array
+        (the Panda's q[1] to q[6]): NAME_sincos can then read them there, with no array to fill;
+        else None. `inputs` are the function's inputs (each with .name and .symbols)."""
+        for inp in inputs:
+            if self.angles and self.angles[0] in inp.symbols:
+                start = list(inp.symbols).index(self.angles[0])
+                if tuple(inp.symbols[start : start + len(self.angles)]) == self.angles:
+                    return inp.name, start
+        return None
 
     @property
     def size(self) -> int:
@@ -101,4 +113,9 @@ def gather(temporaries: Sequence[tuple[sp.Symbol, sp.Expr]], outputs: Sequence[s
     for s, expr in reversed(temporaries):
         if s in live:
             live |= _reads(expr, calls)
-    return SinCos(tuple(index), calls, frozenset(s for s in live if s in definitions))
+    return SinCos(
+        tuple(index),
+        calls,
+        frozenset(s for s in live if s in definitions),
+        frozenset(s for s in live if s not in definitions),
+    )

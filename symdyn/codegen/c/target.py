@@ -26,6 +26,7 @@ from ..loop_solve import loop_solve_context
 from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
+from .order import statement_order
 from .parts import file_groups, reads_in, source_file_name, split_body
 from .printer import CPrinter
 from .sincos import BLOCK, FREESTANDING_ERROR, gather
@@ -81,7 +82,15 @@ def _sincos_view(
     if not angles:
         return printer, temporaries, None
     padding = [CPrinter({}, ctx.precision).literal(0.0)] * (trig.size - len(angles))
-    return printer, temporaries, {"count": len(angles), "size": trig.size, "angles": angles + padding}
+    view = {"count": len(angles), "size": trig.size, "angles": angles + padding, "pointer": None}
+    run = trig.contiguous(spec.inputs) if ctx.freestanding else None
+    if run is not None:
+        # a freestanding NAME_sincos reads exactly `count` angles: it reads them in the input
+        # array, and the inputs read only as angles are not copied into locals (saved on the
+        # Cortex-M4F: a load and a store per angle, and the array on the stack)
+        view["pointer"] = f"{run[0]} + {run[1]}" if run[1] else run[0]
+        view["inputs"] = {names.locals[s] for s in trig.inputs}
+    return printer, temporaries, view
 
 
 def symbol_names(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
@@ -123,6 +132,8 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     """One function as data: its inputs, the locals it reads, temporaries and output stores."""
     printer, temporaries, sincos = _sincos_view(ctx, names, spec, symbol_names(ctx, names, spec))
     inputs, unused, reads = function_inputs(names, spec)
+    if sincos and sincos["pointer"]:
+        reads = [read for read in reads if read[0] in sincos["inputs"]]
     real = CConfig(ctx.precision).real
     outputs = []
     for result in spec.results:
@@ -159,7 +170,9 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
         "body": body,
         "parts": parts,
         # with parts, the function itself reads only the inputs of its angles (symdyn.codegen.c.parts)
-        "angle_reads": reads_in(sincos["angles"], reads) if parts and sincos else [],
+        "angle_reads": (
+            reads_in(sincos["angles"], reads) if parts and sincos and not sincos["pointer"] else []
+        ),
         "name": spec.name,
         "c_name": names.functions[spec.name],
         "doc": spec.doc,
@@ -201,19 +214,28 @@ def _body(spec: FunctionSpec, temporaries: list, printed: list[tuple[str, str]],
     """The statements of a function after its inputs are read: ("let", name, value) for each
     temporary (`printed`: their names and printed values) and ("store", "OUT[k]", value) for each
     output entry of `outputs` (their printed stores), every store right after the last temporary
-    it reads (or first, when it reads none). A value stored as soon as it is known needs no register
-    or stack slot to the end of the function: the stores of a large M at the end made the compiler
-    spill hundreds of temporaries to the stack and load them back."""
-    after: dict[int, list] = {}
+    it reads (or first, when it reads none), and each store's temporaries computed just before it
+    (symdyn.codegen.c.order). A value stored as soon as it is known needs no register or stack
+    slot to the end of the function: the stores of a large M at the end made the compiler spill
+    hundreds of temporaries to the stack and load them back."""
+    position = {sym: k for k, (sym, _) in enumerate(temporaries)}
+
+    def reads(expr: sp.Expr) -> list[int]:
+        return sorted(position[s] for s in sp.sympify(expr).free_symbols if s in position)
+
+    stores = []
     for result, view in zip(spec.results, outputs, strict=True):
-        last = last_reads(temporaries, spec.entries(result))
+        entries = spec.entries(result)
         for k, value in view["stores"]:
-            after.setdefault(last[k], []).append(("store", f"{view['target']}[{k}]", value))
-    body = list(after.get(-1, []))
-    for k, (name, value) in enumerate(printed):
-        body.append(("let", name, value))
-        body.extend(after.get(k, []))
-    return body
+            stores.append((reads(entries[k]), ("store", f"{view['target']}[{k}]", value)))
+    # the stores in the order of the last temporary each reads (the first: those reading none)
+    stores.sort(key=lambda store: store[0][-1] if store[0] else -1)
+    deps = [reads(expr) for _, expr in temporaries]
+    lets = [("let", name, value) for name, value in printed]
+    return [
+        lets[k] if kind == "let" else stores[k][1]
+        for kind, k in statement_order(deps, [r for r, _ in stores])
+    ]
 
 
 def render_context(ctx: RenderContext) -> dict:
@@ -309,16 +331,18 @@ def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
     return list(sizes.values())
 
 
-def render(ctx: RenderContext) -> dict[str, str]:
+def render(ctx: RenderContext, groups: list[list[int]] | None = None) -> dict[str, str]:
     """NAME_dynamics.h, NAME_dynamics.c and CMakeLists.txt (a static library of every .c file
     written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`; a
     large robot's functions go into NAME_dynamics.c, NAME_dynamics_2.c, ...
-    (symdyn.codegen.c.parts.file_groups decides)."""
+    (symdyn.codegen.c.parts.file_groups decides, unless `groups` gives the functions of each file:
+    symdyn.codegen.c.both renders both precisions into the same files)."""
     values = render_context(ctx)
     env = environment()
     files = {values["header_file"]: env.get_template("c/dynamics.h.j2").render(values)}
     functions = values["functions"]
-    groups = file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
+    if groups is None:
+        groups = file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
     for k, group in enumerate(groups):
         chosen = [functions[i] for i in group]
         files[source_file_name(ctx.name, k)] = env.get_template("c/dynamics.c.j2").render(
@@ -329,5 +353,13 @@ def render(ctx: RenderContext) -> dict[str, str]:
             loops=values["loops"] if k == 0 else None,
         )
     sources = sorted(name for name in files if name.endswith(".c"))
-    files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render({**values, "sources": sources})
+    files[CMAKE_FILE] = env.get_template("c/CMakeLists.txt.j2").render(
+        {**values, "sources": sources, "switch": None}
+    )
     return files
+
+
+def file_groups_of(ctx: RenderContext) -> list[list[int]]:
+    """The functions of each source file `render` writes for `ctx` (indices into ctx.functions)."""
+    functions = render_context(ctx)["functions"]
+    return file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
