@@ -10,7 +10,9 @@ _vector_of), not jnp.array, a concatenate that XLA's CPU fusion emitters made 28
 slower under jax.vmap for the Panda (docs/jax.md). Each function has a batched twin NAME_batch
 (vmapped over the leading axis of the arguments that have one, jitted). Inputs and outputs are float64
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
-rather than compute in float32) or float32.
+rather than compute in float32) or float32. The functions of RULES are jax.custom_jvp functions
+whose rule is their generated derivative function (the module's _analytic_jvp; on a floating
+base q's NQ entries mapped to the tangent space by _q_to_tangent).
 
 The names, shapes and printed expressions are the NumPy target's (symdyn.codegen.python,
 printed with the namespace `jnp`); every Python statement is spelled in templates/jax/module.py.j2.
