@@ -1,10 +1,14 @@
-"""The JAX target on the CPU against the NumPy module and ADAM (issue 26), in one run.
+"""The JAX target on the CPU against the NumPy module and ADAM (issues 26 and 37), in one run.
 
-    python bench/jax.py [--batch N] [--reps R] [--adam-python PATH] [--out bench/results/jax.txt]
+    python bench/jax.py [--robot panda|solo12|talos] [--groups G,..] [--functions F,..]
+                        [--batch N] [--reps R] [--xla-grad] [--no-xla-flags] [--adam-python PATH] [--out FILE]
 
-The Panda of example-robot-data (its URDF cut at panda_hand: 7 joints, the hand and fingers
-merged into link 7) is generated in double precision for the targets python and jax
-(--functions dynamics), and each of inverse dynamics, M and forward dynamics is timed per state:
+The robot's URDF of example-robot-data is generated in double precision for the targets python
+and jax (--groups, default dynamics,derivatives: with the derivatives the JAX forward dynamics
+is a jax.custom_jvp whose rule is forward_dynamics_derivatives), into a temporary folder of the
+run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link 7), Solo-12 and
+the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
+of --functions (default inverse dynamics, M and forward dynamics) is timed per state:
 * NumPy, one state per call (the generated NumPy module, from Python);
 * NumPy, one call on the whole batch of N states (default 100,000), divided by N;
 * JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit with XLA's CPU fusion
@@ -12,10 +16,13 @@ merged into link 7) is generated in double precision for the targets python and 
   after a first call that compiles (its time is listed); then jax.jit(jax.vmap(f)) of the
   one-state function with XLA's defaults, as one's own jit gets it, and
   jax.jit(jax.grad(lambda x: jnp.sum(jax.vmap(f)(x, ...) ** 2))), its gradient with respect to
-  the first argument (q, or for M its entries' squares), checked against central differences of
-  the same loss along one direction; then f_batch again in a process with XLA_FLAGS turning the
-  emitters off for everything;
-* ADAM (adam-robotics, its JAX backend) on the same URDF and the same batch, jax.jit(jax.vmap(..)):
+  the first argument (q), through the rule where there is one, with --xla-grad also by XLA's
+  autodiff of the body the rule wraps, each checked against central differences of the same
+  loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q); a jax.lax.scan over the
+  states, one call a step; then (unless --no-xla-flags) f_batch again in a process with
+  XLA_FLAGS turning the emitters off for everything;
+* ADAM (adam-robotics, its JAX backend; the Panda only) on the same URDF and batch,
+  jax.jit(jax.vmap(..)):
   M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + h, h its
   bias_force plus the URDF's joint damping b qd (ADAM's RNEA takes no accelerations, and it
   ignores damping, which symdyn reads as viscous friction), and forward dynamics
@@ -25,12 +32,14 @@ given by --adam-python (a virtual environment with `pip install "adam-robotics[j
 which times the symdyn JAX module there as well, for a ratio under one jax version. Without it
 the ADAM columns are left empty. Every route is checked against the numeric oracle
 (symdyn.rnea) on 8 states before timing; the medians of --reps runs are reported. The machine
-is shared: compare within one run.
+is shared: compare within one run. The table goes to bench/results/jax.txt (the Panda) or
+bench/results/jax_ROBOT.txt.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.util
 import json
 import os
@@ -51,6 +60,12 @@ ROOT = Path(__file__).resolve().parents[1]
 URDF_INSIDE = "panda_description/urdf/panda.urdf"
 TIP = "panda_hand"
 JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
+#: --robot: the URDF in example-robot-data, its tip (None: the whole tree) and floating base
+ROBOTS = {
+    "panda": (URDF_INSIDE, TIP, False),
+    "solo12": ("solo_description/robots/solo12.urdf", None, True),
+    "talos": ("talos_data/robots/talos_reduced.urdf", None, True),
+}
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
 NCHECK = 8
 #: XLA's CPU fusion emitters (the default in recent jax) can make a large fused function far slower
@@ -64,10 +79,16 @@ def _module(path: str, name: str):
     return module
 
 
-def _states(n: int, count: int, seed: int = 26) -> dict[str, np.ndarray]:
+def _states(n: int, count: int, seed: int = 26, nq: int | None = None) -> dict[str, np.ndarray]:
+    """Random states; a floating robot's q (nq given) is its base position, a quaternion of norm
+    about 1 and the joints."""
     rng = np.random.default_rng(seed)
+    q = rng.uniform(-np.pi, np.pi, (count, nq or n))
+    if nq:
+        quaternion = rng.normal(size=(count, 4))
+        q[:, 3:7] = quaternion / np.linalg.norm(quaternion, axis=1, keepdims=True)
     return {
-        "q": rng.uniform(-np.pi, np.pi, (count, n)),
+        "q": q,
         "qd": rng.uniform(-2.0, 2.0, (count, n)),
         "qdd": rng.uniform(-4.0, 4.0, (count, n)),
         "tau": rng.uniform(-20.0, 20.0, (count, n)),
@@ -168,43 +189,73 @@ def _grad_error(jax, jnp, f, grad, args) -> float:
 
 
 def worker(
-    module_path: str, urdf: str | None, count: int, reps: int, reference: dict, gravity=None, own=False
+    module_path: str,
+    urdf: str | None,
+    count: int,
+    reps: int,
+    reference: dict,
+    gravity=None,
+    own=False,
+    functions=FUNCTIONS,
+    xla_grad=False,
 ) -> dict:
-    """Time the generated JAX module (and ADAM when `urdf` is given; jax.jit(jax.vmap(f)) of the
-    one-state functions when `own`) in this interpreter; check each against `reference` (the
-    oracle's values on the first NCHECK states)."""
+    """Time the generated JAX module (and ADAM when `urdf` is given; when `own`, jax.jit(jax.vmap(f))
+    of the one-state functions, jit(grad) through it, jit(vmap(jacfwd(f))) and a jax.lax.scan over
+    the states, and with `xla_grad` jit(grad) by XLA's autodiff of the functions that have a
+    custom_jvp rule) in this interpreter; check each against `reference` (the oracle's values on
+    the first NCHECK states)."""
     import jax
 
     jax.config.update("jax_enable_x64", True)
     import jax.numpy as jnp
 
-    arm = _module(module_path, "panda_urdf_jax")
-    states = _states(arm.NDOF, count)
+    arm = _module(module_path, "symdyn_bench_jax")
+    nq = getattr(arm, "NQ", None)
+    states = _states(arm.NDOF, count, nq=nq)
     device = {k: jnp.asarray(v) for k, v in states.items()}
-    check = _states(arm.NDOF, NCHECK)  # the states of `reference`
+    check = _states(arm.NDOF, NCHECK, nq=nq)  # the states of `reference`
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
-    routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in FUNCTIONS}}
+    routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in functions}}
     if own:
-        out["own"] = {}
-        routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in FUNCTIONS}
-        out["grad"] = {}
-        for f in FUNCTIONS:
-            grad = _grad_route(jax, jnp, getattr(arm, f))
-            error = _grad_error(jax, jnp, getattr(arm, f), grad, _arguments(check, f))
-            out["error"][f"grad {f} (against central differences)"] = error
-            out["grad"][f] = _jax_timing(grad, _arguments(device, f), count, max(1, reps // 2))
+        out.update(own={}, grad={}, jacfwd={}, scan={}, xla_grad={})
+        routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
+        routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
+        for f in functions:
+            fn, args = getattr(arm, f), _arguments(device, f)
+            grads = {"grad": fn}
+            if xla_grad and hasattr(arm, f"_{f}_plain"):  # the body the custom_jvp rule wraps
+                grads["xla_grad"] = functools.partial(getattr(arm, f"_{f}_plain"), p=jnp.zeros((0,)))
+            for key, g in grads.items():
+                log(f"{key} {f}")
+                grad = _grad_route(jax, jnp, g)
+                error = _grad_error(jax, jnp, g, grad, _arguments(check, f))
+                out["error"][f"{key} {f} (against central differences)"] = error
+                out[key][f] = _jax_timing(grad, args, count, max(1, reps // 2))
+            log(f"jacfwd {f}")
+            out["jacfwd"][f] = _jax_timing(jax.jit(jax.vmap(jax.jacfwd(fn))), args, count, max(1, reps // 2))
     if urdf is not None:
         from importlib.metadata import version
 
         out["adam_version"] = version("adam-robotics")
         routes["adam"] = {f: jax.jit(jax.vmap(g)) for f, g in adam_functions(urdf, gravity).items()}
     for route, fns in routes.items():
-        for f in FUNCTIONS:
+        for f in functions:
+            log(f"{route} {f}")
             got = np.asarray(fns[f](*_arguments(check, f)))
             want = np.asarray(reference[f])
             out["error"][f"{route} {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
             out[route][f] = _jax_timing(fns[f], _arguments(device, f), count, reps)
     return out
+
+
+def _scan_route(jax, f):
+    """jit of a jax.lax.scan over the states, one call of the one-state f a step."""
+    return jax.jit(lambda *xs: jax.lax.scan(lambda c, x: (c, f(*x)), 0.0, xs)[1])
+
+
+def log(text: str) -> None:
+    """A line of progress on stderr (the worker's stdout is its JSON)."""
+    print(f"[{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
 
 def _external(python: str, payload: dict, tmp: str, **env) -> dict:
@@ -231,17 +282,19 @@ def _numpy_timing(arm, states, function: str, reps: int) -> tuple[float, float]:
     return one, batch
 
 
-def _generate(urdf: Path, folder: Path):
+def _generate(urdf: Path, folder: Path, robot_name: str, groups: tuple[str, ...]):
     import warnings
 
     from symdyn import generate
     from symdyn.parsers import load
 
+    _, tip, floating = ROBOTS[robot_name]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        robot = load(urdf, tip=TIP)
-    assert tuple(lk.joint_name for lk in robot.links) == JOINTS, [lk.joint_name for lk in robot.links]
-    generate(robot, targets=("python", "jax"), out_dir=folder, functions=("dynamics",))
+        robot = load(urdf, tip=tip, floating=floating)
+    if robot_name == "panda":
+        assert tuple(lk.joint_name for lk in robot.links) == JOINTS, [lk.joint_name for lk in robot.links]
+    generate(robot, targets=("python", "jax"), out_dir=folder, functions=groups)
     return robot, folder / f"{robot.name}_numpy.py", folder / f"{robot.name}_jax.py"
 
 
@@ -251,27 +304,32 @@ def _row(cells, widths) -> str:
     )
 
 
-def table(results: dict, opts) -> list[str]:
-    here, plain, there = results["here"], results["plain"], results.get("there")
+def _title(robot, opts) -> str:
+    kind = f"{robot.nv} velocities, q of {robot.nq}" if robot.floating else f"{robot.n} joints"
+    where = f"cut at {TIP}" if opts.robot == "panda" else "on a free flyer"
+    return (
+        f"{opts.robot} (example-robot-data URDF {where}, {kind}), --functions {','.join(opts.groups)}, "
+        f"double precision, on the CPU: ns per state, batch of {opts.batch:,} states "
+        f"(medians of {opts.reps} runs)"
+    )
+
+
+def table(results: dict, opts, robot) -> list[str]:
+    here, plain, there = results["here"], results.get("plain"), results.get("there")
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
+    pick = lambda route, f: ns(route[f][1]) if route and f in route else "-"  # noqa: E731
     head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
-    head += ["jit(vmap(f))", "jit(grad)", "f_batch, XLA_FLAGS"]
+    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "scan", "f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
     head += ["vmap/f_batch", "grad/vmap", "JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
     rows = [head]
-    for f in FUNCTIONS:
+    for f in opts.functions:
         one, batch = results["numpy"][f]
-        jx = min(here["symdyn"][f][1], plain["symdyn"][f][1])
-        row = [
-            f,
-            ns(one),
-            ns(batch),
-            ns(here["symdyn"][f][1]),
-            ns(here["own"][f][1]),
-            ns(here["grad"][f][1]),
-            ns(plain["symdyn"][f][1]),
-        ]
+        jx = min(here["symdyn"][f][1], plain["symdyn"][f][1]) if plain else here["symdyn"][f][1]
+        row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here["own"], f), pick(here["grad"], f)]
+        row += [pick(here["xla_grad"], f), pick(here["jacfwd"], f), pick(here["scan"], f)]
+        row += [pick(plain and plain["symdyn"], f)]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
         own, grad = here["own"][f][1], here["grad"][f][1]
@@ -281,34 +339,37 @@ def table(results: dict, opts) -> list[str]:
             row += [f"{there['symdyn'][f][1] / there['adam'][f][1]:.2f}x"]
         rows.append(row)
     widths = [max(len(r[i]) for r in rows) for i in range(len(head))]
+
+    def compiles(name: str, route) -> str:
+        return f"{name} " + ", ".join(f"{f} {route[f][0]:.1f}" for f in opts.functions if f in route)
+
+    routes = [("f_batch", here["symdyn"]), ("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
+    routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("scan", here["scan"])]
+    routes += [("XLA_FLAGS", plain["symdyn"])] if plain else []
+    routes += [("ADAM", there["adam"])] if there else []
     lines = [
-        f"The Panda (example-robot-data URDF cut at {TIP}, 7 joints), double precision, on the CPU: "
-        f"ns per state, batch of {opts.batch:,} states (medians of {opts.reps} runs)",
+        _title(robot, opts),
         _row(head, widths),
         _row(["-" * w for w in widths], widths),
         *(_row(r, widths) for r in rows[1:]),
         "",
         "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
         "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
-        "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0, XLA's defaults; "
+        "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0 (q), XLA's defaults, through the module's "
+        "custom_jvp rule where it has one (forward_dynamics with --functions derivatives); "
+        "jit(grad), XLA: the same by XLA's autodiff of the body the rule wraps (--xla-grad); "
+        "jacfwd: jax.jit(jax.vmap(jax.jacfwd(f))) (by q); scan: jax.jit of jax.lax.scan over the "
+        "states, one call a step; "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
         "(one run); JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
-        "compile time of the first batch call (s): "
-        + ", ".join(f"{f} {here['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
-        + "; jit(vmap(f)) "
-        + ", ".join(f"{f} {here['own'][f][0]:.1f}" for f in FUNCTIONS)
-        + "; jit(grad) "
-        + ", ".join(f"{f} {here['grad'][f][0]:.1f}" for f in FUNCTIONS)
-        + "; XLA_FLAGS "
-        + ", ".join(f"{f} {plain['symdyn'][f][0]:.1f}" for f in FUNCTIONS)
-        + ("; ADAM " + ", ".join(f"{f} {there['adam'][f][0]:.1f}" for f in FUNCTIONS) if there else ""),
+        "compile time of the first call (s): " + "; ".join(compiles(n, r) for n, r in routes if r),
         "largest relative error against symdyn.rnea on 8 states (grad: its derivative along one direction): "
         + ", ".join(f"{k} {v:.1e}" for k, v in {**here["error"], **(there or {}).get("error", {})}.items()),
     ]
     if not there:
         lines.append("ADAM: not run (give --adam-python, a Python with adam-robotics[jax] installed)")
     lines += [
-        f"machine: {results['machine']}; load average {results['load']}",
+        f"machine: {results['machine']}; load average {results['load']} (before, after)",
         f"whole run {results['wall']:.0f} s",
     ]
     return lines
@@ -316,38 +377,53 @@ def table(results: dict, opts) -> list[str]:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python bench/jax.py", description=__doc__.split("\n")[0])
+    parser.add_argument("--robot", choices=tuple(ROBOTS), default="panda", help="the robot (default panda)")
+    parser.add_argument("--groups", default="dynamics,derivatives", help="--functions of the generation")
+    parser.add_argument("--functions", default=",".join(FUNCTIONS), help="the functions timed")
     parser.add_argument("--batch", type=int, default=100_000, help="states per batch call")
     parser.add_argument("--reps", type=int, default=5, help="timed repetitions (medians)")
+    parser.add_argument(
+        "--xla-grad", action="store_true", help="also jit(grad) by XLA's autodiff of the rules' bodies"
+    )
+    parser.add_argument("--no-xla-flags", action="store_true", help="skip the run with the emitters off")
     parser.add_argument("--adam-python", help="a Python with adam-robotics[jax] (and its jax) installed")
-    parser.add_argument("--out", default=str(ROOT / "bench" / "results" / "jax.txt"))
+    parser.add_argument("--out", help="the table's file (default bench/results/jax.txt, jax_ROBOT.txt)")
     parser.add_argument("--worker", help=argparse.SUPPRESS)  # a JSON file of worker()'s arguments
     opts = parser.parse_args(argv)
     if opts.worker:
         print(json.dumps(worker(**json.loads(Path(opts.worker).read_text()))))
         return 0
+    opts.groups = tuple(opts.groups.split(","))
+    opts.functions = tuple(opts.functions.split(","))
+    if opts.adam_python and opts.robot != "panda":
+        raise SystemExit("bench/jax.py: --adam-python compares the Panda only")
+    suffix = "" if opts.robot == "panda" else f"_{opts.robot}"
+    out = Path(opts.out or ROOT / "bench" / "results" / f"jax{suffix}.txt")
     sys.path.insert(0, str(ROOT))
-    from machine import load_averages, log, machine
+    from machine import load_averages, machine
     from robots import example_robot_file
 
     from symdyn.rnea import forward_dynamics, mass_matrix, rnea
 
-    urdf = example_robot_file(URDF_INSIDE)
+    urdf = example_robot_file(ROBOTS[opts.robot][0])
     if urdf is None:
-        raise SystemExit("bench/jax.py needs example-robot-data (the test extra) for the Panda URDF")
+        raise SystemExit("bench/jax.py needs example-robot-data (the test extra) for the robots' URDFs")
     start, load_before = time.perf_counter(), load_averages()
     with tempfile.TemporaryDirectory(prefix="symdyn-bench-jax-") as tmp:
-        log("generating the Panda's NumPy and JAX modules")
-        robot, numpy_path, jax_path = _generate(urdf, Path(tmp))
-        check = _states(robot.n, NCHECK)
-        reference = {
-            "inverse_dynamics": rnea(robot, check["q"], check["qd"], check["qdd"]).tolist(),
-            "mass_matrix": mass_matrix(robot, check["q"]).tolist(),
-            "forward_dynamics": forward_dynamics(robot, check["q"], check["qd"], check["tau"]).tolist(),
+        log(f"generating the {opts.robot}'s NumPy and JAX modules (--functions {','.join(opts.groups)})")
+        robot, numpy_path, jax_path = _generate(urdf, Path(tmp), opts.robot, opts.groups)
+        nq = robot.nq if robot.floating else None
+        check = _states(robot.nv, NCHECK, nq=nq)
+        every = {
+            "inverse_dynamics": lambda: rnea(robot, check["q"], check["qd"], check["qdd"]),
+            "mass_matrix": lambda: mass_matrix(robot, check["q"]),
+            "forward_dynamics": lambda: forward_dynamics(robot, check["q"], check["qd"], check["tau"]),
         }
-        arm = _module(str(numpy_path), "panda_urdf_numpy")
-        states = _states(robot.n, opts.batch)
+        reference = {f: every[f]().tolist() for f in opts.functions}
+        arm = _module(str(numpy_path), "symdyn_bench_numpy")
+        states = _states(robot.nv, opts.batch, nq=nq)
         results: dict = {"numpy": {}}
-        for f in FUNCTIONS:
+        for f in opts.functions:
             log(f"NumPy {f}")
             results["numpy"][f] = _numpy_timing(arm, states, f, opts.reps)
             got = getattr(arm, f)(*_arguments(check, f))
@@ -355,10 +431,13 @@ def main(argv=None) -> int:
             assert err < 1e-9, (f, err)
         log("JAX (this Python)")
         args = {"module_path": str(jax_path), "urdf": None, "count": opts.batch, "reps": opts.reps}
-        results["here"] = worker(**args, reference=reference, own=True)
-        log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
-        flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()
-        results["plain"] = _external(sys.executable, {**args, "reference": reference}, tmp, XLA_FLAGS=flags)
+        args["functions"] = opts.functions
+        results["here"] = worker(**args, reference=reference, own=True, xla_grad=opts.xla_grad)
+        if not opts.no_xla_flags:
+            log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
+            flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()
+            payload = {**args, "reference": reference}
+            results["plain"] = _external(sys.executable, payload, tmp, XLA_FLAGS=flags)
         if opts.adam_python:
             log(f"JAX and ADAM ({opts.adam_python})")
             gravity = [float(g) for g in robot.gravity]
@@ -366,10 +445,10 @@ def main(argv=None) -> int:
             results["there"] = _external(opts.adam_python, payload, tmp)
     for route in ("here", "plain", "there"):
         for key, err in results.get(route, {}).get("error", {}).items():
-            assert err < (1e-5 if key.startswith("grad") else 1e-9), (route, key, err)
+            assert err < (1e-5 if "grad" in key else 1e-9), (route, key, err)
     results.update(machine=machine(), load=(load_before, load_averages()), wall=time.perf_counter() - start)
-    text = "\n".join(table(results, opts)) + "\n"
-    Path(opts.out).write_text(text)
+    text = "\n".join(table(results, opts, robot)) + "\n"
+    out.write_text(text)
     print(text, end="")
     return 0
 

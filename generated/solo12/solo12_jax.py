@@ -41,6 +41,7 @@ import functools
 
 import jax
 import jax.numpy as jnp
+from jax.custom_derivatives import SymbolicZero
 
 NDOF = 12
 NPARAM = 0
@@ -140,6 +141,28 @@ def _batch(f):
             return plain(*args)
 
     return call
+
+
+def _analytic_jvp(plain, derivatives, primals, tangents, has_p):
+    """(plain(*primals), its derivative along tangents) from the Jacobians that `derivatives`
+    returns, one per argument but p, in their order: the tangent sum_i J_i t_i, linear in the
+    tangents, so that JAX transposes it for jax.grad and jax.jacrev; a tangent of p is pushed
+    through plain by forward mode. The rule of a jax.custom_jvp with symbolic zeros: an argument
+    that does not move (SymbolicZero) costs nothing, and the Jacobians are computed only when
+    one of their arguments moves."""
+    value = plain(*primals)
+    count = len(primals) - 1 if has_p else len(primals)
+    moving = [i for i in range(count) if not isinstance(tangents[i], SymbolicZero)]
+    tangent = jnp.zeros_like(value)
+    if moving:
+        jacobians = derivatives(*primals)
+        for i in moving:
+            t = tangents[i]
+            tangent = tangent + jacobians[i] @ t
+    if has_p and not isinstance(tangents[-1], SymbolicZero):
+        fixed = primals[:-1]
+        tangent = tangent + jax.jvp(lambda p: plain(*fixed, p), (primals[-1],), (tangents[-1],))[1]
+    return value, tangent
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -2069,6 +2092,12 @@ def forward_dynamics(q, qd, tau, p=None):
     qd = _vector(qd, NDOF, "qd")
     tau = _vector(tau, NDOF, "tau")
     p = _params(p)
+    return _forward_dynamics_rule(q, qd, tau, p)
+
+
+def _forward_dynamics_plain(q, qd, tau, p):
+    """forward_dynamics of checked arguments: the function that _forward_dynamics_rule differentiates
+    by forward_dynamics_derivatives."""
     q1 = q[0]
     q2 = q[1]
     q3 = q[2]
@@ -2697,6 +2726,16 @@ def forward_dynamics(q, qd, tau, p=None):
         x575,
         x577,
     )
+
+
+_forward_dynamics_rule = jax.custom_jvp(_forward_dynamics_plain)
+
+
+@functools.partial(_forward_dynamics_rule.defjvp, symbolic_zeros=True)
+def _forward_dynamics_jvp(primals, tangents):
+    """The derivative of forward_dynamics: the Jacobians of forward_dynamics_derivatives times the tangents
+    (_analytic_jvp)."""
+    return _analytic_jvp(_forward_dynamics_plain, forward_dynamics_derivatives, primals, tangents, True)
 
 
 def regressor(q, qd, qdd, p=None):

@@ -107,9 +107,10 @@ def _in_namespace(view: dict, namespace: str) -> dict:
     }
 
 
-def render_module(ctx: RenderContext, template: str, namespace: str) -> str:
+def render_module(ctx: RenderContext, template: str, namespace: str, **extra) -> str:
     """The text of a Python module of the robot of `ctx` from `template` (a path under templates/),
-    its expressions printed with the array namespace `namespace` ("xp", "jnp")."""
+    its expressions printed with the array namespace `namespace` ("xp", "jnp"); `extra` are
+    further variables of the template (a target's own)."""
     return (
         environment()
         .get_template(template)
@@ -123,6 +124,7 @@ def render_module(ctx: RenderContext, template: str, namespace: str) -> str:
             functions=[_in_namespace(view, namespace) for view in _printed_views(ctx)],
             loops=loop_solve_context(ctx),
             contacts=contacts_of(ctx),
+            **extra,
         )
     )
 
