@@ -33,6 +33,7 @@ def _split(monkeypatch, ctx, statements: int, file_bytes: int) -> dict[str, str]
     `file_bytes` bytes of statements."""
     with monkeypatch.context() as m:
         m.setattr(parts, "PART_ABOVE", statements)
+        m.setattr(parts, "LIVE_ABOVE", 0)
         m.setattr(parts, "PART_STATEMENTS", statements)
         m.setattr(parts, "SPLIT_BYTES", file_bytes)
         return c_target.render(ctx)
@@ -133,6 +134,7 @@ def test_stash_slots_are_reused_once_read():
     ]
     with pytest.MonkeyPatch.context() as m:
         m.setattr(parts, "PART_ABOVE", 2)
+        m.setattr(parts, "LIVE_ABOVE", 0)
         m.setattr(parts, "PART_STATEMENTS", 2)
         split = parts.split_body(body, [("q1", "q", "0")], "f", ["q", "tau"])
     first, second, third = split["parts"]
@@ -142,6 +144,25 @@ def test_stash_slots_are_reused_once_read():
     assert second["body"] == [("load", "x0", "0"), ("load", "x1", "1"), body[2], body[3], ("save", "2", "x3")]
     assert third["loads"] == [("x0", 0), ("x3", 2)] and split["slots"] == 3
     assert first["unused"] == ["tau"] and third["unused"] == ["q"] and third["reads"] == []
+
+
+def test_only_functions_with_a_large_live_span_are_cut(monkeypatch):
+    """A chain (each temporary read by the next only: one alive at a time) stays whole however long;
+    the same number of statements all read by the last (every temporary alive to the end) is cut."""
+    monkeypatch.setattr(parts, "PART_ABOVE", 10)
+    monkeypatch.setattr(parts, "PART_STATEMENTS", 10)
+    monkeypatch.setattr(parts, "LIVE_ABOVE", 1000)
+    chain = [("let", "x0", "q1"), *(("let", f"x{k}", f"2*x{k - 1}") for k in range(1, 100))]
+    chain.append(("store", "tau[0]", "x99"))
+    assert parts._alive(chain) == [0, *[1] * 100, 0]  # x(k-1) alive across the cut before statement k
+    assert parts.split_body(chain, [("q1", "q", "0")], "f", ["q", "tau"]) is None
+    wide = [
+        *(("let", f"x{k}", f"{k}*q1") for k in range(100)),
+        ("store", "tau[0]", "+".join(f"x{k}" for k in range(100))),
+    ]
+    assert sum(parts._alive(wide)) == sum(range(101)) > 1000
+    split = parts.split_body(wide, [("q1", "q", "0")], "f", ["q", "tau"])
+    assert split is not None and len(split["parts"]) == 11
 
 
 def test_file_groups_balance_and_keep_small_robots_in_one_file():
