@@ -14,12 +14,16 @@ s. A function of more than PART_ABOVE statements whose live span is above LIVE_A
 parts of about PART_STATEMENTS consecutive statements
 (as many parts as needed, each cut within a quarter of a part of the even cut where the fewest
 temporaries are alive); part k is a static function NAME_FUNCTION_partk with the
-function's own arguments, called in order by the function, never inlined (NAME_NOINLINE). A
-temporary read by a later part than the one that computes it goes through the function's local
-array `stash`: stored right after it is computed, loaded at the start of each part that reads it;
+function's own arguments, called in order by the function, never inlined (NAME_NOINLINE), without
+gcc's SLP vectorizer (templates/c/parts.c.j2 says why). A temporary read by a later part than the
+one that computes it goes through the function's local array `stash`, passed restrict-qualified:
+stored right after it is computed, loaded where each part that reads it first reads it;
 a slot is reused after the last part that reads its value (a greedy colouring of the intervals
 [defining part, last reading part]). Each part reads the inputs it needs from the input
-arrays itself.
+arrays itself. Measured with gcc 12 at -O2 -march=x86-64-v3 (callgrind, instructions per call), Talos'
+floating coriolis_matrix in 8 parts runs 127,850 instructions against 132,969 whole (-3.8%) and its
+file compiles in 38 s of one core instead of 317 s; without restrict the parts ran 139,741 (+5.1%),
+with gcc's SLP vectorizer as well 150,784 (+13.4%).
 
 Files. `file_groups` puts the functions into the source files: one NAME_dynamics.c while the whole C
 is below SPLIT_BYTES, else consecutive functions in files of about SPLIT_BYTES each (NAME_dynamics.c,
