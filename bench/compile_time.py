@@ -18,7 +18,7 @@ shared: compare the ratios of one run, not the absolute seconds of different run
 
 --menagerie DIR: the humanoids of MuJoCo Menagerie (MENAGERIE, paths inside a copy of the
 repository) found in DIR, each on its floating base: `symdyn generate FILE --floating --target c`
-in a fresh process (wall seconds), then its files compiled as symdyn.compile compiles them (all at
+in a fresh process (CPU and wall seconds), then its files compiled as symdyn.compile compiles them (all at
 once, at most one per core: wall seconds, and CPU seconds of the compilers). A model whose meshes
 are missing is reported in symdyn's one line and skipped; a folder that does not exist, with a
 message.
@@ -124,11 +124,16 @@ def render(ctx, whole: bool) -> dict[str, str]:
         parts.PART_STATEMENTS, parts.SPLIT_BYTES = saved
 
 
-def cpu_seconds(cmd: list[str], folder: Path) -> tuple[float, float]:
-    """The CPU seconds (user + system) and the wall seconds of the compiler running `cmd`."""
+def cpu_seconds(cmd: list[str], folder: Path, check: bool = True) -> tuple[float, float] | str:
+    """The CPU seconds (user + system) and the wall seconds of the process running `cmd`; with
+    `check` False, the last line of its stderr when it fails."""
     before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-    subprocess.run(cmd, cwd=folder, check=True)
+    done = subprocess.run(
+        cmd, cwd=folder, check=check, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+    )
     after, wall = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter() - start
+    if done.returncode:
+        return (done.stderr.strip().splitlines() or ["failed"])[-1]
     return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime, wall
 
 
@@ -294,8 +299,8 @@ def measure_menagerie(folder: Path) -> None:
         return
     print("\nMuJoCo Menagerie, the default functions on a floating base (joints: besides the free flyer)")
     print(
-        f"{'robot':<12} {'joints':>6} {'generate s':>10} {'KB of C':>8} {'files':>5} {'cut':>4} "
-        f"{'gcc -O2 CPU s':>13} {'slowest file s':>14} {'2 idle cores s':>14}"
+        f"{'robot':<12} {'joints':>6} {'generate CPU s':>14} {'wall s':>6} {'KB of C':>8} "
+        f"{'files':>5} {'cut':>4} {'gcc -O2 CPU s':>13} {'slowest file s':>14} {'2 idle cores s':>14}"
     )
     flags = [f for f in COMPILE_FLAGS if f != "-shared"] + list(arch_flags())
     for name, path in MENAGERIE.items():
@@ -305,20 +310,20 @@ def measure_menagerie(folder: Path) -> None:
             continue
         with tempfile.TemporaryDirectory(prefix="symdyn-menagerie-") as tmp:
             cmd = [sys.executable, "-m", "symdyn.cli", "generate", str(model), "--floating", "--target", "c"]
-            start = time.perf_counter()
-            done = subprocess.run([*cmd, "--out", tmp, "--quiet"], capture_output=True, text=True)
-            generate = time.perf_counter() - start
-            if done.returncode:  # e.g. a model whose meshes give its inertia, without its meshes
-                print(f"{name:<12} {done.stderr.strip().splitlines()[-1]}")
+            generate = cpu_seconds([*cmd, "--out", tmp, "--quiet"], Path(tmp), check=False)
+            if isinstance(generate, str):  # e.g. a model whose meshes give its inertia, without its meshes
+                print(f"{name:<12} {generate}")
                 continue
             c_files = sorted(p.name for p in Path(tmp).iterdir() if p.suffix == ".c")
             text = "".join(Path(tmp, n).read_text(encoding="utf-8") for n in c_files)
-            ndof = int(re.search(r"#define \w+_NDOF (\d+)", text).group(1))
+            header = "".join(p.read_text(encoding="utf-8") for p in Path(tmp).glob("*_dynamics.h"))
+            ndof = int(re.search(r"#define \w+_NDOF (\d+)", header).group(1))
             cpu = [cpu_seconds(["gcc", *flags, "-c", n, "-o", n[:-2] + ".o"], Path(tmp))[0] for n in c_files]
             cut = len(set(re.findall(r"^static \w+ void (\w+)_part\d+\(", text, re.M)))
             print(
-                f"{name:<12} {ndof - 6:6d} {generate:10.1f} {len(text.encode()) / 1000:8.0f} "
-                f"{len(c_files):5d} {cut:4d} {sum(cpu):13.1f} {max(cpu):14.1f} {two_cores(cpu):14.1f}"
+                f"{name:<12} {ndof - 6:6d} {generate[0]:14.1f} {generate[1]:6.0f} "
+                f"{len(text.encode()) / 1000:8.0f} {len(c_files):5d} {cut:4d} {sum(cpu):13.1f} "
+                f"{max(cpu):14.1f} {two_cores(cpu):14.1f}"
             )
             sys.stdout.flush()
 
