@@ -5,6 +5,7 @@ whole functions (the layout before issue 35) against functions cut into parts ov
     python bench/compile_time.py                       # panda, solo12 and talos floating
     python bench/compile_time.py talos g1 --floating   # example-robot-data URDFs by name
     python bench/compile_time.py examples/panda.yaml
+    python bench/compile_time.py --menagerie DIR       # MuJoCo Menagerie's humanoids in DIR
 
 Each robot is derived as symdyn.compile derives it (symdyn.codegen.context: the default
 functions, double precision) and rendered in both layouts. Every .c file is compiled with
@@ -12,14 +13,22 @@ symdyn.compile's flags (-O2 -march=native ...): one after the other (CPU seconds
 per file) and all at once as symdyn.compile does (wall seconds, on this machine's cores). A small C
 program (bench/c_snippets-free: written here) then calls every function of both builds on the same
 inputs, checks that their outputs are bit for bit equal, and times them in alternating rounds
-(median ns per call). The machine may be shared: compare the ratios of one run, not the absolute
-seconds of different runs.
+(median ns per call), and callgrind counts the instructions of one call of each. The machine may be
+shared: compare the ratios of one run, not the absolute seconds of different runs.
+
+--menagerie DIR: the humanoids of MuJoCo Menagerie (MENAGERIE, paths inside a copy of the
+repository) found in DIR, each on its floating base: `symdyn generate FILE --floating --target c`
+in a fresh process (CPU and wall seconds), then its files compiled as symdyn.compile compiles them (all at
+once, at most one per core: wall seconds, and CPU seconds of the compilers). A model whose meshes
+are missing is reported in symdyn's one line and skipped; a folder that does not exist, with a
+message.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import resource
 import statistics
 import subprocess
@@ -43,6 +52,14 @@ URDFS = {
     "talos_reduced": "talos_data/robots/talos_reduced.urdf",
     "talos": "talos_data/robots/talos_full_v2.urdf",
     "g1": "g1_description/urdf/g1_29dof_rev_1_0.urdf",
+}
+#: MuJoCo Menagerie's humanoids: name -> the model's path in a copy of the repository
+MENAGERIE = {
+    "talos": "pal_talos/talos.xml",
+    "g1": "unitree_g1/g1.xml",
+    "apollo": "apptronik_apollo/apptronik_apollo.xml",
+    "toddlerbot": "toddlerbot_2xc/toddlerbot_2xc.xml",
+    "op3": "robotis_op3/op3.xml",
 }
 ROUNDS = 7
 
@@ -107,11 +124,16 @@ def render(ctx, whole: bool) -> dict[str, str]:
         parts.PART_STATEMENTS, parts.SPLIT_BYTES = saved
 
 
-def cpu_seconds(cmd: list[str], folder: Path) -> tuple[float, float]:
-    """The CPU seconds (user + system) and the wall seconds of the compiler running `cmd`."""
+def cpu_seconds(cmd: list[str], folder: Path, check: bool = True) -> tuple[float, float] | str:
+    """The CPU seconds (user + system) and the wall seconds of the process running `cmd`; with
+    `check` False, the last line of its stderr when it fails."""
     before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-    subprocess.run(cmd, cwd=folder, check=True)
+    done = subprocess.run(
+        cmd, cwd=folder, check=check, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True
+    )
     after, wall = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter() - start
+    if done.returncode:
+        return (done.stderr.strip().splitlines() or ["failed"])[-1]
     return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime, wall
 
 
@@ -154,7 +176,6 @@ def run_driver(folder: Path, reps: int) -> dict[str, float]:
 def instructions(folder: Path, names: list[str], reps: int = 10) -> dict[str, float] | None:
     """Instructions per call of each function (callgrind's inclusive counts over reps + 1 calls; parts
     included), or None without valgrind: unlike ns, not disturbed by other work on the machine."""
-    import re
     import shutil
 
     if not (shutil.which("valgrind") and shutil.which("callgrind_annotate")):
@@ -175,7 +196,6 @@ def instructions(folder: Path, names: list[str], reps: int = 10) -> dict[str, fl
 
 def largest(files: dict[str, str]) -> str:
     """The function of the whole layout with the most lines of code, and their count."""
-    import re
 
     text = "".join(v for k, v in files.items() if k.endswith(".c"))
 
@@ -197,21 +217,20 @@ def measure_parts(label: str, ctx) -> None:
         print(f"{b['size'] / 1000:.0f} KB of C in {b['files']} files, all at once {b['parallel']:.1f} s wall")
         for name, cpu in b["serial"].items():
             print(f"  {name}: {len(files[name].encode()) / 1000:.0f} KB, gcc -O2 {cpu:.1f} s of CPU")
-        # without the whole build: the instructions the parts add are about their stash traffic (one
-        # store or load each) and their inputs read again (the Panda's derivatives: 470 against 442)
-        import re
-
+        # without the whole build, which can take many minutes: the instructions per call of each
+        # function in parts, and its stash stores and loads in the source (the stash's restrict lets
+        # the compiler reload a value from it instead of spilling it: Talos' coriolis_matrix in parts
+        # runs fewer instructions than whole although 20,761 stash stores and loads are written)
         text = "".join(v for k, v in files.items() if k.endswith(".c"))
         counts = instructions(b["folder"], [e["c_name"] for e in function_table(ctx)]) or {}
         for entry in function_table(ctx):
             c_name = entry["c_name"]
             bodies = re.findall(rf"^static \w+ void {c_name}_part\d+\(.*?^}}", text, re.M | re.S)
             if bodies and c_name in counts:
-                traffic = sum(len(re.findall(r"stash\[|= (?:q|qd|qdd|tau|p)\[", body)) for body in bodies)
-                extra = traffic / (counts[c_name] - traffic)
+                traffic = sum(len(re.findall(r"stash\[", body)) for body in bodies)
                 print(
-                    f"  {entry['name']}: {len(bodies)} parts, {counts[c_name]:.0f} instructions, "
-                    f"{traffic} of them stash stores, loads and inputs read again: +{100 * extra:.1f}%"
+                    f"  {entry['name']}: {len(bodies)} parts, {counts[c_name]:.0f} instructions per call, "
+                    f"{traffic} stash stores and loads written"
                 )
 
 
@@ -259,13 +278,68 @@ def measure(label: str, ctx) -> None:
             print(line)
 
 
+def two_cores(seconds: list[float]) -> float:
+    """The wall seconds of files taking `seconds` of one core each when built as symdyn.compile
+    builds them on an idle machine with two cores: the largest first, each on the first free core."""
+    cores = [0.0, 0.0]
+    for cpu in sorted(seconds, reverse=True):
+        cores[cores.index(min(cores))] += cpu
+    return max(cores)
+
+
+def measure_menagerie(folder: Path) -> None:
+    """`symdyn generate` (a fresh process, floating base, the default functions) and the -O2
+    compile of every file it writes (CPU seconds of the compiler, one file after the other), for
+    each model of MENAGERIE found in `folder`."""
+    from symdyn.progress import quiet
+
+    quiet()
+    if not folder.is_dir():
+        print(f"\nmenagerie: {folder} is not a folder: skipped (a copy of mujoco_menagerie, meshes optional)")
+        return
+    print("\nMuJoCo Menagerie, the default functions on a floating base (joints: besides the free flyer)")
+    print(
+        f"{'robot':<12} {'joints':>6} {'generate CPU s':>14} {'wall s':>6} {'KB of C':>8} "
+        f"{'files':>5} {'cut':>4} {'gcc -O2 CPU s':>13} {'slowest file s':>14} {'2 idle cores s':>14}"
+    )
+    flags = [f for f in COMPILE_FLAGS if f != "-shared"] + list(arch_flags())
+    for name, path in MENAGERIE.items():
+        model = folder / path
+        if not model.is_file():
+            print(f"{name:<12} not in the folder ({path}): skipped")
+            continue
+        with tempfile.TemporaryDirectory(prefix="symdyn-menagerie-") as tmp:
+            cmd = [sys.executable, "-m", "symdyn.cli", "generate", str(model), "--floating", "--target", "c"]
+            generate = cpu_seconds([*cmd, "--out", tmp, "--quiet"], Path(tmp), check=False)
+            if isinstance(generate, str):  # e.g. a model whose meshes give its inertia, without its meshes
+                print(f"{name:<12} {generate}")
+                continue
+            c_files = sorted(p.name for p in Path(tmp).iterdir() if p.suffix == ".c")
+            text = "".join(Path(tmp, n).read_text(encoding="utf-8") for n in c_files)
+            header = "".join(p.read_text(encoding="utf-8") for p in Path(tmp).glob("*_dynamics.h"))
+            ndof = int(re.search(r"#define \w+_NDOF (\d+)", header).group(1))
+            cpu = [cpu_seconds(["gcc", *flags, "-c", n, "-o", n[:-2] + ".o"], Path(tmp))[0] for n in c_files]
+            cut = len(set(re.findall(r"^static \w+ void (\w+)_part\d+\(", text, re.M)))
+            print(
+                f"{name:<12} {ndof - 6:6d} {generate[0]:14.1f} {generate[1]:6.0f} "
+                f"{len(text.encode()) / 1000:8.0f} {len(c_files):5d} {cut:4d} {sum(cpu):13.1f} "
+                f"{max(cpu):14.1f} {two_cores(cpu):14.1f}"
+            )
+            sys.stdout.flush()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("robots", nargs="*", default=list(DEFAULT))
     parser.add_argument("--floating", action="store_true", help="URDFs on a free flyer (default robots: yes)")
     parser.add_argument("--parts-only", action="store_true", help="compile only the current layout")
+    parser.add_argument("--menagerie", type=Path, metavar="DIR", help="MuJoCo Menagerie's humanoids in DIR")
     args = parser.parse_args()
     print(f"{os.cpu_count()} cores, load averages {os.getloadavg()} (a shared machine: compare ratios)")
+    if args.menagerie is not None:
+        measure_menagerie(args.menagerie)
+        if not args.robots or args.robots == list(DEFAULT):
+            return
     for name in args.robots:
         floating = args.floating or name in DEFAULT
         ctx = context(load(name, floating))

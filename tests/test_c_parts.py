@@ -33,6 +33,7 @@ def _split(monkeypatch, ctx, statements: int, file_bytes: int) -> dict[str, str]
     `file_bytes` bytes of statements."""
     with monkeypatch.context() as m:
         m.setattr(parts, "PART_ABOVE", statements)
+        m.setattr(parts, "LIVE_ABOVE", 0)
         m.setattr(parts, "PART_STATEMENTS", statements)
         m.setattr(parts, "SPLIT_BYTES", file_bytes)
         return c_target.render(ctx)
@@ -108,16 +109,36 @@ def test_split_c_gives_the_single_files_numbers_and_the_oracles(roger, tmp_path)
         np.testing.assert_allclose(values[1]["qdd"], qdd, rtol=1e-7, atol=1e-7)
 
 
-@pytest.mark.parametrize("arch", [(), ("-mavx2",)], ids=["libm", "avx2"])
+@pytest.mark.parametrize("arch", [(), ("-mavx2", "-mfma")], ids=["libm", "avx2"])
 def test_split_c_compiles_strict_at_O2(roger, tmp_path, arch):
     """-O2 finds the warnings that need flow analysis; with AVX2 the parts read the sines of the
-    function's arrays, without it they call sin and cos."""
-    files = roger[2]
-    write_files(files, tmp_path)
-    with within(60):
-        compile_shared(
-            source_files(files, tmp_path, "roger_arm"), tmp_path / "lib.so", "gcc", "-O2", STRICT_FLAGS, arch
+    function's arrays, without it they call sin and cos. With AVX2 and FMA the split build still
+    gives the single file's numbers to the bit: gcc's SLP vectorizer, which fused a*b + c into
+    vfmaddsub in Talos' parts despite -ffp-contract=off, is off in the parts (templates/c/parts.c.j2)."""
+    ctx, single, files = roger
+    assert 'optimize("no-tree-slp-vectorize")' in files["roger_arm_dynamics.c"]
+    libs = []
+    for label, layout in (("split", files), ("single", single))[: 1 + bool(arch)]:
+        write_files(layout, tmp_path / label)
+        with within(60):
+            lib = compile_shared(
+                source_files(layout, tmp_path / label, "roger_arm"),
+                tmp_path / label / "lib.so",
+                "gcc",
+                "-O2",
+                STRICT_FLAGS,
+                (*arch, "-ffp-contract=off"),
+            )
+        libs.append(CDynamics(lib, "roger_arm", ctx.robot.n, len(ctx.dynamics.params)))
+    if arch:
+        rng = np.random.default_rng(5)
+        q, qd, _ = random_state(ctx.robot, rng)
+        p = random_params(ctx.robot, rng)
+        split, whole = (
+            np.concatenate([lib.mass_matrix(q, p).ravel(), lib.coriolis_matrix(q, qd, p).ravel()])
+            for lib in libs
         )
+        assert np.array_equal(split, whole)
 
 
 def test_stash_slots_are_reused_once_read():
@@ -133,6 +154,7 @@ def test_stash_slots_are_reused_once_read():
     ]
     with pytest.MonkeyPatch.context() as m:
         m.setattr(parts, "PART_ABOVE", 2)
+        m.setattr(parts, "LIVE_ABOVE", 0)
         m.setattr(parts, "PART_STATEMENTS", 2)
         split = parts.split_body(body, [("q1", "q", "0")], "f", ["q", "tau"])
     first, second, third = split["parts"]
@@ -142,6 +164,25 @@ def test_stash_slots_are_reused_once_read():
     assert second["body"] == [("load", "x0", "0"), ("load", "x1", "1"), body[2], body[3], ("save", "2", "x3")]
     assert third["loads"] == [("x0", 0), ("x3", 2)] and split["slots"] == 3
     assert first["unused"] == ["tau"] and third["unused"] == ["q"] and third["reads"] == []
+
+
+def test_only_functions_with_a_large_live_span_are_cut(monkeypatch):
+    """A chain (each temporary read by the next only: one alive at a time) stays whole however long;
+    the same number of statements all read by the last (every temporary alive to the end) is cut."""
+    monkeypatch.setattr(parts, "PART_ABOVE", 10)
+    monkeypatch.setattr(parts, "PART_STATEMENTS", 10)
+    monkeypatch.setattr(parts, "LIVE_ABOVE", 1000)
+    chain = [("let", "x0", "q1"), *(("let", f"x{k}", f"2*x{k - 1}") for k in range(1, 100))]
+    chain.append(("store", "tau[0]", "x99"))
+    assert parts._alive(chain) == [0, *[1] * 100, 0]  # x(k-1) alive across the cut before statement k
+    assert parts.split_body(chain, [("q1", "q", "0")], "f", ["q", "tau"]) is None
+    wide = [
+        *(("let", f"x{k}", f"{k}*q1") for k in range(100)),
+        ("store", "tau[0]", "+".join(f"x{k}" for k in range(100))),
+    ]
+    assert sum(parts._alive(wide)) == sum(range(101)) > 1000
+    split = parts.split_body(wide, [("q1", "q", "0")], "f", ["q", "tau"])
+    assert split is not None and len(split["parts"]) == 11
 
 
 def test_file_groups_balance_and_keep_small_robots_in_one_file():
