@@ -31,6 +31,7 @@ from symdyn.apps.compilation import build, calling
 from symdyn.apps.compilation.calling import batch_layout, load_library
 from symdyn.codegen import c as c_target
 from symdyn.codegen import context
+from symdyn.codegen.c import parts
 from symdyn.codegen.c.runtime import function_table, render_runtime
 from symdyn.errors import SymdynError
 
@@ -110,8 +111,9 @@ def _states(n: int, count: int, rng) -> np.ndarray:
     return x
 
 
-def _check(build: dict, name: str, function: str, count: int, rng, dtype=np.float64) -> int:
-    """NAME_batch over `count` states against NAME state by state: the same bits. Returns W."""
+def _check(build: dict, name: str, function: str, count: int, rng, dtype=np.float64, params=None) -> int:
+    """NAME_batch over `count` states against NAME state by state: the same bits (p NULL, or
+    `params` for a robot with free parameters). Returns W."""
     ffi, lib, width = build["libs"][name]
     f = build["table"][function]
     inputs = [(n, s) for n, s in f["inputs"] if n != "p"]
@@ -121,7 +123,7 @@ def _check(build: dict, name: str, function: str, count: int, rng, dtype=np.floa
     sizes = [rows * cols for _, rows, cols, _ in f["outputs"]]
     batch = [np.full((count, s), np.nan, dtype) for s in sizes]
     buf = ffi.from_buffer
-    p = [ffi.NULL] if with_p else []
+    p = ([ffi.NULL] if params is None else [buf(f"{real}[]", params)]) if with_p else []
     getattr(lib, f["c_name"] + "_batch")(
         count, *[buf(f"{real}[]", a) for a in arrays], *p, *[buf(f"{real}[]", o) for o in batch]
     )
@@ -333,3 +335,37 @@ def test_the_cache_key_holds_the_flags_and_the_machine(monkeypatch):
     monkeypatch.setenv(build.ARCH_ENV, "native; rm -rf /")
     with pytest.raises(SymdynError, match="SYMDYN_MARCH"):
         build_options("newton-euler")
+
+
+#: the widest vector build this CPU runs (the parts' test builds only it)
+WIDEST = [b for b in BUILDS if b != "scalar"][-1:]
+
+
+@pytest.fixture(scope="module")
+def roger_in_parts(tmp_path_factory):
+    """Roger's arm, fully symbolic (temporaries of the parameters alone: scalars in the vector
+    body), with every function of more than 6 statements cut into parts of about 4, scalar and
+    vector bodies alike (symdyn.codegen.c.vector_parts); the widest vector build."""
+    ctx = context(example("roger_arm"), functions=("dynamics",))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(parts, "PART_ABOVE", 6)
+        mp.setattr(parts, "PART_STATEMENTS", 4)
+        mp.setattr(parts, "LIVE_ABOVE", 0)
+        return ctx, _build_all(ctx, tmp_path_factory.mktemp("roger-parts"), WIDEST)
+
+
+@pytest.mark.skipif(not WIDEST, reason="needs AVX2")
+def test_vector_bodies_in_parts_equal_the_scalar_functions_bit_for_bit(roger_in_parts):
+    """A large body's vector twin cut into parts (the temporaries a later part reads through a stash
+    of vectors, a scalar one in lane 0 of its slot) still computes each lane as the scalar
+    function, bit for bit."""
+    ctx, build_ = roger_in_parts
+    batch = build_["batch"]
+    assert "static __attribute__((noinline)) void roger_arm_simd_mass_matrix_part2(" in batch
+    assert "roger_arm_simd_stash[" in batch and "][0] = " in batch  # a scalar through the stash
+    rng = np.random.default_rng(8)
+    params = rng.uniform(0.5, 2.0, len(ctx.robot.params))
+    width = BUILDS[WIDEST[0]][1]
+    for function in build_["table"]:
+        for count in (1, width + 1, 2 * width + 3):
+            _check(build_, WIDEST[0], function, count, rng, params=params)

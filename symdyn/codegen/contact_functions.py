@@ -217,11 +217,11 @@ def _derivative_rows(dyn, x, prog, kkt: KKT, Jc, gamma, solved, inputs, cols) ->
     e3 = [sp.Add(*[M[i, j] * (vel[j] - qd[j]) for j in range(nv) if M[i, j] != 0]) - JT[i] for i in range(nv)]
     er = e.symbols[0]
     e4 = [sp.Add(*[Jc[r, j] * (vel[j] + er * qd[j]) for j in range(nv) if Jc[r, j] != 0]) for r in range(m)]
-    d2q, d2v = _tangent(prog, e3 + e4, q, qd, robot.floating, "cI")
+    d2q, _ = _tangent(prog, e3 + e4, q, qd, robot.floating, "cI")
     at = dict(zip(vel, qd_plus, strict=True)) | dict(zip(held, imp, strict=True))
-    d2q, d2v = (sp.Matrix(nv + m, nv, substitute(prog, _entries(d), at, "cT")) for d in (d2q, d2v))
+    d2q = sp.Matrix(nv + m, nv, substitute(prog, _entries(d2q), at, "cT"))
     dpq, diq = kkt.sensitivities(d2q[:nv, :], d2q[nv:, :], "cp")
-    dpv, div = kkt.sensitivities(d2v[:nv, :], d2v[nv:, :], "cw")
+    dpv, div = kkt.jump_sensitivities(er, "cw")  # by qd: r1 = -M, r2 = e Jc, in closed form
 
     def square(name, doc):
         return Output(name, nv, nv, doc, (cols, cols))

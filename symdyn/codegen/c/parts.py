@@ -33,6 +33,7 @@ NAME_dynamics_2.c, ...; a function's parts stay with it), which a build compiles
 from __future__ import annotations
 
 import re
+from collections.abc import Container
 from math import ceil
 
 __all__ = [
@@ -62,8 +63,9 @@ SPLIT_BYTES = 1_000_000
 _IDENTIFIER = re.compile(r"\b[A-Za-z_]\w*")
 
 
-def _names_read(text: str, known: set[str]) -> set[str]:
-    """The identifiers of `known` that the printed C expression `text` reads."""
+def _names_read(text: str, known: Container[str]) -> set[str]:
+    """The identifiers of `known` (a set or a dict's keys) that the printed C expression `text`
+    reads; `known` is looked up, never copied, so that a loop over a large body stays linear."""
     return {word for word in _IDENTIFIER.findall(text) if word in known}
 
 
@@ -96,6 +98,7 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
         for c, names in enumerate(used)
     ]
     last = {n: c for c, names in enumerate(loads) for n in names}
+    argument_set = set(arguments)
     slot_of: dict[str, int] = {}
     free: list[int] = []
     slots = 0
@@ -108,7 +111,7 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
             # each temporary of an earlier part loaded right before its first use: a load at the
             # part's start could not move past the stores to the outputs (they may alias the
             # stash), and the value would stay alive, in a register or spilled, through the part
-            for n in sorted(_names_read(s[2], set(pending)), key=_number):
+            for n in sorted(_names_read(s[2], pending), key=_number):
                 statements.append(("load", n, str(pending.pop(n))))
             statements.append(s)
             if s[0] == "let" and s[1] in last:
@@ -121,7 +124,7 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
         free.sort(reverse=True)
         part_reads = [r for r in reads if r[0] in used[c]]
         touched = {r[1] for r in part_reads}
-        touched |= set().union(*(_names_read(s[1], set(arguments)) for s in chunk if s[0] == "store"))
+        touched |= set().union(*(_names_read(s[1], argument_set) for s in chunk if s[0] == "store"))
         stashed = bool(part_loads) or any(s[0] == "save" for s in statements)
         parts.append(
             {
@@ -142,7 +145,7 @@ def _alive(body: list) -> list[int]:
     defined = {s[1]: k for k, s in enumerate(body) if s[0] == "let"}
     last: dict[str, int] = {}
     for k, s in enumerate(body):
-        for name in _names_read(s[2], set(defined)):
+        for name in _names_read(s[2], defined):
             last[name] = k
     change = [0] * (n + 2)
     for name, k in defined.items():

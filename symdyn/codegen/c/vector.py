@@ -24,6 +24,9 @@ regressor (434 outputs, 1429 operations) vectorised takes 0.69 to 0.72 of the sc
 time over identify's chunk of 4,832 states, its full regressor (637 outputs, 1743 operations)
 0.65 to 0.67 (AVX-512, gcc 12, -O2); they took 1.6 to 1.7 times the scalar loop when each
 group's outputs went through a buffer on the stack and a copy.
+
+A body longer than the scalar parts' bound is cut into parts as the scalar function is
+(symdyn.codegen.c.vector_parts).
 """
 
 from __future__ import annotations
@@ -36,9 +39,11 @@ from ..functions import FunctionSpec
 from ..printing import step_comparison
 from ..render import RenderContext
 from .config import MATH_CALLS, CNames
+from .parts import reads_in
 from .printer import ATOM, MUL, CPrinter
 from .sincos import gather, trig_calls
 from .target import function_inputs, last_reads, symbol_names
+from .vector_parts import vector_parts
 
 __all__ = [
     "VectorPrinter",
@@ -176,12 +181,20 @@ def vector_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict |
         return None
     body = _interleaved(spec, temporaries, lets, outputs, ctx.precision == "double")
     sizes = {inp.name: len(inp.symbols) for inp in spec.inputs}
+    lanes = [(local, array, index, array != "p") for local, array, index in reads]
+    arguments = [inp.name for inp in spec.inputs] + [r.name for r in spec.results]
+    parts = vector_parts(body, lanes, prefix + spec.name, arguments)
     return {
         "block": prefix + spec.name,
         "inputs": [(inp.name, sizes[inp.name]) for inp in spec.inputs],
         "outputs": outputs,
         "unused": unused,
-        "reads": [(local, array, index, array != "p") for local, array, index in reads],
+        "reads": lanes,
+        "parts": parts,
+        # with parts, the block itself reads only the inputs of its angles
+        "angle_reads": [r for r in lanes if r[:3] in reads_in([*angles, *lane_pairs], reads)]
+        if parts
+        else [],
         "angles": angles,
         "angle_groups": _angle_groups(angles),
         "lane_pairs": lane_pairs,
