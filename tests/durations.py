@@ -143,7 +143,7 @@ def main(argv: list[str]) -> int:
         files, processes = gather(Path(folder))
     print(report(files, processes))
     print(f"wall {wall:.0f} s, exit status {status}")
-    if write and status == 0:
+    if write:  # a test that failed still took its time (a time bound missed on a busy machine)
         TABLE.write_text(
             json.dumps({n: round(e["cpu"], 1) for n, e in sorted(files.items())}, indent=1) + "\n"
         )
