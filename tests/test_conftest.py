@@ -30,3 +30,19 @@ def test_after_it_a_collection_has_almost_nothing_to_look_at(monkeypatch, reques
     finally:
         gc.unfreeze()  # the other tests of this worker run as before
     del heap
+
+
+def test_a_file_is_frozen_when_it_ends(request):
+    """The end-of-file collection runs after pytest's runner has torn the file's fixtures down."""
+    caller = request.config.pluginmanager.hook.pytest_runtest_teardown
+    ours = next(impl for impl in caller.get_hookimpls() if impl.function is conftest.pytest_runtest_teardown)
+    assert not ours.hookwrapper and not ours.wrapper and ours.trylast
+
+
+def test_files_run_longest_first_and_unknown_ones_as_an_average_file(monkeypatch):
+    import durations
+
+    monkeypatch.setattr(durations, "table", lambda: {"a.py": 1.0, "b.py": 90.0, "c.py": 30.0})
+    rank = durations.order(["a.py", "new.py", "c.py", "b.py", "a.py"])
+    assert sorted(rank, key=rank.get) == ["b.py", "c.py", "new.py", "a.py"]
+    assert durations.UNKNOWN_SECONDS == 5.0  # between c.py and a.py above
