@@ -37,14 +37,18 @@ CONTACT_INPUTS = ("active", "e", "anchor", "gains")
 ROTATION_TOL = 1e-6
 
 
+def _numbers(x, what: str, where: str) -> np.ndarray:
+    """`x` as an array of floats, or SymdynError: `where`: `what`, naming the type given."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise SymdynError(f"{where}: {what}, got {type(x).__name__}") from None
+
+
 def check_mask(active, ncontact: int, where: str) -> np.ndarray:
     """`active` as floats when its last axis has `ncontact` entries, each exactly 0 or 1; else
     SymdynError naming `where`."""
-    try:
-        a = np.asarray(active, dtype=float)
-    except (TypeError, ValueError):
-        what = type(active).__name__
-        raise SymdynError(f"{where}: active must be {ncontact} numbers 0 or 1, got {what}") from None
+    a = _numbers(active, f"active must be {ncontact} numbers 0 or 1", where)
     if a.ndim == 0 or a.shape[-1] != ncontact:
         raise SymdynError(
             f"{where}: active must have {ncontact} entries (one per contact), got shape {a.shape}"
@@ -59,24 +63,13 @@ def check_mask(active, ncontact: int, where: str) -> np.ndarray:
 
 def check_restitution(e, where: str) -> np.ndarray:
     """`e` as floats when its last axis has one entry, finite and in [0, 1]; else SymdynError."""
-    try:
-        a = np.asarray(e, dtype=float)
-    except (TypeError, ValueError):
-        what = type(e).__name__
-        raise SymdynError(f"{where}: the restitution e must be a number in [0, 1], got {what}") from None
+    a = _numbers(e, "the restitution e must be a number in [0, 1]", where)
     if a.ndim == 0 or a.shape[-1] != 1:
         raise SymdynError(f"{where}: the restitution e must have shape (1,) or (..., 1), got {a.shape}")
     bad = ~((a >= 0.0) & (a <= 1.0))
     if bad.any():
         raise SymdynError(f"{where}: the restitution e must be in [0, 1], got {a[bad].flat[0]!r}")
     return a
-
-
-def _numbers(x, what: str, where: str) -> np.ndarray:
-    try:
-        return np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise SymdynError(f"{where}: {what}, got {type(x).__name__}") from None
 
 
 def check_anchor(anchor, size: int, where: str) -> np.ndarray:
