@@ -3,7 +3,16 @@ messages that several floors print."""
 
 from __future__ import annotations
 
-__all__ = ["SymdynError", "SymdynWarning", "location", "link_fields", "one_line", "SINGULAR_REASONS"]
+__all__ = [
+    "SymdynError",
+    "SymdynWarning",
+    "location",
+    "link_fields",
+    "one_line",
+    "shown",
+    "SHOWN",
+    "SINGULAR_REASONS",
+]
 
 #: Why a joint makes M(q) singular, as the end of a sentence whose subject is the joint: said by
 #: the derivation (symdyn.algorithms.singular) and by the numeric oracle (symdyn.oracle) alike.
@@ -80,3 +89,13 @@ def one_line(text) -> str:
     return "".join(
         c if c.isprintable() or c == " " else c.encode("unicode_escape").decode("ascii") for c in str(text)
     )
+
+
+#: the longest quotation of a user's value in a message (`shown`)
+SHOWN = 60
+
+
+def shown(value) -> str:
+    """repr(value) for a message: one line (one_line), cut to SHOWN characters."""
+    text = one_line(repr(value))
+    return text if len(text) <= SHOWN else text[: SHOWN - 3] + "..."

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SymdynError
-from .contact_kinematics import ContactRows, contact_kinematics, contact_poses, contact_rows, shown
+from ..errors import SymdynError, shown
+from .contact_kinematics import ContactRows, contact_kinematics, contact_poses, contact_rows
 from .contact_solve import checked_mask, checked_number, checked_state, float_array, kkt_solve
 from .rnea import mass_matrix, rnea
 

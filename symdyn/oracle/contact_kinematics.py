@@ -34,26 +34,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..errors import SymdynError, one_line
+from ..errors import SHOWN, SymdynError, shown
 from .floating import base_rotation
 from .inputs import body_positions, body_rates, numeric_model
 from .spatial import joint_poses
 
-__all__ = ["KINDS", "ContactRows", "contact_rows", "contact_kinematics", "contact_poses", "shown"]
+__all__ = ["KINDS", "ContactRows", "contact_rows", "contact_kinematics", "contact_poses"]
 
 
 #: the rows of each kind of contact
 KINDS = {"point": 3, "6d": 6}
-
-
-#: the longest quotation of a user's value in a message
-SHOWN = 60
-
-
-def shown(value) -> str:
-    """repr(value) for a message: one line (symdyn.errors.one_line), cut to SHOWN characters."""
-    text = one_line(repr(value))
-    return text if len(text) <= SHOWN else text[: SHOWN - 3] + "..."
 
 
 @dataclasses.dataclass(frozen=True)

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import SymdynError
-from .contact_kinematics import ContactRows, contact_kinematics, shown
+from ..errors import SymdynError, shown
+from .contact_kinematics import ContactRows, contact_kinematics
 from .floating import floating_inputs
 from .inputs import checked_inputs
 from .rnea import mass_matrix, rnea

@@ -15,38 +15,30 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...errors import SymdynError
+from ...errors import SymdynError, shown
 
 __all__ = ["stance_schedule"]
-
-#: the longest quotation of a user's value in a message
-SHOWN = 60
-
-
-def _shown(value) -> str:
-    text = repr(value).replace("\n", " ")
-    return text if len(text) <= SHOWN else text[: SHOWN - 3] + "..."
 
 
 def _entry(robot, entry, i: int, duration: float) -> tuple[float, np.ndarray]:
     """(T, the NCONTACT mask) of one (T, names) entry, checked."""
     names = [c.name for c in robot.contacts]
     if isinstance(entry, (str, bytes)) or not isinstance(entry, Sequence) or len(entry) != 2:
-        raise SymdynError(f"stance entry {i} must be a pair (time, contact names), got {_shown(entry)}")
+        raise SymdynError(f"stance entry {i} must be a pair (time, contact names), got {shown(entry)}")
     t, held = entry
     if isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)):
-        raise SymdynError(f"stance entry {i}: the time must be a number, got {_shown(t)}")
+        raise SymdynError(f"stance entry {i}: the time must be a number, got {shown(t)}")
     if not (math.isfinite(t) and 0.0 <= t <= duration):
         raise SymdynError(
             f"stance entry {i}: the time {t!r} s must lie in [0, {duration:g}] s, the run's time"
         )
     if isinstance(held, (str, bytes)) or not isinstance(held, Sequence | set | frozenset):
-        raise SymdynError(f"stance entry {i}: the contacts must be a list of names, got {_shown(held)}")
+        raise SymdynError(f"stance entry {i}: the contacts must be a list of names, got {shown(held)}")
     mask = np.zeros(len(names))
     for name in held:
         if name not in names:
             raise SymdynError(
-                f"stance at t = {t:g} s: no contact is named {_shown(name)} (contacts: {', '.join(names)})"
+                f"stance at t = {t:g} s: no contact is named {shown(name)} (contacts: {', '.join(names)})"
             )
         mask[names.index(name)] = 1.0
     return float(t), mask
@@ -67,7 +59,7 @@ def stance_schedule(
     else:
         if isinstance(stance, (str, bytes)) or not isinstance(stance, Sequence) or not stance:
             raise SymdynError(
-                f"the stance must be a non-empty list of (time, contact names), got {_shown(stance)}"
+                f"the stance must be a non-empty list of (time, contact names), got {shown(stance)}"
             )
         entries = [_entry(robot, e, i, duration) for i, e in enumerate(stance)]
         for (t0, _), (t1, _) in zip(entries, entries[1:], strict=False):
