@@ -14,7 +14,7 @@ temporary the one needing the most registers comes first (Sethi and Ullman's lab
 17(4), 1970, on the graph as if it were a tree), so that fewer values wait in registers while it is
 computed. The statements and their values are unchanged (every expression is the same; only
 independent statements swap), so the results are bit-identical; on the Panda's float inverse
-dynamics for the Cortex-M4F at -Os the function takes 991 instructions instead of 1,086
+dynamics for the Cortex-M4F at -Os the function itself takes 984 instructions instead of 1,086
 (docs/embedded.md). The walk is iterative (a function of ten thousand temporaries has chains
 deeper than Python's recursion limit) and deterministic: ties keep the previous order.
 """
