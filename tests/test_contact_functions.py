@@ -18,7 +18,9 @@ computeImpulseDynamicsDerivatives) and identities:
   active rows and lam 0 on the free ones;
 - a small floating robot's derivatives (point contacts on its base and its hand, or a 6d one at
   the hand) against central differences of its own generated functions, q perturbed on the
-  manifold (q (+) dq).
+  manifold (q (+) dq);
+- that robot's three contact groups in CasADi, JAX and Octave against its NumPy module (the
+  matrix layouts, the mask, the restitution and the anchors of each target's printer).
 
 Pinocchio's computeImpulseDynamicsDerivatives gives d(qd_plus - qd)/dqd (its ddq_dv), symdyn's
 dqd_plus_dqd is d qd_plus/dqd: the two differ by the identity. The Solo-12 and Talos derivatives
@@ -35,11 +37,15 @@ from functools import cache
 import numpy as np
 import pytest
 from cbuild import compile_shared, compilers, write_files
+from octave_run import OCTAVE, octave_numbers, octave_values
 
 import symdyn
 from symdyn.algorithms.contact_dynamics import DAMPING
 from symdyn.codegen import c as c_target
+from symdyn.codegen import casadi as casadi_target
 from symdyn.codegen import context
+from symdyn.codegen import jax as jax_target
+from symdyn.codegen import matlab as matlab_target
 from symdyn.codegen import python as numpy_target
 from symdyn.oracle.contact_baumgarte import contact_error, contact_forward_dynamics_baumgarte
 from symdyn.oracle.contact_kinematics import contact_poses, contact_rows
@@ -399,9 +405,16 @@ contacts:
 """
 
 
-def test_floating_derivatives_equal_differences_of_the_generated_functions(tmp_path):
+@pytest.fixture(scope="module")
+def flyer(tmp_path_factory):
+    """The floating flyer's three contact groups, derived once: (robot, context, NumPy module)."""
     robot = symdyn.robot_from_data(__import__("yaml").safe_load(FLYER2))
-    g = numpy_module(context(robot, functions=("contacts", "contact_derivatives")), tmp_path)
+    ctx = context(robot, functions=("contacts", "contact_derivatives", "contact_baumgarte"))
+    return robot, ctx, numpy_module(ctx, tmp_path_factory.mktemp("flyer"))
+
+
+def test_floating_derivatives_equal_differences_of_the_generated_functions(flyer):
+    robot, _, g = flyer
     rng = np.random.default_rng(3)
     quat = rng.normal(size=4)
     q = np.r_[rng.normal(size=3), quat / np.linalg.norm(quat), rng.normal(size=1)]
@@ -459,3 +472,64 @@ def test_symdyn_compile_binds_the_contact_functions(tmp_path, monkeypatch):
     assert np.array_equal(batch[0][7], qdd) and np.array_equal(batch[1][3], lam)
     qd_plus, imp = cd.impulse_dynamics(q, v, active, [0.0])
     _close((Jc @ qd_plus + MU * imp)[:6], np.zeros(6), "impact", 1e-9)
+
+
+@pytest.mark.skipif(OCTAVE is None, reason="GNU Octave (octave-cli) is not installed")
+def test_casadi_jax_and_octave_agree_with_numpy_on_every_contact_function(flyer, tmp_path):
+    """Every function of the groups contacts, contact_derivatives and contact_baumgarte of the
+    floating flyer in CasADi, JAX and Octave against its NumPy module (which the test above checks
+    against differences, and Pinocchio checks on the xArm and Solo-12): what is target-specific is
+    the printers' matrix layout (row-major in C and NumPy, column-major in CasADi and MATLAB), the
+    mask, the restitution input and the anchors."""
+    jax = pytest.importorskip("jax")
+    jax.config.update("jax_enable_x64", True)
+    robot, ctx, reference = flyer
+    files = casadi_target.render(ctx) | jax_target.render(ctx) | matlab_target.render(ctx)
+    write_files(files, tmp_path)
+    casadi_functions: dict = {}
+    exec(compile(files["flyer2_casadi.py"], "flyer2_casadi.py", "exec"), casadi_functions)  # symdyn's own
+    built = casadi_functions["functions"]()
+    jax_module: dict = {}
+    exec(compile(files["flyer2_jax.py"], "flyer2_jax.py", "exec"), jax_module)  # symdyn's own
+
+    rng = np.random.default_rng(21)
+    quat = rng.normal(size=4)
+    q = np.r_[rng.normal(size=3), quat / np.linalg.norm(quat), rng.normal(size=1)]
+    poses = contact_poses(robot, contact_rows(robot, robot.contacts), q[None])[0]
+    anchor = np.concatenate(
+        [np.r_[T[:3, 3] + rng.normal(scale=0.01, size=3), T[:3, :3].reshape(-1)] for T in poses]
+    )
+    values = {
+        "q": q,
+        "qd": rng.normal(size=7),
+        "tau": rng.normal(size=7),
+        "e": np.array([0.4]),
+        "anchor": anchor,
+        "gains": np.array([40.0, 6.0]),
+        "p": np.zeros(0),
+    }
+    calls, want = {}, {}
+    for active in ([1.0, 1.0, 0.0], [0.0, 0.0, 1.0]):  # two points or the 6d grip: regular sets
+        values["active"] = np.array(active)
+        for f in ctx.functions:
+            args = [values[i.name] for i in f.inputs]
+            out = getattr(reference, f.name)(*args[:-1])
+            want[f.name, active[0]] = [np.asarray(o) for o in (out if isinstance(out, tuple) else (out,))]
+            got_casadi = built[f.name](*args)
+            got_jax = jax_module[f.name](*args[:-1])
+            for target, got in (("casadi", got_casadi), ("jax", got_jax)):
+                got = got if isinstance(got, tuple) else (got,)
+                for r, g, w in zip(f.results, got, want[f.name, active[0]], strict=True):
+                    _close(np.array(g, dtype=float), w, f"{target} {f.name} {r.name} {active}", 1e-12)
+            numbers = ", ".join(octave_numbers(a) for a in args)
+            calls[f.name, active[0]] = f"symdyn_outputs(@flyer2_{f.name}, {len(f.results)}, {numbers})"
+    (tmp_path / "symdyn_outputs.m").write_text(
+        "function o = symdyn_outputs(f, n, varargin)\n"
+        "  [c{1:n}] = f(varargin{:});\n"
+        "  o = [];\n"
+        "  for k = 1:n\n    x = c{k}.';\n    o = [o; x(:)];\n  end\n"
+        "end\n"
+    )
+    got = octave_values(tmp_path, calls)
+    for key, outs in want.items():
+        _close(got[key], np.concatenate([o.reshape(-1) for o in outs]), f"octave {key}", 1e-12)
