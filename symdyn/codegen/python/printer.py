@@ -1,6 +1,7 @@
 """SymPy expression -> array-API text, and the Python names of the NumPy and JAX backends.
 
-`NumpyPrinter` is SymPy's NumPyPrinter with the functions of the Python array API standard
+`NumpyPrinter` is SymPy's NumPyPrinter (terms in the expression's own order, as the C target
+prints them) with the functions of the Python array API standard
 taken from a namespace variable (`xp.sin`: the NumPy module's namespace, picked from its
 inputs by array-api-compat; `jnp.sin` in the JAX module), small integer powers as products
 (as the operation counts assume), floats and rationals in full precision (repr), every
@@ -51,7 +52,10 @@ class NumpyPrinter(NumPyPrinter):
     """
 
     def __init__(self, names: dict[sp.Symbol, str] | None = None, module: str = "xp") -> None:
-        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False})
+        # order "none": terms and factors in the expression's own (canonical, deterministic)
+        # order, as the C printer writes them; SymPy's default sorts every Add and Mul again by
+        # sort_key, which was half of the time of printing a module
+        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False, "order": "none"})
         self._names = names or {}
         self._xp = module
 
