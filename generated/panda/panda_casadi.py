@@ -13738,7 +13738,7 @@ def build_link7_operational_space_bias() -> ca.Function:
 
 
 def functions() -> dict[str, ca.Function]:
-    """The seven functions by name, each a casadi.Function over fresh SX symbols."""
+    """Every function of the module by name, each a casadi.Function over fresh SX symbols."""
     return {
         "inverse_dynamics": build_inverse_dynamics(),
         "mass_matrix": build_mass_matrix(),

@@ -6584,7 +6584,7 @@ def build_linearize() -> ca.Function:
 
 
 def functions() -> dict[str, ca.Function]:
-    """The seven functions by name, each a casadi.Function over fresh SX symbols."""
+    """Every function of the module by name, each a casadi.Function over fresh SX symbols."""
     return {
         "inverse_dynamics": build_inverse_dynamics(),
         "mass_matrix": build_mass_matrix(),
