@@ -9,6 +9,7 @@ with the numeric oracle.
 
 from __future__ import annotations
 
+import ctypes
 import os
 import re
 import shutil
@@ -54,11 +55,12 @@ def test_the_file_set_is_deterministic_and_each_function_is_defined_once(roger, 
     ctx, single, split = roger
     assert sorted(single) == ["CMakeLists.txt", "roger_arm_dynamics.c", "roger_arm_dynamics.h"]
     names = sorted(split)
-    count = len(names) - 2
+    count = len(names) - 3
     assert count >= 3 and names == sorted(
         [
             "CMakeLists.txt",
             "roger_arm_dynamics.h",
+            "roger_arm_dynamics_parts.h",
             "roger_arm_dynamics.c",
             *(f"roger_arm_dynamics_{k}.c" for k in range(2, count + 1)),
         ]
@@ -73,6 +75,31 @@ def test_the_file_set_is_deterministic_and_each_function_is_defined_once(roger, 
         assert len(defined) == 1, c_name
     cut = [s.name for s in ctx.functions if any(f"void roger_arm_{s.name}_part2(" in split[n] for n in names)]
     assert {"inverse_dynamics", "mass_matrix", "coriolis_matrix", "forward_dynamics"} <= set(cut)
+    # each part defined once; those outside their function's file hidden and declared in the
+    # internal header, which the files defining or calling them include
+    header = split["roger_arm_dynamics_parts.h"]
+    spread = set()
+    for name in (spec.name for spec in ctx.functions):
+        where = {}
+        for n in names:
+            for linkage, part in re.findall(
+                rf"^(\w+) roger_arm_NOINLINE void (roger_arm_{name}_part\d+)\(", split[n], re.M
+            ):
+                assert part not in where, part
+                where[part] = (n, linkage)
+        home = next(
+            n for n in names if n.endswith(".c") and re.search(rf"^void roger_arm_{name}\(", split[n], re.M)
+        )
+        for part, (n, linkage) in where.items():
+            declared = f"roger_arm_HIDDEN void {part}(" in header
+            assert (linkage, declared) == (("static", False) if n == home else ("roger_arm_HIDDEN", True)), (
+                part
+            )
+            if n != home:
+                spread.add(name)
+                assert '#include "roger_arm_dynamics_parts.h"' in split[n]
+        assert '#include "roger_arm_dynamics_parts.h"' in split[home] or name not in spread
+    assert len(spread) >= 2
 
 
 def test_split_c_gives_the_single_files_numbers_and_the_oracles(roger, tmp_path):
@@ -83,6 +110,11 @@ def test_split_c_gives_the_single_files_numbers_and_the_oracles(roger, tmp_path)
         write_files(files, out)
         lib = compile_shared(source_files(files, out, "roger_arm"), out / "lib.so", "gcc", "-O0")
         libs.append(CDynamics(lib, "roger_arm", ctx.robot.n, len(ctx.dynamics.params)))
+    # the parts in another file than their function are not exported (hidden visibility)
+    exported = ctypes.CDLL(str(tmp_path / "split" / "lib.so"))
+    hidden = re.findall(r"roger_arm_HIDDEN void (\w+)\(", split["roger_arm_dynamics_parts.h"])
+    assert hidden and not any(hasattr(exported, name) for name in hidden)
+    assert hasattr(exported, "roger_arm_mass_matrix")
     robot, rng = ctx.robot, np.random.default_rng(35)
     for _ in range(5):
         q, qd, qdd = random_state(robot, rng)
@@ -127,7 +159,7 @@ def test_split_c_compiles_strict_at_O2(roger, tmp_path, arch):
                 "gcc",
                 "-O2",
                 STRICT_FLAGS,
-                (*arch, "-ffp-contract=off"),
+                (*arch, "-ffp-contract=off", "-Wmissing-prototypes", "-Wmissing-declarations"),
             )
         libs.append(CDynamics(lib, "roger_arm", ctx.robot.n, len(ctx.dynamics.params)))
     if arch:
