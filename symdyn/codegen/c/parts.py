@@ -32,9 +32,10 @@ parallel. A function's parts may lie in several files, so that no file holds muc
 SPLIT_BYTES: Menagerie's Talos has a coriolis_matrix of 3.2 MB in 12 parts, 72 s of one core at -O2
 in one file. A part in the file of its function is static; one in another file has the hidden
 visibility of NAME_HIDDEN and is declared in the internal header NAME_dynamics_parts.h
-(templates/c/parts.h.j2), which the files defining or calling it include. Run time: measured with
-callgrind, the same parts called across files run within a fraction of a percent of the static
-ones (docs/speed.md#compile-time).
+(templates/c/parts.h.j2), which the files defining or calling it include. Run time (callgrind, gcc
+12 -O2): Talos' coriolis_matrix with 11 of its 12 parts in other files runs 228,121 instructions
+against 227,790 with all of them static beside it (+0.15%, docs/speed.md#compile-time); its file,
+3.2 MB, took 78 s of one core, the largest of the three files now 39 s.
 """
 
 from __future__ import annotations
