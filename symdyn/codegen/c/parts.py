@@ -53,6 +53,8 @@ __all__ = [
     "reads_in",
     "file_groups",
     "file_units",
+    "layout",
+    "part_counts",
     "source_file_name",
 ]
 
@@ -235,6 +237,34 @@ def file_units(whole: list[int], parts: list[list[int]]) -> list[list[tuple[int,
     units = [(i, k) for i, sizes in enumerate(parts) for k in [*range(1, len(sizes) + 1), 0]]
     sizes = [whole[i] if k == 0 else parts[i][k - 1] for i, k in units]
     return [[units[j] for j in group] for group in file_groups(sizes)]
+
+
+def _size(statements: list) -> int:
+    """The bytes of a function's or a part's statements (their names and printed values)."""
+    return sum(len(s[1]) + len(s[2]) for s in statements)
+
+
+def layout(functions: list[dict]) -> list[list[tuple[int, int]]]:
+    """The units of each source file (`file_units`) of the function views `functions`
+    (symdyn.codegen.c.target): a function in parts counts the angles it prints and a line per call
+    of a part."""
+    whole = [
+        _size(f["body"])
+        if not f["parts"]
+        else sum(map(len, f["sincos"]["angles"] if f["sincos"] else [])) + 80 * len(f["parts"]["parts"])
+        for f in functions
+    ]
+    sizes = [[_size(p["body"]) for p in f["parts"]["parts"]] if f["parts"] else [] for f in functions]
+    return file_units(whole, sizes)
+
+
+def part_counts(groups: list[list[tuple[int, int]]], count: int) -> list[int]:
+    """The number of parts of each of `count` functions in the files' units `groups` (0: whole)."""
+    counts = [0] * count
+    for group in groups:
+        for i, n in group:
+            counts[i] = max(counts[i], n)
+    return counts
 
 
 def source_file_name(name: str, index: int) -> str:

@@ -27,7 +27,7 @@ from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .order import statement_order
-from .parts import file_units, reads_in, source_file_name, split_body
+from .parts import layout, part_counts, reads_in, source_file_name, split_body
 from .printer import CPrinter
 from .sincos import BLOCK, FREESTANDING_ERROR, gather
 
@@ -345,13 +345,13 @@ def render(ctx: RenderContext, groups: list[list[tuple[int, int]]] | None = None
     (symdyn.codegen.c.parts.file_units decides, unless `groups` gives the units of each file, and
     so the number of parts of each function: symdyn.codegen.c.both renders both precisions into
     the same files)."""
-    counts = None if groups is None else _part_counts(groups, len(ctx.functions))
+    counts = None if groups is None else part_counts(groups, len(ctx.functions))
     values = render_context(ctx, counts)
     env = environment()
     files = {values["header_file"]: env.get_template("c/dynamics.h.j2").render(values)}
     functions = values["functions"]
     if groups is None:
-        groups = _layout(functions)
+        groups = layout(functions)
     file_of = {unit: k for k, group in enumerate(groups) for unit in group}
     # the parts in another file than their function: not static, declared in the internal header
     shared = [
@@ -392,33 +392,6 @@ def render(ctx: RenderContext, groups: list[list[tuple[int, int]]] | None = None
     return files
 
 
-def _size(statements: list) -> int:
-    """The bytes of a function's or a part's statements (their names and printed values)."""
-    return sum(len(s[1]) + len(s[2]) for s in statements)
-
-
-def _layout(functions: list[dict]) -> list[list[tuple[int, int]]]:
-    """The units of each source file (symdyn.codegen.c.parts.file_units) of the function views
-    `functions`: a function in parts counts the angles it prints and a line per call of a part."""
-    whole = [
-        _size(f["body"])
-        if not f["parts"]
-        else sum(map(len, f["sincos"]["angles"] if f["sincos"] else [])) + 80 * len(f["parts"]["parts"])
-        for f in functions
-    ]
-    sizes = [[_size(p["body"]) for p in f["parts"]["parts"]] if f["parts"] else [] for f in functions]
-    return file_units(whole, sizes)
-
-
-def _part_counts(groups: list[list[tuple[int, int]]], count: int) -> list[int]:
-    """The number of parts of each of `count` functions in the files' units `groups` (0: whole)."""
-    counts = [0] * count
-    for group in groups:
-        for i, n in group:
-            counts[i] = max(counts[i], n)
-    return counts
-
-
 def file_groups_of(ctx: RenderContext) -> list[list[tuple[int, int]]]:
     """The units of each source file `render` writes for `ctx` (symdyn.codegen.c.parts.file_units)."""
-    return _layout(render_context(ctx)["functions"])
+    return layout(render_context(ctx)["functions"])
