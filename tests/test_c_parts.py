@@ -9,9 +9,12 @@ with the numeric oracle.
 
 from __future__ import annotations
 
+import ctypes
+import dataclasses
 import os
 import re
 import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -23,20 +26,21 @@ import symdyn.rnea as oracle
 from symdyn.apps.compilation import build
 from symdyn.codegen.c import parts
 from symdyn.codegen.c import target as c_target
+from symdyn.codegen.c.both import render_both
 from symdyn.errors import SymdynError
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
 
 
-def _split(monkeypatch, ctx, statements: int, file_bytes: int) -> dict[str, str]:
-    """The C of `ctx` rendered with parts of at most `statements` statements and files of about
-    `file_bytes` bytes of statements."""
+def _split(monkeypatch, ctx, statements: int, file_bytes: int, render=c_target.render) -> dict[str, str]:
+    """The C of `ctx` rendered (by `render`) with parts of at most `statements` statements and files
+    of about `file_bytes` bytes of statements."""
     with monkeypatch.context() as m:
         m.setattr(parts, "PART_ABOVE", statements)
         m.setattr(parts, "LIVE_ABOVE", 0)
         m.setattr(parts, "PART_STATEMENTS", statements)
         m.setattr(parts, "SPLIT_BYTES", file_bytes)
-        return c_target.render(ctx)
+        return render(ctx)
 
 
 @pytest.fixture(scope="module")
@@ -54,11 +58,12 @@ def test_the_file_set_is_deterministic_and_each_function_is_defined_once(roger, 
     ctx, single, split = roger
     assert sorted(single) == ["CMakeLists.txt", "roger_arm_dynamics.c", "roger_arm_dynamics.h"]
     names = sorted(split)
-    count = len(names) - 2
+    count = len(names) - 3
     assert count >= 3 and names == sorted(
         [
             "CMakeLists.txt",
             "roger_arm_dynamics.h",
+            "roger_arm_dynamics_parts.h",
             "roger_arm_dynamics.c",
             *(f"roger_arm_dynamics_{k}.c" for k in range(2, count + 1)),
         ]
@@ -73,6 +78,31 @@ def test_the_file_set_is_deterministic_and_each_function_is_defined_once(roger, 
         assert len(defined) == 1, c_name
     cut = [s.name for s in ctx.functions if any(f"void roger_arm_{s.name}_part2(" in split[n] for n in names)]
     assert {"inverse_dynamics", "mass_matrix", "coriolis_matrix", "forward_dynamics"} <= set(cut)
+    # each part defined once; those outside their function's file hidden and declared in the
+    # internal header, which the files defining or calling them include
+    header = split["roger_arm_dynamics_parts.h"]
+    spread = set()
+    for name in (spec.name for spec in ctx.functions):
+        where = {}
+        for n in names:
+            for linkage, part in re.findall(
+                rf"^(\w+) roger_arm_NOINLINE void (roger_arm_{name}_part\d+)\(", split[n], re.M
+            ):
+                assert part not in where, part
+                where[part] = (n, linkage)
+        home = next(
+            n for n in names if n.endswith(".c") and re.search(rf"^void roger_arm_{name}\(", split[n], re.M)
+        )
+        for part, (n, linkage) in where.items():
+            declared = f"roger_arm_HIDDEN void {part}(" in header
+            assert (linkage, declared) == (("static", False) if n == home else ("roger_arm_HIDDEN", True)), (
+                part
+            )
+            if n != home:
+                spread.add(name)
+                assert '#include "roger_arm_dynamics_parts.h"' in split[n]
+        assert '#include "roger_arm_dynamics_parts.h"' in split[home] or name not in spread
+    assert len(spread) >= 2
 
 
 def test_split_c_gives_the_single_files_numbers_and_the_oracles(roger, tmp_path):
@@ -83,6 +113,11 @@ def test_split_c_gives_the_single_files_numbers_and_the_oracles(roger, tmp_path)
         write_files(files, out)
         lib = compile_shared(source_files(files, out, "roger_arm"), out / "lib.so", "gcc", "-O0")
         libs.append(CDynamics(lib, "roger_arm", ctx.robot.n, len(ctx.dynamics.params)))
+    # the parts in another file than their function are not exported (hidden visibility)
+    exported = ctypes.CDLL(str(tmp_path / "split" / "lib.so"))
+    hidden = re.findall(r"roger_arm_HIDDEN void (\w+)\(", split["roger_arm_dynamics_parts.h"])
+    assert hidden and not any(hasattr(exported, name) for name in hidden)
+    assert hasattr(exported, "roger_arm_mass_matrix")
     robot, rng = ctx.robot, np.random.default_rng(35)
     for _ in range(5):
         q, qd, qdd = random_state(robot, rng)
@@ -127,7 +162,7 @@ def test_split_c_compiles_strict_at_O2(roger, tmp_path, arch):
                 "gcc",
                 "-O2",
                 STRICT_FLAGS,
-                (*arch, "-ffp-contract=off"),
+                (*arch, "-ffp-contract=off", "-Wmissing-prototypes", "-Wmissing-declarations"),
             )
         libs.append(CDynamics(lib, "roger_arm", ctx.robot.n, len(ctx.dynamics.params)))
     if arch:
@@ -139,6 +174,63 @@ def test_split_c_compiles_strict_at_O2(roger, tmp_path, arch):
             for lib in libs
         )
         assert np.array_equal(split, whole)
+
+
+def test_spread_parts_build_in_both_precisions_freestanding_and_with_cmake(roger, tmp_path, monkeypatch):
+    """Parts spread over several files in the other layouts: `--precision both` (the float
+    functions cut as the double ones, into the same files) compiled in either precision, and
+    --freestanding. Every file compiles under the strict flags with -Wmissing-prototypes (the
+    internal header declares the parts) and each build gives its single file's numbers to the
+    bit; the CMakeLists.txt builds the files of both precisions into a library a program links."""
+    ctx, _, split = roger
+    free_ctx = dataclasses.replace(ctx, freestanding=True)
+    both = _split(monkeypatch, ctx, 12, 4_000, render_both)
+    free = _split(monkeypatch, free_ctx, 12, 4_000)
+    assert "roger_arm_dynamics_parts.h" in both and "roger_arm_dynamics_parts.h" in free
+    # the double branch of each file is the double split file (built by the tests above)
+    assert both.keys() == split.keys()
+    assert all(split[name] in both[name] for name in split if name.endswith((".c", ".h")))
+    layouts = {
+        "both float": (both, "float", ("-Droger_arm_USE_FLOAT",)),
+        "float": (c_target.render(dataclasses.replace(ctx, precision="float")), "float", ()),
+        "free split": (free, "double", ()),
+        "free": (c_target.render(free_ctx), "double", ()),
+    }
+    strict = (*STRICT_FLAGS, "-Wmissing-prototypes", "-Wmissing-declarations")
+    rng = np.random.default_rng(41)
+    q, qd, _ = random_state(ctx.robot, rng)
+    p = random_params(ctx.robot, rng)
+    values = {}
+    for label, (files, precision, defines) in layouts.items():
+        out = tmp_path / label.replace(" ", "_")
+        write_files(files, out)
+        with within(60):
+            lib = compile_shared(
+                source_files(files, out, "roger_arm"), out / "lib.so", "gcc", "-O0", strict, defines
+            )
+        c = CDynamics(lib, "roger_arm", ctx.robot.n, len(ctx.dynamics.params), precision)
+        values[label] = np.concatenate([c.mass_matrix(q, p).ravel(), c.coriolis_matrix(q, qd, p).ravel()])
+    for cut, whole in (("both float", "float"), ("free split", "free")):
+        assert values[cut].dtype == values[whole].dtype and np.array_equal(values[cut], values[whole]), cut
+    if shutil.which("cmake") is None:
+        return
+    project = tmp_path / "cmake"
+    write_files(both, project / "dyn")
+    main = '#include "roger_arm_dynamics.h"\nint main(void)\n{\n    roger_arm_real q[2] = {0.3f, -0.7f};\n'
+    main += "    roger_arm_real p[5] = {9.81f, 1, 1, 1, 1}, M[4];\n"
+    main += "    roger_arm_mass_matrix(q, p, M);\n    return !(M[0] > 0);\n}\n"
+    (project / "main.c").write_text(main)
+    (project / "CMakeLists.txt").write_text(
+        "cmake_minimum_required(VERSION 3.13)\nproject(app C)\nadd_subdirectory(dyn)\n"
+        "add_executable(app main.c)\ntarget_link_libraries(app PRIVATE roger_arm_dynamics)\n"
+    )
+    flags = "-DCMAKE_C_FLAGS=" + " ".join((*STRICT_FLAGS[1:], "-Wmissing-prototypes"))
+    build_dir = project / "build"
+    with within(60):
+        configure = ["cmake", "-S", str(project), "-B", str(build_dir), flags, "-Droger_arm_PRECISION=float"]
+        subprocess.run(configure, check=True, capture_output=True)
+        subprocess.run(["cmake", "--build", str(build_dir), "-j", "2"], check=True, capture_output=True)
+        subprocess.run([str(build_dir / "app")], check=True)
 
 
 def test_stash_slots_are_reused_once_read():

@@ -43,7 +43,7 @@ def render_both(ctx: RenderContext) -> dict[str, str]:
             header_lines=lines,
             name=ctx.name,
             macro=macro,
-            header=name.endswith(".h"),
+            header=name.endswith("_dynamics.h"),  # not NAME_dynamics_parts.h
             float_text=files["float"][name],
             double_text=files["double"][name],
         )

@@ -118,7 +118,9 @@ class CNames:
     # when the helper is used), the locals "angle", "sine" and "cosine" (the arrays)
     sincos: dict[str, str]
     # the parts of a large function (symdyn.codegen.c.parts): the macro "noinline" (keeps each part a
-    # function of its own) and the local array "stash" (the temporaries passed between parts)
+    # function of its own), the local array "stash" (the temporaries passed between parts), and for
+    # the parts in another file than their function the internal "header" NAME_dynamics_parts.h,
+    # its include "guard" and the macro "hidden" (their visibility)
     parts: dict[str, str]
 
 
@@ -182,8 +184,14 @@ def c_names(ctx: RenderContext) -> CNames:
         + ([f"{name}_NCONTACT", f"{name}_NLAMBDA"] if contacts_of(ctx) else [])
         + ([f"{name}_NANCHOR"] if "contact_error" in functions else [])
     )
-    parts = {"noinline": f"{name}_NOINLINE"}
-    taken = set(written) | set(functions.values()) | {guard} | set(sincos.values()) | set(parts.values())
+    parts = {
+        "noinline": f"{name}_NOINLINE",
+        "hidden": f"{name}_HIDDEN",
+        "guard": f"{name.upper()}_DYNAMICS_PARTS_H",
+        "header": f"{name}_dynamics_parts.h",
+    }
+    macros = {parts[k] for k in ("noinline", "hidden", "guard")}
+    taken = set(written) | set(functions.values()) | {guard} | set(sincos.values()) | macros
     aliases = _aliases(written, taken)
 
     joint_symbols = _joint_symbols(ctx)

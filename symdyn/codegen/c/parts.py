@@ -25,9 +25,17 @@ floating coriolis_matrix in 8 parts runs 127,850 instructions against 132,969 wh
 file compiles in 38 s of one core instead of 317 s; without restrict the parts ran 139,741 (+5.1%),
 with gcc's SLP vectorizer as well 150,784 (+13.4%).
 
-Files. `file_groups` puts the functions into the source files: one NAME_dynamics.c while the whole C
-is below SPLIT_BYTES, else consecutive functions in files of about SPLIT_BYTES each (NAME_dynamics.c,
-NAME_dynamics_2.c, ...; a function's parts stay with it), which a build compiles in parallel.
+Files. `file_units` puts the functions and parts into the source files (`file_groups` on their
+sizes): one NAME_dynamics.c while the whole C is below SPLIT_BYTES, else consecutive units in files
+of about SPLIT_BYTES each (NAME_dynamics.c, NAME_dynamics_2.c, ...), which a build compiles in
+parallel. A function's parts may lie in several files, so that no file holds much more than
+SPLIT_BYTES: Menagerie's Talos has a coriolis_matrix of 3.2 MB in 12 parts, 72 s of one core at -O2
+in one file. A part in the file of its function is static; one in another file has the hidden
+visibility of NAME_HIDDEN and is declared in the internal header NAME_dynamics_parts.h
+(templates/c/parts.h.j2), which the files defining or calling it include. Run time (callgrind, gcc
+12 -O2): Talos' coriolis_matrix with 11 of its 12 parts in other files runs 228,121 instructions
+against 227,790 with all of them static beside it (+0.15%, docs/speed.md#compile-time); its file,
+3.2 MB, took 78 s of one core, the largest of the three files now 39 s.
 """
 
 from __future__ import annotations
@@ -44,6 +52,9 @@ __all__ = [
     "split_body",
     "reads_in",
     "file_groups",
+    "file_units",
+    "layout",
+    "part_counts",
     "source_file_name",
 ]
 
@@ -69,10 +80,14 @@ def _names_read(text: str, known: Container[str]) -> set[str]:
     return {word for word in _IDENTIFIER.findall(text) if word in known}
 
 
-def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> dict | None:
+def split_body(
+    body: list, reads: list, c_name: str, arguments: list[str], count: int | None = None
+) -> dict | None:
     """{"parts", "slots": the size of the array `stash`} of a function whose `body` (("let", name,
     value) and ("store", target, value) in order, symdyn.codegen.c.target) has more than
-    PART_STATEMENTS statements; None when it has not.
+    PART_STATEMENTS statements; None when it has not. `count`, when given, is the number of parts
+    to cut (below 2: None, the function stays whole) instead of the rule's: `--precision both`
+    cuts the float function as the double one, so that both put the same parts in the same files.
 
     `reads` are the function's (local, input, index): each input value it copies into a local;
     `arguments` the names of its inputs and outputs, which each part takes too.
@@ -82,12 +97,18 @@ def split_body(body: list, reads: list, c_name: str, arguments: list[str]) -> di
     reads), "unused" (the arguments it neither reads nor writes, and the stash's name "" when it
     neither loads nor saves)}.
     """
-    if len(body) <= max(PART_ABOVE, PART_STATEMENTS):
+    if count is None:
+        if len(body) <= max(PART_ABOVE, PART_STATEMENTS):
+            return None
+        alive = _alive(body)
+        if sum(alive) <= LIVE_ABOVE:
+            return None
+        count = ceil(len(body) / PART_STATEMENTS)
+    elif count < 2 or len(body) < count:
         return None
-    alive = _alive(body)
-    if sum(alive) <= LIVE_ABOVE:
-        return None
-    chunks = [body[a:b] for a, b in _cuts(body, alive)]
+    else:
+        alive = _alive(body)
+    chunks = [body[a:b] for a, b in _cuts(body, alive, count)]
     defined_in = {s[1]: c for c, chunk in enumerate(chunks) for s in chunk if s[0] == "let"}
     inputs = {local for local, _, _ in reads}
     known = set(defined_in) | inputs
@@ -159,12 +180,11 @@ def _alive(body: list) -> list[int]:
     return alive
 
 
-def _cuts(body: list, alive: list[int]) -> list[tuple[int, int]]:
-    """The parts' [start, end) in `body`: as many as PART_STATEMENTS asks, each cut placed, within a
-    quarter of a part's length of the even cut, where the fewest temporaries are alive (`alive`,
-    `_alive`): every such value costs a store and a load per later part reading it."""
+def _cuts(body: list, alive: list[int], count: int) -> list[tuple[int, int]]:
+    """The `count` parts' [start, end) in `body`, each cut placed, within a quarter of a part's
+    length of the even cut, where the fewest temporaries are alive (`alive`, `_alive`): every such
+    value costs a store and a load per later part reading it."""
     n = len(body)
-    count = ceil(n / PART_STATEMENTS)
     size = n / count
     cuts, start = [], 0
     for part in range(1, count):
@@ -206,6 +226,45 @@ def file_groups(sizes: list[int]) -> list[list[int]]:
         groups[-1].append(k)
         done += size
     return groups
+
+
+def file_units(whole: list[int], parts: list[list[int]]) -> list[list[tuple[int, int]]]:
+    """The units of each source file: (i, 0) is function i itself (its body, or the calls of its
+    parts), (i, k) its part k. `whole[i]` is the bytes of function i's own code, `parts[i]` those
+    of each of its parts (empty: the function is whole). The units, each function's parts then the
+    function, are grouped by `file_groups` on their sizes: a function's parts may lie in several
+    files, the function in the file of its last part."""
+    units = [(i, k) for i, sizes in enumerate(parts) for k in [*range(1, len(sizes) + 1), 0]]
+    sizes = [whole[i] if k == 0 else parts[i][k - 1] for i, k in units]
+    return [[units[j] for j in group] for group in file_groups(sizes)]
+
+
+def _size(statements: list) -> int:
+    """The bytes of a function's or a part's statements (their names and printed values)."""
+    return sum(len(s[1]) + len(s[2]) for s in statements)
+
+
+def layout(functions: list[dict]) -> list[list[tuple[int, int]]]:
+    """The units of each source file (`file_units`) of the function views `functions`
+    (symdyn.codegen.c.target): a function in parts counts the angles it prints and a line per call
+    of a part."""
+    whole = [
+        _size(f["body"])
+        if not f["parts"]
+        else sum(map(len, f["sincos"]["angles"] if f["sincos"] else [])) + 80 * len(f["parts"]["parts"])
+        for f in functions
+    ]
+    sizes = [[_size(p["body"]) for p in f["parts"]["parts"]] if f["parts"] else [] for f in functions]
+    return file_units(whole, sizes)
+
+
+def part_counts(groups: list[list[tuple[int, int]]], count: int) -> list[int]:
+    """The number of parts of each of `count` functions in the files' units `groups` (0: whole)."""
+    counts = [0] * count
+    for group in groups:
+        for i, n in group:
+            counts[i] = max(counts[i], n)
+    return counts
 
 
 def source_file_name(name: str, index: int) -> str:

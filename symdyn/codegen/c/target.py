@@ -27,7 +27,7 @@ from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .order import statement_order
-from .parts import file_groups, reads_in, source_file_name, split_body
+from .parts import layout, part_counts, reads_in, source_file_name, split_body
 from .printer import CPrinter
 from .sincos import BLOCK, FREESTANDING_ERROR, gather
 
@@ -48,6 +48,7 @@ FILL_ZEROS = 16
 #: CMakeLists.txt header carries the operation counts).
 TOOLS = {
     "_dynamics.h": ("sympy",),
+    "_dynamics_parts.h": ("sympy",),
     ".c": ("sympy",),
     "CMakeLists.txt": ("sympy",),
 }  # .c: NAME_dynamics.c, NAME_dynamics_2.c, ...
@@ -128,8 +129,9 @@ def function_inputs(names: CNames, spec: FunctionSpec) -> tuple[list, list, list
     return inputs, unused, reads
 
 
-def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dict:
-    """One function as data: its inputs, the locals it reads, temporaries and output stores."""
+def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec, count: int | None = None) -> dict:
+    """One function as data: its inputs, the locals it reads, temporaries and output stores;
+    `count`: the number of parts to cut it into (0: whole; None: symdyn.codegen.c.parts decides)."""
     printer, temporaries, sincos = _sincos_view(ctx, names, spec, symbol_names(ctx, names, spec))
     inputs, unused, reads = function_inputs(names, spec)
     if sincos and sincos["pointer"]:
@@ -165,7 +167,7 @@ def _function_view(ctx: RenderContext, names: CNames, spec: FunctionSpec) -> dic
     printed = [(sym.name, printer.doprint(expr)) for sym, expr in temporaries]
     body = _body(spec, temporaries, printed, outputs)
     arguments = [inp["name"] for inp in inputs] + [out["name"] for out in outputs]
-    parts = split_body(body, reads, names.functions[spec.name], arguments)
+    parts = split_body(body, reads, names.functions[spec.name], arguments, count)
     return {
         "body": body,
         "parts": parts,
@@ -238,10 +240,14 @@ def _body(spec: FunctionSpec, temporaries: list, printed: list[tuple[str, str]],
     ]
 
 
-def render_context(ctx: RenderContext) -> dict:
-    """Everything templates/c/ needs for the robot of `ctx`: names, numbers and printed expressions."""
+def render_context(ctx: RenderContext, counts: list[int] | None = None) -> dict:
+    """Everything templates/c/ needs for the robot of `ctx`: names, numbers and printed expressions
+    (`counts`: the number of parts of each function, 0 for a whole one; None: the rule's)."""
     names = c_names(ctx)
-    functions = [_function_view(ctx, names, spec) for spec in ctx.functions]
+    functions = [
+        _function_view(ctx, names, spec, None if counts is None else counts[k])
+        for k, spec in enumerate(ctx.functions)
+    ]
     return {
         "name": ctx.name,
         "real": CConfig(ctx.precision).real,
@@ -331,25 +337,52 @@ def _column_sizes(ctx: RenderContext, names: CNames) -> list[dict]:
     return list(sizes.values())
 
 
-def render(ctx: RenderContext, groups: list[list[int]] | None = None) -> dict[str, str]:
+def render(ctx: RenderContext, groups: list[list[tuple[int, int]]] | None = None) -> dict[str, str]:
     """NAME_dynamics.h, NAME_dynamics.c and CMakeLists.txt (a static library of every .c file
     written, for a parent project's add_subdirectory; docs/embedded.md) for the robot of `ctx`; a
-    large robot's functions go into NAME_dynamics.c, NAME_dynamics_2.c, ...
-    (symdyn.codegen.c.parts.file_groups decides, unless `groups` gives the functions of each file:
-    symdyn.codegen.c.both renders both precisions into the same files)."""
-    values = render_context(ctx)
+    large robot's functions and parts go into NAME_dynamics.c, NAME_dynamics_2.c, ..., and the parts
+    that lie in another file than their function are declared in NAME_dynamics_parts.h
+    (symdyn.codegen.c.parts.file_units decides, unless `groups` gives the units of each file, and
+    so the number of parts of each function: symdyn.codegen.c.both renders both precisions into
+    the same files)."""
+    counts = None if groups is None else part_counts(groups, len(ctx.functions))
+    values = render_context(ctx, counts)
     env = environment()
     files = {values["header_file"]: env.get_template("c/dynamics.h.j2").render(values)}
     functions = values["functions"]
     if groups is None:
-        groups = file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
+        groups = layout(functions)
+    file_of = {unit: k for k, group in enumerate(groups) for unit in group}
+    # the parts in another file than their function: not static, declared in the internal header
+    shared = [
+        (functions[i], functions[i]["parts"]["parts"][n - 1])
+        for i, n in sorted(file_of)
+        if n and file_of[i, n] != file_of[i, 0]
+    ]
+    parts_header = values["parts"]["header"] if shared else None
+    if parts_header:
+        files[parts_header] = env.get_template("c/parts.h.j2").render(values, shared=shared)
     for k, group in enumerate(groups):
-        chosen = [functions[i] for i in group]
+        chosen, linked = [], False
+        for i in sorted({i for i, _ in group}):
+            f = functions[i]
+            units = range(len(f["parts"]["parts"]) + 1 if f["parts"] else 1)
+            # the parts here, each with whether it is static (in the file of its function)
+            here = [
+                (n, f["parts"]["parts"][n - 1], file_of[i, n] == file_of[i, 0])
+                for n in units[1:]
+                if (i, n) in group
+            ]
+            chosen.append({**f, "here": here, "defined": (i, 0) in group})
+            linked = linked or any(file_of[i, n] != k for n in units)
+        defined = [f for f in chosen if f["defined"]]
         files[source_file_name(ctx.name, k)] = env.get_template("c/dynamics.c.j2").render(
             values,
             functions=chosen,
             sincos=values["sincos"] if any(f["sincos"] for f in chosen) else None,
+            sincos_helper=any(f["sincos"] for f in defined),
             parts=values["parts"] if any(f["parts"] for f in chosen) else None,
+            parts_header=parts_header if linked else None,
             loops=values["loops"] if k == 0 else None,
         )
     sources = sorted(name for name in files if name.endswith(".c"))
@@ -359,7 +392,6 @@ def render(ctx: RenderContext, groups: list[list[int]] | None = None) -> dict[st
     return files
 
 
-def file_groups_of(ctx: RenderContext) -> list[list[int]]:
-    """The functions of each source file `render` writes for `ctx` (indices into ctx.functions)."""
-    functions = render_context(ctx)["functions"]
-    return file_groups([sum(len(s[1]) + len(s[2]) for s in f["body"]) for f in functions])
+def file_groups_of(ctx: RenderContext) -> list[list[tuple[int, int]]]:
+    """The units of each source file `render` writes for `ctx` (symdyn.codegen.c.parts.file_units)."""
+    return layout(render_context(ctx)["functions"])
