@@ -161,7 +161,8 @@ def _reap(block: bool) -> None:
 def serve(address: str) -> None:
     """Import WARM_MODULES, then serve requests on the Unix socket `address` until SIGTERM: each
     one runs in a forked child, which sends the command's exit status back when it ends. On
-    SIGTERM the server waits for its children and exits."""
+    SIGTERM, or when its parent (the test process) is gone, the server waits for its children
+    and exits."""
     import importlib
     import signal
 
@@ -181,9 +182,18 @@ def serve(address: str) -> None:
     listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     listener.bind(address)
     listener.listen(16)
+    listener.settimeout(5.0)
+    parent = os.getppid()
     print("ready", flush=True)
     while True:
-        conn, _ = listener.accept()
+        try:
+            conn, _ = listener.accept()
+        except TimeoutError:
+            _reap(block=False)
+            if os.getppid() != parent:  # the test process is gone (killed): so is the server
+                stop(signal.SIGTERM, None)
+            continue
+        conn.settimeout(None)
         _reap(block=False)
         try:
             request, fds = _receive(conn)
