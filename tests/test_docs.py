@@ -6,8 +6,10 @@
    `<!-- test: file PATH -->` writes the block to PATH, `<!-- test: run -->` runs a python or
    shell block (`<!-- test: run exit=N -->` expects exit status N), `<!-- test: output -->`
    holds the expected output of the run block before it (a line `...` stands for any lines).
-   The blocks of one page run in order, in one fresh Python process, in a temporary folder
-   holding a copy of examples/, with `symdyn` and `python` on PATH meaning this source tree.
+   The blocks of one page run in order, in one Python process of their own, in a temporary folder
+   holding a copy of examples/, with `symdyn` and `python` on PATH meaning this source tree; that
+   process and the blocks' `symdyn` and `python` commands are forked from a warm interpreter
+   (tests/warm_python.py), which imported SymPy and symdyn once.
 4. The embedded C example (examples/embedded_control/main.c) compiles with the strict flags of
    the C contract and tracks its reference as the linear error equation predicts, and the
    CasADi tutorial's optimal trajectory satisfies the dynamics of the numeric oracle.
@@ -16,6 +18,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import difflib
 import importlib.util
@@ -31,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import warm_python
 import yaml
 
 import symdyn
@@ -150,12 +154,25 @@ WORKER = textwrap.dedent(
 )
 
 
+#: the client end of the warm interpreter (tests/warm_python.py)
+WARM = Path(__file__).resolve().parent / "warm_python.py"
+
+
+def _through_warm(arguments: str) -> str:
+    """The command line of `python ARGUMENTS` through the warm interpreter's client."""
+    return f'exec "{sys.executable}" -S "{WARM}" client "{sys.executable}" {arguments}'
+
+
 def environment(shims: Path) -> dict[str, str]:
-    """The environment of the blocks: this source tree's symdyn, unbuffered, `symdyn` on PATH."""
+    """The environment of the blocks: this source tree's symdyn, unbuffered, `symdyn` on PATH.
+
+    `symdyn` and `python` are served by a warm interpreter once `warm_interpreter` has started
+    one (tests/warm_python.py: a forked child of a process that imported SymPy and symdyn once),
+    else run by this one."""
     shims.mkdir(parents=True, exist_ok=True)
     for name, command in (("symdyn", '-m symdyn.cli "$@"'), ("python", '"$@"'), ("python3", '"$@"')):
         script = shims / name
-        script.write_text(f'#!/bin/sh\nexec "{sys.executable}" {command}\n')
+        script.write_text(f"#!/bin/sh\n{_through_warm(command)}\n")
         script.chmod(0o755)
     env = dict(os.environ)
     env.update(
@@ -167,6 +184,33 @@ def environment(shims: Path) -> dict[str, str]:
         COLUMNS="100",
     )
     return env
+
+
+@contextlib.contextmanager
+def warm_interpreter(env: dict[str, str], folder: Path):
+    """A warm interpreter (tests/warm_python.py) serving the commands run with `env`, which names
+    it ($SYMDYN_WARM_PYTHON) while the context lasts."""
+    address = folder / "warm.sock"
+    server = subprocess.Popen(
+        [sys.executable, str(WARM), "serve", str(address)],
+        env=env,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert server.stdout.readline().strip() == "ready", "the warm interpreter did not start"
+        env[warm_python.ADDRESS_ENV] = str(address)
+        yield env
+    finally:
+        env.pop(warm_python.ADDRESS_ENV, None)
+        server.terminate()  # it waits for its children: their CPU time counts as this process's
+        try:
+            server.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            server.wait()
+        server.stdout.close()
 
 
 def workspace(tmp_path: Path) -> Path:
@@ -181,7 +225,7 @@ def run_blocks(blocks: list[Block], work: Path, env: dict[str, str]) -> list[dic
     todo, done = work.parent / "blocks.json", work.parent / "results.json"
     todo.write_text(json.dumps(spec))
     proc = subprocess.run(
-        [sys.executable, "-c", WORKER, str(todo), str(done)],
+        [sys.executable, "-S", str(WARM), "client", sys.executable, "-c", WORKER, str(todo), str(done)],
         cwd=work,
         env=env,
         capture_output=True,
@@ -207,7 +251,10 @@ def output_matches(expected: str, actual: str) -> bool:
 
 @pytest.fixture(scope="module")
 def block_env(tmp_path_factory) -> dict[str, str]:
-    return environment(tmp_path_factory.mktemp("bin"))
+    """The blocks' environment, with a warm interpreter for their commands (`warm_interpreter`)."""
+    folder = tmp_path_factory.mktemp("bin")
+    with warm_interpreter(environment(folder), folder) as env:
+        yield env
 
 
 def check_results(blocks: list[Block], results: list[dict]) -> None:

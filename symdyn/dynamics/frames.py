@@ -20,7 +20,7 @@ from ..algorithms.operational_space import operational_space, task_rows
 from ..algorithms.tip_wrench import tip_wrench_torque
 from ..errors import SymdynError
 from ..model.free_flyer import NQ_BASE, NV_BASE
-from .numeric import state_vector
+from .numeric import program_function, state_vector
 from .quantities import simplify_entry
 
 __all__ = ["FrameFacade"]
@@ -82,8 +82,7 @@ class FrameFacade:
         if f is None:
             steps = self.frames.program.needed(list(m))
             args = [list(self.q), list(self.qd), list(self.params)]
-            f = sp.lambdify(args, sp.Matrix(m), modules="numpy", cse=lambda exprs: (steps, exprs))
-            self._compiled[key] = f
+            f = self._compiled[key] = program_function(self._compiled, args, m, steps)
         if self.robot.floating:
             vq = state_vector(q, self.robot.nq, "q", where)
             vqd = state_vector(qd, self.robot.nv, "qd", where)
