@@ -18,7 +18,11 @@ contact_forward_dynamics, impulse_dynamics, contact_forward_dynamics_derivatives
 impulse_dynamics_derivatives (the restitution e = 0) called
 on the same NSTATES states as one batch (one thread; the thread's CPU time of the call over
 NSTATES: the generated C plus the batch call's share of Python's overhead), checked against the
-oracle first. Where symdyn has no such functions yet, or they fail, the column says "n/a" and the
+oracle first. The table's calls write into the output arrays of that first call (`out=`, as
+docs/python-api.md advises for repeated calls and as Pinocchio's harness reuses its Data); the
+same calls allocating their outputs each time are timed too and printed below the table (a fresh
+array costs the kernel's mapping and zeroing of its pages: Talos' derivatives write 30 to 46 kB a
+state). Where symdyn has no such functions yet, or they fail, the column says "n/a" and the
 next line says why. Pinocchio's harness and symdyn's batches run in alternating rounds; the
 figures are medians. The targets (issue 36): forward and impulse dynamics <= 0.25 x Pinocchio,
 the derivatives <= 0.35 x. The table goes to stdout and bench/results/contacts.txt.
@@ -149,9 +153,13 @@ def symdyn_methods(robot, contacts) -> tuple[dict, str]:
     return methods, note
 
 
-def symdyn_batches(methods: dict, robot, contacts, st, refs: list[dict]) -> tuple[dict, dict, list[str]]:
-    """Per method: the batch call (a closure), the worst relative error against the oracle at the
-    first NCHECK states, and notes for the methods that fail."""
+def symdyn_batches(
+    methods: dict, robot, contacts, st, refs: list[dict]
+) -> tuple[dict, dict, dict, list[str]]:
+    """Per method: the batch call writing into the output arrays of the first call (out=, as
+    Pinocchio's harness reuses its Data), the same call allocating its outputs (a closure each), the
+    worst relative error against the oracle at the first NCHECK states, and notes for the methods
+    that fail."""
     active = np.ones((NSTATES, len(contacts)))
     e = np.zeros((NSTATES, 1))  # the restitution, an input of its own (0: the contacts stick)
     args = {
@@ -168,7 +176,7 @@ def symdyn_batches(methods: dict, robot, contacts, st, refs: list[dict]) -> tupl
         ),
         "impulse_dynamics_derivatives": ("dqd_plus_dq", "dqd_plus_dqd", "dimpulse_dq", "dimpulse_dqd"),
     }  # fmt: skip
-    calls, errors, notes = {}, {}, []
+    calls, fresh, errors, notes = {}, {}, {}, []
     for name, method in methods.items():
         try:
             got = method(*args[name], threads=1)
@@ -181,9 +189,10 @@ def symdyn_batches(methods: dict, robot, contacts, st, refs: list[dict]) -> tupl
         except Exception as exc:  # noqa: BLE001
             notes.append(f"symdyn {name}: {type(exc).__name__}: {exc}")
             continue
-        calls[name] = lambda method=method, a=args[name]: method(*a, threads=1)
+        calls[name] = lambda method=method, a=args[name], out=got: method(*a, threads=1, out=out)
+        fresh[name] = lambda method=method, a=args[name]: method(*a, threads=1)
         errors[name] = worst
-    return calls, errors, notes
+    return calls, fresh, errors, notes
 
 
 def bench_robot(name: str, work: Path, opts, pin_exe: Path | None) -> dict:
@@ -205,22 +214,25 @@ def bench_robot(name: str, work: Path, opts, pin_exe: Path | None) -> dict:
         pin_cmd = [pin_exe, model]
     log(f"{name}: symdyn.compile with contacts ...")
     methods, note = symdyn_methods(robot, contacts)
-    calls, errors, notes = symdyn_batches(methods, robot, contacts, st, refs)
+    calls, fresh, errors, notes = symdyn_batches(methods, robot, contacts, st, refs)
     result |= {"symdyn_note": note, "symdyn_errors": errors, "notes": notes}
     pin_samples: dict[str, list[float]] = {}
     ours: dict[str, list[float]] = {m: [] for m in calls}
+    allocating: dict[str, list[float]] = {m: [] for m in fresh}
     per_round = max(1, -(-opts.reps // opts.rounds))
     for _ in range(opts.rounds):
         if pin_cmd is not None:
             for label, values in parse_harness(run([*pin_cmd, per_round, opts.target_ms]).stdout)[1].items():
                 pin_samples.setdefault(label, []).extend(values)
-        for method, call in calls.items():
-            for _ in range(per_round):
-                t0 = time.thread_time_ns()
-                call()
-                ours[method].append((time.thread_time_ns() - t0) / NSTATES)
+        for samples, timed in ((ours, calls), (allocating, fresh)):
+            for method, call in timed.items():
+                for _ in range(per_round):
+                    t0 = time.thread_time_ns()
+                    call()
+                    samples[method].append((time.thread_time_ns() - t0) / NSTATES)
     result["pinocchio_ns"] = {k: statistics.median(v) for k, v in pin_samples.items()}
     result["symdyn_ns"] = {k: statistics.median(v) for k, v in ours.items() if v}
+    result["fresh_ns"] = {k: statistics.median(v) for k, v in allocating.items() if v}
     return result
 
 
@@ -250,6 +262,13 @@ def table(results: list[dict], note: str) -> list[str]:
         if r["symdyn_errors"]:
             errs = ", ".join(f"{k} {v:.0e}" for k, v in r["symdyn_errors"].items())
             lines.append(f"{r['robot']}: symdyn against the oracle (relative): {errs}")
+        if r.get("fresh_ns"):
+            fresh = ", ".join(
+                f"{title} {r['fresh_ns'][m]:.0f}" for title, (m, _, _) in ROWS.items() if m in r["fresh_ns"]
+            )
+            lines.append(
+                f"{r['robot']}: symdyn ns allocating its output arrays at every call (no out=): {fresh}"
+            )
         lines += [f"{r['robot']}: {n}" for n in r["notes"]]
     return lines
 

@@ -146,6 +146,27 @@ def test_lagrange_route_in_the_tangent_space_equals_newton_euler(arm):
             )
 
 
+def test_inertia_efforts_change_with_q_as_the_mass_matrix_times_x(arm):
+    """The impulse derivatives differentiate M(q) x through one recursion at rest (inertia_efforts):
+    between two configurations it changes as M(q) x (its constant rotor terms cancel), floating and
+    fixed."""
+    import sympy as sp
+
+    from symdyn.algorithms.floating import inertia_efforts
+    from symdyn.symbolic.program import Program
+
+    planar = symdyn.load_robot(Path(__file__).parents[1] / "examples" / "planar_3r.yaml")
+    rng = np.random.default_rng(5)
+    for dyn in (arm[1], symdyn.derive(planar, simplify=False)):
+        r, prog = dyn.robot, Program()
+        xs = sp.symbols(f"x0:{r.nv}")
+        f = sp.lambdify([list(dyn.q), xs], prog.expand(inertia_efforts(r, list(dyn.q), xs, prog)))
+        x = rng.normal(size=r.nv)
+        q1, q2 = (_state(r, rng)[0] if r.floating else rng.normal(size=r.n) for _ in range(2))
+        got = np.ravel(f(q1, x)) - np.ravel(f(q2, x))
+        np.testing.assert_allclose(got, (mass_matrix(r, q1) - mass_matrix(r, q2)) @ x, atol=1e-12)
+
+
 def test_bad_input(arm):
     robot, dyn = arm
     with pytest.raises(SymdynError, match=r"q has shape \(5,\), expected \(10,\)"):

@@ -35,10 +35,14 @@ computeConstraintDynamicsDerivatives): differentiating the KKT system at the sol
 
     dlambda = A^-1 a * (Jc M^-1 r1 - r2),   dqdd = M^-1 (Jc^T a * dlambda - r1),
 
-and for tau, r1 = -I, r2 = 0. For the impulse, with qd_plus and the impulse held,
+and for tau, r1 = -I, r2 = 0: dqdd/dtau = M^-1 - M^-1 Jc^T A^-1 a* Jc M^-1 is symmetric, and
+KKT.tau_sensitivities computes the half its back substitutions reach first. W's rows are kept
+scaled as D^-1 W too (KKT.WD), so that each product W^T D^-1 u costs one multiplication a term.
+For the impulse, with qd_plus and the impulse held,
 r1 = -d/dx (Jc^T impulse) (M's own derivative times qd_plus - qd enters through
 d/dx (M (qd_plus - qd)), computed as d/dx ID(q, 0, qd_plus - qd) without gravity: the
-inertia part of the RNEA), r2 = d/dx (Jc (qd_plus + e qd)). By qd, M and Jc are constant:
+inertia part of the RNEA, symdyn.algorithms.floating.inertia_efforts, one recursion to
+differentiate instead of M's NV^2 entries), r2 = d/dx (Jc (qd_plus + e qd)). By qd, M and Jc are constant:
 r1 = -M, r2 = e Jc, and the sensitivities reduce to dimpulse/dqd = -(1 + e) A^-1 a * Jc,
 dqd_plus/dqd = I + M^-1 Jc^T dimpulse/dqd (KKT.jump_sensitivities: no solves of M's dense columns,
 a third of Talos' impulse derivatives before). The derivatives by q are taken in
@@ -90,11 +94,14 @@ class FactoredMass:
             y.append(self.program.let(s, hint) if s != 0 else sp.S.Zero)
         return y
 
-    def backward(self, y: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
-        """P^T L^-T D^-1 y: M^-1 x for y = forward(x), in the natural order."""
+    def backward(self, y: Sequence[sp.Expr], hint: str, last: int = 0) -> list[sp.Expr]:
+        """P^T L^-T D^-1 y: M^-1 x for y = forward(x), in the natural order. The solve runs from the
+        last eliminated coordinate down to position `last` of the order: entry order[i] of the result
+        reads only positions above i, so stopping there leaves exactly the positions below `last`
+        out (their entries are None)."""
         n, L = len(self.order), self.L
-        z: list[sp.Expr] = [sp.S.Zero] * n
-        for i in reversed(range(n)):
+        z: list = [None] * n
+        for i in range(n - 1, last - 1, -1):
             s = y[i] * self.Dinv[i] - _sum(L[k, i] * z[k] for k in range(i + 1, n) if L[k, i] != 0)
             z[i] = self.program.let(s, hint) if s != 0 else sp.S.Zero
         out: list[sp.Expr] = [sp.S.Zero] * n
@@ -102,9 +109,16 @@ class FactoredMass:
             out[j] = z[i]
         return out
 
-    def weighted(self, u: Sequence[sp.Expr], w: Sequence[sp.Expr]) -> sp.Expr:
-        """u^T D^-1 w of two forward() results."""
-        return _sum(a * d * b for a, d, b in zip(u, self.Dinv, w, strict=True) if a != 0 and b != 0)
+    def scaled(self, w: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
+        """D^-1 w of a forward() result, nonzero entries named (for `dot` with many vectors)."""
+        return [
+            self.program.let(a * d, hint) if a != 0 else sp.S.Zero for a, d in zip(w, self.Dinv, strict=True)
+        ]
+
+
+def _dot(u: Sequence[sp.Expr], w: Sequence[sp.Expr]) -> sp.Expr:
+    """u^T w over the entries that are not exact zeros."""
+    return _sum(a * b for a, b in zip(u, w, strict=True) if a != 0 and b != 0)
 
 
 def masked_delassus(A0: sp.Matrix, active: Sequence[sp.Expr], program: Program, hint: str) -> sp.Matrix:
@@ -144,10 +158,11 @@ class KKT:
         self.mass = FactoredMass.of(self.M, self.order, prog, "kD")
         m = self.Jc.rows
         self.W = [self.mass.forward(list(self.Jc[r, :]), "kW") for r in range(m)]  # L^-1 P Jc_r^T
+        self.WD = [self.mass.scaled(w, "kV") for w in self.W]  # D^-1 L^-1 P Jc_r^T
         A0 = sp.zeros(m, m)
         for r in range(m):
             for s in range(r, m):
-                A0[r, s] = A0[s, r] = self.mass.weighted(self.W[r], self.W[s])
+                A0[r, s] = A0[s, r] = _dot(self.WD[r], self.W[s])
         self.A = masked_delassus(A0, self.active, prog, "kA")
         self.factor = FactoredMass.of(self.A, range(m), prog, "kL")
 
@@ -162,7 +177,7 @@ class KKT:
     def forward_dynamics(self, force: Sequence[sp.Expr], gamma: Sequence[sp.Expr]) -> tuple[list, list]:
         """(qdd, lambda) solving M qdd = force + Jc^T lambda, Jc qdd + gamma = 0 (force = tau - b)."""
         u = self.mass.forward(list(force), "ku")
-        rhs = [-(g + self.mass.weighted(w, u)) for g, w in zip(gamma, self.W, strict=True)]
+        rhs = [-(g + _dot(w, u)) for g, w in zip(gamma, self.WD, strict=True)]
         lam = self.solve_rows(rhs, "kl")
         return self._accelerate(u, lam, "kq"), lam
 
@@ -177,13 +192,14 @@ class KKT:
         dv = self._accelerate([sp.S.Zero] * len(self.order), imp, "kp")
         return [self.program.let(q + d, "kp") for q, d in zip(qd, dv, strict=True)], imp
 
-    def _accelerate(self, u: Sequence[sp.Expr], lam: Sequence[sp.Expr], hint: str) -> list[sp.Expr]:
-        """M^-1 (x + Jc^T lam) for u = L^-1 P x."""
+    def _accelerate(self, u: Sequence[sp.Expr], lam: Sequence[sp.Expr], hint: str, last: int = 0) -> list:
+        """M^-1 (x + Jc^T lam) for u = L^-1 P x (down to position `last` of the order:
+        FactoredMass.backward)."""
         y = [
             _sum([u[i], *(self.W[r][i] * lam[r] for r in range(len(lam)) if self.W[r][i] != 0)])
             for i in range(len(u))
         ]
-        return self.mass.backward(y, hint)
+        return self.mass.backward(y, hint, last)
 
     def sensitivities(self, r1: sp.Matrix, r2: sp.Matrix, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
         """(dqdd, dlambda) = (M^-1 (Jc^T dlambda - r1), A^-1 a * (Jc M^-1 r1 - r2)) column by column
@@ -192,13 +208,35 @@ class KKT:
         cols_q, cols_l = [], []
         for j in range(r1.cols):
             u = self.mass.forward([-x for x in r1[:, j]], f"{hint}u")  # L^-1 P (-r1)
-            rhs = [-(self.mass.weighted(w, u) + r2[r, j]) for r, w in enumerate(self.W)]
+            rhs = [-(_dot(w, u) + r2[r, j]) for r, w in enumerate(self.WD)]
             dl = self.solve_rows(rhs, f"{hint}l")
             cols_q.append(self._accelerate(u, dl, f"{hint}q"))
             cols_l.append(dl)
         dq = sp.Matrix(r1.rows, r1.cols, lambda i, j: cols_q[j][i])
         dl = sp.Matrix(r2.rows, r1.cols, lambda i, j: cols_l[j][i])
         return dq, dl
+
+    def tau_sensitivities(self, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
+        """(dqdd/dtau, dlambda/dtau): `sensitivities` with r1 = -I, r2 = 0, using the symmetry of
+        dqdd/dtau = M^-1 - M^-1 Jc^T A^-1 a* Jc M^-1 (the top-left block of the KKT matrix's inverse:
+        A^-1 a* = a* A^-1 a* when every a_r is 0 or 1, as A then has no entry between an active and an
+        inactive row). Column j's back substitution stops at j's position in M's elimination order,
+        so each column computes the entries eliminated at or after j (M^-1's column j reads those
+        only) and the rest are mirrored: half the back substitutions' work. dlambda/dtau =
+        -A^-1 a* Jc M^-1 column by column, as before."""
+        n, m = self.Jc.cols, self.Jc.rows
+        position = {j: i for i, j in enumerate(self.order)}
+        cols_q, cols_l = [], []
+        for j in range(n):
+            u = self.mass.forward([sp.S.One if i == j else sp.S.Zero for i in range(n)], f"{hint}u")
+            dl = self.solve_rows([-_dot(w, u) for w in self.WD], f"{hint}l")
+            cols_q.append(self._accelerate(u, dl, f"{hint}q", position[j]))
+            cols_l.append(dl)
+
+        def entry(i: int, j: int) -> sp.Expr:
+            return cols_q[j][i] if position[i] >= position[j] else cols_q[i][j]
+
+        return sp.Matrix(n, n, entry), sp.Matrix(m, n, lambda i, j: cols_l[j][i])
 
     def jump_sensitivities(self, restitution: sp.Expr, hint: str) -> tuple[sp.Matrix, sp.Matrix]:
         """(dqd_plus/dqd, dimpulse/dqd) of `impulse` in closed form (module docstring): M and Jc do

@@ -44,7 +44,7 @@ from .floating_lagrange import floating_lagrange
 from .frames import joint_frames
 from .newton_euler import LinkAcceleration, body_wrench, newton_euler, tilde
 
-__all__ = ["floating_newton_euler_terms", "floating_lagrange_terms", "base_gravity_vector"]
+__all__ = ["floating_newton_euler_terms", "floating_lagrange_terms", "base_gravity_vector", "inertia_efforts"]
 
 
 def base_gravity_vector(robot: Robot, quaternion: Sequence, program: Program) -> v3.Vec:
@@ -144,6 +144,25 @@ def floating_newton_euler_terms(robot: Robot, q, qd, qdd, program: Program) -> d
             ]
         out[key] = sp.Matrix([*rows, *project_vector(robot, tau_b, program, key)])
     return out
+
+
+def inertia_efforts(robot: Robot, q, x, program: Program, tag: str = "X") -> list[sp.Expr]:
+    """The part of M(q) x that depends on q, by one Newton-Euler pass at rest without gravity:
+    NE(q, 0, x) (n entries; on a floating robot NV, x's base rows the base twist's rate, from the
+    moving root above), the rotors' reflected inertia and the tendons' armature (constant in q) left
+    out. So d(M(q) x)/dq = d NE(q, 0, x)/dq with x held: one recursion to differentiate, where the
+    entries of M would be NV^2 (the impulse's derivative, symdyn.codegen.contact_functions)."""
+    q = list(q)
+    joints_q, joints_x = (q[7:], list(x[6:])) if robot.floating else (q, list(x))
+    q_b, x_b = robot.body_positions(joints_q), robot.body_rates(joints_x)
+    rot = joint_frames(robot, q_b)
+    zeros = [0] * robot.nb
+    if not robot.floating:
+        tau_b = newton_euler(robot, q_b, zeros, x_b, program, gravity=False, tag=tag, rotations=rot)
+        return project_vector(robot, tau_b, program, tag)
+    base = _base_motion([0] * 6, list(x[:6]), None, program, tag)
+    tau_b, rows = _base_pass(robot, q_b, zeros, x_b, base, rot, program, tag)
+    return [*rows, *project_vector(robot, tau_b, program, tag)]
 
 
 def floating_lagrange_terms(robot: Robot, q, qd, qdd, program: Program) -> dict[str, sp.Matrix]:

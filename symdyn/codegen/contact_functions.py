@@ -32,6 +32,7 @@ import sympy as sp
 from ..algorithms.contact_dynamics import DAMPING, KKT
 from ..algorithms.contacts import ContactKinematics
 from ..algorithms.derivatives import elimination_order, floating_effort_jacobians, jacobian, substitute
+from ..algorithms.floating import inertia_efforts
 from ..dynamics import Dynamics
 from .frame_functions import frames_of
 from .function_rows import FunctionRow, Input, Inputs, Output
@@ -211,10 +212,11 @@ def _derivative_rows(dyn, x, prog, kkt: KKT, Jc, gamma, solved, inputs, cols) ->
     d1q, d1v = (sp.Matrix(nv + m, nv, substitute(prog, _entries(d), at, "cS")) for d in (d1q, d1v))
     ddq, dlq = kkt.sensitivities(d1q[:nv, :], d1q[nv:, :], "cq")
     ddv, dlv = kkt.sensitivities(d1v[:nv, :], d1v[nv:, :], "cv")
-    ddt, dlt = kkt.sensitivities(-sp.eye(nv), sp.zeros(m, nv), "ct")
-    # impulse: r1 = d(M (qd_plus - qd) - Jc^T impulse), r2 = d(Jc (qd_plus + e qd)), both held
-    M = sp.Matrix(c["M"])
-    e3 = [sp.Add(*[M[i, j] * (vel[j] - qd[j]) for j in range(nv) if M[i, j] != 0]) - JT[i] for i in range(nv)]
+    ddt, dlt = kkt.tau_sensitivities("ct")  # r1 = -I, r2 = 0: dqdd/dtau symmetric
+    # impulse: r1 = d(M (qd_plus - qd) - Jc^T impulse), r2 = d(Jc (qd_plus + e qd)), both held;
+    # M (qd_plus - qd) by the recursion at rest (its q-dependent part, inertia_efforts)
+    Mx = inertia_efforts(robot, q, [v - w for v, w in zip(vel, qd, strict=True)], prog)
+    e3 = [a - b for a, b in zip(Mx, JT, strict=True)]
     er = e.symbols[0]
     e4 = [sp.Add(*[Jc[r, j] * (vel[j] + er * qd[j]) for j in range(nv) if Jc[r, j] != 0]) for r in range(m)]
     d2q, _ = _tangent(prog, e3 + e4, q, qd, robot.floating, "cI")
