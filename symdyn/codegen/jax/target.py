@@ -4,15 +4,19 @@ It holds every function of the context (docs/generated-code.md) with the NumPy t
 names and arguments, written for ONE state: vectors of shape (n,), p of shape (k,). The
 bodies are the eliminated straight-line code, one statement per temporary, with no branch
 on a value, no in-place update and no NumPy call, so that jax.jit, jax.vmap, jax.grad and
-jax.jacfwd, and jax.lax.scan apply to them unchanged; p is an argument, so parameters can
-be fitted by gradient. Vectors are returned through jax.lax.select_n (the module's
-_vector_of), not jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times
-slower under jax.vmap for the Panda (docs/jax.md). Each function has a batched twin NAME_batch
-(vmapped over the leading axis of the arguments that have one, jitted). Inputs and outputs are float64
+jax.lax.scan apply to them unchanged; p is an argument, so parameters can be fitted by
+gradient. Vectors are returned through jax.lax.select_n (the module's _vector_of), not
+jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times slower under jax.vmap
+for the Panda (docs/jax.md). Each function has a batched twin NAME_batch (vmapped over the
+leading axis of the arguments that have one, jitted). Inputs and outputs are float64
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
-rather than compute in float32) or float32. The functions of RULES are jax.custom_jvp functions
-whose rule is their generated derivative function (the module's _analytic_jvp; on a floating
-base q's NQ entries mapped to the tangent space by _q_to_tangent).
+rather than compute in float32) or float32.
+
+The functions of ADJOINTS are jax.custom_vjp functions whose backward pass is their adjoint
+program (symdyn.symbolic.adjoint: w^T dy/dx for every input, p included, one straight-line
+function whose cotangents are selected vectors too): XLA's own reverse mode of the long
+straight-line bodies makes every cotangent entry a fusion of its own that recomputes what it
+reads (docs/jax.md), 10 to 60 times slower.
 
 The names, shapes and printed expressions are the NumPy target's (symdyn.codegen.python,
 printed with the namespace `jnp`); every Python statement is spelled in templates/jax/module.py.j2.
@@ -20,19 +24,26 @@ printed with the namespace `jnp`); every Python statement is spelled in template
 
 from __future__ import annotations
 
-from ..python.target import render_module
+import re
+from collections.abc import Iterator
+
+import sympy as sp
+
+from ...symbolic.adjoint import adjoint_program
+from ..function_rows import FunctionSpec
+from ..python.printer import NumpyPrinter, local_names
+from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 
-__all__ = ["render", "file_name", "TOOLS", "RULES"]
+__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "adjoint_view"]
 
-#: The functions differentiated by a jax.custom_jvp rule made of a generated derivative function,
-#: {function: derivative function}, when the module holds both: the derivative function returns
-#: the Jacobians by each input of the function but p, in the order of the inputs (forward
-#: dynamics: dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1). Chosen by measurement (bench/jax.py,
-#: docs/jax.md): for the Panda, jax.jit(jax.grad(...)) through jax.vmap of the forward dynamics
-#: took 6.2 ms a state by XLA's reverse mode and 108 us by the rule; the inverse dynamics keeps
-#: XLA's autodiff, which was faster than its rule (12 against 17 us; jacfwd 16 against 31 us).
-RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
+#: The functions given a jax.custom_vjp whose backward pass is their generated adjoint program
+#: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
+#: argument of that name). Chosen by measurement (bench/jax.py, docs/jax.md): for the Panda,
+#: jax.jit(jax.grad(...)) through jax.vmap of the inverse dynamics took 7.9 us a state by XLA's
+#: reverse mode, 17.6 us through a custom_jvp rule of the generated tangent program (JAX
+#: transposing it) and 0.59 us through the adjoint program (3.3 times the forward pass).
+ADJOINTS = ("inverse_dynamics", "forward_dynamics")
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
@@ -42,22 +53,48 @@ def file_name(name: str) -> str:
     return f"{name}_jax.py"
 
 
-def rules(ctx: RenderContext) -> dict[str, str]:
-    """The entries of RULES whose two functions are both in `ctx`, with the same inputs, and
-    the derivative function with one Jacobian per input but p."""
-    specs = {spec.name: spec for spec in ctx.functions}
-    out = {}
-    for name, derivative in RULES.items():
-        f, d = specs.get(name), specs.get(derivative)
-        if f is None or d is None:
-            continue
-        inputs = [inp.name for inp in f.inputs]
-        moving = [i for i in inputs if i != "p"]
-        if inputs == [inp.name for inp in d.inputs] and len(d.results) == len(moving):
-            out[name] = derivative
-    return out
+def _numbered_after(spec: FunctionSpec) -> Iterator[sp.Symbol]:
+    """Fresh temporaries x<k>, numbered after the spec's own (no parameter is named so: local_names)."""
+    taken = [int(m.group(1)) for s, _ in spec.temporaries if (m := re.fullmatch(r"x(\d+)", s.name))]
+    return sp.numbered_symbols("x", start=max(taken, default=-1) + 1)
+
+
+def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
+    """The adjoint program of `spec` as the template prints it: arguments (the inputs, p, then the
+    output's cotangent, named as the output), the entries it reads, temporaries, and one vector of
+    cotangent entries per input (p's last); None unless `spec` has one vector output named as no
+    input."""
+    (out,) = spec.results if len(spec.results) == 1 else (None,)
+    names = [inp.name for inp in spec.inputs]
+    if out is None or out.matrix or out.name in names or out.name not in JOINT_INPUTS:
+        return None
+    fresh = _numbered_after(spec)
+    weights = [next(fresh) for _ in range(out.size)]
+    inputs = [s for inp in spec.inputs for s in inp.symbols]
+    program = adjoint_program(spec.temporaries, spec.outputs, weights, inputs, fresh)
+    exprs = [e for _, e in program.temporaries] + list(program.outputs)
+    free = set().union(*(e.free_symbols for e in exprs))
+    read = [(s, inp.name, k) for inp in spec.inputs for k, s in enumerate(inp.symbols) if s in free]
+    read += [(w, out.name, k) for k, w in enumerate(weights) if w in free]
+    cotangents, start = [], 0
+    for inp in spec.inputs:
+        cotangents.append([printer.doprint(e) for e in program.outputs[start : start + len(inp.symbols)]])
+        start += len(inp.symbols)
+    return {
+        "args": [*names, out.name],
+        "unpack": [(printer.doprint(s), array, k) for s, array, k in read],
+        "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in program.temporaries],
+        "cotangents": cotangents,
+    }
+
+
+def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
+    """{function: adjoint_view} for the functions of ADJOINTS in `ctx`."""
+    printer = NumpyPrinter(local_names(ctx), module="jnp")
+    views = {spec.name: adjoint_view(spec, printer) for spec in ctx.functions if spec.name in ADJOINTS}
+    return {name: view for name, view in views.items() if view is not None}
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_jax.py: module text} for the robot of `ctx`."""
-    return {file_name(ctx.name): render_module(ctx, "jax/module.py.j2", "jnp", rules=rules(ctx))}
+    return {file_name(ctx.name): render_module(ctx, "jax/module.py.j2", "jnp", adjoints=adjoint_views(ctx))}
