@@ -1,7 +1,8 @@
 """The JAX target on the CPU against the NumPy module and ADAM (issues 26 and 37), in one run.
 
     python bench/jax.py [--robot panda|solo12|talos] [--groups G,..] [--functions F,..]
-                        [--batch N] [--reps R] [--xla-grad] [--no-xla-flags] [--adam-python PATH] [--out FILE]
+                        [--batch N] [--reps R] [--xla-grad] [--no-xla-flags] [--no-jacobians]
+                        [--adam-python PATH] [--out FILE]
 
 The robot's URDF of example-robot-data is generated in double precision for the targets python
 and jax (--groups, default dynamics; the JAX inverse and forward dynamics are jax.custom_vjp
@@ -199,12 +200,13 @@ def worker(
     own=False,
     functions=FUNCTIONS,
     xla_grad=False,
+    jacobians=True,
 ) -> dict:
     """Time the generated JAX module (and ADAM when `urdf` is given; when `own`, jax.jit(jax.vmap(f))
     of the one-state functions, jit(grad) through it, jit(vmap(jacfwd(f))), jit(vmap(jacrev(f)))
     and a jax.lax.scan over the states, and with `xla_grad` jit(grad) by XLA's autodiff of the
-    functions that have an adjoint program) in this interpreter; check each against `reference`
-    (the oracle's values on the first NCHECK states)."""
+    functions that have an adjoint program; without `jacobians` no jacfwd or jacrev) in this
+    interpreter; check each against `reference` (the oracle's values on the first NCHECK states)."""
     import jax
 
     jax.config.update("jax_enable_x64", True)
@@ -232,7 +234,7 @@ def worker(
                 error = _grad_error(jax, jnp, g, grad, _arguments(check, f))
                 out["error"][f"{key} {f} (against central differences)"] = error
                 out[key][f] = _jax_timing(grad, args, count, max(1, reps // 2))
-            for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)):
+            for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)) if jacobians else ():
                 log(f"{key} {f}")
                 try:
                     route = jax.jit(jax.vmap(jacobian(fn)))
@@ -394,6 +396,7 @@ def main(argv=None) -> int:
         "--xla-grad", action="store_true", help="also jit(grad) by XLA's autodiff of the adjoints' bodies"
     )
     parser.add_argument("--no-xla-flags", action="store_true", help="skip the run with the emitters off")
+    parser.add_argument("--no-jacobians", action="store_true", help="skip jit(vmap(jacfwd)) and jacrev")
     parser.add_argument("--adam-python", help="a Python with adam-robotics[jax] (and its jax) installed")
     parser.add_argument("--out", help="the table's file (default bench/results/jax.txt, jax_ROBOT.txt)")
     parser.add_argument("--worker", help=argparse.SUPPRESS)  # a JSON file of worker()'s arguments
@@ -440,7 +443,9 @@ def main(argv=None) -> int:
         log("JAX (this Python)")
         args = {"module_path": str(jax_path), "urdf": None, "count": opts.batch, "reps": opts.reps}
         args["functions"] = opts.functions
-        results["here"] = worker(**args, reference=reference, own=True, xla_grad=opts.xla_grad)
+        results["here"] = worker(
+            **args, reference=reference, own=True, xla_grad=opts.xla_grad, jacobians=not opts.no_jacobians
+        )
         if not opts.no_xla_flags:
             log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
             flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()
