@@ -5,9 +5,10 @@
                         [--adam-python PATH] [--out FILE]
 
 The robot's URDF of example-robot-data is generated in double precision for the targets python
-and jax (--groups, default dynamics; the JAX inverse and forward dynamics are jax.custom_vjp
-functions whose backward pass is their generated adjoint program), into a temporary folder of the
-run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link 7), Solo-12 and
+and jax (--groups, default dynamics,derivatives; the JAX inverse dynamics is a jax.custom_vjp
+function whose backward pass is its generated adjoint program, and with the derivatives the
+forward dynamics a jax.custom_jvp whose rule is forward_dynamics_derivatives), into a temporary
+folder of the run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link 7), Solo-12 and
 the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
 of --functions (default inverse dynamics, M and forward dynamics) is timed per state:
 * NumPy, one state per call (the generated NumPy module, from Python);
@@ -365,7 +366,8 @@ def table(results: dict, opts, robot) -> list[str]:
         "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
         "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
         "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0 (q), XLA's defaults, through the module's "
-        "adjoint program where it has one (a custom_vjp: the inverse and forward dynamics); "
+        "adjoint program or custom_jvp rule where it has one (the inverse dynamics' custom_vjp, the "
+        "forward dynamics' rule with --functions derivatives); "
         "jit(grad), XLA: the same by XLA's autodiff of the body (--xla-grad); "
         "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q; jacfwd '-': "
         "forward mode refused, a custom_vjp function); scan: jax.jit of jax.lax.scan over the "
@@ -388,7 +390,7 @@ def table(results: dict, opts, robot) -> list[str]:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python bench/jax.py", description=__doc__.split("\n")[0])
     parser.add_argument("--robot", choices=tuple(ROBOTS), default="panda", help="the robot (default panda)")
-    parser.add_argument("--groups", default="dynamics", help="--functions of the generation")
+    parser.add_argument("--groups", default="dynamics,derivatives", help="--functions of the generation")
     parser.add_argument("--functions", default=",".join(FUNCTIONS), help="the functions timed")
     parser.add_argument("--batch", type=int, default=100_000, help="states per batch call")
     parser.add_argument("--reps", type=int, default=5, help="timed repetitions (medians)")

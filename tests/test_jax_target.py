@@ -4,8 +4,9 @@ generated/ holds NAME_jax.py beside NAME_numpy.py for roger_arm, puma560, panda 
 functions) and the legs of solo12 (a kinematic tree), kept up to date by tests/test_generated.py,
 so no robot is derived here. At a random state every function of each JAX module must equal the
 NumPy module's (itself checked against the oracle by tests/test_numpy_target.py) to 1e-12, and
-the dynamics the oracle's; jax.jacrev of the JAX inverse and forward dynamics (their adjoint
-programs) must equal the generated derivative functions, jax.jacrev in p central differences;
+the dynamics the oracle's; jax.jacrev of the JAX inverse dynamics (its adjoint program) and
+jax.jacfwd of the forward dynamics must equal the generated derivative functions, jax.jacrev in
+p central differences;
 jit and vmap (the f_batch twins) and jax.lax.scan (a simulation) give the NumPy module's
 values; a float32 module is checked with a float32 tolerance, and a double one refuses to
 import without JAX's x64 mode.
@@ -133,10 +134,11 @@ def test_every_function_matches_numpy_and_the_oracle(robot, modules):
     _close(jax_mod.forward_dynamics(q, qd, tau, p), qdd, rtol=1e-9)
 
 
-def test_jacrev_equals_the_generated_derivatives(modules):
-    """jax.jit of jax.jacrev through the JAX inverse and forward dynamics (their adjoint
-    programs) = the derivative functions symdyn derived symbolically (and M^-1 = d qdd / d tau),
-    for Roger's arm; forward mode of these custom_vjp functions is refused by JAX (TypeError)."""
+def test_jacobians_equal_the_generated_derivatives(modules):
+    """jax.jit of jax.jacrev through the JAX inverse dynamics (its adjoint program) and of
+    jax.jacfwd through the forward dynamics (its custom_jvp rule) = the derivative functions
+    symdyn derived symbolically (and M^-1 = d qdd / d tau), for Roger's arm; forward mode of the
+    inverse dynamics, a custom_vjp function, is refused by JAX (TypeError)."""
     jax_mod, _, _ = modules["roger_arm"]
     rng = np.random.default_rng(3)
     q, qd, qdd, tau = rng.uniform(-2.0, 2.0, (4, jax_mod.NDOF))
@@ -145,23 +147,24 @@ def test_jacrev_equals_the_generated_derivatives(modules):
     want_dq, want_dqd = jax_mod.inverse_dynamics_derivatives(q, qd, qdd, p)
     _close(dq, want_dq, rtol=1e-10)
     _close(dqd, want_dqd, rtol=1e-10)
-    dq, dqd, dtau = jax.jit(jax.jacrev(jax_mod.forward_dynamics, argnums=(0, 1, 2)))(q, qd, tau, p)
+    dq, dqd, dtau = jax.jit(jax.jacfwd(jax_mod.forward_dynamics, argnums=(0, 1, 2)))(q, qd, tau, p)
     want_dq, want_dqd, minv = jax_mod.forward_dynamics_derivatives(q, qd, tau, p)
     _close(dq, want_dq, rtol=1e-10)
     _close(dqd, want_dqd, rtol=1e-10)
     _close(dtau, minv, rtol=1e-10)
-    for f, args in ((jax_mod.inverse_dynamics, (q, qd, qdd, p)), (jax_mod.forward_dynamics, (q, qd, tau, p))):
-        with pytest.raises(TypeError, match="custom_vjp"):
-            jax.jacfwd(f)(*args)
+    with pytest.raises(TypeError, match="custom_vjp"):
+        jax.jacfwd(jax_mod.inverse_dynamics)(q, qd, qdd, p)
 
 
 def test_adjoints_equal_autodiff_and_differences(modules):
-    """forward_dynamics and inverse_dynamics are jax.custom_vjp functions whose backward pass is
-    their adjoint program: jacrev by every argument, p included, equals XLA's autodiff of the
-    body as written (_NAME_plain); jacrev vmapped over states equals the generated derivatives
-    state by state; grad of a vmapped loss equals central differences of the NumPy module's
-    loss (Roger's arm: 5 free parameters). All in one jit: one compilation costs less than
-    running the transformations op by op."""
+    """inverse_dynamics is a jax.custom_vjp function whose backward pass is its adjoint program,
+    forward_dynamics a jax.custom_jvp whose rule is forward_dynamics_derivatives: jacrev of both
+    (and jacfwd of the forward dynamics) by every argument, p included, equals XLA's autodiff of
+    the body as written (_NAME_plain); jacrev vmapped over states equals the generated
+    derivatives state by state; grad of a vmapped loss equals central differences of the NumPy
+    module's loss (Roger's arm: 5 free parameters, a tangent of p goes through forward mode in
+    the rule). All in one jit: one compilation costs less than running the transformations op
+    by op."""
     jax_mod, numpy_mod, _ = modules["roger_arm"]
     fd, every = jax_mod.forward_dynamics, (0, 1, 2, 3)
     rng = np.random.default_rng(31)
@@ -178,13 +181,14 @@ def test_adjoints_equal_autodiff_and_differences(modules):
     def transformed(q, qd, tau, p, Q):
         return (
             [jax.jacfwd(plain, argnums=every)(q, qd, tau, p) for plain, _ in pairs],
-            [jax.jacrev(f, argnums=every)(q, qd, tau, p) for _, f in pairs],
+            [jax.jacrev(f, argnums=every)(q, qd, tau, p) for _, f in pairs]
+            + [jax.jacfwd(fd, argnums=every)(q, qd, tau, p)],
             jax.vmap(jax.jacrev(fd, argnums=(0, 1, 2)), in_axes=(0, 0, 0, None))(Q, QD, TAU, p),
             jax.grad(lambda q, p: jnp.sum(vmapped(q, QD, TAU, p) ** 2), argnums=(0, 1))(Q, p),
         )
 
     wants, reverses, per_state, (got_q, got_p) = transformed(q, qd, tau, p, Q)
-    for want, reverse in zip(wants, reverses, strict=True):
+    for want, reverse in zip([*wants, wants[0]], reverses, strict=True):
         for g, w in zip(reverse, want, strict=True):
             _close(g, w, rtol=1e-10)
     for k in range(len(Q)):
@@ -208,7 +212,7 @@ def test_adjoints_equal_autodiff_and_differences(modules):
 
 def test_grad_through_a_lax_scan_equals_differences(modules):
     """jit(grad) of the end of a jax.lax.scan simulation (reverse mode through the scan and the
-    forward dynamics' adjoint program) by the initial rates = central differences of the same loop
+    forward dynamics' rule) by the initial rates = central differences of the same loop
     written with the NumPy module."""
     jax_mod, numpy_mod, _ = modules["roger_arm"]
     p = np.array([9.81, 1.0, 1.2, 0.8, 0.7])
@@ -244,7 +248,7 @@ def test_grad_through_a_lax_scan_equals_differences(modules):
     _close(got, want, rtol=1e-7)
 
 
-#: A floating base with one revolute joint: the smallest robot whose adjoint reads a quaternion
+#: A floating base with one revolute joint: the smallest robot whose rule maps a quaternion
 FLYER = """
 name: flyer
 base: {floating: true, mass: 2, com: [0.05, -0.02, 0.1], inertia: {ixx: 0.1, iyy: 0.12, izz: 0.2, ixy: 0.01}}
@@ -254,12 +258,12 @@ links:
 """
 
 
-def test_forward_dynamics_adjoint_by_the_quaternion_entries(x64, tmp_path):
-    """On a floating base the adjoint program differentiates by q's NQ entries (a quaternion of
-    any norm, which the functions normalise): jax.jacrev of the forward dynamics by q equals
-    central differences of the numeric oracle in q's entries (the base position's columns 0, a
-    change along the quaternion none). Only the two functions are rendered (the groups' other
-    functions dropped before printing)."""
+def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
+    """On a floating base the rule maps q's NQ entries (a quaternion of any norm) to the tangent
+    space of the generated Jacobians: jax.jacrev of the
+    forward dynamics by q equals central differences of the numeric oracle in q's entries (the
+    base position's columns 0, a change along the quaternion none). Only the two functions are
+    rendered (the groups' other functions dropped before printing)."""
     (tmp_path / "flyer.yaml").write_text(FLYER)
     robot = load_robot(tmp_path / "flyer.yaml")
     ctx = context(robot, functions=["dynamics", "derivatives"])

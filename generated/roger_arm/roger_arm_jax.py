@@ -41,6 +41,7 @@ import functools
 
 import jax
 import jax.numpy as jnp
+from jax.custom_derivatives import SymbolicZero
 
 NDOF = 2
 NPARAM = 5
@@ -140,6 +141,28 @@ def _batch(f):
             return plain(*args)
 
     return call
+
+
+def _analytic_jvp(plain, derivatives, primals, tangents, has_p):
+    """(plain(*primals), its derivative along tangents) from the Jacobians that `derivatives`
+    returns, one per argument but p, in their order: the tangent sum_i J_i t_i, linear in the
+    tangents, so that JAX transposes it for jax.grad and jax.jacrev; a tangent of p is pushed
+    through plain by forward mode. The rule of a jax.custom_jvp with symbolic zeros: an argument
+    that does not move (SymbolicZero) costs nothing, and the Jacobians are computed only when
+    one of their arguments moves."""
+    value = plain(*primals)
+    count = len(primals) - 1 if has_p else len(primals)
+    moving = [i for i in range(count) if not isinstance(tangents[i], SymbolicZero)]
+    tangent = jnp.zeros_like(value)
+    if moving:
+        jacobians = derivatives(*primals)
+        for i in moving:
+            t = tangents[i]
+            tangent = tangent + jacobians[i] @ t
+    if has_p and not isinstance(tangents[-1], SymbolicZero):
+        fixed = primals[:-1]
+        tangent = tangent + jax.jvp(lambda p: plain(*fixed, p), (primals[-1],), (tangents[-1],))[1]
+    return value, tangent
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -468,7 +491,7 @@ def forward_dynamics(q, qd, tau, p=None):
 
 def _forward_dynamics_plain(q, qd, tau, p):
     """forward_dynamics of checked arguments: the function that _forward_dynamics_rule differentiates
-    in reverse mode by _forward_dynamics_adjoint."""
+    by forward_dynamics_derivatives."""
     q1 = q[0]
     q2 = q[1]
     qd1 = qd[0]
@@ -527,135 +550,14 @@ def _forward_dynamics_plain(q, qd, tau, p):
     )
 
 
-def _forward_dynamics_adjoint(q, qd, tau, p, qdd):
-    """The cotangents of the inputs of forward_dynamics (q, qd, tau, p) for the
-    cotangent qdd of its output: qdd^T dqdd/d(input), by the adjoint program
-    (symdyn.symbolic.adjoint: its statements in reverse order, each one's adjoint passed on
-    through the partial derivatives of its expression), one selected vector per input."""
-    q1 = q[0]
-    q2 = q[1]
-    qd1 = qd[0]
-    qd2 = qd[1]
-    tau1 = tau[0]
-    tau2 = tau[1]
-    g = p[0]
-    l1 = p[1]
-    m1 = p[2]
-    l2 = p[3]
-    m2 = p[4]
-    x41 = qdd[0]
-    x42 = qdd[1]
-    x0 = g*jnp.sin(q1)
-    x1 = m1*x0
-    x2 = l1*x1
-    x3 = jnp.cos(q2)
-    x4 = x0*x3
-    x5 = jnp.sin(q2)
-    x6 = qd1*qd1
-    x7 = l1*x6
-    x8 = g*jnp.cos(q1)
-    x9 = -x7 - x8
-    x10 = -x5*x9
-    x11 = x10 + x4
-    x12 = m2*x11
-    x13 = l2*x12
-    x14 = qd1 + qd2
-    x15 = x14*x14
-    x16 = l2*x15
-    x17 = x3*x9
-    x18 = x0*x5 + x17
-    x19 = -x16 + x18
-    x20 = m2*x19
-    x21 = x12*x3 + x20*x5
-    x22 = l1*x21 + x13 + x2
-    x23 = tau1 - x22
-    x24 = l1*l1
-    x25 = l2*m2
-    x26 = x25*x3
-    x27 = l1*x26
-    x28 = (l2*l2)*m2
-    x29 = m1*x24
-    x30 = m2*x24 + 2*x27 + x28 + x29
-    x31 = 1/x30
-    x32 = tau2 - x13
-    x33 = x27 + x28
-    x34 = x31*x33
-    x35 = x28 - x33*x34
-    x36 = -x23*x34 + x32
-    x37 = 1/x35
-    x38 = x36*x37
-    x39 = x23 - x33*x38
-    x40 = x31*x39
-    x43 = jnp.sin(q1)
-    x44 = jnp.cos(q1)
-    x45 = x31*x41
-    x46 = -x33*x45 + x42
-    x47 = x36*x46
-    x48 = x37*x46
-    x49 = -x47/(x35*x35)
-    x50 = -x23*x48 - x33*x49
-    x51 = x31*x50 - x34*x49 - x38*x45
-    x52 = x33*x50 + x39*x41
-    x53 = -x52/(x30*x30)
-    x54 = x49 + x51 + x53
-    x55 = x51 + 2*x53
-    x56 = l1*x55
-    x57 = x3*x56
-    x58 = m1*x53 + m2*x53
-    x59 = -x34*x48 + x45
-    x60 = -x59
-    x61 = l1*x60
-    x62 = x5*x61
-    x63 = m2*x62
-    x64 = -x63
-    x65 = l2*x64
-    x66 = 2*x14*x65
-    x67 = -x48 + x60
-    x68 = l2*x67 + x3*x61
-    x69 = m2*x68
-    x70 = x3*x63 - x5*x69
-    x71 = -x70
-    x72 = -x70
-    x73 = l1*x72
-    x74 = x0*x63 + x20*x61 - x69*x9
-    x75 = x0*x69 + x12*x61 + x25*x56 + x63*x9
-    x76 = l1*x60
-    x77 = m1*x76 + x3*x69 + x5*x63
-    return (
-        _vector_of(
-            -g*x43*x71 + g*x44*x77,
-            x74*jnp.cos(q2) - x75*jnp.sin(q2),
-        ),
-        _vector_of(
-            2*qd1*x73 + x66,
-            x66,
-        ),
-        _vector_of(
-            x59,
-            x48,
-        ),
-        _vector_of(
-            x43*x77 + x44*x71,
-            2*l1*x58 + x1*x60 + x21*x60 + x26*x55 + x6*x72,
-            x0*x76 + x24*x53,
-            2*l2*m2*x54 + m2*x57 + x12*x67 + x15*x64,
-            (l2*l2)*x54 + l2*x57 + x11*x68 + x19*x62 + x24*x53,
-        ),
-    )
+_forward_dynamics_rule = jax.custom_jvp(_forward_dynamics_plain)
 
 
-def _forward_dynamics_forward(q, qd, tau, p):
-    return _forward_dynamics_plain(q, qd, tau, p), (q, qd, tau, p,)
-
-
-def _forward_dynamics_backward(inputs, qdd):
-    return _forward_dynamics_adjoint(*inputs, qdd)
-
-
-#: reverse mode (jax.grad, jax.jacrev, jax.vjp) by the adjoint program; forward mode (jax.jvp,
-#: jax.jacfwd) is refused by JAX (a TypeError: a custom_vjp function)
-_forward_dynamics_rule = jax.custom_vjp(_forward_dynamics_plain)
-_forward_dynamics_rule.defvjp(_forward_dynamics_forward, _forward_dynamics_backward)
+@functools.partial(_forward_dynamics_rule.defjvp, symbolic_zeros=True)
+def _forward_dynamics_jvp(primals, tangents):
+    """The derivative of forward_dynamics: the Jacobians of forward_dynamics_derivatives times the tangents
+    (_analytic_jvp)."""
+    return _analytic_jvp(_forward_dynamics_plain, forward_dynamics_derivatives, primals, tangents, True)
 
 
 def regressor(q, qd, qdd, p=None):

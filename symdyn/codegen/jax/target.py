@@ -16,7 +16,9 @@ The functions of ADJOINTS are jax.custom_vjp functions whose backward pass is th
 program (symdyn.symbolic.adjoint: w^T dy/dx for every input, p included, one straight-line
 function whose cotangents are selected vectors too): XLA's own reverse mode of the long
 straight-line bodies makes every cotangent entry a fusion of its own that recomputes what it
-reads (docs/jax.md), 10 to 60 times slower.
+reads (docs/jax.md), 10 times slower. The functions of RULES are jax.custom_jvp functions whose
+rule is their generated derivative function (the module's _analytic_jvp; on a floating base
+q's NQ entries mapped to the tangent space by _q_to_tangent).
 
 The names, shapes and printed expressions are the NumPy target's (symdyn.codegen.python,
 printed with the namespace `jnp`); every Python statement is spelled in templates/jax/module.py.j2.
@@ -35,15 +37,26 @@ from ..python.printer import NumpyPrinter, local_names
 from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 
-__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "adjoint_view"]
+__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "adjoint_view"]
 
 #: The functions given a jax.custom_vjp whose backward pass is their generated adjoint program
 #: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
 #: argument of that name). Chosen by measurement (bench/jax.py, docs/jax.md): for the Panda,
 #: jax.jit(jax.grad(...)) through jax.vmap of the inverse dynamics took 7.9 us a state by XLA's
 #: reverse mode, 17.6 us through a custom_jvp rule of the generated tangent program (JAX
-#: transposing it) and 0.59 us through the adjoint program (3.3 times the forward pass).
-ADJOINTS = ("inverse_dynamics", "forward_dynamics")
+#: transposing it) and 0.59 us through the adjoint program (3.3 times the forward pass); the
+#: forward dynamics' adjoint program took 9.2 ms, twice XLA's reverse mode, so it keeps RULES.
+ADJOINTS = ("inverse_dynamics",)
+
+#: The functions differentiated by a jax.custom_jvp rule made of a generated derivative function,
+#: {function: derivative function}, when the module holds both: the derivative function returns
+#: the Jacobians by each input of the function but p, in the order of the inputs (forward
+#: dynamics: dqdd/dq, dqdd/dqd, dqdd/dtau = M^-1). Chosen by measurement (bench/jax.py,
+#: docs/jax.md): for the Panda, jax.jit(jax.grad(...)) through jax.vmap of the forward dynamics
+#: took 6.2 ms a state by XLA's reverse mode and 108 us by the rule; the inverse dynamics keeps
+#: XLA's autodiff, which was faster than its rule (12 against 17 us; jacfwd 16 against 31 us).
+RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
+
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
@@ -88,6 +101,22 @@ def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
     }
 
 
+def rules(ctx: RenderContext) -> dict[str, str]:
+    """The entries of RULES whose two functions are both in `ctx`, with the same inputs, and
+    the derivative function with one Jacobian per input but p."""
+    specs = {spec.name: spec for spec in ctx.functions}
+    out = {}
+    for name, derivative in RULES.items():
+        f, d = specs.get(name), specs.get(derivative)
+        if f is None or d is None:
+            continue
+        inputs = [inp.name for inp in f.inputs]
+        moving = [i for i in inputs if i != "p"]
+        if inputs == [inp.name for inp in d.inputs] and len(d.results) == len(moving):
+            out[name] = derivative
+    return out
+
+
 def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
     """{function: adjoint_view} for the functions of ADJOINTS in `ctx`."""
     printer = NumpyPrinter(local_names(ctx), module="jnp")
@@ -97,4 +126,5 @@ def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
 
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_jax.py: module text} for the robot of `ctx`."""
-    return {file_name(ctx.name): render_module(ctx, "jax/module.py.j2", "jnp", adjoints=adjoint_views(ctx))}
+    text = render_module(ctx, "jax/module.py.j2", "jnp", rules=rules(ctx), adjoints=adjoint_views(ctx))
+    return {file_name(ctx.name): text}
