@@ -8,8 +8,8 @@ The robot's URDF of example-robot-data is generated in double precision for the 
 and jax (--groups, default dynamics,derivatives; the JAX inverse dynamics is a jax.custom_vjp
 function whose backward pass is its generated adjoint program, and with the derivatives the
 forward dynamics a jax.custom_jvp whose rule is forward_dynamics_derivatives), into a temporary
-folder of the run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link 7), Solo-12 and
-the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
+folder of the run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link
+7), Solo-12 and the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
 of --functions (default inverse dynamics, M and forward dynamics) is timed per state:
 * NumPy, one state per call (the generated NumPy module, from Python);
 * NumPy, one call on the whole batch of N states (default 100,000), divided by N;
