@@ -135,25 +135,72 @@ def test_every_function_matches_numpy_and_the_oracle(robot, modules):
 
 
 def test_jacobians_equal_the_generated_derivatives(modules):
-    """jax.jit of jax.jacrev through the JAX inverse dynamics (its adjoint program) and of
-    jax.jacfwd through the forward dynamics (its custom_jvp rule) = the derivative functions
-    symdyn derived symbolically (and M^-1 = d qdd / d tau), for Roger's arm; forward mode of the
-    inverse dynamics, a custom_vjp function, is refused by JAX (TypeError)."""
+    """jax.jit of jax.jacrev (the adjoint program) and of jax.jacfwd (forward mode of the body)
+    through the JAX inverse dynamics and of jax.jacfwd through the forward dynamics (its
+    custom_jvp rule) = the derivative functions symdyn derived symbolically (and M^-1 =
+    d qdd / d tau), for Roger's arm."""
     jax_mod, _, _ = modules["roger_arm"]
     rng = np.random.default_rng(3)
     q, qd, qdd, tau = rng.uniform(-2.0, 2.0, (4, jax_mod.NDOF))
     p = _params(jax_mod, rng)
-    dq, dqd = jax.jit(jax.jacrev(jax_mod.inverse_dynamics, argnums=(0, 1)))(q, qd, qdd, p)
     want_dq, want_dqd = jax_mod.inverse_dynamics_derivatives(q, qd, qdd, p)
-    _close(dq, want_dq, rtol=1e-10)
-    _close(dqd, want_dqd, rtol=1e-10)
+    for jacobian in (jax.jacrev, jax.jacfwd):
+        dq, dqd = jax.jit(jacobian(jax_mod.inverse_dynamics, argnums=(0, 1)))(q, qd, qdd, p)
+        _close(dq, want_dq, rtol=1e-10)
+        _close(dqd, want_dqd, rtol=1e-10)
     dq, dqd, dtau = jax.jit(jax.jacfwd(jax_mod.forward_dynamics, argnums=(0, 1, 2)))(q, qd, tau, p)
     want_dq, want_dqd, minv = jax_mod.forward_dynamics_derivatives(q, qd, tau, p)
     _close(dq, want_dq, rtol=1e-10)
     _close(dqd, want_dqd, rtol=1e-10)
     _close(dtau, minv, rtol=1e-10)
-    with pytest.raises(TypeError, match="custom_vjp"):
-        jax.jacfwd(jax_mod.inverse_dynamics)(q, qd, qdd, p)
+
+
+def _every_mode(f, plain, args, batch):
+    """(got, want): jax.jvp, jax.jacfwd, jax.jacrev, jax.hessian (of a weighted sum of the
+    output), jax.vmap of jax.jacfwd and jax.jacrev over the states `batch` (of the first
+    argument), a jax.lax.scan of jax.jvp over them and jax.grad through that scan, all under one
+    jax.jit, of f (a ruled function) and of plain (its body: XLA's autodiff, forward mode for
+    the Jacobians), as flat lists of arrays."""
+    every = tuple(range(len(args)))
+    tangents = tuple(np.cos(np.arange(np.size(a)) + k) for k, a in enumerate(args))
+    weights = np.linspace(-1.0, 2.0, len(plain(*args)))
+    rest = (None,) * (len(args) - 1)
+
+    def modes(g, jacobian):
+        def along(x):
+            return jax.jvp(lambda x: g(x, *args[1:]), (x,), (tangents[0],))[1]
+
+        def scanned(states):
+            return jax.lax.scan(lambda c, x: (c + jnp.sum(g(x, *args[1:]) ** 2), along(x)), 0.0, states)
+
+        return [
+            jax.jvp(g, args, tangents)[1],
+            jacobian(g, argnums=every)(*args),
+            jax.hessian(lambda *a: jnp.sum(g(*a) * weights), argnums=every)(*args),
+            jax.vmap(jax.jacfwd(g), in_axes=(0, *rest))(batch, *args[1:]),
+            jax.vmap(jacobian(g), in_axes=(0, *rest))(batch, *args[1:]),
+            scanned(batch)[1],
+            jax.grad(lambda states: scanned(states)[0])(batch),
+        ]
+
+    transformed = jax.jit(lambda: [modes(f, jax.jacfwd), modes(f, jax.jacrev), modes(plain, jax.jacfwd)])
+    forward, reverse, want = (jax.tree.leaves(m) for m in transformed())
+    return forward + reverse, want + want
+
+
+def test_every_mode_of_the_ruled_functions_equals_autodiff(modules):
+    """Forward and reverse mode, second order, vmap and lax.scan of the inverse dynamics (a
+    linear primitive: forward mode of the body, transposed by the adjoint program) and of the
+    forward dynamics (its custom_jvp rule) by every argument, p included, equal XLA's autodiff of
+    the bodies as written (_NAME_plain), for Roger's arm (a fixed base, 5 free parameters)."""
+    jax_mod, _, _ = modules["roger_arm"]
+    rng = np.random.default_rng(41)
+    args = tuple(rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))) + (_params(jax_mod, rng),)
+    batch = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
+    for name in ("inverse_dynamics", "forward_dynamics"):
+        got, want = _every_mode(getattr(jax_mod, name), getattr(jax_mod, f"_{name}_plain"), args, batch)
+        for g, w in zip(got, want, strict=True):
+            _close(g, w, rtol=1e-10)
 
 
 def test_adjoints_equal_autodiff_and_differences(modules):
@@ -267,7 +314,7 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     (tmp_path / "flyer.yaml").write_text(FLYER)
     robot = load_robot(tmp_path / "flyer.yaml")
     ctx = context(robot, functions=["dynamics", "derivatives"])
-    keep = ("forward_dynamics", "forward_dynamics_derivatives")
+    keep = ("inverse_dynamics", "forward_dynamics", "forward_dynamics_derivatives")
     ctx = dataclasses.replace(ctx, functions=tuple(f for f in ctx.functions if f.name in keep))
     (text,) = jax_target.render(ctx).values()
     (tmp_path / "flyer_jax.py").write_text(text)
@@ -287,6 +334,13 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     _close(got, want, rtol=1e-7)
     np.testing.assert_allclose(np.asarray(got)[:, :3], 0.0, atol=1e-12)
     np.testing.assert_allclose(np.asarray(got)[:, 3:7] @ q[3:7], 0.0, atol=1e-9)
+    qdd = rng.normal(size=robot.nv)
+    batch = np.concatenate([rng.normal(size=(2, 7)), rng.uniform(-1, 1, (2, robot.n))], axis=1)
+    for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
+        plain = getattr(mod, f"_{name}_plain")
+        got, want = _every_mode(getattr(mod, name), lambda *a, plain=plain: plain(*a, jnp.zeros(0)), args, batch)
+        for g, w in zip(got, want, strict=True):
+            _close(g, w, rtol=1e-9)
 
 
 def test_jacrev_of_inverse_dynamics_on_a_tree(modules):

@@ -42,6 +42,8 @@ import functools
 import jax
 import jax.numpy as jnp
 from jax.custom_derivatives import SymbolicZero
+from jax.extend.core import Primitive
+from jax.interpreters import ad, batching, mlir
 
 NDOF = 2
 NPARAM = 5
@@ -163,6 +165,71 @@ def _analytic_jvp(plain, derivatives, primals, tangents, has_p):
         fixed = primals[:-1]
         tangent = tangent + jax.jvp(lambda p: plain(*fixed, p), (primals[-1],), (tangents[-1],))[1]
     return value, tangent
+
+
+def _nest(f, levels):
+    """f vmapped `levels` times over axis 0 of every argument."""
+    for _ in range(levels):
+        f = jax.vmap(f)
+    return f
+
+
+def _adjoint_ruled(name, plain, adjoint, shape):
+    """plain (its arguments, one output of `shape`) as a jax.custom_jvp function whose tangent is
+    a linear primitive whose transpose is the adjoint program `adjoint` (plain's arguments and the
+    output's cotangent w -> w^T d(output)/d(argument) for each argument, p's included).
+
+    The primitive NAME_linear(*primals, *tangents, levels) is the derivative of plain at the
+    primals along the tangents (every argument's, p's too; a tangent that does not move arrives
+    as zeros), over `levels` leading batch axes of every argument: forward mode (jax.jvp,
+    jax.jacfwd) evaluates it as JAX's forward mode of plain; reverse mode (jax.grad, jax.jacrev,
+    jax.vjp) transposes it, which is the adjoint program, not XLA's transpose of the long
+    straight-line body (10 times slower, docs/jax.md); jax.vmap binds it again with one more
+    level; its own derivative (second order, jax.hessian) is forward mode of the tangent map."""
+
+    def tangent(*args):
+        n = len(args) // 2
+        return jax.jvp(plain, args[:n], args[n:])[1]
+
+    def linear(*args, levels):
+        return _nest(tangent, levels)(*args)
+
+    def abstract(*args, levels):
+        return jax.core.ShapedArray(args[0].shape[:levels] + shape, args[0].dtype)
+
+    def transpose(w, *args, levels):
+        n = len(args) // 2
+        if any(ad.is_undefined_primal(a) for a in args[:n]):
+            raise NotImplementedError(f"{name}: the primals of its derivative are not linear inputs")
+        cotangents = _nest(adjoint, levels)(*args[:n], ad.instantiate_zeros(w))
+        return [None] * n + [c if ad.is_undefined_primal(t) else None for c, t in zip(cotangents, args[n:])]
+
+    def derivative(primals, tangents, *, levels):
+        tangents = tuple(ad.instantiate_zeros(t) for t in tangents)
+        return jax.jvp(functools.partial(linear, levels=levels), primals, tangents)
+
+    def batch(args, axes, *, levels):
+        size = next(a.shape[axis] for a, axis in zip(args, axes) if axis is not None)
+        args = [
+            jnp.broadcast_to(a, (size, *a.shape)) if axis is None else jnp.moveaxis(a, axis, 0)
+            for a, axis in zip(args, axes)
+        ]
+        return primitive.bind(*args, levels=levels + 1), 0
+
+    primitive = Primitive(f"{name}_linear")
+    primitive.def_impl(linear)
+    primitive.def_abstract_eval(abstract)
+    mlir.register_lowering(primitive, mlir.lower_fun(linear, multiple_results=False))
+    ad.primitive_transposes[primitive] = transpose
+    ad.primitive_jvps[primitive] = derivative
+    batching.primitive_batchers[primitive] = batch
+    ruled = jax.custom_jvp(plain)
+
+    @ruled.defjvp
+    def _(primals, tangents):
+        return plain(*primals), primitive.bind(*primals, *tangents, levels=0)
+
+    return ruled
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -308,18 +375,9 @@ def _inverse_dynamics_adjoint(q, qd, qdd, p, tau):
     )
 
 
-def _inverse_dynamics_forward(q, qd, qdd, p):
-    return _inverse_dynamics_plain(q, qd, qdd, p), (q, qd, qdd, p,)
-
-
-def _inverse_dynamics_backward(inputs, tau):
-    return _inverse_dynamics_adjoint(*inputs, tau)
-
-
-#: reverse mode (jax.grad, jax.jacrev, jax.vjp) by the adjoint program; forward mode (jax.jvp,
-#: jax.jacfwd) is refused by JAX (a TypeError: a custom_vjp function)
-_inverse_dynamics_rule = jax.custom_vjp(_inverse_dynamics_plain)
-_inverse_dynamics_rule.defvjp(_inverse_dynamics_forward, _inverse_dynamics_backward)
+#: forward mode (jax.jvp, jax.jacfwd) by JAX's forward mode of the body, reverse mode (jax.grad,
+#: jax.jacrev, jax.vjp) by the adjoint program: _adjoint_ruled
+_inverse_dynamics_rule = _adjoint_ruled("inverse_dynamics", _inverse_dynamics_plain, _inverse_dynamics_adjoint, (2,))
 
 
 def mass_matrix(q, p=None):

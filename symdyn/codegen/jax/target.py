@@ -95,6 +95,7 @@ def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
         start += len(inp.symbols)
     return {
         "args": [*names, out.name],
+        "shape": [out.size],
         "unpack": [(printer.doprint(s), array, k) for s, array, k in read],
         "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in program.temporaries],
         "cotangents": cotangents,
