@@ -155,37 +155,40 @@ def test_jacobians_equal_the_generated_derivatives(modules):
     _close(dtau, minv, rtol=1e-10)
 
 
-def _every_mode(f, plain, args, batch):
-    """(got, want): jax.jvp, jax.jacfwd, jax.jacrev, jax.hessian (of a weighted sum of the
-    output), jax.vmap of jax.jacfwd and jax.jacrev over the states `batch` (of the first
-    argument), a jax.lax.scan of jax.jvp over them and jax.grad through that scan, all under one
-    jax.jit, of f (a ruled function) and of plain (its body: XLA's autodiff, forward mode for
-    the Jacobians), as flat lists of arrays."""
+def _every_mode(f, plain, args, batch=None, hessian=True):
+    """[(got, want)]: jax.jvp, jax.jacfwd, jax.jacrev, a Hessian-vector product (jax.jvp of
+    jax.grad of a weighted sum of the output: jax.hessian's forward-over-reverse, one direction),
+    jax.hessian itself if `hessian`, and given the states `batch` (of the first argument) both
+    Jacobians vmapped over them, a jax.lax.scan of jax.jvp over them and jax.grad through that
+    scan, all under one jax.jit, of f (a ruled function) and of plain (its body: XLA's autodiff,
+    forward mode for both Jacobians), as pairs of arrays."""
     every = tuple(range(len(args)))
     tangents = tuple(np.cos(np.arange(np.size(a)) + k) for k, a in enumerate(args))
     weights = np.linspace(-1.0, 2.0, len(plain(*args)))
     rest = (None,) * (len(args) - 1)
 
-    def modes(g, jacobian):
+    def modes(g, jacobians):
         def along(x):
             return jax.jvp(lambda x: g(x, *args[1:]), (x,), (tangents[0],))[1]
 
         def scanned(states):
             return jax.lax.scan(lambda c, x: (c + jnp.sum(g(x, *args[1:]) ** 2), along(x)), 0.0, states)
 
-        return [
-            jax.jvp(g, args, tangents)[1],
-            jacobian(g, argnums=every)(*args),
-            jax.hessian(lambda *a: jnp.sum(g(*a) * weights), argnums=every)(*args),
-            jax.vmap(jax.jacfwd(g), in_axes=(0, *rest))(batch, *args[1:]),
-            jax.vmap(jacobian(g), in_axes=(0, *rest))(batch, *args[1:]),
-            scanned(batch)[1],
-            jax.grad(lambda states: scanned(states)[0])(batch),
-        ]
+        def weighted(*a):
+            return jnp.sum(g(*a) * weights)
 
-    transformed = jax.jit(lambda: [modes(f, jax.jacfwd), modes(f, jax.jacrev), modes(plain, jax.jacfwd)])
-    forward, reverse, want = (jax.tree.leaves(m) for m in transformed())
-    return forward + reverse, want + want
+        out = [jax.jvp(g, args, tangents)[1], jax.jvp(jax.grad(weighted, argnums=every), args, tangents)[1]]
+        out += [jax.hessian(weighted, argnums=every)(*args)] if hessian else []
+        if batch is not None:
+            out += [scanned(batch)[1], jax.grad(lambda states: scanned(states)[0])(batch)]
+            out += [jax.vmap(jacobian(g), in_axes=(0, *rest))(batch, *args[1:]) for jacobian in jacobians]
+        return out + [jacobian(g, argnums=every)(*args) for jacobian in jacobians]
+
+    # both Jacobians against forward mode of the body (XLA merges its two copies)
+    got, want = jax.jit(
+        lambda: [modes(f, (jax.jacfwd, jax.jacrev)), modes(plain, (jax.jacfwd, jax.jacfwd))]
+    )()
+    return list(zip(jax.tree.leaves(got), jax.tree.leaves(want), strict=True))
 
 
 def test_every_mode_of_the_ruled_functions_equals_autodiff(modules):
@@ -198,46 +201,36 @@ def test_every_mode_of_the_ruled_functions_equals_autodiff(modules):
     args = tuple(rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))) + (_params(jax_mod, rng),)
     batch = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
     for name in ("inverse_dynamics", "forward_dynamics"):
-        got, want = _every_mode(getattr(jax_mod, name), getattr(jax_mod, f"_{name}_plain"), args, batch)
-        for g, w in zip(got, want, strict=True):
-            _close(g, w, rtol=1e-10)
+        f, plain = getattr(jax_mod, name), getattr(jax_mod, f"_{name}_plain")
+        # the forward dynamics' rule under vmap and lax.scan: test_adjoints_equal_autodiff_and_differences,
+        # test_grad_through_a_lax_scan_equals_differences
+        for got, want in _every_mode(f, plain, args, batch if name == "inverse_dynamics" else None):
+            _close(got, want, rtol=1e-10)
 
 
 def test_adjoints_equal_autodiff_and_differences(modules):
-    """inverse_dynamics is a jax.custom_vjp function whose backward pass is its adjoint program,
-    forward_dynamics a jax.custom_jvp whose rule is forward_dynamics_derivatives: jacrev of both
-    (and jacfwd of the forward dynamics) by every argument, p included, equals XLA's autodiff of
-    the body as written (_NAME_plain); jacrev vmapped over states equals the generated
-    derivatives state by state; grad of a vmapped loss equals central differences of the NumPy
-    module's loss (Roger's arm: 5 free parameters, a tangent of p goes through forward mode in
-    the rule). All in one jit: one compilation costs less than running the transformations op
-    by op."""
+    """The forward dynamics' custom_jvp rule (forward_dynamics_derivatives): jacrev vmapped over
+    states equals the generated derivatives state by state; grad of a vmapped loss equals central
+    differences of the NumPy module's loss (Roger's arm: 5 free parameters, a tangent of p goes
+    through forward mode in the rule); every mode of both dynamics against XLA's autodiff:
+    test_every_mode_of_the_ruled_functions_equals_autodiff. All in one jit: one compilation
+    costs less than running the transformations op by op."""
     jax_mod, numpy_mod, _ = modules["roger_arm"]
-    fd, every = jax_mod.forward_dynamics, (0, 1, 2, 3)
+    fd = jax_mod.forward_dynamics
     rng = np.random.default_rng(31)
-    q, qd, tau = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
+    rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))  # the state the Jacobians took before (same draws after)
     p = _params(jax_mod, rng)
     Q, QD, TAU = rng.uniform(-2.0, 2.0, (3, 4, jax_mod.NDOF))
     vmapped = jax.vmap(fd, in_axes=(0, 0, 0, None))
-    pairs = [
-        (jax_mod._forward_dynamics_plain, fd),
-        (jax_mod._inverse_dynamics_plain, jax_mod.inverse_dynamics),
-    ]
 
     @jax.jit
-    def transformed(q, qd, tau, p, Q):
+    def transformed(Q):
         return (
-            [jax.jacfwd(plain, argnums=every)(q, qd, tau, p) for plain, _ in pairs],
-            [jax.jacrev(f, argnums=every)(q, qd, tau, p) for _, f in pairs]
-            + [jax.jacfwd(fd, argnums=every)(q, qd, tau, p)],
             jax.vmap(jax.jacrev(fd, argnums=(0, 1, 2)), in_axes=(0, 0, 0, None))(Q, QD, TAU, p),
             jax.grad(lambda q, p: jnp.sum(vmapped(q, QD, TAU, p) ** 2), argnums=(0, 1))(Q, p),
         )
 
-    wants, reverses, per_state, (got_q, got_p) = transformed(q, qd, tau, p, Q)
-    for want, reverse in zip([*wants, wants[0]], reverses, strict=True):
-        for g, w in zip(reverse, want, strict=True):
-            _close(g, w, rtol=1e-10)
+    per_state, (got_q, got_p) = transformed(Q)
     for k in range(len(Q)):
         derivatives = jax_mod.forward_dynamics_derivatives(Q[k], QD[k], TAU[k], p)
         for g, w in zip(per_state, derivatives, strict=True):
@@ -335,12 +328,15 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     np.testing.assert_allclose(np.asarray(got)[:, :3], 0.0, atol=1e-12)
     np.testing.assert_allclose(np.asarray(got)[:, 3:7] @ q[3:7], 0.0, atol=1e-9)
     qdd = rng.normal(size=robot.nv)
-    batch = np.concatenate([rng.normal(size=(2, 7)), rng.uniform(-1, 1, (2, robot.n))], axis=1)
     for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
-        plain = getattr(mod, f"_{name}_plain")
-        got, want = _every_mode(getattr(mod, name), lambda *a, plain=plain: plain(*a, jnp.zeros(0)), args, batch)
-        for g, w in zip(got, want, strict=True):
-            _close(g, w, rtol=1e-9)
+        f, plain = getattr(mod, name), getattr(mod, f"_{name}_plain")
+        # vmap and lax.scan of both: test_every_mode_of_the_ruled_functions_equals_autodiff; the
+        # forward dynamics' hessian took 30 s to compile here: its Hessian-vector product
+        pairs = _every_mode(
+            f, lambda *a, plain=plain: plain(*a, jnp.zeros(0)), args, None, name == "inverse_dynamics"
+        )
+        for got, want in pairs:
+            _close(got, want, rtol=1e-9)
 
 
 def test_jacrev_of_inverse_dynamics_on_a_tree(modules):
