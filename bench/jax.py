@@ -5,9 +5,10 @@
                         [--adam-python PATH] [--out FILE]
 
 The robot's URDF of example-robot-data is generated in double precision for the targets python
-and jax (--groups, default dynamics,derivatives; the JAX inverse dynamics is a jax.custom_vjp
-function whose backward pass is its generated adjoint program, and with the derivatives the
-forward dynamics a jax.custom_jvp whose rule is forward_dynamics_derivatives), into a temporary
+and jax (--groups, default dynamics,derivatives; the JAX inverse dynamics is a jax.custom_jvp
+function whose tangent is a linear primitive transposed by its generated adjoint program, and
+with the derivatives the forward dynamics a jax.custom_jvp whose rule is
+forward_dynamics_derivatives), into a temporary
 folder of the run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link
 7), Solo-12 and the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
 of --functions (default inverse dynamics, M and forward dynamics) is timed per state:
@@ -20,8 +21,8 @@ of --functions (default inverse dynamics, M and forward dynamics) is timed per s
   jax.jit(jax.grad(lambda x: jnp.sum(jax.vmap(f)(x, ...) ** 2))), its gradient with respect to
   the first argument (q), through the adjoint program where there is one, with --xla-grad also
   by XLA's autodiff of the body it differentiates, each checked against central differences of
-  the same loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q; "-" where JAX
-  refuses forward mode, a custom_vjp function) and jax.jit(jax.vmap(jax.jacrev(f))); a jax.lax.scan over the
+  the same loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q) and
+  jax.jit(jax.vmap(jax.jacrev(f))); a jax.lax.scan over the
   states, one call a step; then (unless --no-xla-flags) f_batch again in a process with
   XLA_FLAGS turning the emitters off for everything;
 * ADAM (adam-robotics, its JAX backend; the Panda only) on the same URDF and batch,
@@ -237,11 +238,7 @@ def worker(
                 out[key][f] = _jax_timing(grad, args, count, max(1, reps // 2))
             for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)) if jacobians else ():
                 log(f"{key} {f}")
-                try:
-                    route = jax.jit(jax.vmap(jacobian(fn)))
-                    out[key][f] = _jax_timing(route, args, count, max(1, reps // 2))
-                except TypeError as error:  # forward mode of a custom_vjp function
-                    log(f"{key} {f} refused: {error}")
+                out[key][f] = _jax_timing(jax.jit(jax.vmap(jacobian(fn))), args, count, max(1, reps // 2))
     if urdf is not None:
         from importlib.metadata import version
 
@@ -366,11 +363,11 @@ def table(results: dict, opts, robot) -> list[str]:
         "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
         "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
         "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0 (q), XLA's defaults, through the module's "
-        "adjoint program or custom_jvp rule where it has one (the inverse dynamics' custom_vjp, the "
+        "adjoint program or custom_jvp rule where it has one (the inverse dynamics' linear primitive, the "
         "forward dynamics' rule with --functions derivatives); "
         "jit(grad), XLA: the same by XLA's autodiff of the body (--xla-grad); "
-        "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q; jacfwd '-': "
-        "forward mode refused, a custom_vjp function); scan: jax.jit of jax.lax.scan over the "
+        "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q); "
+        "scan: jax.jit of jax.lax.scan over the "
         "states, one call a step; "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
         "(one run); JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",

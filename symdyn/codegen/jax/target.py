@@ -12,9 +12,11 @@ leading axis of the arguments that have one, jitted). Inputs and outputs are flo
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
 rather than compute in float32) or float32.
 
-The functions of ADJOINTS are jax.custom_vjp functions whose backward pass is their adjoint
-program (symdyn.symbolic.adjoint: w^T dy/dx for every input, p included, one straight-line
-function whose cotangents are selected vectors too): XLA's own reverse mode of the long
+The functions of ADJOINTS are jax.custom_jvp functions whose tangent is a linear primitive
+(the module's _adjoint_ruled: JAX's forward mode of the body for jax.jvp and jax.jacfwd) whose
+transpose, for jax.grad and jax.jacrev, is their adjoint program (symdyn.symbolic.adjoint:
+w^T dy/dx for every input, p included, one straight-line function whose cotangents are selected
+vectors too): XLA's own reverse mode of the long
 straight-line bodies makes every cotangent entry a fusion of its own that recomputes what it
 reads (docs/jax.md), 10 times slower. The functions of RULES are jax.custom_jvp functions whose
 rule is their generated derivative function (the module's _analytic_jvp; on a floating base
@@ -39,7 +41,7 @@ from ..render import RenderContext
 
 __all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "adjoint_view"]
 
-#: The functions given a jax.custom_vjp whose backward pass is their generated adjoint program
+#: The functions whose derivative is a linear primitive transposed by their generated adjoint program
 #: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
 #: argument of that name). Chosen by measurement (bench/jax.py, docs/jax.md): for the Panda,
 #: jax.jit(jax.grad(...)) through jax.vmap of the inverse dynamics took 7.9 us a state by XLA's
