@@ -6,9 +6,9 @@
 
 The robot's URDF of example-robot-data is generated in double precision for the targets python
 and jax (--groups, default dynamics,derivatives; the JAX inverse dynamics is a jax.custom_jvp
-function whose tangent is a linear primitive transposed by its generated adjoint program, and
-with the derivatives the forward dynamics a jax.custom_jvp whose rule is
-forward_dynamics_derivatives), into a temporary
+function whose tangent is a linear primitive transposed by its generated adjoint program, the
+forward dynamics the same, transposed through the inverse dynamics' adjoint program at M^-1 w),
+into a temporary
 folder of the run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link
 7), Solo-12 and the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
 of --functions (default inverse dynamics, M and forward dynamics) is timed per state:
@@ -364,7 +364,7 @@ def table(results: dict, opts, robot) -> list[str]:
         "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
         "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0 (q), XLA's defaults, through the module's "
         "adjoint program or custom_jvp rule where it has one (the inverse dynamics' linear primitive, the "
-        "forward dynamics' rule with --functions derivatives); "
+        "forward dynamics' through the inverse dynamics' adjoint); "
         "jit(grad), XLA: the same by XLA's autodiff of the body (--xla-grad); "
         "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q); "
         "scan: jax.jit of jax.lax.scan over the "

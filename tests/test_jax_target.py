@@ -136,8 +136,8 @@ def test_every_function_matches_numpy_and_the_oracle(robot, modules):
 
 def test_jacobians_equal_the_generated_derivatives(modules):
     """jax.jit of jax.jacrev (the adjoint program) and of jax.jacfwd (forward mode of the body)
-    through the JAX inverse dynamics and of jax.jacfwd through the forward dynamics (its
-    custom_jvp rule) = the derivative functions symdyn derived symbolically (and M^-1 =
+    through the JAX inverse dynamics and of jax.jacfwd through the forward dynamics (forward mode
+    of its body) = the derivative functions symdyn derived symbolically (and M^-1 =
     d qdd / d tau), for Roger's arm."""
     jax_mod, _, _ = modules["roger_arm"]
     rng = np.random.default_rng(3)
@@ -194,7 +194,8 @@ def _every_mode(f, plain, args, batch=None, hessian=True):
 def test_every_mode_of_the_ruled_functions_equals_autodiff(modules):
     """Forward and reverse mode, second order, vmap and lax.scan of the inverse dynamics (a
     linear primitive: forward mode of the body, transposed by the adjoint program) and of the
-    forward dynamics (its custom_jvp rule) by every argument, p included, equal XLA's autodiff of
+    forward dynamics (the same, transposed through the inverse dynamics' adjoint program by the
+    identity of IDENTITIES) by every argument, p included, equal XLA's autodiff of
     the bodies as written (_NAME_plain), for Roger's arm (a fixed base, 5 free parameters)."""
     jax_mod, _, _ = modules["roger_arm"]
     rng = np.random.default_rng(41)
@@ -209,10 +210,10 @@ def test_every_mode_of_the_ruled_functions_equals_autodiff(modules):
 
 
 def test_adjoints_equal_autodiff_and_differences(modules):
-    """The forward dynamics' custom_jvp rule (forward_dynamics_derivatives): jacrev vmapped over
-    states equals the generated derivatives state by state; grad of a vmapped loss equals central
-    differences of the NumPy module's loss (Roger's arm: 5 free parameters, a tangent of p goes
-    through forward mode in the rule); every mode of both dynamics against XLA's autodiff:
+    """The forward dynamics' reverse mode (the inverse dynamics' adjoint program at weight
+    M^-1 w): jacrev vmapped over states equals the generated derivatives state by state; grad of
+    a vmapped loss equals central differences of the NumPy module's loss (Roger's arm: 5 free
+    parameters); every mode of both dynamics against XLA's autodiff:
     test_every_mode_of_the_ruled_functions_equals_autodiff. All in one jit: one compilation
     costs less than running the transformations op by op."""
     jax_mod, numpy_mod, _ = modules["roger_arm"]

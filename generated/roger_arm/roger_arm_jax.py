@@ -41,7 +41,6 @@ import functools
 
 import jax
 import jax.numpy as jnp
-from jax.custom_derivatives import SymbolicZero
 from jax.extend.core import Primitive
 from jax.interpreters import ad, batching, mlir
 
@@ -143,28 +142,6 @@ def _batch(f):
             return plain(*args)
 
     return call
-
-
-def _analytic_jvp(plain, derivatives, primals, tangents, has_p):
-    """(plain(*primals), its derivative along tangents) from the Jacobians that `derivatives`
-    returns, one per argument but p, in their order: the tangent sum_i J_i t_i, linear in the
-    tangents, so that JAX transposes it for jax.grad and jax.jacrev; a tangent of p is pushed
-    through plain by forward mode. The rule of a jax.custom_jvp with symbolic zeros: an argument
-    that does not move (SymbolicZero) costs nothing, and the Jacobians are computed only when
-    one of their arguments moves."""
-    value = plain(*primals)
-    count = len(primals) - 1 if has_p else len(primals)
-    moving = [i for i in range(count) if not isinstance(tangents[i], SymbolicZero)]
-    tangent = jnp.zeros_like(value)
-    if moving:
-        jacobians = derivatives(*primals)
-        for i in moving:
-            t = tangents[i]
-            tangent = tangent + jacobians[i] @ t
-    if has_p and not isinstance(tangents[-1], SymbolicZero):
-        fixed = primals[:-1]
-        tangent = tangent + jax.jvp(lambda p: plain(*fixed, p), (primals[-1],), (tangents[-1],))[1]
-    return value, tangent
 
 
 def _nest(f, levels):
@@ -549,7 +526,7 @@ def forward_dynamics(q, qd, tau, p=None):
 
 def _forward_dynamics_plain(q, qd, tau, p):
     """forward_dynamics of checked arguments: the function that _forward_dynamics_rule differentiates
-    by forward_dynamics_derivatives."""
+    in reverse mode by _forward_dynamics_adjoint."""
     q1 = q[0]
     q2 = q[1]
     qd1 = qd[0]
@@ -608,14 +585,20 @@ def _forward_dynamics_plain(q, qd, tau, p):
     )
 
 
-_forward_dynamics_rule = jax.custom_jvp(_forward_dynamics_plain)
+def _forward_dynamics_adjoint(q, qd, tau, p, w):
+    """The cotangents of (q, qd, tau, p) for the cotangent w of forward_dynamics's qdd, by the identity
+    inverse_dynamics(q, qd, qdd, p) = tau at qdd = forward_dynamics(q, qd, tau, p): with u = M(q)^-1 w
+    (M = mass_matrix, symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd,
+    p (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T."""
+    qdd = _forward_dynamics_plain(q, qd, tau, p)
+    u = jnp.linalg.solve(mass_matrix(q, p), w)
+    dq, dqd, _, dp = _inverse_dynamics_adjoint(q, qd, qdd, p, u)
+    return -dq, -dqd, u, -dp
 
 
-@functools.partial(_forward_dynamics_rule.defjvp, symbolic_zeros=True)
-def _forward_dynamics_jvp(primals, tangents):
-    """The derivative of forward_dynamics: the Jacobians of forward_dynamics_derivatives times the tangents
-    (_analytic_jvp)."""
-    return _analytic_jvp(_forward_dynamics_plain, forward_dynamics_derivatives, primals, tangents, True)
+#: forward mode by JAX's forward mode of the body, reverse mode through the inverse dynamics'
+#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled
+_forward_dynamics_rule = _adjoint_ruled("forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (2,))
 
 
 def regressor(q, qd, qdd, p=None):

@@ -39,7 +39,7 @@ from ..python.printer import NumpyPrinter, local_names
 from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 
-__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "adjoint_view"]
+__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "adjoint_view"]
 
 #: The functions whose derivative is a linear primitive transposed by their generated adjoint program
 #: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
@@ -57,8 +57,18 @@ ADJOINTS = ("inverse_dynamics",)
 #: docs/jax.md): for the Panda, jax.jit(jax.grad(...)) through jax.vmap of the forward dynamics
 #: took 6.2 ms a state by XLA's reverse mode and 108 us by the rule; the inverse dynamics keeps
 #: XLA's autodiff, which was faster than its rule (12 against 17 us; jacfwd 16 against 31 us).
+#: IDENTITIES takes the forward dynamics over when the module holds the inverse dynamics and M.
 RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
 
+
+#: The functions reverse-differentiated through another's adjoint program by an identity,
+#: {function: (inverse dynamics, mass matrix)}: differentiating ID(q, qd, FD(q, qd, tau)) = tau
+#: gives w^T dqdd/dx = -(M^-1 w)^T dID/dx for x = q, qd, p (at qdd = FD) and w^T dqdd/dtau =
+#: (M^-1 w)^T: one solve and the inverse dynamics' adjoint program. Chosen by measurement (the
+#: Panda, bench/jax.py on the loaded machine): jax.jit(jax.grad(...)) through jax.vmap 15.5 us a
+#: state (2.7 times the forward pass, compiled in 19 s), against 108 us by RULES (compiled in 551 s).
+#: Taken over RULES when the module holds the three functions with these inputs.
+IDENTITIES = {"forward_dynamics": ("inverse_dynamics", "mass_matrix")}
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
@@ -120,6 +130,22 @@ def rules(ctx: RenderContext) -> dict[str, str]:
     return out
 
 
+def identities(ctx: RenderContext, adjoints: dict[str, dict]) -> dict[str, dict]:
+    """{function: {"inverse": ..., "mass": ..., "shape": ...}} for the entries of IDENTITIES whose
+    three functions are in `ctx` with the inputs (q, qd, tau, p), (q, qd, qdd, p) and (q, p), the
+    inverse dynamics having an adjoint program (`adjoints`)."""
+    specs = {spec.name: spec for spec in ctx.functions}
+    wanted = (["q", "qd", "tau", "p"], ["q", "qd", "qdd", "p"], ["q", "p"])
+    out = {}
+    for name, (inverse, mass) in IDENTITIES.items():
+        found = [specs.get(n) for n in (name, inverse, mass)]
+        if inverse not in adjoints or any(s is None for s in found):
+            continue
+        if [[inp.name for inp in s.inputs] for s in found] == list(wanted) and len(found[0].results) == 1:
+            out[name] = {"inverse": inverse, "mass": mass, "shape": [found[0].results[0].size]}
+    return out
+
+
 def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
     """{function: adjoint_view} for the functions of ADJOINTS in `ctx`."""
     printer = NumpyPrinter(local_names(ctx), module="jnp")
@@ -129,5 +155,8 @@ def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
 
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_jax.py: module text} for the robot of `ctx`."""
-    text = render_module(ctx, "jax/module.py.j2", "jnp", rules=rules(ctx), adjoints=adjoint_views(ctx))
+    adjoints = adjoint_views(ctx)
+    through = identities(ctx, adjoints)
+    derived = {name: d for name, d in rules(ctx).items() if name not in through}
+    text = render_module(ctx, "jax/module.py.j2", "jnp", rules=derived, adjoints=adjoints, identities=through)
     return {file_name(ctx.name): text}
