@@ -303,16 +303,22 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     """On a floating base the rule maps q's NQ entries (a quaternion of any norm) to the tangent
     space of the generated Jacobians: jax.jacrev of the
     forward dynamics by q equals central differences of the numeric oracle in q's entries (the
-    base position's columns 0, a change along the quaternion none). Only the two functions are
-    rendered (the groups' other functions dropped before printing)."""
+    base position's columns 0, a change along the quaternion none), and so does jax.jacrev of the
+    forward dynamics through the inverse dynamics' adjoint (a module with M too). Only these
+    functions are rendered (the groups' other functions dropped before printing)."""
     (tmp_path / "flyer.yaml").write_text(FLYER)
     robot = load_robot(tmp_path / "flyer.yaml")
-    ctx = context(robot, functions=["dynamics", "derivatives"])
-    keep = ("inverse_dynamics", "forward_dynamics", "forward_dynamics_derivatives")
-    ctx = dataclasses.replace(ctx, functions=tuple(f for f in ctx.functions if f.name in keep))
-    (text,) = jax_target.render(ctx).values()
-    (tmp_path / "flyer_jax.py").write_text(text)
-    mod = load_module(tmp_path / "flyer_jax.py", "_symdyn_test_flyer_jax")
+    full = context(robot, functions=["dynamics", "derivatives"])
+    keep = ("inverse_dynamics", "forward_dynamics", "forward_dynamics_derivatives", "mass_matrix")
+    modules = []
+    for kept in (keep[:3], keep):  # without M the rule, with M the identity (IDENTITIES)
+        ctx = dataclasses.replace(full, functions=tuple(f for f in full.functions if f.name in kept))
+        (text,) = jax_target.render(ctx).values()
+        (tmp_path / f"flyer{len(kept)}_jax.py").write_text(text)
+        modules.append(
+            load_module(tmp_path / f"flyer{len(kept)}_jax.py", f"_symdyn_test_flyer{len(kept)}_jax")
+        )
+    mod, identity = modules
     rng = np.random.default_rng(37)
     q = np.concatenate([rng.normal(size=3), 1.7 * rng.normal(size=4), rng.uniform(-1, 1, robot.n)])
     qd, tau = rng.normal(size=(2, robot.nv))
@@ -328,6 +334,8 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     _close(got, want, rtol=1e-7)
     np.testing.assert_allclose(np.asarray(got)[:, :3], 0.0, atol=1e-12)
     np.testing.assert_allclose(np.asarray(got)[:, 3:7] @ q[3:7], 0.0, atol=1e-9)
+    # the identity's reverse mode in q's entries, op by op (compiling would cost more)
+    _close(jax.jacrev(identity.forward_dynamics)(q, qd, tau), want, rtol=1e-7)
     qdd = rng.normal(size=robot.nv)
     for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
         f, plain = getattr(mod, name), getattr(mod, f"_{name}_plain")
