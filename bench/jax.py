@@ -1,13 +1,16 @@
 """The JAX target on the CPU against the NumPy module and ADAM (issues 26 and 37), in one run.
 
     python bench/jax.py [--robot panda|solo12|talos] [--groups G,..] [--functions F,..]
-                        [--batch N] [--reps R] [--xla-grad] [--no-xla-flags] [--adam-python PATH] [--out FILE]
+                        [--batch N] [--reps R] [--xla-grad] [--no-xla-flags] [--no-jacobians]
+                        [--adam-python PATH] [--out FILE]
 
 The robot's URDF of example-robot-data is generated in double precision for the targets python
-and jax (--groups, default dynamics,derivatives: with the derivatives the JAX forward dynamics
-is a jax.custom_jvp whose rule is forward_dynamics_derivatives), into a temporary folder of the
-run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link 7), Solo-12 and
-the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
+and jax (--groups, default dynamics,derivatives; the JAX inverse dynamics is a jax.custom_jvp
+function whose tangent is a linear primitive transposed by its generated adjoint program, the
+forward dynamics the same, transposed through the inverse dynamics' adjoint program at M^-1 w),
+into a temporary
+folder of the run: the Panda cut at panda_hand (7 joints, the hand and fingers merged into link
+7), Solo-12 and the Talos (talos_reduced) on a free flyer (q of NQ = NV + 1 entries, a unit quaternion). Each
 of --functions (default inverse dynamics, M and forward dynamics) is timed per state:
 * NumPy, one state per call (the generated NumPy module, from Python);
 * NumPy, one call on the whole batch of N states (default 100,000), divided by N;
@@ -16,9 +19,10 @@ of --functions (default inverse dynamics, M and forward dynamics) is timed per s
   after a first call that compiles (its time is listed); then jax.jit(jax.vmap(f)) of the
   one-state function with XLA's defaults, as one's own jit gets it, and
   jax.jit(jax.grad(lambda x: jnp.sum(jax.vmap(f)(x, ...) ** 2))), its gradient with respect to
-  the first argument (q), through the rule where there is one, with --xla-grad also by XLA's
-  autodiff of the body the rule wraps, each checked against central differences of the same
-  loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q); a jax.lax.scan over the
+  the first argument (q), through the adjoint program where there is one, with --xla-grad also
+  by XLA's autodiff of the body it differentiates, each checked against central differences of
+  the same loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q) and
+  jax.jit(jax.vmap(jax.jacrev(f))); a jax.lax.scan over the
   states, one call a step; then (unless --no-xla-flags) f_batch again in a process with
   XLA_FLAGS turning the emitters off for everything;
 * ADAM (adam-robotics, its JAX backend; the Panda only) on the same URDF and batch,
@@ -198,12 +202,13 @@ def worker(
     own=False,
     functions=FUNCTIONS,
     xla_grad=False,
+    jacobians=True,
 ) -> dict:
     """Time the generated JAX module (and ADAM when `urdf` is given; when `own`, jax.jit(jax.vmap(f))
-    of the one-state functions, jit(grad) through it, jit(vmap(jacfwd(f))) and a jax.lax.scan over
-    the states, and with `xla_grad` jit(grad) by XLA's autodiff of the functions that have a
-    custom_jvp rule) in this interpreter; check each against `reference` (the oracle's values on
-    the first NCHECK states)."""
+    of the one-state functions, jit(grad) through it, jit(vmap(jacfwd(f))), jit(vmap(jacrev(f)))
+    and a jax.lax.scan over the states, and with `xla_grad` jit(grad) by XLA's autodiff of the
+    functions that have an adjoint program; without `jacobians` no jacfwd or jacrev) in this
+    interpreter; check each against `reference` (the oracle's values on the first NCHECK states)."""
     import jax
 
     jax.config.update("jax_enable_x64", True)
@@ -217,13 +222,13 @@ def worker(
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in functions}}
     if own:
-        out.update(own={}, grad={}, jacfwd={}, scan={}, xla_grad={})
+        out.update(own={}, grad={}, jacfwd={}, jacrev={}, scan={}, xla_grad={})
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
         routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
         for f in functions:
             fn, args = getattr(arm, f), _arguments(device, f)
             grads = {"grad": fn}
-            if xla_grad and hasattr(arm, f"_{f}_plain"):  # the body the custom_jvp rule wraps
+            if xla_grad and hasattr(arm, f"_{f}_plain"):  # the body the adjoint program differentiates
                 grads["xla_grad"] = functools.partial(getattr(arm, f"_{f}_plain"), p=jnp.zeros((0,)))
             for key, g in grads.items():
                 log(f"{key} {f}")
@@ -231,8 +236,9 @@ def worker(
                 error = _grad_error(jax, jnp, g, grad, _arguments(check, f))
                 out["error"][f"{key} {f} (against central differences)"] = error
                 out[key][f] = _jax_timing(grad, args, count, max(1, reps // 2))
-            log(f"jacfwd {f}")
-            out["jacfwd"][f] = _jax_timing(jax.jit(jax.vmap(jax.jacfwd(fn))), args, count, max(1, reps // 2))
+            for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)) if jacobians else ():
+                log(f"{key} {f}")
+                out[key][f] = _jax_timing(jax.jit(jax.vmap(jacobian(fn))), args, count, max(1, reps // 2))
     if urdf is not None:
         from importlib.metadata import version
 
@@ -319,7 +325,7 @@ def table(results: dict, opts, robot) -> list[str]:
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
     pick = lambda route, f: ns(route[f][1]) if route and f in route else "-"  # noqa: E731
     head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
-    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "scan", "f_batch, XLA_FLAGS"]
+    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "jacrev", "scan", "f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
     head += ["vmap/f_batch", "grad/vmap", "JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
@@ -328,7 +334,7 @@ def table(results: dict, opts, robot) -> list[str]:
         one, batch = results["numpy"][f]
         jx = min(here["symdyn"][f][1], plain["symdyn"][f][1]) if plain else here["symdyn"][f][1]
         row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here["own"], f), pick(here["grad"], f)]
-        row += [pick(here["xla_grad"], f), pick(here["jacfwd"], f), pick(here["scan"], f)]
+        row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "scan")]
         row += [pick(plain and plain["symdyn"], f)]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
@@ -344,7 +350,8 @@ def table(results: dict, opts, robot) -> list[str]:
         return f"{name} " + ", ".join(f"{f} {route[f][0]:.1f}" for f in opts.functions if f in route)
 
     routes = [("f_batch", here["symdyn"]), ("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
-    routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("scan", here["scan"])]
+    routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("jacrev", here["jacrev"])]
+    routes += [("scan", here["scan"])]
     routes += [("XLA_FLAGS", plain["symdyn"])] if plain else []
     routes += [("ADAM", there["adam"])] if there else []
     lines = [
@@ -356,9 +363,11 @@ def table(results: dict, opts, robot) -> list[str]:
         "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
         "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
         "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0 (q), XLA's defaults, through the module's "
-        "custom_jvp rule where it has one (forward_dynamics with --functions derivatives); "
-        "jit(grad), XLA: the same by XLA's autodiff of the body the rule wraps (--xla-grad); "
-        "jacfwd: jax.jit(jax.vmap(jax.jacfwd(f))) (by q); scan: jax.jit of jax.lax.scan over the "
+        "adjoint program or custom_jvp rule where it has one (the inverse dynamics' linear primitive, the "
+        "forward dynamics' through the inverse dynamics' adjoint); "
+        "jit(grad), XLA: the same by XLA's autodiff of the body (--xla-grad); "
+        "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q); "
+        "scan: jax.jit of jax.lax.scan over the "
         "states, one call a step; "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
         "(one run); JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
@@ -383,9 +392,10 @@ def main(argv=None) -> int:
     parser.add_argument("--batch", type=int, default=100_000, help="states per batch call")
     parser.add_argument("--reps", type=int, default=5, help="timed repetitions (medians)")
     parser.add_argument(
-        "--xla-grad", action="store_true", help="also jit(grad) by XLA's autodiff of the rules' bodies"
+        "--xla-grad", action="store_true", help="also jit(grad) by XLA's autodiff of the adjoints' bodies"
     )
     parser.add_argument("--no-xla-flags", action="store_true", help="skip the run with the emitters off")
+    parser.add_argument("--no-jacobians", action="store_true", help="skip jit(vmap(jacfwd)) and jacrev")
     parser.add_argument("--adam-python", help="a Python with adam-robotics[jax] (and its jax) installed")
     parser.add_argument("--out", help="the table's file (default bench/results/jax.txt, jax_ROBOT.txt)")
     parser.add_argument("--worker", help=argparse.SUPPRESS)  # a JSON file of worker()'s arguments
@@ -432,7 +442,9 @@ def main(argv=None) -> int:
         log("JAX (this Python)")
         args = {"module_path": str(jax_path), "urdf": None, "count": opts.batch, "reps": opts.reps}
         args["functions"] = opts.functions
-        results["here"] = worker(**args, reference=reference, own=True, xla_grad=opts.xla_grad)
+        results["here"] = worker(
+            **args, reference=reference, own=True, xla_grad=opts.xla_grad, jacobians=not opts.no_jacobians
+        )
         if not opts.no_xla_flags:
             log(f"JAX (this Python, XLA_FLAGS={NO_EMITTERS})")
             flags = f"{os.environ.get('XLA_FLAGS', '')} {NO_EMITTERS}".strip()

@@ -4,10 +4,12 @@ generated/ holds NAME_jax.py beside NAME_numpy.py for roger_arm, puma560, panda 
 functions) and the legs of solo12 (a kinematic tree), kept up to date by tests/test_generated.py,
 so no robot is derived here. At a random state every function of each JAX module must equal the
 NumPy module's (itself checked against the oracle by tests/test_numpy_target.py) to 1e-12, and
-the dynamics the oracle's; jax.jacfwd of the JAX inverse and forward dynamics must equal the
-generated derivative functions, jax.jacfwd in p central differences; jit and vmap (the f_batch
-twins) and jax.lax.scan (a simulation) give the NumPy module's values; a float32 module is
-checked with a float32 tolerance, and a double one refuses to import without JAX's x64 mode.
+the dynamics the oracle's; jax.jacrev of the JAX inverse dynamics (its adjoint program) and
+jax.jacfwd of the forward dynamics must equal the generated derivative functions, jax.jacrev in
+p central differences;
+jit and vmap (the f_batch twins) and jax.lax.scan (a simulation) give the NumPy module's
+values; a float32 module is checked with a float32 tolerance, and a double one refuses to
+import without JAX's x64 mode.
 """
 
 from __future__ import annotations
@@ -132,17 +134,20 @@ def test_every_function_matches_numpy_and_the_oracle(robot, modules):
     _close(jax_mod.forward_dynamics(q, qd, tau, p), qdd, rtol=1e-9)
 
 
-def test_jacfwd_equals_the_generated_derivatives(modules):
-    """jax.jit of jax.jacfwd through the JAX inverse and forward dynamics = the derivative
-    functions symdyn derived symbolically (and M^-1 = d qdd / d tau), for Roger's arm."""
+def test_jacobians_equal_the_generated_derivatives(modules):
+    """jax.jit of jax.jacrev (the adjoint program) and of jax.jacfwd (forward mode of the body)
+    through the JAX inverse dynamics and of jax.jacfwd through the forward dynamics (forward mode
+    of its body) = the derivative functions symdyn derived symbolically (and M^-1 =
+    d qdd / d tau), for Roger's arm."""
     jax_mod, _, _ = modules["roger_arm"]
     rng = np.random.default_rng(3)
     q, qd, qdd, tau = rng.uniform(-2.0, 2.0, (4, jax_mod.NDOF))
     p = _params(jax_mod, rng)
-    dq, dqd = jax.jit(jax.jacfwd(jax_mod.inverse_dynamics, argnums=(0, 1)))(q, qd, qdd, p)
     want_dq, want_dqd = jax_mod.inverse_dynamics_derivatives(q, qd, qdd, p)
-    _close(dq, want_dq, rtol=1e-10)
-    _close(dqd, want_dqd, rtol=1e-10)
+    for jacobian in (jax.jacrev, jax.jacfwd):
+        dq, dqd = jax.jit(jacobian(jax_mod.inverse_dynamics, argnums=(0, 1)))(q, qd, qdd, p)
+        _close(dq, want_dq, rtol=1e-10)
+        _close(dqd, want_dqd, rtol=1e-10)
     dq, dqd, dtau = jax.jit(jax.jacfwd(jax_mod.forward_dynamics, argnums=(0, 1, 2)))(q, qd, tau, p)
     want_dq, want_dqd, minv = jax_mod.forward_dynamics_derivatives(q, qd, tau, p)
     _close(dq, want_dq, rtol=1e-10)
@@ -150,35 +155,83 @@ def test_jacfwd_equals_the_generated_derivatives(modules):
     _close(dtau, minv, rtol=1e-10)
 
 
-def test_forward_dynamics_rule_equals_autodiff_and_differences(modules):
-    """forward_dynamics is a jax.custom_jvp whose rule is forward_dynamics_derivatives: jacfwd
-    and jacrev (the rule transposed) by q, qd, tau and p equal XLA's autodiff of the body as
-    written (_forward_dynamics_plain); jacrev vmapped over states equals the generated
-    derivatives state by state; grad of a vmapped loss equals central differences of the NumPy
-    module's loss (Roger's arm: 5 free parameters, a tangent of p goes through forward mode).
-    All in one jit: one compilation costs less than running the transformations op by op."""
+def _every_mode(f, plain, args, batch=None, hessian=True):
+    """[(got, want)]: jax.jvp, jax.jacfwd, jax.jacrev, a Hessian-vector product (jax.jvp of
+    jax.grad of a weighted sum of the output: jax.hessian's forward-over-reverse, one direction),
+    jax.hessian itself if `hessian`, and given the states `batch` (of the first argument) both
+    Jacobians vmapped over them, a jax.lax.scan of jax.jvp over them and jax.grad through that
+    scan, all under one jax.jit, of f (a ruled function) and of plain (its body: XLA's autodiff,
+    forward mode for both Jacobians), as pairs of arrays."""
+    every = tuple(range(len(args)))
+    tangents = tuple(np.cos(np.arange(np.size(a)) + k) for k, a in enumerate(args))
+    weights = np.linspace(-1.0, 2.0, len(plain(*args)))
+    rest = (None,) * (len(args) - 1)
+
+    def modes(g, jacobians):
+        def along(x):
+            return jax.jvp(lambda x: g(x, *args[1:]), (x,), (tangents[0],))[1]
+
+        def scanned(states):
+            return jax.lax.scan(lambda c, x: (c + jnp.sum(g(x, *args[1:]) ** 2), along(x)), 0.0, states)
+
+        def weighted(*a):
+            return jnp.sum(g(*a) * weights)
+
+        out = [jax.jvp(g, args, tangents)[1], jax.jvp(jax.grad(weighted, argnums=every), args, tangents)[1]]
+        out += [jax.hessian(weighted, argnums=every)(*args)] if hessian else []
+        if batch is not None:
+            out += [scanned(batch)[1], jax.grad(lambda states: scanned(states)[0])(batch)]
+            out += [jax.vmap(jacobian(g), in_axes=(0, *rest))(batch, *args[1:]) for jacobian in jacobians]
+        return out + [jacobian(g, argnums=every)(*args) for jacobian in jacobians]
+
+    # both Jacobians against forward mode of the body (XLA merges its two copies)
+    got, want = jax.jit(
+        lambda: [modes(f, (jax.jacfwd, jax.jacrev)), modes(plain, (jax.jacfwd, jax.jacfwd))]
+    )()
+    return list(zip(jax.tree.leaves(got), jax.tree.leaves(want), strict=True))
+
+
+def test_every_mode_of_the_ruled_functions_equals_autodiff(modules):
+    """Forward and reverse mode, second order, vmap and lax.scan of the inverse dynamics (a
+    linear primitive: forward mode of the body, transposed by the adjoint program) and of the
+    forward dynamics (the same, transposed through the inverse dynamics' adjoint program by the
+    identity of IDENTITIES) by every argument, p included, equal XLA's autodiff of
+    the bodies as written (_NAME_plain), for Roger's arm (a fixed base, 5 free parameters)."""
+    jax_mod, _, _ = modules["roger_arm"]
+    rng = np.random.default_rng(41)
+    args = tuple(rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))) + (_params(jax_mod, rng),)
+    batch = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
+    for name in ("inverse_dynamics", "forward_dynamics"):
+        f, plain = getattr(jax_mod, name), getattr(jax_mod, f"_{name}_plain")
+        # the forward dynamics' rule under vmap and lax.scan: test_adjoints_equal_autodiff_and_differences,
+        # test_grad_through_a_lax_scan_equals_differences
+        for got, want in _every_mode(f, plain, args, batch if name == "inverse_dynamics" else None):
+            _close(got, want, rtol=1e-10)
+
+
+def test_adjoints_equal_autodiff_and_differences(modules):
+    """The forward dynamics' reverse mode (the inverse dynamics' adjoint program at weight
+    M^-1 w): jacrev vmapped over states equals the generated derivatives state by state; grad of
+    a vmapped loss equals central differences of the NumPy module's loss (Roger's arm: 5 free
+    parameters); every mode of both dynamics against XLA's autodiff:
+    test_every_mode_of_the_ruled_functions_equals_autodiff. All in one jit: one compilation
+    costs less than running the transformations op by op."""
     jax_mod, numpy_mod, _ = modules["roger_arm"]
-    fd, every = jax_mod.forward_dynamics, (0, 1, 2, 3)
+    fd = jax_mod.forward_dynamics
     rng = np.random.default_rng(31)
-    q, qd, tau = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
+    rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))  # the state the Jacobians took before (same draws after)
     p = _params(jax_mod, rng)
     Q, QD, TAU = rng.uniform(-2.0, 2.0, (3, 4, jax_mod.NDOF))
     vmapped = jax.vmap(fd, in_axes=(0, 0, 0, None))
 
     @jax.jit
-    def transformed(q, qd, tau, p, Q):
+    def transformed(Q):
         return (
-            jax.jacfwd(jax_mod._forward_dynamics_plain, argnums=every)(q, qd, tau, p),
-            jax.jacfwd(fd, argnums=every)(q, qd, tau, p),
-            jax.jacrev(fd, argnums=every)(q, qd, tau, p),
             jax.vmap(jax.jacrev(fd, argnums=(0, 1, 2)), in_axes=(0, 0, 0, None))(Q, QD, TAU, p),
             jax.grad(lambda q, p: jnp.sum(vmapped(q, QD, TAU, p) ** 2), argnums=(0, 1))(Q, p),
         )
 
-    want, forward, reverse, per_state, (got_q, got_p) = transformed(q, qd, tau, p, Q)
-    for got in (forward, reverse):
-        for g, w in zip(got, want, strict=True):
-            _close(g, w, rtol=1e-10)
+    per_state, (got_q, got_p) = transformed(Q)
     for k in range(len(Q)):
         derivatives = jax_mod.forward_dynamics_derivatives(Q[k], QD[k], TAU[k], p)
         for g, w in zip(per_state, derivatives, strict=True):
@@ -250,16 +303,22 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     """On a floating base the rule maps q's NQ entries (a quaternion of any norm) to the tangent
     space of the generated Jacobians: jax.jacrev of the
     forward dynamics by q equals central differences of the numeric oracle in q's entries (the
-    base position's columns 0, a change along the quaternion none). Only the two functions are
-    rendered (the groups' other functions dropped before printing)."""
+    base position's columns 0, a change along the quaternion none), and so does jax.jacrev of the
+    forward dynamics through the inverse dynamics' adjoint (a module with M too). Only these
+    functions are rendered (the groups' other functions dropped before printing)."""
     (tmp_path / "flyer.yaml").write_text(FLYER)
     robot = load_robot(tmp_path / "flyer.yaml")
-    ctx = context(robot, functions=["dynamics", "derivatives"])
-    keep = ("forward_dynamics", "forward_dynamics_derivatives")
-    ctx = dataclasses.replace(ctx, functions=tuple(f for f in ctx.functions if f.name in keep))
-    (text,) = jax_target.render(ctx).values()
-    (tmp_path / "flyer_jax.py").write_text(text)
-    mod = load_module(tmp_path / "flyer_jax.py", "_symdyn_test_flyer_jax")
+    full = context(robot, functions=["dynamics", "derivatives"])
+    keep = ("inverse_dynamics", "forward_dynamics", "forward_dynamics_derivatives", "mass_matrix")
+    modules = []
+    for kept in (keep[:3], keep):  # without M the rule, with M the identity (IDENTITIES)
+        ctx = dataclasses.replace(full, functions=tuple(f for f in full.functions if f.name in kept))
+        (text,) = jax_target.render(ctx).values()
+        (tmp_path / f"flyer{len(kept)}_jax.py").write_text(text)
+        modules.append(
+            load_module(tmp_path / f"flyer{len(kept)}_jax.py", f"_symdyn_test_flyer{len(kept)}_jax")
+        )
+    mod, identity = modules
     rng = np.random.default_rng(37)
     q = np.concatenate([rng.normal(size=3), 1.7 * rng.normal(size=4), rng.uniform(-1, 1, robot.n)])
     qd, tau = rng.normal(size=(2, robot.nv))
@@ -275,27 +334,40 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     _close(got, want, rtol=1e-7)
     np.testing.assert_allclose(np.asarray(got)[:, :3], 0.0, atol=1e-12)
     np.testing.assert_allclose(np.asarray(got)[:, 3:7] @ q[3:7], 0.0, atol=1e-9)
+    # the identity's reverse mode in q's entries, op by op (compiling would cost more)
+    _close(jax.jacrev(identity.forward_dynamics)(q, qd, tau), want, rtol=1e-7)
+    qdd = rng.normal(size=robot.nv)
+    for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
+        f, plain = getattr(mod, name), getattr(mod, f"_{name}_plain")
+        # vmap and lax.scan of both: test_every_mode_of_the_ruled_functions_equals_autodiff; the
+        # forward dynamics' hessian took 30 s to compile here: its Hessian-vector product
+        pairs = _every_mode(
+            f, lambda *a, plain=plain: plain(*a, jnp.zeros(0)), args, None, name == "inverse_dynamics"
+        )
+        for got, want in pairs:
+            _close(got, want, rtol=1e-9)
 
 
-def test_jacfwd_of_inverse_dynamics_on_a_tree(modules):
-    """jax.jacfwd (op by op: compiling would cost more) of the inverse dynamics of the Solo-12
+def test_jacrev_of_inverse_dynamics_on_a_tree(modules):
+    """jax.jacrev (op by op: compiling would cost more) of the inverse dynamics of the Solo-12
     legs, a kinematic tree of 12 joints = the generated inverse_dynamics_derivatives."""
     jax_mod, _, _ = modules["solo12"]
     rng = np.random.default_rng(4)
     q, qd, qdd = rng.uniform(-2.0, 2.0, (3, jax_mod.NDOF))
-    dq, dqd = jax.jacfwd(jax_mod.inverse_dynamics, argnums=(0, 1))(q, qd, qdd, None)
+    dq, dqd = jax.jacrev(jax_mod.inverse_dynamics, argnums=(0, 1))(q, qd, qdd, None)
     want_dq, want_dqd = jax_mod.inverse_dynamics_derivatives(q, qd, qdd, None)
     _close(dq, want_dq, rtol=1e-10)
     _close(dqd, want_dqd, rtol=1e-10)
 
 
 def test_gradient_in_the_parameters(modules):
-    """jax.jacfwd of tau in p = central differences of the NumPy module in p."""
+    """jax.jacrev of tau in p (the adjoint program's cotangent of p) = central differences of
+    the NumPy module in p."""
     jax_mod, numpy_mod, _ = modules["roger_arm"]
     rng = np.random.default_rng(5)
     q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 2))
     p = _params(jax_mod, rng)
-    got = jax.jacfwd(jax_mod.inverse_dynamics, argnums=3)(q, qd, qdd, p)
+    got = jax.jacrev(jax_mod.inverse_dynamics, argnums=3)(q, qd, qdd, p)
     h = 1e-6
     want = np.stack(
         [

@@ -41,7 +41,8 @@ import functools
 
 import jax
 import jax.numpy as jnp
-from jax.custom_derivatives import SymbolicZero
+from jax.extend.core import Primitive
+from jax.interpreters import ad, batching, mlir
 
 NDOF = 6
 NPARAM = 0
@@ -143,26 +144,69 @@ def _batch(f):
     return call
 
 
-def _analytic_jvp(plain, derivatives, primals, tangents, has_p):
-    """(plain(*primals), its derivative along tangents) from the Jacobians that `derivatives`
-    returns, one per argument but p, in their order: the tangent sum_i J_i t_i, linear in the
-    tangents, so that JAX transposes it for jax.grad and jax.jacrev; a tangent of p is pushed
-    through plain by forward mode. The rule of a jax.custom_jvp with symbolic zeros: an argument
-    that does not move (SymbolicZero) costs nothing, and the Jacobians are computed only when
-    one of their arguments moves."""
-    value = plain(*primals)
-    count = len(primals) - 1 if has_p else len(primals)
-    moving = [i for i in range(count) if not isinstance(tangents[i], SymbolicZero)]
-    tangent = jnp.zeros_like(value)
-    if moving:
-        jacobians = derivatives(*primals)
-        for i in moving:
-            t = tangents[i]
-            tangent = tangent + jacobians[i] @ t
-    if has_p and not isinstance(tangents[-1], SymbolicZero):
-        fixed = primals[:-1]
-        tangent = tangent + jax.jvp(lambda p: plain(*fixed, p), (primals[-1],), (tangents[-1],))[1]
-    return value, tangent
+def _nest(f, levels):
+    """f vmapped `levels` times over axis 0 of every argument."""
+    for _ in range(levels):
+        f = jax.vmap(f)
+    return f
+
+
+def _adjoint_ruled(name, plain, adjoint, shape):
+    """plain (its arguments, one output of `shape`) as a jax.custom_jvp function whose tangent is
+    a linear primitive whose transpose is the adjoint program `adjoint` (plain's arguments and the
+    output's cotangent w -> w^T d(output)/d(argument) for each argument, p's included).
+
+    The primitive NAME_linear(*primals, *tangents, levels) is the derivative of plain at the
+    primals along the tangents (every argument's, p's too; a tangent that does not move arrives
+    as zeros), over `levels` leading batch axes of every argument: forward mode (jax.jvp,
+    jax.jacfwd) evaluates it as JAX's forward mode of plain; reverse mode (jax.grad, jax.jacrev,
+    jax.vjp) transposes it, which is the adjoint program, not XLA's transpose of the long
+    straight-line body (10 times slower, docs/jax.md); jax.vmap binds it again with one more
+    level; its own derivative (second order, jax.hessian) is forward mode of the tangent map."""
+
+    def tangent(*args):
+        n = len(args) // 2
+        return jax.jvp(plain, args[:n], args[n:])[1]
+
+    def linear(*args, levels):
+        return _nest(tangent, levels)(*args)
+
+    def abstract(*args, levels):
+        return jax.core.ShapedArray(args[0].shape[:levels] + shape, args[0].dtype)
+
+    def transpose(w, *args, levels):
+        n = len(args) // 2
+        if any(ad.is_undefined_primal(a) for a in args[:n]):
+            raise NotImplementedError(f"{name}: the primals of its derivative are not linear inputs")
+        cotangents = _nest(adjoint, levels)(*args[:n], ad.instantiate_zeros(w))
+        return [None] * n + [c if ad.is_undefined_primal(t) else None for c, t in zip(cotangents, args[n:])]
+
+    def derivative(primals, tangents, *, levels):
+        tangents = tuple(ad.instantiate_zeros(t) for t in tangents)
+        return jax.jvp(functools.partial(linear, levels=levels), primals, tangents)
+
+    def batch(args, axes, *, levels):
+        size = next(a.shape[axis] for a, axis in zip(args, axes) if axis is not None)
+        args = [
+            jnp.broadcast_to(a, (size, *a.shape)) if axis is None else jnp.moveaxis(a, axis, 0)
+            for a, axis in zip(args, axes)
+        ]
+        return primitive.bind(*args, levels=levels + 1), 0
+
+    primitive = Primitive(f"{name}_linear")
+    primitive.def_impl(linear)
+    primitive.def_abstract_eval(abstract)
+    mlir.register_lowering(primitive, mlir.lower_fun(linear, multiple_results=False))
+    ad.primitive_transposes[primitive] = transpose
+    ad.primitive_jvps[primitive] = derivative
+    batching.primitive_batchers[primitive] = batch
+    ruled = jax.custom_jvp(plain)
+
+    @ruled.defjvp
+    def _(primals, tangents):
+        return plain(*primals), primitive.bind(*primals, *tangents, levels=0)
+
+    return ruled
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -174,6 +218,12 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd")
     qdd = _vector(qdd, NDOF, "qdd")
     p = _params(p)
+    return _inverse_dynamics_rule(q, qd, qdd, p)
+
+
+def _inverse_dynamics_plain(q, qd, qdd, p):
+    """inverse_dynamics of checked arguments: the function that _inverse_dynamics_rule differentiates
+    in reverse mode by _inverse_dynamics_adjoint."""
     q2 = q[1]
     q3 = q[2]
     q4 = q[3]
@@ -395,6 +445,407 @@ def inverse_dynamics(q, qd, qdd, p=None):
         x194 + x138 + 0.17070629165700002*qdd5,
         x128 + x195 + 0.19406450566800004*qdd6,
     )
+
+
+def _inverse_dynamics_adjoint(q, qd, qdd, p, tau):
+    """The cotangents of the inputs of inverse_dynamics (q, qd, qdd, p) for the
+    cotangent tau of its output: tau^T dtau/d(input), by the adjoint program
+    (symdyn.symbolic.adjoint: its statements in reverse order, each one's adjoint passed on
+    through the partial derivatives of its expression), one selected vector per input."""
+    q2 = q[1]
+    q3 = q[2]
+    q4 = q[3]
+    q5 = q[4]
+    q6 = q[5]
+    qd1 = qd[0]
+    qd2 = qd[1]
+    qd3 = qd[2]
+    qd4 = qd[3]
+    qd5 = qd[4]
+    qd6 = qd[5]
+    qdd1 = qdd[0]
+    qdd2 = qdd[1]
+    qdd3 = qdd[2]
+    qdd4 = qdd[3]
+    qdd5 = qdd[4]
+    qdd6 = qdd[5]
+    x196 = tau[0]
+    x197 = tau[1]
+    x198 = tau[2]
+    x199 = tau[3]
+    x200 = tau[4]
+    x201 = tau[5]
+    x0 = 5.8018217679508*qd1 + 24.7313845*jnp.sign(qd1)
+    x1 = jnp.sin(q2)
+    x2 = jnp.cos(q2)
+    x3 = jnp.cos(q3)
+    x4 = jnp.sin(q3)
+    x5 = qd1*x2
+    x6 = qd2*x5
+    x7 = 0.015000000000000013*x6
+    x8 = qdd1*x1 + x6
+    x9 = qd1*x1
+    x10 = x9*x9
+    x11 = qd2*qd2
+    x12 = x10 + x11
+    x13 = -0.006*x12
+    x14 = 9.81*x2
+    x15 = x5*x9
+    x16 = qdd2 + x15
+    x17 = x6 - x8
+    x18 = x13 + x14 + 0.068*x16 + 0.2275*x17
+    x19 = x5*x5
+    x20 = x10 + x19
+    x21 = -0.2275*x20
+    x22 = qd2*x9
+    x23 = qdd1*x2 - x22
+    x24 = x22 - x23
+    x25 = x6 + x8
+    x26 = x21 + 0.068*x24 + 0.006*x25
+    x27 = -3.9585*x18 + 0.10439999999999999*x26 + x7 + 0.13*x8
+    x28 = jnp.cos(q4)
+    x29 = jnp.sin(q4)
+    x30 = x3*x5
+    x31 = x30 - x4*x9
+    x32 = qd2 + qd3
+    x33 = x31*x32
+    x34 = 0.0735*x33
+    x35 = qd3*x31
+    x36 = x23*x4 + x3*x8 + x35
+    x37 = x4*x5
+    x38 = x3*x9 + x37
+    x39 = x38*x38
+    x40 = x32*x32
+    x41 = x39 + x40
+    x42 = -0.07*x41
+    x43 = x11 + x19
+    x44 = 0.4318*x43
+    x45 = 9.81*x1
+    x46 = -x44 + x45
+    x47 = x22 + x23
+    x48 = x46 + 0.15005*x47
+    x49 = x14 + 0.4318*x16 + 0.15005*x17
+    x50 = x3*x49 - x4*x48
+    x51 = x33 - x36
+    x52 = x42 + x50 + 0.0141*x51
+    x53 = x31*x31
+    x54 = x39 + x53
+    x55 = -0.0141*x54
+    x56 = -0.15005*x20
+    x57 = 0.4318*x24 + x56
+    x58 = x33 + x36
+    x59 = x55 + x57 + 0.07*x58
+    x60 = x34 + 0.066*x36 - 0.06767999999999999*x52 + 0.336*x59
+    x61 = jnp.sin(q5)
+    x62 = jnp.cos(q5)
+    x63 = -x28*x32 - x29*x38
+    x64 = qd4 + x31
+    x65 = x63*x64
+    x66 = 0.0005*x65
+    x67 = qd4*x63
+    x68 = qdd2 + qdd3
+    x69 = x28*x36 - x29*x68 + x67
+    x70 = x40 + x53
+    x71 = -0.0203*x70
+    x72 = x3*x48 + x4*x49
+    x73 = x31*x38
+    x74 = -x68 + x73
+    x75 = x71 + x72 + 0.4318*x74
+    x76 = x32*x38
+    x77 = qd3*x38
+    x78 = x23*x3 - x4*x8 - x77
+    x79 = x76 - x78
+    x80 = x57 + 0.4318*x58 + 0.0203*x79
+    x81 = -x28*x80 - x29*x75
+    x82 = x65 - x69
+    x83 = x81 + 0.019*x82
+    x84 = -x66 + 0.0018*x69 - 0.015579999999999998*x83
+    x85 = jnp.cos(q6)
+    x86 = jnp.sin(q6)
+    x87 = qd5 - x63
+    x88 = 0.00010000000000000005*x87
+    x89 = x28*x38 - x29*x32
+    x90 = -x61*x89 + x62*x64
+    x91 = x88*x90
+    x92 = qd5*x90
+    x93 = qdd4 + x78
+    x94 = x61*x93 + x62*x69 + x92
+    x95 = x91 + 0.0003*x94
+    x96 = x61*x64 + x62*x89
+    x97 = -x85*x87 - x86*x96
+    x98 = qd6 + x90
+    x99 = x97*x98
+    x100 = 0.00010999999999999999*x99
+    x101 = qd6*x97
+    x102 = qd4*x89
+    x103 = -x102 - x28*x68 - x29*x36
+    x104 = qdd5 - x103
+    x105 = x101 - x104*x86 + x85*x94
+    x106 = x28*x75 - x29*x80
+    x107 = -0.4318*x41
+    x108 = x68 + x73
+    x109 = x107 + 0.0203*x108 + x50
+    x110 = x106*x62 + x109*x61
+    x111 = -x110*x86 + x81*x85
+    x112 = -x105 + x99
+    x113 = x111 + 0.032*x112
+    x114 = -x100 + 0.00015*x105 - 0.0028799999999999997*x113
+    x115 = x85*x96 - x86*x87
+    x116 = x115*x98
+    x117 = 0.00010999999999999999*x116
+    x118 = qd6*x115
+    x119 = -x104*x85 - x118 - x86*x94
+    x120 = x110*x85 + x81*x86
+    x121 = x116 + x119
+    x122 = x120 + 0.032*x121
+    x123 = x117 + 0.00015*x119 + 0.0028799999999999997*x122
+    x124 = x114*x85 - x123*x86 + x95
+    x125 = qd5*x96
+    x126 = -x125 - x61*x69 + x62*x93
+    x127 = qdd6 + x126
+    x128 = 4e-05*x127
+    x129 = -x88*x96
+    x130 = 0.0003*x126 + x129
+    x131 = x128 + x130
+    x132 = x124*x62 - x131*x61 + x84
+    x133 = x64*x89
+    x134 = 0.0005*x133
+    x135 = x103 + x133
+    x136 = x106 + 0.019*x135
+    x137 = 0.0018*x103 + x134 + 0.015579999999999998*x136
+    x138 = 0.0004*x104 - x114*x86 - x123*x85
+    x139 = x137 - x138
+    x140 = 0.09*x122
+    x141 = 0.09*x113
+    x142 = x140*x85 - x141*x86
+    x143 = 0.34*x110 + x142
+    x144 = -x106*x61 + x109*x62
+    x145 = x115*x115
+    x146 = x97*x97
+    x147 = x145 + x146
+    x148 = -0.032*x147
+    x149 = x144 + x148
+    x150 = 0.34*x144 + 0.09*x149
+    x151 = x143*x62 - x150*x61
+    x152 = 0.82*x136 + x151
+    x153 = -x140*x86 - x141*x85
+    x154 = x153 - 0.34*x81
+    x155 = -x154 + 0.82*x83
+    x156 = -x152*x29 - x155*x28
+    x157 = x132*x28 - x139*x29 + 0.4318*x156 + x60
+    x158 = -0.01999999999999999*x76
+    x159 = x76 + x78
+    x160 = 0.0141*x159 + x72 + 0.07*x74
+    x161 = x158 + 0.06767999999999999*x160 + 0.0125*x78
+    x162 = x124*x61 + x131*x62 + 0.0013*x93
+    x163 = -0.0203*x156 + x161 + x162
+    x164 = x152*x28 - x155*x29
+    x165 = 4.8*x160 + x164
+    x166 = x89*x89
+    x167 = x63*x63
+    x168 = x166 + x167
+    x169 = -0.019*x168
+    x170 = x109 + x169
+    x171 = x143*x61 + x150*x62
+    x172 = 0.82*x170 + x171
+    x173 = x172 + 4.8*x52
+    x174 = x165*x4 + x173*x3
+    x175 = x157*x3 - x163*x4 - 0.15005*x174 + x27
+    x176 = 0.40900000000000003*x22
+    x177 = -0.068*x43
+    x178 = -qdd2 + x15
+    x179 = x177 + 0.006*x178 + x45 + 0.2275*x47
+    x180 = -x176 + 3.9585*x179 + 0.524*x23 - 1.1832*x26
+    x181 = x156 + 4.8*x59
+    x182 = x165*x3 - x173*x4
+    x183 = x157*x4 + x163*x3 + x180 - 0.4318*x181 + 0.15005*x182
+    x184 = 0.35*qdd1 + x1*x175 + x183*x2
+    x185 = 9.496868641825001*qd2 + 13.58469*jnp.sign(qd2)
+    x186 = 0.394*x15
+    x187 = 0.539*qdd2 - 0.10439999999999999*x179 + 1.1832*x18 + x186
+    x188 = 0.053500000000000006*x73
+    x189 = -0.336*x160 - x188 + 0.086*x68
+    x190 = -x132*x29 - x139*x28 - 0.4318*x164 + 0.0203*x172 + x189
+    x191 = 0.4318*x174 + x187 + x190
+    x192 = 3.9804259903721997*qd3 + 7.0892316*jnp.sign(qd3)
+    x193 = 0.41164522969715195*qd4 + 0.85160768*jnp.sign(qd4)
+    x194 = 0.42728302093540005*qd5 + 0.6660069799999999*jnp.sign(qd5)
+    x195 = 0.2158232532732*qd6 + 0.30367656000000004*jnp.sign(qd6)
+    x202 = x197 + x198
+    x203 = -x202
+    x204 = x196*x2
+    x205 = 0.15005*x204
+    x206 = -0.4318*x204
+    x207 = -0.10439999999999999*x197 + 3.9585*x204
+    x208 = 0.006*x207
+    x209 = -x204
+    x210 = x1*x196
+    x211 = 0.4318*x197 - 0.15005*x210
+    x212 = -x205*x4 + x211*x3
+    x213 = 0.0203*x202 + x212
+    x214 = 0.82*x213
+    x215 = -0.019*x214
+    x216 = x205*x3 + x211*x4
+    x217 = -0.4318*x202 + x216
+    x218 = x204*x3 - x210*x4
+    x219 = x199 + x218
+    x220 = -0.336*x202 + 4.8*x216 + 0.06767999999999999*x218
+    x221 = 0.0141*x220
+    x222 = x204*x4 + x210*x3
+    x223 = x206 - 0.0203*x218 + 0.4318*x222
+    x224 = -x217*x29 - x223*x28
+    x225 = -x224
+    x226 = x217*x28 - x223*x29
+    x227 = x213*x62 - x226*x61
+    x228 = 0.09*x227
+    x229 = -0.032*x228
+    x230 = 0.34*x227 + x228
+    x231 = x213*x61 + x226*x62
+    x232 = -x225*x85 - x231*x86
+    x233 = -x225*x86 + x231*x85
+    x234 = -x202*x28 - x222*x29
+    x235 = x200 - x234
+    x236 = 0.82*x226 + 0.015579999999999998*x234
+    x237 = 0.019*x236
+    x238 = 0.0005*x234 + x237
+    x239 = -x202*x29 + x222*x28
+    x240 = x219*x62 - x239*x61
+    x241 = x201 + x240
+    x242 = 4e-05*x241
+    x243 = 0.0003*x240 + x242
+    x244 = -x243
+    x245 = x219*x61 + x239*x62
+    x246 = -x235*x85 - x245*x86
+    x247 = 0.09*x233 + 0.0028799999999999997*x246
+    x248 = 0.032*x247
+    x249 = 0.00015*x246 + x248
+    x250 = -x249
+    x251 = 0.00010999999999999999*x246 + x248
+    x252 = qd6*x250 + 2*x115*x229 + x251*x98
+    x253 = -x235*x86 + x245*x85
+    x254 = 0.09*x232 - 0.0028799999999999997*x253
+    x255 = 0.032*x254
+    x256 = 0.34*x231 + x247*x85 - x254*x86
+    x257 = x214 + x230*x62 + x256*x61
+    x258 = 0.0203*x257
+    x259 = -x230*x61 + x236 + x256*x62
+    x260 = 0.00015*x253 - x255
+    x261 = 0.0004*x235 - x249*x85 - x260*x86
+    x262 = 0.0018*x234 + x237 - x261
+    x263 = -x262
+    x264 = -x253
+    x265 = x255 + 0.00010999999999999999*x264
+    x266 = x115*x251 + x265*x97
+    x267 = qd6*x260 + 2*x229*x97 + x265*x98
+    x268 = qd5*x244 - x240*x88 + x252*x85 - x267*x86
+    x269 = 0.0003*x245 - x249*x86 + x260*x85
+    x270 = 0.0013*x219 + x243*x62 + x269*x61
+    x271 = qd5*x269 + x245*x88 + x266
+    x272 = qd4*x263 + 2*x215*x89 + x238*x64 + x268*x62 - x271*x61
+    x273 = -x240*x96 + x245*x90
+    x274 = -x252*x86 - x267*x85 + 0.00010000000000000005*x273
+    x275 = -x104*x260 - x110*x254 - x114*x235 - x123*x245 - x140*x225 - x141*x231 + x247*x81 - x249*x94 - x252*x87 - x267*x96
+    x276 = -x104*x249 + x110*x247 + x114*x245 - x123*x235 + x140*x231 - x141*x225 + x252*x96 + x254*x81 + x260*x94 - x267*x87
+    x277 = 0.82*x224 - 0.015579999999999998*x239
+    x278 = 0.019*x277
+    x279 = -0.34*x225 + x247*x86 + x254*x85 + x277
+    x280 = -x259*x29 - x279*x28
+    x281 = 0.0203*x280
+    x282 = 0.0125*x218 + x221 + x270 - x281
+    x283 = -x282
+    x284 = -0.01999999999999999*x218 + x221 + x281
+    x285 = x259*x28 - x279*x29
+    x286 = 0.07*x220 + 0.4318*x285
+    x287 = 0.053500000000000006*x203 + x258 + x286
+    x288 = x220 + x285
+    x289 = -0.0203*x285
+    x290 = 0.0018*x239 - x243*x61 + x269*x62 - x278
+    x291 = 0.086*x202 + x258 - x262*x28 - x286 - x29*x290
+    x292 = -x239
+    x293 = x278 + 0.0005*x292
+    x294 = x238*x89 + x268*x61 + x271*x62 + x293*x63
+    x295 = qd4*x290 + 2*x215*x63 - x274 + x293*x64
+    x296 = x106*x256 + x109*x230 + x124*x239 + x131*x219 + x143*x226 + x150*x213 + x243*x93 + x268*x89 + x269*x69 + x271*x64
+    x297 = -x106*x230 + x109*x256 + x124*x219 - x131*x239 + x143*x213 - x150*x226 - x243*x69 + x268*x64 + x269*x93 - x271*x89
+    x298 = 4.8*x206 + 0.336*x222
+    x299 = 0.4318*x280 + 0.07*x298
+    x300 = x280 + x298
+    x301 = -0.0141*x298
+    x302 = x289 + x301
+    x303 = 4.8*x212 - 0.06767999999999999*x222
+    x304 = 0.0141*x303
+    x305 = x257 + x303
+    x306 = x288*x4 + x3*x305
+    x307 = x288*x3 - x305*x4
+    x308 = 0.2275*x207 + 0.15005*x307
+    x309 = x207 + x307
+    x310 = -x307
+    x311 = -0.068*x207 + 0.4318*x310
+    x312 = -0.4318*x257 - 0.07*x303
+    x313 = x289 + x312
+    x314 = x301 + x312
+    x315 = qd3*x283 + x272*x28 + x284*x32 + x287*x31 - x29*x295 + 2*x314*x38
+    x316 = 0.066*x222 - x262*x29 + x28*x290 + x299 - x304
+    x317 = 0.0735*x222 + x299 + x304
+    x318 = -x272*x29 - x28*x295 + x284*x38 + x31*x317 + 2*x313*x32
+    x319 = qd3*x316 + x287*x38 + x294 + 2*x302*x31 + x317*x32
+    x320 = -x132*x202 - x139*x222 - x152*x223 - x155*x217 - x259*x80 - x262*x36 - x272*x32 - x279*x75 - x290*x68 - x295*x38
+    x321 = x132*x222 - x139*x202 + x152*x217 - x155*x223 + x259*x75 - x262*x68 + x272*x38 - x279*x80 + x290*x36 - x295*x32
+    x322 = -1.1832*x204 + 0.10439999999999999*x210
+    x323 = 0.006*x322
+    x324 = 0.4318*x300 + 0.068*x322
+    x325 = 0.524*x204 + x282*x3 + x308 + x316*x4 - x324
+    x326 = 0.40900000000000003*x209 + x308 + x324 - x325
+    x327 = -0.15005*x300 - 0.2275*x322
+    x328 = x311 + x327
+    x329 = 1.1832*x197 - 3.9585*x210
+    x330 = 0.15005*x306 + 0.2275*x329
+    x331 = 0.4318*x306 + 0.068*x329
+    x332 = 0.394*x197 + x208 + x331
+    x333 = x306 + x329
+    x334 = -0.006*x329
+    x335 = x311 + x334
+    x336 = x327 + x334
+    x337 = qd2*x326 + x3*x315 - x319*x4 + x332*x5 + 2*x336*x9
+    x338 = 0.13*x210 - x282*x4 + x3*x316 + x323 - x330
+    x339 = 0.015000000000000013*x210 + x323 + x330 + x338
+    x340 = qd2*x339 + x3*x319 + x315*x4 + 2*x328*x5 + x332*x9
+    x341 = x157*x204 - x163*x210 + x165*x211 - x173*x205 + x23*x316 - x282*x8 + x288*x49 - x305*x48 + x315*x5 - x319*x9
+    x342 = x157*x210 + x163*x204 + x165*x205 + x173*x211 + x23*x282 + x288*x48 + x305*x49 + x315*x9 + x316*x8 + x319*x5
+    x343 = qd1*x340 + qdd1*x325 + x183*x196 + 9.81*x333
+    x344 = qd1*x337 + qdd1*x338 + x175*x196 + 9.81*x309
+    return (
+        _vector_of(
+            0,
+            -x343*jnp.sin(q2) + x344*jnp.cos(q2),
+            x341*jnp.cos(q3) - x342*jnp.sin(q3),
+            x320*jnp.cos(q4) - x321*jnp.sin(q4),
+            -x296*jnp.sin(q5) + x297*jnp.cos(q5),
+            x275*jnp.cos(q6) - x276*jnp.sin(q6),
+        ),
+        _vector_of(
+            x1*x337 + 5.8018217679508*x196 + x2*x340,
+            2*qd2*x335 + 9.496868641825001*x197 + x318 + x326*x9 + x339*x5,
+            3.9804259903721997*x198 + x283*x38 + x31*x316 + x318,
+            0.41164522969715195*x199 + x263*x89 + x290*x63 + x294,
+            0.42728302093540005*x200 + x244*x96 + x269*x90 + x274,
+            x115*x250 + 0.2158232532732*x201 + x260*x97 + x266,
+        ),
+        _vector_of(
+            x1*x338 + 1.134029968642*x196 + x2*x325,
+            2.8638148450000003*x197 - x208 + x291 + x331,
+            0.576873331938*x198 + x291,
+            0.19079062612368*x199 + x270,
+            0.17070629165700002*x200 + x261,
+            0.19406450566800004*x201 + x242,
+        ),
+        jnp.zeros((0,), dtype=DTYPE),
+    )
+
+
+#: forward mode (jax.jvp, jax.jacfwd) by JAX's forward mode of the body, reverse mode (jax.grad,
+#: jax.jacrev, jax.vjp) by the adjoint program: _adjoint_ruled
+_inverse_dynamics_rule = _adjoint_ruled("inverse_dynamics", _inverse_dynamics_plain, _inverse_dynamics_adjoint, (6,))
 
 
 def mass_matrix(q, p=None):
@@ -1276,7 +1727,7 @@ def forward_dynamics(q, qd, tau, p=None):
 
 def _forward_dynamics_plain(q, qd, tau, p):
     """forward_dynamics of checked arguments: the function that _forward_dynamics_rule differentiates
-    by forward_dynamics_derivatives."""
+    in reverse mode by _forward_dynamics_adjoint."""
     q2 = q[1]
     q3 = q[2]
     q4 = q[3]
@@ -1684,14 +2135,20 @@ def _forward_dynamics_plain(q, qd, tau, p):
     )
 
 
-_forward_dynamics_rule = jax.custom_jvp(_forward_dynamics_plain)
+def _forward_dynamics_adjoint(q, qd, tau, p, w):
+    """The cotangents of (q, qd, tau, p) for the cotangent w of forward_dynamics's qdd, by the identity
+    inverse_dynamics(q, qd, qdd, p) = tau at qdd = forward_dynamics(q, qd, tau, p): with u = M(q)^-1 w
+    (M = mass_matrix, symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd,
+    p (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T."""
+    qdd = _forward_dynamics_plain(q, qd, tau, p)
+    u = jnp.linalg.solve(mass_matrix(q, p), w)
+    dq, dqd, _, dp = _inverse_dynamics_adjoint(q, qd, qdd, p, u)
+    return -dq, -dqd, u, -dp
 
 
-@functools.partial(_forward_dynamics_rule.defjvp, symbolic_zeros=True)
-def _forward_dynamics_jvp(primals, tangents):
-    """The derivative of forward_dynamics: the Jacobians of forward_dynamics_derivatives times the tangents
-    (_analytic_jvp)."""
-    return _analytic_jvp(_forward_dynamics_plain, forward_dynamics_derivatives, primals, tangents, True)
+#: forward mode by JAX's forward mode of the body, reverse mode through the inverse dynamics'
+#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled
+_forward_dynamics_rule = _adjoint_ruled("forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (6,))
 
 
 def regressor(q, qd, qdd, p=None):

@@ -41,7 +41,8 @@ import functools
 
 import jax
 import jax.numpy as jnp
-from jax.custom_derivatives import SymbolicZero
+from jax.extend.core import Primitive
+from jax.interpreters import ad, batching, mlir
 
 NDOF = 2
 NPARAM = 5
@@ -143,26 +144,69 @@ def _batch(f):
     return call
 
 
-def _analytic_jvp(plain, derivatives, primals, tangents, has_p):
-    """(plain(*primals), its derivative along tangents) from the Jacobians that `derivatives`
-    returns, one per argument but p, in their order: the tangent sum_i J_i t_i, linear in the
-    tangents, so that JAX transposes it for jax.grad and jax.jacrev; a tangent of p is pushed
-    through plain by forward mode. The rule of a jax.custom_jvp with symbolic zeros: an argument
-    that does not move (SymbolicZero) costs nothing, and the Jacobians are computed only when
-    one of their arguments moves."""
-    value = plain(*primals)
-    count = len(primals) - 1 if has_p else len(primals)
-    moving = [i for i in range(count) if not isinstance(tangents[i], SymbolicZero)]
-    tangent = jnp.zeros_like(value)
-    if moving:
-        jacobians = derivatives(*primals)
-        for i in moving:
-            t = tangents[i]
-            tangent = tangent + jacobians[i] @ t
-    if has_p and not isinstance(tangents[-1], SymbolicZero):
-        fixed = primals[:-1]
-        tangent = tangent + jax.jvp(lambda p: plain(*fixed, p), (primals[-1],), (tangents[-1],))[1]
-    return value, tangent
+def _nest(f, levels):
+    """f vmapped `levels` times over axis 0 of every argument."""
+    for _ in range(levels):
+        f = jax.vmap(f)
+    return f
+
+
+def _adjoint_ruled(name, plain, adjoint, shape):
+    """plain (its arguments, one output of `shape`) as a jax.custom_jvp function whose tangent is
+    a linear primitive whose transpose is the adjoint program `adjoint` (plain's arguments and the
+    output's cotangent w -> w^T d(output)/d(argument) for each argument, p's included).
+
+    The primitive NAME_linear(*primals, *tangents, levels) is the derivative of plain at the
+    primals along the tangents (every argument's, p's too; a tangent that does not move arrives
+    as zeros), over `levels` leading batch axes of every argument: forward mode (jax.jvp,
+    jax.jacfwd) evaluates it as JAX's forward mode of plain; reverse mode (jax.grad, jax.jacrev,
+    jax.vjp) transposes it, which is the adjoint program, not XLA's transpose of the long
+    straight-line body (10 times slower, docs/jax.md); jax.vmap binds it again with one more
+    level; its own derivative (second order, jax.hessian) is forward mode of the tangent map."""
+
+    def tangent(*args):
+        n = len(args) // 2
+        return jax.jvp(plain, args[:n], args[n:])[1]
+
+    def linear(*args, levels):
+        return _nest(tangent, levels)(*args)
+
+    def abstract(*args, levels):
+        return jax.core.ShapedArray(args[0].shape[:levels] + shape, args[0].dtype)
+
+    def transpose(w, *args, levels):
+        n = len(args) // 2
+        if any(ad.is_undefined_primal(a) for a in args[:n]):
+            raise NotImplementedError(f"{name}: the primals of its derivative are not linear inputs")
+        cotangents = _nest(adjoint, levels)(*args[:n], ad.instantiate_zeros(w))
+        return [None] * n + [c if ad.is_undefined_primal(t) else None for c, t in zip(cotangents, args[n:])]
+
+    def derivative(primals, tangents, *, levels):
+        tangents = tuple(ad.instantiate_zeros(t) for t in tangents)
+        return jax.jvp(functools.partial(linear, levels=levels), primals, tangents)
+
+    def batch(args, axes, *, levels):
+        size = next(a.shape[axis] for a, axis in zip(args, axes) if axis is not None)
+        args = [
+            jnp.broadcast_to(a, (size, *a.shape)) if axis is None else jnp.moveaxis(a, axis, 0)
+            for a, axis in zip(args, axes)
+        ]
+        return primitive.bind(*args, levels=levels + 1), 0
+
+    primitive = Primitive(f"{name}_linear")
+    primitive.def_impl(linear)
+    primitive.def_abstract_eval(abstract)
+    mlir.register_lowering(primitive, mlir.lower_fun(linear, multiple_results=False))
+    ad.primitive_transposes[primitive] = transpose
+    ad.primitive_jvps[primitive] = derivative
+    batching.primitive_batchers[primitive] = batch
+    ruled = jax.custom_jvp(plain)
+
+    @ruled.defjvp
+    def _(primals, tangents):
+        return plain(*primals), primitive.bind(*primals, *tangents, levels=0)
+
+    return ruled
 
 
 def inverse_dynamics(q, qd, qdd, p=None):
@@ -174,6 +218,12 @@ def inverse_dynamics(q, qd, qdd, p=None):
     qd = _vector(qd, NDOF, "qd")
     qdd = _vector(qdd, NDOF, "qdd")
     p = _params(p)
+    return _inverse_dynamics_rule(q, qd, qdd, p)
+
+
+def _inverse_dynamics_plain(q, qd, qdd, p):
+    """inverse_dynamics of checked arguments: the function that _inverse_dynamics_rule differentiates
+    in reverse mode by _inverse_dynamics_adjoint."""
     q1 = q[0]
     q2 = q[1]
     qd1 = qd[0]
@@ -214,6 +264,97 @@ def inverse_dynamics(q, qd, qdd, p=None):
         x24,
         x15,
     )
+
+
+def _inverse_dynamics_adjoint(q, qd, qdd, p, tau):
+    """The cotangents of the inputs of inverse_dynamics (q, qd, qdd, p) for the
+    cotangent tau of its output: tau^T dtau/d(input), by the adjoint program
+    (symdyn.symbolic.adjoint: its statements in reverse order, each one's adjoint passed on
+    through the partial derivatives of its expression), one selected vector per input."""
+    q1 = q[0]
+    q2 = q[1]
+    qd1 = qd[0]
+    qd2 = qd[1]
+    qdd1 = qdd[0]
+    qdd2 = qdd[1]
+    g = p[0]
+    l1 = p[1]
+    m1 = p[2]
+    l2 = p[3]
+    m2 = p[4]
+    x25 = tau[0]
+    x26 = tau[1]
+    x0 = g*jnp.sin(q1)
+    x1 = l1*qdd1 + x0
+    x2 = m1*x1
+    x3 = l1*x2
+    x4 = qdd1 + qdd2
+    x5 = jnp.cos(q2)
+    x6 = jnp.sin(q2)
+    x7 = qd1*qd1
+    x8 = l1*x7
+    x9 = g*jnp.cos(q1)
+    x10 = -x8 - x9
+    x11 = -x10*x6
+    x12 = x1*x5 + x11
+    x13 = l2*x4 + x12
+    x14 = m2*x13
+    x15 = l2*x14
+    x16 = qd1 + qd2
+    x17 = x16*x16
+    x18 = l2*x17
+    x19 = x10*x5
+    x20 = x1*x6 + x19
+    x21 = -x18 + x20
+    x22 = m2*x21
+    x23 = x14*x5 + x22*x6
+    x24 = l1*x23 + x15 + x3
+    x27 = jnp.sin(q1)
+    x28 = jnp.cos(q1)
+    x29 = l1*x25
+    x30 = x29*x6
+    x31 = m2*x30
+    x32 = -x31
+    x33 = l2*x32
+    x34 = 2*x16*x33
+    x35 = x25 + x26
+    x36 = l2*x35 + x29*x5
+    x37 = m2*x36
+    x38 = x31*x5 - x37*x6
+    x39 = -x38
+    x40 = -x38
+    x41 = l1*x40
+    x42 = x1*x31 - x10*x37 + x22*x29
+    x43 = x1*x37 + x10*x31 + x14*x29
+    x44 = l2*x37
+    x45 = l1*x25
+    x46 = m1*x45 + x31*x6 + x37*x5
+    return (
+        _vector_of(
+            -g*x27*x39 + g*x28*x46,
+            x42*jnp.cos(q2) - x43*jnp.sin(q2),
+        ),
+        _vector_of(
+            2*qd1*x41 + x34,
+            x34,
+        ),
+        _vector_of(
+            l1*x46 + x44,
+            x44,
+        ),
+        _vector_of(
+            x27*x46 + x28*x39,
+            qdd1*x46 + x2*x25 + x23*x25 + x40*x7,
+            x1*x45,
+            x14*x35 + x17*x32 + x37*x4,
+            x13*x36 + x21*x30,
+        ),
+    )
+
+
+#: forward mode (jax.jvp, jax.jacfwd) by JAX's forward mode of the body, reverse mode (jax.grad,
+#: jax.jacrev, jax.vjp) by the adjoint program: _adjoint_ruled
+_inverse_dynamics_rule = _adjoint_ruled("inverse_dynamics", _inverse_dynamics_plain, _inverse_dynamics_adjoint, (2,))
 
 
 def mass_matrix(q, p=None):
@@ -385,7 +526,7 @@ def forward_dynamics(q, qd, tau, p=None):
 
 def _forward_dynamics_plain(q, qd, tau, p):
     """forward_dynamics of checked arguments: the function that _forward_dynamics_rule differentiates
-    by forward_dynamics_derivatives."""
+    in reverse mode by _forward_dynamics_adjoint."""
     q1 = q[0]
     q2 = q[1]
     qd1 = qd[0]
@@ -444,14 +585,20 @@ def _forward_dynamics_plain(q, qd, tau, p):
     )
 
 
-_forward_dynamics_rule = jax.custom_jvp(_forward_dynamics_plain)
+def _forward_dynamics_adjoint(q, qd, tau, p, w):
+    """The cotangents of (q, qd, tau, p) for the cotangent w of forward_dynamics's qdd, by the identity
+    inverse_dynamics(q, qd, qdd, p) = tau at qdd = forward_dynamics(q, qd, tau, p): with u = M(q)^-1 w
+    (M = mass_matrix, symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd,
+    p (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T."""
+    qdd = _forward_dynamics_plain(q, qd, tau, p)
+    u = jnp.linalg.solve(mass_matrix(q, p), w)
+    dq, dqd, _, dp = _inverse_dynamics_adjoint(q, qd, qdd, p, u)
+    return -dq, -dqd, u, -dp
 
 
-@functools.partial(_forward_dynamics_rule.defjvp, symbolic_zeros=True)
-def _forward_dynamics_jvp(primals, tangents):
-    """The derivative of forward_dynamics: the Jacobians of forward_dynamics_derivatives times the tangents
-    (_analytic_jvp)."""
-    return _analytic_jvp(_forward_dynamics_plain, forward_dynamics_derivatives, primals, tangents, True)
+#: forward mode by JAX's forward mode of the body, reverse mode through the inverse dynamics'
+#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled
+_forward_dynamics_rule = _adjoint_ruled("forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (2,))
 
 
 def regressor(q, qd, qdd, p=None):

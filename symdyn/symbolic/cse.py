@@ -21,7 +21,7 @@ three times faster than `sympy.cse` for the same operation counts.
 from __future__ import annotations
 
 import importlib
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import sympy as sp
 from sympy.core.mul import _keep_coeff
@@ -92,8 +92,11 @@ def _optimisations(exprs: Sequence[sp.Expr]) -> dict:
     return opt_subs
 
 
-def fast_cse(exprs: Sequence[sp.Expr], prefix: str) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
-    """(temporaries in evaluation order, reduced exprs); temporaries are named prefix0, prefix1, ..."""
+def fast_cse(
+    exprs: Sequence[sp.Expr], prefix: str, names: Iterator[sp.Symbol] | None = None
+) -> tuple[list[tuple[sp.Symbol, sp.Expr]], list[sp.Expr]]:
+    """(temporaries in evaluation order, reduced exprs); temporaries are named prefix0, prefix1, ...
+    or, when given, by the symbols `names` yields."""
     opt_subs = _optimisations(exprs)
     seen: set = set()
     repeated: set = set()
@@ -108,7 +111,7 @@ def fast_cse(exprs: Sequence[sp.Expr], prefix: str) -> tuple[list[tuple[sp.Symbo
         seen.add(x)
         stack.extend(reversed(opt_subs.get(x, x).args))
 
-    names = sp.numbered_symbols(prefix)
+    names = sp.numbered_symbols(prefix) if names is None else names
     replacements: list[tuple[sp.Symbol, sp.Expr]] = []
     memo: dict = {}
 

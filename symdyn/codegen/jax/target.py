@@ -4,15 +4,23 @@ It holds every function of the context (docs/generated-code.md) with the NumPy t
 names and arguments, written for ONE state: vectors of shape (n,), p of shape (k,). The
 bodies are the eliminated straight-line code, one statement per temporary, with no branch
 on a value, no in-place update and no NumPy call, so that jax.jit, jax.vmap, jax.grad and
-jax.jacfwd, and jax.lax.scan apply to them unchanged; p is an argument, so parameters can
-be fitted by gradient. Vectors are returned through jax.lax.select_n (the module's
-_vector_of), not jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times
-slower under jax.vmap for the Panda (docs/jax.md). Each function has a batched twin NAME_batch
-(vmapped over the leading axis of the arguments that have one, jitted). Inputs and outputs are float64
+jax.lax.scan apply to them unchanged; p is an argument, so parameters can be fitted by
+gradient. Vectors are returned through jax.lax.select_n (the module's _vector_of), not
+jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times slower under jax.vmap
+for the Panda (docs/jax.md). Each function has a batched twin NAME_batch (vmapped over the
+leading axis of the arguments that have one, jitted). Inputs and outputs are float64
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
-rather than compute in float32) or float32. The functions of RULES are jax.custom_jvp functions
-whose rule is their generated derivative function (the module's _analytic_jvp; on a floating
-base q's NQ entries mapped to the tangent space by _q_to_tangent).
+rather than compute in float32) or float32.
+
+The functions of ADJOINTS are jax.custom_jvp functions whose tangent is a linear primitive
+(the module's _adjoint_ruled: JAX's forward mode of the body for jax.jvp and jax.jacfwd) whose
+transpose, for jax.grad and jax.jacrev, is their adjoint program (symdyn.symbolic.adjoint:
+w^T dy/dx for every input, p included, one straight-line function whose cotangents are selected
+vectors too): XLA's own reverse mode of the long
+straight-line bodies makes every cotangent entry a fusion of its own that recomputes what it
+reads (docs/jax.md), 10 times slower. The functions of RULES are jax.custom_jvp functions whose
+rule is their generated derivative function (the module's _analytic_jvp; on a floating base
+q's NQ entries mapped to the tangent space by _q_to_tangent).
 
 The names, shapes and printed expressions are the NumPy target's (symdyn.codegen.python,
 printed with the namespace `jnp`); every Python statement is spelled in templates/jax/module.py.j2.
@@ -20,10 +28,27 @@ printed with the namespace `jnp`); every Python statement is spelled in template
 
 from __future__ import annotations
 
-from ..python.target import render_module
+import re
+from collections.abc import Iterator
+
+import sympy as sp
+
+from ...symbolic.adjoint import adjoint_program
+from ..function_rows import FunctionSpec
+from ..python.printer import NumpyPrinter, local_names
+from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 
-__all__ = ["render", "file_name", "TOOLS", "RULES"]
+__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "adjoint_view"]
+
+#: The functions whose derivative is a linear primitive transposed by their generated adjoint program
+#: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
+#: argument of that name). Chosen by measurement (bench/jax.py, docs/jax.md): for the Panda,
+#: jax.jit(jax.grad(...)) through jax.vmap of the inverse dynamics took 7.9 us a state by XLA's
+#: reverse mode, 17.6 us through a custom_jvp rule of the generated tangent program (JAX
+#: transposing it) and 0.59 us through the adjoint program (3.3 times the forward pass); the
+#: forward dynamics' adjoint program took 9.2 ms, twice XLA's reverse mode, so it keeps RULES.
+ADJOINTS = ("inverse_dynamics",)
 
 #: The functions differentiated by a jax.custom_jvp rule made of a generated derivative function,
 #: {function: derivative function}, when the module holds both: the derivative function returns
@@ -32,7 +57,18 @@ __all__ = ["render", "file_name", "TOOLS", "RULES"]
 #: docs/jax.md): for the Panda, jax.jit(jax.grad(...)) through jax.vmap of the forward dynamics
 #: took 6.2 ms a state by XLA's reverse mode and 108 us by the rule; the inverse dynamics keeps
 #: XLA's autodiff, which was faster than its rule (12 against 17 us; jacfwd 16 against 31 us).
+#: IDENTITIES takes the forward dynamics over when the module holds the inverse dynamics and M.
 RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
+
+
+#: The functions reverse-differentiated through another's adjoint program by an identity,
+#: {function: (inverse dynamics, mass matrix)}: differentiating ID(q, qd, FD(q, qd, tau)) = tau
+#: gives w^T dqdd/dx = -(M^-1 w)^T dID/dx for x = q, qd, p (at qdd = FD) and w^T dqdd/dtau =
+#: (M^-1 w)^T: one solve and the inverse dynamics' adjoint program. Chosen by measurement (the
+#: Panda, bench/jax.py on the loaded machine): jax.jit(jax.grad(...)) through jax.vmap 15.5 us a
+#: state (2.7 times the forward pass, compiled in 19 s), against 108 us by RULES (compiled in 551 s).
+#: Taken over RULES when the module holds the three functions with these inputs.
+IDENTITIES = {"forward_dynamics": ("inverse_dynamics", "mass_matrix")}
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
@@ -40,6 +76,42 @@ TOOLS = {"_jax.py": ("sympy",)}
 
 def file_name(name: str) -> str:
     return f"{name}_jax.py"
+
+
+def _numbered_after(spec: FunctionSpec) -> Iterator[sp.Symbol]:
+    """Fresh temporaries x<k>, numbered after the spec's own (no parameter is named so: local_names)."""
+    taken = [int(m.group(1)) for s, _ in spec.temporaries if (m := re.fullmatch(r"x(\d+)", s.name))]
+    return sp.numbered_symbols("x", start=max(taken, default=-1) + 1)
+
+
+def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
+    """The adjoint program of `spec` as the template prints it: arguments (the inputs, p, then the
+    output's cotangent, named as the output), the entries it reads, temporaries, and one vector of
+    cotangent entries per input (p's last); None unless `spec` has one vector output named as no
+    input."""
+    (out,) = spec.results if len(spec.results) == 1 else (None,)
+    names = [inp.name for inp in spec.inputs]
+    if out is None or out.matrix or out.name in names or out.name not in JOINT_INPUTS:
+        return None
+    fresh = _numbered_after(spec)
+    weights = [next(fresh) for _ in range(out.size)]
+    inputs = [s for inp in spec.inputs for s in inp.symbols]
+    program = adjoint_program(spec.temporaries, spec.outputs, weights, inputs, fresh)
+    exprs = [e for _, e in program.temporaries] + list(program.outputs)
+    free = set().union(*(e.free_symbols for e in exprs))
+    read = [(s, inp.name, k) for inp in spec.inputs for k, s in enumerate(inp.symbols) if s in free]
+    read += [(w, out.name, k) for k, w in enumerate(weights) if w in free]
+    cotangents, start = [], 0
+    for inp in spec.inputs:
+        cotangents.append([printer.doprint(e) for e in program.outputs[start : start + len(inp.symbols)]])
+        start += len(inp.symbols)
+    return {
+        "args": [*names, out.name],
+        "shape": [out.size],
+        "unpack": [(printer.doprint(s), array, k) for s, array, k in read],
+        "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in program.temporaries],
+        "cotangents": cotangents,
+    }
 
 
 def rules(ctx: RenderContext) -> dict[str, str]:
@@ -58,6 +130,33 @@ def rules(ctx: RenderContext) -> dict[str, str]:
     return out
 
 
+def identities(ctx: RenderContext, adjoints: dict[str, dict]) -> dict[str, dict]:
+    """{function: {"inverse": ..., "mass": ..., "shape": ...}} for the entries of IDENTITIES whose
+    three functions are in `ctx` with the inputs (q, qd, tau, p), (q, qd, qdd, p) and (q, p), the
+    inverse dynamics having an adjoint program (`adjoints`)."""
+    specs = {spec.name: spec for spec in ctx.functions}
+    wanted = (["q", "qd", "tau", "p"], ["q", "qd", "qdd", "p"], ["q", "p"])
+    out = {}
+    for name, (inverse, mass) in IDENTITIES.items():
+        found = [specs.get(n) for n in (name, inverse, mass)]
+        if inverse not in adjoints or any(s is None for s in found):
+            continue
+        if [[inp.name for inp in s.inputs] for s in found] == list(wanted) and len(found[0].results) == 1:
+            out[name] = {"inverse": inverse, "mass": mass, "shape": [found[0].results[0].size]}
+    return out
+
+
+def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
+    """{function: adjoint_view} for the functions of ADJOINTS in `ctx`."""
+    printer = NumpyPrinter(local_names(ctx), module="jnp")
+    views = {spec.name: adjoint_view(spec, printer) for spec in ctx.functions if spec.name in ADJOINTS}
+    return {name: view for name, view in views.items() if view is not None}
+
+
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_jax.py: module text} for the robot of `ctx`."""
-    return {file_name(ctx.name): render_module(ctx, "jax/module.py.j2", "jnp", rules=rules(ctx))}
+    adjoints = adjoint_views(ctx)
+    through = identities(ctx, adjoints)
+    derived = {name: d for name, d in rules(ctx).items() if name not in through}
+    text = render_module(ctx, "jax/module.py.j2", "jnp", rules=derived, adjoints=adjoints, identities=through)
+    return {file_name(ctx.name): text}
