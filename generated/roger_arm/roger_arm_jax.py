@@ -285,30 +285,30 @@ def _inverse_dynamics_adjoint(q, qd, qdd, p, tau):
     x25 = tau[0]
     x26 = tau[1]
     x0 = g*jnp.sin(q1)
-    x1 = l1*qdd1 + x0
-    x2 = m1*x1
-    x3 = l1*x2
+    x1 = x0 + l1*qdd1
+    x2 = x1*m1
+    x3 = x2*l1
     x4 = qdd1 + qdd2
     x5 = jnp.cos(q2)
     x6 = jnp.sin(q2)
     x7 = qd1*qd1
-    x8 = l1*x7
+    x8 = x7*l1
     x9 = g*jnp.cos(q1)
     x10 = -x8 - x9
     x11 = -x10*x6
     x12 = x1*x5 + x11
-    x13 = l2*x4 + x12
-    x14 = m2*x13
-    x15 = l2*x14
+    x13 = x12 + x4*l2
+    x14 = x13*m2
+    x15 = x14*l2
     x16 = qd1 + qd2
     x17 = x16*x16
-    x18 = l2*x17
+    x18 = x17*l2
     x19 = x10*x5
     x20 = x1*x6 + x19
-    x21 = -x18 + x20
-    x22 = m2*x21
-    x23 = x14*x5 + x22*x6
-    x24 = l1*x23 + x15 + x3
+    x21 = x20 - x18
+    x22 = x21*m2
+    x23 = x22*x6 + x14*x5
+    x24 = x3 + x15 + x23*l1
     x27 = jnp.sin(q1)
     x28 = jnp.cos(q1)
     x29 = l1*x25
@@ -324,22 +324,22 @@ def _inverse_dynamics_adjoint(q, qd, qdd, p, tau):
     x39 = -x38
     x40 = -x38
     x41 = l1*x40
-    x42 = x1*x31 - x10*x37 + x22*x29
+    x42 = x1*x31 + x22*x29 - x10*x37
     x43 = x1*x37 + x10*x31 + x14*x29
     x44 = l2*x37
     x45 = l1*x25
     x46 = m1*x45 + x31*x6 + x37*x5
     return (
         _vector_of(
-            -g*x27*x39 + g*x28*x46,
+            g*x28*x46 - g*x27*x39,
             x42*jnp.cos(q2) - x43*jnp.sin(q2),
         ),
         _vector_of(
-            2*qd1*x41 + x34,
+            x34 + 2*qd1*x41,
             x34,
         ),
         _vector_of(
-            l1*x46 + x44,
+            x44 + l1*x46,
             x44,
         ),
         _vector_of(
