@@ -391,14 +391,15 @@ def test_batch_files_of_a_large_robot_equal_the_scalar_functions_bit_for_bit(rog
             ("PART_ABOVE", 6),
             ("PART_STATEMENTS", 4),
             ("LIVE_ABOVE", 0),
-            ("SPLIT_BYTES", 3000),
+            ("SPLIT_BYTES", 16_000),
         ):
             mp.setattr(parts, name, value)
-        assert render_runtime(ctx) == render_runtime(ctx)
         spread = _build_all(ctx, tmp_path, WIDEST, ("-Wmissing-prototypes", "-Wmissing-declarations"))
+        again = render_runtime(ctx)
     files = spread["files"]
+    assert again == {name: text for name, text in files.items() if name in again}  # the same bytes
     batch = sorted(n for n in files if n.startswith("roger_arm_batch"))
-    assert len(batch) >= 4 and "roger_arm_batch_parts.h" in batch and "roger_arm_batch_2.c" in batch
+    assert len(batch) >= 3 and "roger_arm_batch_parts.h" in batch and "roger_arm_batch_2.c" in batch
     sources = [files[n] for n in batch if n.endswith(".c")]
     for f in ["batch_width", *(f"{name}_batch" for name in spread["table"])]:
         assert sum(len(re.findall(rf"^(?:int|void) roger_arm_{f}\(.*\)$", s, re.M)) for s in sources) == 1, f

@@ -3,10 +3,11 @@
 symdyn.compile builds, beside the files `generate` writes, the SIMD twin of every function
 (symdyn.codegen.c.vector) and its batch wrapper. For MuJoCo Menagerie's humanoids that C is
 larger than the scalar C (both widths' output stores, the vector types' names): Unitree G1's was
-4.7 MB in one file, which gcc 12 compiled in ~190 s of one core at -O2 while the largest of its three scalar
-files took about 36 s, so the batch file alone set the build's wall time. Its units, each vector block's parts
+4.7 MB in one file, 105 s of one core at -O2 -march=native (gcc 12, a busy machine) while the
+largest of its three scalar files took 35 s, so the batch file alone set the build's wall time.
+Its units, each vector block's parts
 then the block with its wrapper (a function without a vector form: its wrapper alone), go into files
-as the scalar units do (symdyn.codegen.c.parts.file_units, about SPLIT_BYTES of C each):
+as the scalar units do (symdyn.codegen.c.parts.file_units, in files of half the statements):
 NAME_batch.c, NAME_batch_2.c, ..., which symdyn.compile builds in parallel. A part in the file of
 its block is static; one in another file has the hidden visibility of NAME_SIMD_HIDDEN and is
 declared in the internal header NAME_batch_parts.h (templates/c/batch_parts.h.j2). Each lane
@@ -16,9 +17,15 @@ function bit for bit, whichever file a part lies in.
 
 from __future__ import annotations
 
-from .parts import file_units
+from . import parts as layout
 
-__all__ = ["WRAPPER_BYTES", "vector_layout", "batch_file_name"]
+__all__ = ["WRAPPER_BYTES", "BATCH_SHARE", "vector_layout", "batch_file_name"]
+
+#: a batch file holds about SPLIT_BYTES / BATCH_SHARE of statements: vector C costs gcc more per
+#: byte than scalar C (Menagerie's Talos, with files of about SPLIT_BYTES: its forward dynamics'
+#: seven vector parts and block, 2.1 MB in one file, took 48 s of one core, the largest of its
+#: scalar files 28 s)
+BATCH_SHARE = 2
 
 #: the bytes of C of a batch wrapper (its loops over the states, the block layout's copies)
 WRAPPER_BYTES = 2000
@@ -55,7 +62,7 @@ def vector_layout(views: list[dict | None]) -> list[list[tuple[int, int]]]:
         else:
             whole.append(WRAPPER_BYTES + _items_size(v["body"]))
             parts.append([])
-    return file_units(whole, parts)
+    return layout.file_units(whole, parts, layout.SPLIT_BYTES // BATCH_SHARE)
 
 
 def batch_file_name(name: str, index: int) -> str:
