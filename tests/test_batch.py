@@ -15,9 +15,11 @@ C-contiguous float64 arrays, and threads= giving the one-thread result bit for b
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
 import os
 import platform
+import re
 import subprocess
 from pathlib import Path
 
@@ -65,22 +67,28 @@ AVX_ONLY = {"avx": (("-mavx", "-O3"), 4)} if X86 and "avx" in CPU else {}
 ALL_BUILDS = {**BUILDS, **AVX_ONLY}
 
 
-def _build_all(ctx, folder: Path, names) -> dict:
-    """Compile the robot's C and batch wrappers once per build of `names`, all at once; load each."""
+def _build_all(ctx, folder: Path, names, extra=()) -> dict:
+    """Compile the robot's C and batch wrappers (every file of each: NAME_dynamics*.c, NAME_batch*.c)
+    once per build of `names`, with the flags `extra` too, all at once; load each."""
     files = {**c_target.render(ctx), **render_runtime(ctx)}
     paths = write_files(files, folder)
-    sources = [str(p) for p in paths if p.name.endswith(("_dynamics.c", "_batch.c"))]
+    sources = [str(p) for p in paths if re.fullmatch(r".*_(dynamics|batch)(_\d+)?\.c", p.name)]
     jobs = {}
     for name in names:
         flags, _ = ALL_BUILDS[name]
-        cmd = ["gcc", *STRICT_FLAGS, *BASE, *flags, "-o", str(folder / f"{name}.so"), *sources, "-lm"]
+        cmd = ["gcc", *STRICT_FLAGS, *BASE, *flags, *extra, "-o", str(folder / f"{name}.so"), *sources, "-lm"]
         jobs[name] = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
     table = function_table(ctx)
     libs = {}
     for name, job in jobs.items():
         assert job.wait() == 0, job.stderr.read()
         libs[name] = load_library(folder / f"{name}.so", table, f"{ctx.name}_batch_width", ctx.precision)
-    return {"table": {f["name"]: f for f in table}, "libs": libs, "batch": files[f"{ctx.name}_batch.c"]}
+    return {
+        "table": {f["name"]: f for f in table},
+        "libs": libs,
+        "batch": files[f"{ctx.name}_batch.c"],
+        "files": files,
+    }
 
 
 @pytest.fixture(scope="module")
@@ -369,3 +377,41 @@ def test_vector_bodies_in_parts_equal_the_scalar_functions_bit_for_bit(roger_in_
     for function in build_["table"]:
         for count in (1, width + 1, 2 * width + 3):
             _check(build_, WIDEST[0], function, count, rng, params=params)
+
+
+@pytest.mark.skipif(not WIDEST, reason="needs AVX2")
+def test_batch_files_of_a_large_robot_equal_the_scalar_functions_bit_for_bit(roger_in_parts, tmp_path):
+    """The batch wrappers spread over several files as a large robot's (symdyn.codegen.c.vector_files):
+    each block and wrapper defined once, a part in another file than its block hidden and declared
+    in NAME_batch_parts.h (-Wmissing-prototypes), the same bytes twice, and every lane still the
+    scalar function, bit for bit."""
+    ctx, _ = roger_in_parts
+    with pytest.MonkeyPatch.context() as mp:
+        for name, value in (
+            ("PART_ABOVE", 6),
+            ("PART_STATEMENTS", 4),
+            ("LIVE_ABOVE", 0),
+            ("SPLIT_BYTES", 16_000),
+        ):
+            mp.setattr(parts, name, value)
+        spread = _build_all(ctx, tmp_path, WIDEST, ("-Wmissing-prototypes", "-Wmissing-declarations"))
+        again = render_runtime(ctx)
+    files = spread["files"]
+    assert again == {name: text for name, text in files.items() if name in again}  # the same bytes
+    batch = sorted(n for n in files if n.startswith("roger_arm_batch"))
+    assert len(batch) >= 3 and "roger_arm_batch_parts.h" in batch and "roger_arm_batch_2.c" in batch
+    sources = [files[n] for n in batch if n.endswith(".c")]
+    for f in ["batch_width", *(f"{name}_batch" for name in spread["table"])]:
+        assert sum(len(re.findall(rf"^(?:int|void) roger_arm_{f}\(.*\)$", s, re.M)) for s in sources) == 1, f
+    hidden = re.findall(r"roger_arm_SIMD_HIDDEN void (\w+)\(", files["roger_arm_batch_parts.h"])
+    assert hidden and all(
+        sum(f"roger_arm_SIMD_HIDDEN __attribute__((noinline)) void {h}(" in s for s in sources) == 1
+        for h in hidden
+    )
+    library = ctypes.CDLL(str(tmp_path / f"{WIDEST[0]}.so"))
+    assert hasattr(library, "roger_arm_mass_matrix_batch") and not any(hasattr(library, h) for h in hidden)
+    rng = np.random.default_rng(9)
+    params = rng.uniform(0.5, 2.0, len(ctx.robot.params))
+    width = BUILDS[WIDEST[0]][1]
+    for function in spread["table"]:
+        _check(spread, WIDEST[0], function, 2 * width + 3, rng, params=params)

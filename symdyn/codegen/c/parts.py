@@ -209,14 +209,15 @@ def _number(name: str) -> tuple[int, str]:
     return (int(digits), name) if digits.isdigit() else (0, name)
 
 
-def file_groups(sizes: list[int]) -> list[list[int]]:
+def file_groups(sizes: list[int], split: int | None = None) -> list[list[int]]:
     """The functions of each source file, as indices into `sizes` (each function's bytes of C):
-    all in one file while the sum is at most SPLIT_BYTES, else consecutive functions in about
-    sum / SPLIT_BYTES files of balanced size."""
+    all in one file while the sum is at most `split` (default SPLIT_BYTES), else consecutive
+    functions in about sum / `split` files of balanced size."""
+    split = SPLIT_BYTES if split is None else split
     total = sum(sizes)
-    if total <= SPLIT_BYTES or len(sizes) < 2:
+    if total <= split or len(sizes) < 2:
         return [list(range(len(sizes)))]
-    count = min(len(sizes), ceil(total / SPLIT_BYTES))
+    count = min(len(sizes), ceil(total / split))
     groups: list[list[int]] = [[]]
     done = 0
     for k, size in enumerate(sizes):
@@ -228,15 +229,17 @@ def file_groups(sizes: list[int]) -> list[list[int]]:
     return groups
 
 
-def file_units(whole: list[int], parts: list[list[int]]) -> list[list[tuple[int, int]]]:
+def file_units(
+    whole: list[int], parts: list[list[int]], split: int | None = None
+) -> list[list[tuple[int, int]]]:
     """The units of each source file: (i, 0) is function i itself (its body, or the calls of its
     parts), (i, k) its part k. `whole[i]` is the bytes of function i's own code, `parts[i]` those
     of each of its parts (empty: the function is whole). The units, each function's parts then the
     function, are grouped by `file_groups` on their sizes: a function's parts may lie in several
-    files, the function in the file of its last part."""
+    files, the function in the file of its last part; `split`: file_groups'."""
     units = [(i, k) for i, sizes in enumerate(parts) for k in [*range(1, len(sizes) + 1), 0]]
     sizes = [whole[i] if k == 0 else parts[i][k - 1] for i, k in units]
-    return [[units[j] for j in group] for group in file_groups(sizes)]
+    return [[units[j] for j in group] for group in file_groups(sizes, split)]
 
 
 def _size(statements: list) -> int:

@@ -8,7 +8,8 @@ NAME_solve_loops of a robot with closed loops, the one function with a loop (not
 it returns an int). `render_runtime(ctx)` gives
 NAME_batch.c (one NAME_batch(count, ...) per function, the loop over a batch in C, W states
 per instruction through the function's body over vectors: symdyn.codegen.c.vector; and
-NAME_solve_loops_batch, a plain loop over the states),
+NAME_solve_loops_batch, a plain loop over the states; a large robot's in NAME_batch.c,
+NAME_batch_2.c ..., symdyn.codegen.c.vector_files),
 symdyn_step.c (the fixed-step integrators of symdyn.apps.simulation.simulate) and symdyn_csv.c (the
 CSV writer of symdyn.apps.simulation.csv_format), the last two robot-independent. Every C statement
 is spelled in templates/c/batch.c.j2, templates/c/step.c.j2 and templates/c/csv.c.j2.
@@ -21,6 +22,7 @@ from ..render import RenderContext, environment, header_lines
 from .config import CConfig, c_names
 from .sincos import BLOCK
 from .vector import LANE_CALLS, simd_prefix, vector_view
+from .vector_files import batch_file_name, vector_layout
 
 __all__ = ["function_table", "solve_loops_entry", "render_runtime", "STEP_SOURCE", "CSV_SOURCE"]
 
@@ -59,7 +61,8 @@ def solve_loops_entry(ctx: RenderContext) -> dict | None:
 
 
 def render_runtime(ctx: RenderContext) -> dict[str, str]:
-    """NAME_batch.c, symdyn_step.c and symdyn_csv.c for the robot of `ctx` (compiled with NAME_dynamics.c)."""
+    """NAME_batch.c (a large robot's also NAME_batch_2.c ... and NAME_batch_parts.h), symdyn_step.c
+    and symdyn_csv.c for the robot of `ctx` (compiled with NAME_dynamics.c ...)."""
     names = c_names(ctx)
     config = CConfig(ctx.precision)
     prefix = simd_prefix(ctx)
@@ -74,31 +77,71 @@ def render_runtime(ctx: RenderContext) -> dict[str, str]:
                 "vector": vector_view(ctx, names, spec),
             }
         )
-    added = {prefix + f.name for f in ctx.functions} | {f"{ctx.name}_batch_width"}
+    hidden = f"{ctx.name}_SIMD_HIDDEN"
+    added = {prefix + f.name for f in ctx.functions} | {f"{ctx.name}_batch_width", hidden}
     taken = set(names.functions.values()) | {c + "_batch" for c in names.functions.values()}
     assert not added & taken, f"a generated function has the name of a batch helper: {added & taken}"
     env = environment()
-    lines = header_lines(ctx)
     trig = any(f["vector"] and (f["vector"]["angles"] or f["vector"]["lane_pairs"]) for f in functions)
-    return {
-        f"{ctx.name}_batch.c": env.get_template("c/batch.c.j2").render(
-            header_lines=lines,
-            header_file=names.header_file,
-            real=config.real,
-            functions=functions,
-            W=f"{ctx.name}_SIMD_W",
-            width=f"{ctx.name}_batch_width",
-            vd=f"{ctx.name}_vd",
-            vi=f"{ctx.name}_vi",
-            P=prefix,
-            lane_calls=[config.math(c) for c in LANE_CALLS],
-            pow=config.math("pow"),
-            sincos={**names.sincos, "block": BLOCK} if trig else None,
-            sincos_groups=sorted(
-                {len(group) for f in functions if f["vector"] for _, group in f["vector"]["angle_groups"]}
-            ),
-            loops=solve_loops_entry(ctx),
-        ),
-        STEP_SOURCE: env.get_template("c/step.c.j2").render(header_lines=lines, real=config.real),
-        CSV_SOURCE: env.get_template("c/csv.c.j2").render(header_lines=lines),
+    values = {
+        "name": ctx.name,
+        "header_lines": header_lines(ctx),
+        "header_file": names.header_file,
+        "real": config.real,
+        "W": f"{ctx.name}_SIMD_W",
+        "width": f"{ctx.name}_batch_width",
+        "vd": f"{ctx.name}_vd",
+        "vi": f"{ctx.name}_vi",
+        "P": prefix,
+        "hidden": hidden,
+        "lane_calls": [config.math(c) for c in LANE_CALLS],
+        "pow": config.math("pow"),
+        "sincos": {**names.sincos, "block": BLOCK} if trig else None,
     }
+    files = _batch_files(ctx, env, values, functions)
+    files[STEP_SOURCE] = env.get_template("c/step.c.j2").render(
+        header_lines=values["header_lines"], real=config.real
+    )
+    files[CSV_SOURCE] = env.get_template("c/csv.c.j2").render(header_lines=values["header_lines"])
+    return files
+
+
+def _batch_files(ctx: RenderContext, env, values: dict, functions: list[dict]) -> dict[str, str]:
+    """NAME_batch.c, and for a large robot NAME_batch_2.c ... and the internal header
+    NAME_batch_parts.h (symdyn.codegen.c.vector_files): each file with the parts, blocks and
+    wrappers of its units, and the helpers these need."""
+    groups = vector_layout([f["vector"] for f in functions])
+    file_of = {unit: k for k, group in enumerate(groups) for unit in group}
+    shared = [
+        (functions[i]["vector"], functions[i]["vector"]["parts"]["parts"][n - 1])
+        for i, n in sorted(file_of)
+        if n and file_of[i, n] != file_of[i, 0]
+    ]
+    files = {}
+    header = f"{ctx.name}_batch_parts.h" if shared else None
+    if header:
+        guard = f"{ctx.name.upper()}_SIMD_PARTS_H"
+        files[header] = env.get_template("c/batch_parts.h.j2").render(values, shared=shared, guard=guard)
+    for k, group in enumerate(groups):
+        chosen, linked = [], False
+        for i in sorted({i for i, _ in group}):
+            f, v = functions[i], functions[i]["vector"]
+            count = len(v["parts"]["parts"]) if v and v["parts"] else 0
+            here = [
+                (n, v["parts"]["parts"][n - 1], file_of[i, n] == file_of[i, 0])
+                for n in range(1, count + 1)
+                if (i, n) in group
+            ]
+            chosen.append({**f, "here": here, "defined": (i, 0) in group})
+            linked = linked or any(file_of[i, n] != k for n in range(count + 1))
+        blocks = [f["vector"] for f in chosen if f["defined"] and f["vector"]]
+        files[batch_file_name(ctx.name, k)] = env.get_template("c/batch.c.j2").render(
+            values,
+            functions=chosen,
+            first=k == 0,
+            parts_header=header if linked else None,
+            sincos_helper=any(v["angles"] or v["lane_pairs"] for v in blocks),
+            sincos_groups=sorted({len(group) for v in blocks for _, group in v["angle_groups"]}),
+            loops=solve_loops_entry(ctx) if k == 0 else None,
+        )
+    return files
