@@ -55,6 +55,7 @@ __all__ = [
     "file_units",
     "layout",
     "part_counts",
+    "placement",
     "source_file_name",
 ]
 
@@ -270,6 +271,31 @@ def part_counts(groups: list[list[tuple[int, int]]], count: int) -> list[int]:
     return counts
 
 
-def source_file_name(name: str, index: int) -> str:
-    """NAME_dynamics.c for the first file (index 0), NAME_dynamics_2.c ... for the others."""
-    return f"{name}_dynamics.c" if index == 0 else f"{name}_dynamics_{index + 1}.c"
+def placement(groups: list[list[tuple[int, int]]], parts: list[list]) -> tuple[list, list]:
+    """Where the units of each file (`file_units`) put each function and part, `parts[i]` being
+    function i's parts (empty: whole): (the parts in another file than their function, which are
+    not static and are declared in an internal header, as (i, part) in order; for each file, ([(i,
+    here, defined)] for each function with a unit in it, `here` its parts in the file as (k, part,
+    static) and `defined` whether the function itself is there, and whether the file calls or is
+    called from another file)). The scalar files (symdyn.codegen.c.target) and the batch files
+    (symdyn.codegen.c.runtime) are laid out by it."""
+    file_of = {unit: k for k, group in enumerate(groups) for unit in group}
+    shared = [(i, parts[i][n - 1]) for i, n in sorted(file_of) if n and file_of[i, n] != file_of[i, 0]]
+    files = []
+    for k, group in enumerate(groups):
+        members, linked = [], False
+        for i in sorted({i for i, _ in group}):
+            units = range(len(parts[i]) + 1)
+            here = [
+                (n, parts[i][n - 1], file_of[i, n] == file_of[i, 0]) for n in units[1:] if (i, n) in group
+            ]
+            members.append((i, here, (i, 0) in group))
+            linked = linked or any(file_of[i, n] != k for n in units)
+        files.append((members, linked))
+    return shared, files
+
+
+def source_file_name(name: str, index: int, stem: str = "dynamics") -> str:
+    """NAME_dynamics.c for the first file (index 0), NAME_dynamics_2.c ... for the others (`stem`:
+    NAME_batch.c, NAME_batch_2.c ... for the batch files)."""
+    return f"{name}_{stem}.c" if index == 0 else f"{name}_{stem}_{index + 1}.c"

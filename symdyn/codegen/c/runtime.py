@@ -20,6 +20,7 @@ from __future__ import annotations
 from ..loop_solve import loop_solve_context
 from ..render import RenderContext, environment, header_lines
 from .config import CConfig, c_names
+from .parts import placement
 from .sincos import BLOCK
 from .vector import LANE_CALLS, simd_prefix, vector_view
 from .vector_files import batch_file_name, vector_layout
@@ -110,30 +111,18 @@ def _batch_files(ctx: RenderContext, env, values: dict, functions: list[dict]) -
     """NAME_batch.c, and for a large robot NAME_batch_2.c ... and the internal header
     NAME_batch_parts.h (symdyn.codegen.c.vector_files): each file with the parts, blocks and
     wrappers of its units, and the helpers these need."""
-    groups = vector_layout([f["vector"] for f in functions])
-    file_of = {unit: k for k, group in enumerate(groups) for unit in group}
-    shared = [
-        (functions[i]["vector"], functions[i]["vector"]["parts"]["parts"][n - 1])
-        for i, n in sorted(file_of)
-        if n and file_of[i, n] != file_of[i, 0]
-    ]
+    vectors = [f["vector"] for f in functions]
+    shared, placed = placement(
+        vector_layout(vectors), [v["parts"]["parts"] if v and v["parts"] else [] for v in vectors]
+    )
     files = {}
     header = f"{ctx.name}_batch_parts.h" if shared else None
     if header:
         guard = f"{ctx.name.upper()}_SIMD_PARTS_H"
+        shared = [(vectors[i], part) for i, part in shared]
         files[header] = env.get_template("c/batch_parts.h.j2").render(values, shared=shared, guard=guard)
-    for k, group in enumerate(groups):
-        chosen, linked = [], False
-        for i in sorted({i for i, _ in group}):
-            f, v = functions[i], functions[i]["vector"]
-            count = len(v["parts"]["parts"]) if v and v["parts"] else 0
-            here = [
-                (n, v["parts"]["parts"][n - 1], file_of[i, n] == file_of[i, 0])
-                for n in range(1, count + 1)
-                if (i, n) in group
-            ]
-            chosen.append({**f, "here": here, "defined": (i, 0) in group})
-            linked = linked or any(file_of[i, n] != k for n in range(count + 1))
+    for k, (members, linked) in enumerate(placed):
+        chosen = [{**functions[i], "here": here, "defined": defined} for i, here, defined in members]
         blocks = [f["vector"] for f in chosen if f["defined"] and f["vector"]]
         files[batch_file_name(ctx.name, k)] = env.get_template("c/batch.c.j2").render(
             values,

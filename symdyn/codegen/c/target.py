@@ -27,7 +27,7 @@ from ..regressor_functions import columns
 from ..render import RenderContext, environment, header_lines
 from .config import TEMPORARY, CConfig, CNames, c_names
 from .order import statement_order
-from .parts import layout, part_counts, reads_in, source_file_name, split_body
+from .parts import layout, part_counts, placement, reads_in, source_file_name, split_body
 from .printer import CPrinter
 from .sincos import BLOCK, FREESTANDING_ERROR, gather
 
@@ -352,29 +352,14 @@ def render(ctx: RenderContext, groups: list[list[tuple[int, int]]] | None = None
     functions = values["functions"]
     if groups is None:
         groups = layout(functions)
-    file_of = {unit: k for k, group in enumerate(groups) for unit in group}
+    shared, placed = placement(groups, [f["parts"]["parts"] if f["parts"] else [] for f in functions])
     # the parts in another file than their function: not static, declared in the internal header
-    shared = [
-        (functions[i], functions[i]["parts"]["parts"][n - 1])
-        for i, n in sorted(file_of)
-        if n and file_of[i, n] != file_of[i, 0]
-    ]
     parts_header = values["parts"]["header"] if shared else None
     if parts_header:
+        shared = [(functions[i], part) for i, part in shared]
         files[parts_header] = env.get_template("c/parts.h.j2").render(values, shared=shared)
-    for k, group in enumerate(groups):
-        chosen, linked = [], False
-        for i in sorted({i for i, _ in group}):
-            f = functions[i]
-            units = range(len(f["parts"]["parts"]) + 1 if f["parts"] else 1)
-            # the parts here, each with whether it is static (in the file of its function)
-            here = [
-                (n, f["parts"]["parts"][n - 1], file_of[i, n] == file_of[i, 0])
-                for n in units[1:]
-                if (i, n) in group
-            ]
-            chosen.append({**f, "here": here, "defined": (i, 0) in group})
-            linked = linked or any(file_of[i, n] != k for n in units)
+    for k, (members, linked) in enumerate(placed):
+        chosen = [{**functions[i], "here": here, "defined": defined} for i, here, defined in members]
         defined = [f for f in chosen if f["defined"]]
         files[source_file_name(ctx.name, k)] = env.get_template("c/dynamics.c.j2").render(
             values,

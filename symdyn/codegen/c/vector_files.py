@@ -67,4 +67,4 @@ def vector_layout(views: list[dict | None]) -> list[list[tuple[int, int]]]:
 
 def batch_file_name(name: str, index: int) -> str:
     """NAME_batch.c for the first file (index 0), NAME_batch_2.c ... for the others."""
-    return f"{name}_batch.c" if index == 0 else f"{name}_batch_{index + 1}.c"
+    return layout.source_file_name(name, index, "batch")
