@@ -47,7 +47,8 @@ __all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "a
 #: jax.jit(jax.grad(...)) through jax.vmap of the inverse dynamics took 7.9 us a state by XLA's
 #: reverse mode, 17.6 us through a custom_jvp rule of the generated tangent program (JAX
 #: transposing it) and 0.59 us through the adjoint program (3.3 times the forward pass); the
-#: forward dynamics' adjoint program took 9.2 ms, twice XLA's reverse mode, so it keeps RULES.
+#: forward dynamics' own adjoint program took 9.2 ms, twice XLA's reverse mode, so it goes
+#: through IDENTITIES (or RULES).
 ADJOINTS = ("inverse_dynamics",)
 
 #: The functions differentiated by a jax.custom_jvp rule made of a generated derivative function,
