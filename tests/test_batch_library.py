@@ -3,7 +3,8 @@
 One-state calls and a simulation build the scalar library alone; the first batch call builds the
 batch library once, whichever threads call at once, and its results equal the one-state calls bit
 for bit; a later compile of the robot finds both in the cache. A compiler that fails on the batch
-files leaves the scalar library working and raises one line, again at the next batch call.
+files leaves the scalar library working and raises one line, again at the next batch call; a
+scalar object file changed in the cache is found before the batch library links it.
 """
 
 from __future__ import annotations
@@ -113,3 +114,19 @@ def test_a_failed_batch_build_leaves_the_one_state_calls(built, tmp_path, monkey
         after = fast.inverse_dynamics(q[1], qd[1], qdd[1])  # still working after the failures
         np.testing.assert_allclose(after, symdyn.rnea(robot, q[1], qd[1], qdd[1]), rtol=1e-10, atol=1e-10)
     assert built == ["libplanar_3r.so", *["libplanar_3r_batch.so"] * 3] and cache.usage()[1] == 1
+
+
+def test_a_changed_object_file_is_rebuilt_before_the_batch_links_it(built):
+    """The scalar objects the batch library links are verified against the entry's manifest when a
+    later compile (a cache hit, which verifies the library alone) first needs them: one changed since
+    the build removes the entry, which is built again, then the batch library."""
+    robot = example("planar_3r")
+    first = symdyn.compile(robot)
+    (first._entry.path / first._entry.meta["batch"]["objects"][0]).write_bytes(b"not an object file")
+    fast = symdyn.compile(robot)  # as a later process: the scalar library verified and loaded
+    q, qd, qdd = _states(robot.n, 5)
+    with within(60):
+        tau = fast.inverse_dynamics(q, qd, qdd)
+    assert built == ["libplanar_3r.so", "libplanar_3r.so", "libplanar_3r_batch.so"]
+    one = np.array([fast.inverse_dynamics(*s) for s in zip(q, qd, qdd, strict=True)])
+    assert tau.tobytes() == one.tobytes()
