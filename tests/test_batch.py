@@ -82,7 +82,9 @@ def _build_all(ctx, folder: Path, names, extra=()) -> dict:
     libs = {}
     for name, job in jobs.items():
         assert job.wait() == 0, job.stderr.read()
-        libs[name] = load_library(folder / f"{name}.so", table, f"{ctx.name}_batch_width", ctx.precision)
+        width = f"{ctx.name}_batch_width"
+        ffi, lib = load_library(folder / f"{name}.so", table, width, ctx.precision)
+        libs[name] = (ffi, lib, int(getattr(lib, width)()))
     return {
         "table": {f["name"]: f for f in table},
         "libs": libs,

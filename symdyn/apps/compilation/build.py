@@ -112,13 +112,21 @@ def compile_estimate(size: int) -> str:
 
 
 def compile_library(
-    compiler: list[str], sources: Mapping[str, str], target: str | os.PathLike, arch: Sequence[str] = ()
+    compiler: list[str],
+    sources: Mapping[str, str],
+    target: str | os.PathLike,
+    arch: Sequence[str] = (),
+    objects: Sequence[str | os.PathLike] = (),
+    keep: Sequence[str] = (),
 ) -> Path:
     """Compile the C `sources` (file name -> text; headers included) into the library `target`,
     with COMPILE_FLAGS and `arch` (arch_flags()); without -march=native when the compiler refuses it.
     Each .c file compiles in a process of its own, all at once (the large generated files dominate),
-    then they are linked, in $TMPDIR/symdyn-build-PID-XXXXXXXX; the folders that builds killed
-    mid-way left there are removed first, once stale (symdyn.leftovers).
+    then they are linked, with the object files `objects` (compiled before, with the same flags),
+    in $TMPDIR/symdyn-build-PID-XXXXXXXX; the folders that builds killed mid-way left there are
+    removed first, once stale (symdyn.leftovers). The objects of the .c files named in `keep` are
+    copied beside `target` (NAME.c gives NAME.o), for a later build to link (the batch library,
+    symdyn.apps.compilation.batch_library).
 
     Raises SymdynError with the compiler's messages when it fails.
     """
@@ -145,13 +153,16 @@ def compile_library(
                 arch = ()
                 failed = _compile_objects(compiler, c_files, arch, tmp)
             if not failed:
-                objects = [name[:-2] + ".o" for name in c_files]
-                link = [*compiler, *COMPILE_FLAGS, *arch, "-o", os.fspath(target), *objects, "-lm"]
+                compiled = [name[:-2] + ".o" for name in c_files]
+                given = [os.fspath(o) for o in objects]
+                link = [*compiler, *COMPILE_FLAGS, *arch, "-o", os.fspath(target), *compiled, *given, "-lm"]
                 failed = _run(link, tmp)
         except OSError as exc:
             raise SymdynError(f"cannot run the C compiler {compiler[0]}: {exc}") from exc
         if failed:
             raise SymdynError(_failure(failed, count))
+        for name in keep:
+            shutil.copyfile(Path(tmp, name[:-2] + ".o"), Path(target).parent / (name[:-2] + ".o"))
     return Path(target)
 
 

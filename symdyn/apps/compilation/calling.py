@@ -2,8 +2,10 @@
 
 The methods of `CompiledDynamics` (symdyn.apps.compilation.compile) are built here from the library's
 function table (symdyn.codegen.c.runtime.function_table) through cffi's ABI mode. One state
-(vectors of their size) is one C call. A batch (leading axes, e.g. (B, n)) is one call of
-NAME_batch, which evaluates W states per instruction (templates/c/batch.c.j2): the arrays are
+(vectors of their size) is one C call of the scalar library. A batch (leading axes, e.g. (B, n))
+is one call of NAME_batch, in the batch library built on the first batch call
+(symdyn.apps.compilation.batch_library), which evaluates W states per instruction
+(templates/c/batch.c.j2): the arrays are
 passed to C without a copy when they are C-contiguous float64 of the batch's full shape (a state's
 values contiguous, the states one after the other); any other array (another dtype, a strided
 view, an input broadcast against the others) is copied once into that layout. With threads > 1 a
@@ -62,20 +64,24 @@ def _declarations(functions: list[dict], solve: dict | None = None) -> str:
 
 
 def load_library(
-    path: Path, functions: list[dict], width: str, real: str = "double", solve: dict | None = None
+    path: Path, functions: list[dict], width: str, real: str = "double", solve: dict | None = None, ffi=None
 ):
-    """(ffi, lib, W) for the library at `path` (opened once per process); `width` names its
-    NAME_batch_width function (the states NAME_batch evaluates per instruction); `real` is the
-    floating type of its functions (symdyn.compile's are double); `solve`: NAME_solve_loops of a
-    robot with loops (symdyn.codegen.c.runtime.solve_loops_entry), or None."""
+    """(ffi, lib) for the library at `path` (opened once per process); `width` names its
+    NAME_batch_width function (the states NAME_batch evaluates per instruction, in the batch
+    library); `real` is the floating type of its functions (symdyn.compile's are double); `solve`:
+    NAME_solve_loops of a robot with loops (symdyn.codegen.c.runtime.solve_loops_entry), or None.
+    `ffi`: the cffi.FFI of the scalar library of the same functions, which a batch library
+    (symdyn.apps.compilation.batch_library) shares, so that the arrays handed to either are of one FFI."""
     key = str(path)
     if key not in _LIBRARIES:
-        import cffi
+        if ffi is None:
+            import cffi
 
-        ffi = cffi.FFI()
-        ffi.cdef(_declarations(functions, solve).replace("symdyn_batch_width", width).replace("double", real))
-        lib = ffi.dlopen(key)
-        _LIBRARIES[key] = (ffi, lib, int(getattr(lib, width)()))
+            ffi = cffi.FFI()
+            ffi.cdef(
+                _declarations(functions, solve).replace("symdyn_batch_width", width).replace("double", real)
+            )
+        _LIBRARIES[key] = (ffi, ffi.dlopen(key))
     return _LIBRARIES[key]
 
 
@@ -87,13 +93,15 @@ def batch_layout(a: np.ndarray, lead: tuple, size: int, count: int) -> np.ndarra
     return np.ascontiguousarray(np.broadcast_to(a, (*lead, size)), dtype=np.float64).reshape(count, size)
 
 
-def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
-    """One generated function as a Python callable: one state per C call, a batch through NAME_batch.
+def c_method(ffi, lib, f: dict, p_ptr, owner, batch_library: Callable[[], object]) -> Callable:
+    """One generated function as a Python callable: one state per C call of `lib`, a batch through
+    NAME_batch of batch_library() (the batch library, built on the first batch call:
+    symdyn.apps.compilation.batch_library).
 
     `owner.threads` is the default number of threads of a batch; a call may give its own (threads=).
     """
     single = getattr(lib, f["c_name"])
-    batch = getattr(lib, f["c_name"] + "_batch")
+    batch_name = f["c_name"] + "_batch"
     sizes = [size for name, size in f["inputs"] if name != "p"]
     names = [name for name, _ in f["inputs"] if name != "p"]
     with_p = len(sizes) != len(f["inputs"])
@@ -139,7 +147,7 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
         flat_outs = [o.reshape(count, int(np.prod(shape))) for o, shape in zip(outs, shapes, strict=True)]
         chunks = _chunks(count, owner.threads if threads is None else threads)
         if count:
-            _run(batch, buf, chunks, flat, p_args, flat_outs)
+            _run(getattr(batch_library(), batch_name), buf, chunks, flat, p_args, flat_outs)
         return outs[0] if one else tuple(outs)
 
     call.__name__ = f["name"]
@@ -150,13 +158,13 @@ def c_method(ffi, lib, f: dict, p_ptr, owner) -> Callable:
     return call
 
 
-def solve_loops_method(ffi, lib, solve: dict, p_ptr, owner) -> Callable:
+def solve_loops_method(ffi, lib, solve: dict, p_ptr, owner, batch_library: Callable[[], object]) -> Callable:
     """NAME_solve_loops as a Python callable solve_loops(qa, q_guess, threads=None) -> (iterations, q):
     one state (qa of NACT values, q_guess of n) is one C call returning (int, q of shape (n,)); a
     batch (leading axes, qa and q_guess broadcast) is one call of NAME_solve_loops_batch, a loop
-    over the states in C, in `threads` chunks, returning (iterations of the leading shape, int32,
-    and q of shape (..., n))."""
-    single, batch = getattr(lib, solve["c_name"]), getattr(lib, solve["c_name"] + "_batch")
+    over the states in C (batch_library(), as c_method's), in `threads` chunks, returning
+    (iterations of the leading shape, int32, and q of shape (..., n))."""
+    single = getattr(lib, solve["c_name"])
     buf = ffi.from_buffer
     sizes = {"qa": solve["nact"], "q_guess": solve["n"]}
 
@@ -177,6 +185,7 @@ def solve_loops_method(ffi, lib, solve: dict, p_ptr, owner) -> Callable:
         qa, guess = (batch_layout(a, lead, sizes[k], count) for k, a in arrays.items())
         q, iterations = np.empty((*lead, solve["n"])), np.empty(lead, dtype=np.int32)
         flat_q, flat_it = q.reshape(count, solve["n"]), iterations.reshape(count)
+        batch = getattr(batch_library(), solve["c_name"] + "_batch") if count else None
 
         def run(chunk: tuple[int, int]) -> None:
             start, stop = chunk

@@ -12,7 +12,10 @@ function's name and inputs (without p, which is bound): whatever the code genera
 emits, including functions with several outputs (returned as a tuple) or outputs that
 are not square. One state (vectors of their size) runs one C call; a batch (leading
 axes, e.g. (B, n)) runs one call of NAME_batch, W states per instruction, optionally in
-threads (symdyn.apps.compilation.calling: the layout, when arrays are passed without a copy). A robot with
+threads (symdyn.apps.compilation.calling: the layout, when arrays are passed without a copy).
+NAME_batch is in a library of its own, built and cached when a batch call first needs it
+(symdyn.apps.compilation.batch_library): a robot only called one state at a time, or only
+simulated, never pays for the batch wrappers' compile. A robot with
 closed loops also gets `solve_loops`, the generated C NAME_solve_loops (one state, or a batch
 looped in C; symdyn.apps.compilation.calling.solve_loops_method). Joint
 quantities are in joint space (rad or m), the base frame fixes gravity, as in
@@ -38,6 +41,7 @@ from collections.abc import Callable
 from ...errors import SymdynError, SymdynWarning
 from ...generated_modules import load_module
 from . import cache
+from .batch_library import batch_entry
 from .calling import c_method, check_threads, load_library, numpy_solve_loops, solve_loops_method
 from .compiled_frames import FrameMethods
 from .configuration_check import quaternion_checked
@@ -119,7 +123,7 @@ def _function_groups(functions) -> tuple[str, ...] | None:
 
 
 def compile(
-    robot, params=None, method: str = "newton-euler", threads: int = 1, functions=None
+    robot, params=None, method: str = "newton-euler", threads: int = 1, functions=None, batch: str = "lazy"
 ) -> CompiledDynamics:
     """The robot's generated functions compiled to C, with its free parameters bound to `params`.
 
@@ -133,14 +137,23 @@ def compile(
     robot, the options and the groups (docs/speed.md: the cache); the second compile of an
     unchanged robot loads it in milliseconds.
 
+    batch: "lazy" (the default) builds the scalar library only (the generated functions, one state
+    per call, and the stepping loop of `simulate`); the batch library (the batch wrappers
+    NAME_batch, about as much compiler work again) is built and cached when a call first needs it:
+    a batch (leading axes), `batch_width`, `solve_loops` on a batch
+    (symdyn.apps.compilation.batch_library). "eager" builds both now, one after the other.
+
     Raises:
-        SymdynError: not a Robot, bad parameter values, an unknown group.
+        SymdynError: not a Robot, bad parameter values, an unknown group, a `batch` other than
+            "lazy" or "eager", or (eager) a failed build of the batch library.
     """
     from ...model.robot import Robot
 
     if not isinstance(robot, Robot):
         raise SymdynError(f"symdyn.compile expects a Robot, not {type(robot).__name__}")
     groups = _function_groups(functions)
+    if batch not in ("lazy", "eager"):
+        raise SymdynError(f'symdyn.compile: batch must be "lazy" or "eager", not {batch!r}')
     if robot.params:  # the values pass the robot file's physical checks (mass >= 0, ...)
         from ...model.physical import check_values
 
@@ -151,7 +164,10 @@ def compile(
     key = {"robot": robot_digest(robot), "families": families}
     if groups is not None:  # (the default's key is unchanged: its cache entries stay valid)
         key["functions"] = list(groups)
-    return cached_dynamics(key, lambda: robot, params, method, threads, groups)
+    compiled = cached_dynamics(key, lambda: robot, params, method, threads, groups)
+    if batch == "eager" and compiled.backend == "c":
+        compiled._batch_loaded()
+    return compiled
 
 
 class CompiledDynamics(FrameMethods):
@@ -163,9 +179,9 @@ class CompiledDynamics(FrameMethods):
     """
 
     def __init__(
-        self, robot, params=None, method: str = "newton-euler", threads: int = 1, functions=None
+        self, robot, params=None, method: str = "newton-euler", threads: int = 1, functions=None, batch="lazy"
     ) -> None:
-        other = compile(robot, params, method, threads, functions)
+        other = compile(robot, params, method, threads, functions, batch)
         self.__dict__.update(other.__dict__)
 
     @classmethod
@@ -199,18 +215,45 @@ class CompiledDynamics(FrameMethods):
             raise NotGeneratedError(self.robot.name, name)
         if entry is None or name not in self.__dict__.get("functions", ()) or self._library is None:
             raise AttributeError(f"'CompiledDynamics' object has no attribute '{name}'")
-        ffi, lib, _ = self._loaded()
+        ffi, lib = self._loaded()
         p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
         for f in entry.meta["functions"]:
-            method = quaternion_checked(f, contact_checked(f, c_method(ffi, lib, f, p_ptr, self)), self.n)
+            called = c_method(ffi, lib, f, p_ptr, self, self._batch_library)
+            method = quaternion_checked(f, contact_checked(f, called), self.n)
             setattr(self, f["name"], guarded(self, f["name"], method))
         return self.__dict__[name]
 
-    def _loaded(self) -> tuple:
-        """(ffi, lib, W) of the library (symdyn.apps.compilation.calling.load_library)."""
+    def _loaded(self, path=None, ffi=None) -> tuple:
+        """(ffi, lib) of the scalar library, or of the library at `path` with the scalar one's `ffi`
+        (symdyn.apps.compilation.calling.load_library)."""
         meta = self._entry.meta
         width = f"{meta['robot']['name']}_batch_width"
-        return load_library(self._library, meta["functions"], width, solve=meta.get("solve_loops"))
+        solve = meta.get("solve_loops")
+        return load_library(path or self._library, meta["functions"], width, solve=solve, ffi=ffi)
+
+    def _batch_loaded(self) -> tuple:
+        """(lib, W) of the batch library (NAME_batch ...), built and cached on the first call that needs
+        it, once whichever threads call at once (symdyn.apps.compilation.batch_library)."""
+        loaded = self.__dict__.get("_batch")
+        if loaded is None:
+            try:
+                entry = batch_entry(self._entry)
+            except cache.CorruptEntryError:  # a file of the scalar entry changed: build that again
+                if "_rebuild" not in self.__dict__:
+                    raise
+                self._entry = self._rebuild()
+                entry = batch_entry(self._entry)
+            ffi, _ = self._loaded()
+            _, lib = self._loaded(entry.file(entry.meta["library"]), ffi)
+            loaded = self._batch = (
+                lib,
+                int(getattr(lib, f"{self._entry.meta['robot']['name']}_batch_width")()),
+            )
+        return loaded
+
+    def _batch_library(self):
+        """The batch library's cffi lib (built on first use: _batch_loaded)."""
+        return self._batch_loaded()[0]
 
     def solve_loops(self, qa, q_guess, threads: int | None = None):
         """Close the loops of a robot with closed loops: (iterations, q), q with its actuated entries
@@ -225,29 +268,33 @@ class CompiledDynamics(FrameMethods):
         if self._library is None:  # the NumPy module's, one state per call
             return numpy_solve_loops(self.module, qa, q_guess, self.p)
         if "_solve_loops" not in self.__dict__:
-            ffi, lib, _ = self._loaded()
+            ffi, lib = self._loaded()
             p_ptr = ffi.NULL if self.p is None else ffi.from_buffer("double[]", self.p)
-            self._solve_loops = solve_loops_method(ffi, lib, solve, p_ptr, self)
+            self._solve_loops = solve_loops_method(ffi, lib, solve, p_ptr, self, self._batch_library)
         return self._solve_loops(qa, q_guess, threads)
 
     @property
     def batch_width(self) -> int:
         """W, the states a batch call evaluates per instruction (8 with AVX-512, 4 with AVX, else 1;
-        1 on the NumPy backend)."""
+        1 on the NumPy backend). It is the batch library's: asking builds it when it is not built."""
         if self._library is None:
             return 1
-        return self._loaded()[2]
+        return self._batch_loaded()[1]
 
     @property
     def cdll(self):
-        """The library through ctypes (loads in microseconds; simulation.stepping calls it once per run)."""
+        """The scalar library through ctypes (loads in microseconds; simulation.stepping calls it once per
+        run): every generated function's one-state C function, symdyn_simulate (the stepping loop) and
+        symdyn_csv, but not the batch wrappers NAME_batch, which are in the batch library built on the
+        first batch call (symdyn.apps.compilation.batch_library)."""
         assert self.backend == "c"
         import ctypes
 
         return _CDLLS.setdefault(str(self._library), ctypes.CDLL(str(self._library)))
 
     def pointer(self, name: str) -> int:
-        """The address of the C function `name` (for the stepping loop's function pointers)."""
+        """The address of the one-state C function `name` in the scalar library (`cdll`; for the
+        stepping loop's function pointers)."""
         import ctypes
 
         c_name = next(f["c_name"] for f in self._entry.meta["functions"] if f["name"] == name)

@@ -2,9 +2,11 @@
 
 The entry's key holds the robot's content and the options (`build_options`: the method, the compiler,
 its flags, the machine); building it (`entry_builder`) derives the robot, generates its C, its
-NumPy module and the batch runtime (symdyn.codegen) and compiles the C into a shared library
-(symdyn.apps.compilation.build); the entry's metadata names its functions and files for
-`CompiledDynamics` (symdyn.apps.compilation.compile).
+NumPy module and the batch runtime (symdyn.codegen) and compiles the generated C with the stepping
+loop and the CSV writer into a shared library (symdyn.apps.compilation.build), keeping the generated
+C's object files; the batch wrappers' sources (NAME_batch*.c) wait in the entry until a batch call
+needs them (symdyn.apps.compilation.batch_library links them with those objects). The entry's
+metadata names its functions and files for `CompiledDynamics` (symdyn.apps.compilation.compile).
 """
 
 from __future__ import annotations
@@ -43,21 +45,31 @@ def entry_builder(robot, method: str, options: dict, frames: dict | None = None)
         from ...codegen import c as c_target
         from ...codegen import context
         from ...codegen import python as numpy_target
-        from ...codegen.c.runtime import function_table, render_runtime, solve_loops_entry
+        from ...codegen.c.runtime import (
+            CSV_SOURCE,
+            STEP_SOURCE,
+            function_table,
+            render_runtime,
+            solve_loops_entry,
+        )
         from .build import compile_library, library_suffix
 
         ctx = context(robot, options["precision"], method, **(frames or {}))
-        files = {**c_target.render(ctx), **render_runtime(ctx), **numpy_target.render(ctx)}
+        generated, runtime = c_target.render(ctx), render_runtime(ctx)
+        files = {**generated, **runtime, **numpy_target.render(ctx)}
         for name, text in files.items():
             (folder / name).write_text(text, encoding="utf-8")
+        batch = sorted(set(runtime) - {STEP_SOURCE, CSV_SOURCE})  # NAME_batch*.c, built on first use
+        kept = sorted(name for name in generated if name.endswith(".c"))
         library = None
         if options["compiler"]:
             library = f"lib{ctx.name}{library_suffix()}"
             compile_library(
                 options["compiler"],
-                {k: v for k, v in files.items() if k.endswith((".c", ".h"))},
+                {k: v for k, v in files.items() if k.endswith((".c", ".h")) and k not in batch},
                 folder / library,
                 options["arch"],
+                keep=kept,
             )
         return {
             "robot": {
@@ -70,6 +82,13 @@ def entry_builder(robot, method: str, options: dict, frames: dict | None = None)
             "solve_loops": solve_loops_entry(ctx),
             "numpy": numpy_target.file_name(ctx.name),
             "library": library,
+            "batch": {  # what batch_library compiles and links into the batch library, on first use
+                "sources": batch,
+                "objects": [name[:-2] + ".o" for name in kept] if library else [],
+                "library": f"lib{ctx.name}_batch{library_suffix()}",
+                "compiler": options["compiler"],  # those of the key, as the scalar library's
+                "arch": options["arch"],
+            },
         }
 
     return build
