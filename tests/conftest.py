@@ -20,9 +20,7 @@
   (`pytest_runtest_teardown` below), so that full collections stop walking the heap of the files
   before; a pytest-xdist worker does the same before it reports its end (`pytest_sessionfinish`),
   so that it stops at once when asked to.
-- The files run longest first, by the seconds tests/durations.py records in tests/durations.json;
-  under pytest-xdist the files of a group of durations.GROUPS (files that derive the same robots)
-  run on one worker, one after the other (`pytest_xdist_make_scheduler`).
+- The files run longest first, by the seconds tests/durations.py records in tests/durations.json.
 - The tests' builds of generated C (tests/cbuild.py) are cached by content in a folder the
   workers share (`_temporary_symdyn_cache`): the same C with the same flags is compiled once.
 - With SYMDYN_TEST_TIMES set to a folder, each process writes the cost of each test file there
@@ -43,7 +41,7 @@ if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
 from cbuild import CACHE_ENV as CBUILD_CACHE  # noqa: E402  (tests/ is on the path only from here)
-from durations import Recorder, order, unit  # noqa: E402
+from durations import Recorder, order  # noqa: E402
 from warm_python import GC_THRESHOLDS  # noqa: E402
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
@@ -62,38 +60,14 @@ gc.set_threshold(*GC_THRESHOLDS)
 
 
 def pytest_collection_modifyitems(session, config, items):
-    """The longest work units first, by the CPU seconds recorded in tests/durations.json
-    (tests/durations.py writes it): pytest-xdist hands whole units to the workers in collection
-    order (`pytest_xdist_make_scheduler` below), so a long one collected last would leave one
-    worker running it alone while the other idles. A unit is a test file, or the files of one
-    group of durations.GROUPS, in the order of their own seconds. A stable sort: the tests of one
-    file keep their order."""
+    """The longest test files first, by the CPU seconds recorded in tests/durations.json
+    (tests/durations.py writes it): pytest-xdist hands whole files to the workers in collection
+    order (--dist loadfile with --no-loadscope-reorder, pyproject.toml: pytest-xdist 3.8 otherwise
+    reorders the files by their number of tests), so a long file collected last would leave one
+    worker running it alone while the other idles. A stable sort: the tests of one file keep
+    their order."""
     rank = order([item.path.name for item in items])
     items.sort(key=lambda item: rank[item.path.name])
-
-
-@pytest.hookimpl(optionalhook=True)
-def pytest_xdist_make_scheduler(config, log):
-    """`--dist loadfile` with the files of a group of durations.GROUPS as one unit, and the units
-    in collection order (`pytest_collection_modifyitems`).
-
-    The files of a group share the derivations the session caches in each process
-    (tests/robots.py: the configuration-space and product forms of the exact examples, the
-    floating Solo-12 ...): on one worker they are made once instead of once per worker. And
-    pytest-xdist's own reordering of the units (by their number of tests, --loadscope-reorder,
-    on by default) is turned off: the longest first is what keeps the workers busy to the end.
-    """
-    if config.getvalue("dist") != "loadfile":
-        return None
-    from xdist.scheduler import LoadFileScheduling
-
-    class GroupedFiles(LoadFileScheduling):
-        def _split_scope(self, nodeid: str) -> str:
-            path = nodeid.split("::", 1)[0]
-            return unit(path.rsplit("/", 1)[-1]) or path
-
-    config.option.loadscopereorder = False
-    return GroupedFiles(config, log)
 
 
 def pytest_configure(config):

@@ -36,11 +36,6 @@ HERE = Path(__file__).resolve().parent
 TABLE = HERE / "durations.json"
 #: the CPU seconds assumed for a test file missing from the table
 UNKNOWN_SECONDS = 5.0
-#: test files run on one pytest-xdist worker, one after the other (tests/conftest.py's scheduler):
-#: group name -> files. Each group's files derive the same robots, which the session caches per
-#: process (tests/robots.py); on two workers each would be derived twice. Measured: see each group.
-GROUPS: dict[str, tuple[str, ...]] = {}
-_GROUP_OF = {name: group for group, files in GROUPS.items() for name in files}
 
 
 def _cpu() -> float:
@@ -98,24 +93,11 @@ def table() -> dict[str, float]:
     return {str(k): float(v) for k, v in data.items()} if isinstance(data, dict) else {}
 
 
-def unit(name: str) -> str | None:
-    """The group of GROUPS test file `name` belongs to, or None."""
-    return _GROUP_OF.get(name)
-
-
 def order(names: list[str]) -> dict[str, int]:
-    """Rank of each test file name: the longest unit first (a file, or a group of GROUPS with the
-    seconds of its files summed; by the table, unknown files as an average one, `UNKNOWN_SECONDS`),
-    the files of a group together, longest first; ties by name."""
+    """Rank of each test file name: the longest (by the table) first, unknown files as an average
+    one (`UNKNOWN_SECONDS`), ties by name."""
     seconds = table()
-
-    def cost(n: str) -> float:
-        return seconds.get(n, UNKNOWN_SECONDS)
-
-    units: dict[str, float] = {}
-    for n in set(names):
-        units[unit(n) or n] = units.get(unit(n) or n, 0.0) + cost(n)
-    ranked = sorted(set(names), key=lambda n: (-units[unit(n) or n], unit(n) or n, -cost(n), n))
+    ranked = sorted(set(names), key=lambda n: (-seconds.get(n, UNKNOWN_SECONDS), n))
     return {name: k for k, name in enumerate(ranked)}
 
 

@@ -48,34 +48,10 @@ def test_files_run_longest_first_and_unknown_ones_as_an_average_file(monkeypatch
     assert durations.UNKNOWN_SECONDS == 5.0  # between c.py and a.py above
 
 
-def test_a_group_runs_as_one_unit_where_its_files_summed_rank_it(monkeypatch):
-    import durations
-
-    monkeypatch.setattr(durations, "table", lambda: {"a.py": 40.0, "b.py": 90.0, "c.py": 30.0, "d.py": 35.0})
-    monkeypatch.setattr(durations, "_GROUP_OF", {"c.py": "cd", "d.py": "cd"})
-    rank = durations.order(["a.py", "b.py", "c.py", "d.py", "new.py"])
-    assert sorted(rank, key=rank.get) == ["b.py", "d.py", "c.py", "a.py", "new.py"]  # cd: 65 s
-    assert durations.unit("c.py") == "cd" and durations.unit("a.py") is None
-
-
-def test_the_scheduler_keeps_a_group_on_one_worker_and_the_collection_order(monkeypatch, request):
-    import durations
-
-    config = request.config
-    monkeypatch.setattr(durations, "_GROUP_OF", {"test_c.py": "cd", "test_d.py": "cd"})
-    monkeypatch.setattr(conftest, "unit", durations.unit)
-    monkeypatch.setattr(config.option, "dist", "loadfile")
-    monkeypatch.setattr(config.option, "loadscopereorder", True)
-    monkeypatch.setattr(config.option, "tx", ["popen", "popen"])  # two workers, also under -n 0
-    monkeypatch.setattr(config.option, "numprocesses", None)
-    scheduler = conftest.pytest_xdist_make_scheduler(config, None)
-    assert config.option.loadscopereorder is False
-    assert scheduler._split_scope("tests/test_c.py::test_x[1]") == scheduler._split_scope(
-        "tests/test_d.py::y"
-    )
-    assert scheduler._split_scope("tests/test_a.py::test_x") == "tests/test_a.py"
-    monkeypatch.setattr(config.option, "dist", "load")
-    assert conftest.pytest_xdist_make_scheduler(config, None) is None
+def test_pytest_xdist_keeps_the_files_in_collection_order(request):
+    """--no-loadscope-reorder (pyproject.toml): without it pytest-xdist 3.8 hands the files out
+    by their number of tests, not longest first as pytest_collection_modifyitems orders them."""
+    assert request.config.getoption("loadscopereorder") is False
 
 
 def _c_files(folder, header_value: int):
