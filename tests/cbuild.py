@@ -35,6 +35,7 @@ import os
 import re
 import shutil
 import subprocess
+import threading
 import types
 from collections.abc import Iterable, Mapping, Sequence
 from functools import cache
@@ -128,14 +129,14 @@ def compile_program(
     key = _build_key(compiler, options, sources)
     cached = None if key is None else Path(os.environ[CACHE_ENV]) / key
     if cached is not None and cached.is_file():
-        partial = out.with_name(f".{out.name}.{os.getpid()}.part")
+        partial = out.with_name(f".{out.name}.{_writer()}.part")
         shutil.copy2(cached, partial)
         os.replace(partial, out)  # a new file: a library loaded from `out` before keeps its own
         return out
     _run([compiler, *options, "-o", str(out), *map(str, sources), "-lm"])
     if cached is not None:
         cached.parent.mkdir(parents=True, exist_ok=True)
-        partial = cached.with_name(f"{key}.{os.getpid()}.part")
+        partial = cached.with_name(f"{key}.{_writer()}.part")
         shutil.copy2(out, partial)
         os.replace(partial, cached)  # atomic: the other worker reads a whole file or none
     return out
@@ -145,6 +146,12 @@ def compile_program(
 CACHE_ENV = "CBUILD_CACHE"
 #: flags whose build writes files besides its output, or no output: never cached
 _UNCACHED = ("-S", "-E", "-M", "-save-temps", "-fstack-usage", "-fdump-", "-fcallgraph-info")
+
+
+def _writer() -> str:
+    """This process and thread: the name of a partial file no other writer uses (test files
+    compile in threads: tests/test_c_target.py)."""
+    return f"{os.getpid()}.{threading.get_ident()}"
 
 
 @cache
