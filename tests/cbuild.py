@@ -15,17 +15,30 @@ the code computes, which do not depend on the optimisation level (no -ffast-math
 about ten times longer than -O0 on a large generated file (the Panda's: 8.4 s against 0.7 s).
 The warnings only the optimiser finds are checked by tests/test_c_target.py's -O2 strict builds
 (test_optimised_strict_build); the sanitizers (SANITIZE_FLAGS) work unoptimised as well.
+
+Builds are cached by content when the environment variable CBUILD_CACHE names a folder (the suite
+sets it: tests/conftest.py, one folder shared by the pytest-xdist workers): the key is a SHA-256 of
+the compiler's path and version, the command's flags, each source's name and bytes, and the name
+and bytes of every .c and .h file beside a source or in a folder named by -I (the files a source
+can include); a folder path in the command counts by those files, not by its name. A build that
+succeeded is copied from the cache instead of being compiled again, by another test file or the
+other worker (the same C compiled with the same flags: a build that warned or failed is never
+stored, so it fails again each time). A build that writes more than its output (-S, -E, -M...,
+-save-temps, -fstack-usage, -fdump-...) is never cached.
 """
 
 from __future__ import annotations
 
 import ctypes
+import hashlib
 import os
 import re
 import shutil
 import subprocess
+import threading
 import types
 from collections.abc import Iterable, Mapping, Sequence
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -108,10 +121,91 @@ def compile_program(
     flags: Sequence[str] = STRICT_FLAGS,
     extra: Sequence[str] = (),
 ) -> Path:
-    """Compile C sources into an executable (linked with libm)."""
+    """Compile C sources into an executable (linked with libm); from the build cache when the same
+    build has succeeded before (the module's docstring)."""
     out = Path(output)
-    _run([compiler, *flags, opt, *extra, "-o", str(out), *map(str, sources), "-lm"])
+    sources = [Path(s) for s in sources]
+    options = [*flags, opt, *extra]
+    key = _build_key(compiler, options, sources)
+    cached = None if key is None else Path(os.environ[CACHE_ENV]) / key
+    if cached is not None and cached.is_file():
+        partial = out.with_name(f".{out.name}.{_writer()}.part")
+        shutil.copy2(cached, partial)
+        os.replace(partial, out)  # a new file: a library loaded from `out` before keeps its own
+        return out
+    _run([compiler, *options, "-o", str(out), *map(str, sources), "-lm"])
+    if cached is not None:
+        cached.parent.mkdir(parents=True, exist_ok=True)
+        partial = cached.with_name(f"{key}.{_writer()}.part")
+        shutil.copy2(out, partial)
+        os.replace(partial, cached)  # atomic: the other worker reads a whole file or none
     return out
+
+
+#: the environment variable naming the build cache's folder (unset: no cache)
+CACHE_ENV = "CBUILD_CACHE"
+#: flags whose build writes files besides its output, or no output: never cached
+_UNCACHED = ("-S", "-E", "-M", "-save-temps", "-fstack-usage", "-fdump-", "-fcallgraph-info")
+
+
+def _writer() -> str:
+    """This process and thread: the name of a partial file no other writer uses (test files
+    compile in threads: tests/test_c_target.py)."""
+    return f"{os.getpid()}.{threading.get_ident()}"
+
+
+@cache
+def _compiler_identity(compiler: str) -> str:
+    """The compiler's resolved path and its --version text."""
+    path = shutil.which(compiler) or compiler
+    version = subprocess.run([path, "--version"], capture_output=True, text=True).stdout
+    return f"{os.path.realpath(path)}\n{version}"
+
+
+def _build_key(compiler: str, options: Sequence[str], sources: Sequence[Path]) -> str | None:
+    """The build's cache key (the module's docstring), or None when it is not cached."""
+    if not os.environ.get(CACHE_ENV) or any(o == "-I" or o.startswith(_UNCACHED) for o in options):
+        return None
+    key = hashlib.sha256(_compiler_identity(compiler).encode())
+    folders = [Path(o[2:]) for o in options if o.startswith("-I")]
+    for option in options:
+        key.update(("-I" if option.startswith("-I") else option).encode() + b"\0")
+    for source in sources:
+        key.update(b"source\0" + source.name.encode() + b"\0" + source.read_bytes() + b"\0")
+    # each file by the rank of its folder among the sources' and the -I folders, and its name and
+    # content: the same files in another test's folder are the same build
+    places = list(dict.fromkeys([*(s.parent for s in sources), *folders]))
+    files = [
+        (str(places.index(p.parent)) if p.parent in places else str(p.parent), p.name, p)
+        for p in _included(sources, folders)
+    ]
+    for where, name, path in sorted(files):
+        key.update(f"{where}\0{name}\0".encode() + hashlib.sha256(path.read_bytes()).digest())
+    return key.hexdigest()
+
+
+_INCLUDE = re.compile(rb'^[ \t]*#[ \t]*include[ \t]*"([^"]+)"', re.MULTILINE)
+
+
+def _included(sources: Sequence[Path], folders: Sequence[Path]) -> set[Path]:
+    """Every .c and .h file beside a source or in `folders` (the -I folders), and every file a
+    source includes with #include "..." (looked up as the compiler does: beside the including
+    file, then in `folders`; followed through the files it reaches)."""
+    found = {p for f in (*folders, *(s.parent for s in sources)) for p in f.glob("*.[ch]")}
+    todo = [*sources, *sorted(found)]
+    seen = set(todo)
+    while todo:
+        including = todo.pop()
+        for name in _INCLUDE.findall(including.read_bytes()):
+            for folder in (including.parent, *folders):
+                candidate = folder / os.fsdecode(name)  # an absolute name stays itself
+                if candidate.is_file():
+                    if candidate not in seen:
+                        seen.add(candidate)
+                        found.add(candidate)
+                        todo.append(candidate)
+                    break
+    return found
 
 
 _DEFINE = re.compile(r"^#define\s+([A-Za-z_][A-Za-z0-9_]*)\s+(\S+)\s*$", re.MULTILINE)

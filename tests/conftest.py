@@ -21,6 +21,8 @@
   before; a pytest-xdist worker does the same before it reports its end (`pytest_sessionfinish`),
   so that it stops at once when asked to.
 - The files run longest first, by the seconds tests/durations.py records in tests/durations.json.
+- The tests' builds of generated C (tests/cbuild.py) are cached by content in a folder the
+  workers share (`_temporary_symdyn_cache`): the same C with the same flags is compiled once.
 - With SYMDYN_TEST_TIMES set to a folder, each process writes the cost of each test file there
   (tests/durations.py, which sets it).
 """
@@ -38,7 +40,8 @@ HERE = str(Path(__file__).resolve().parent)
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
-from durations import Recorder, order  # noqa: E402  (tests/ is on the path only from here)
+from cbuild import CACHE_ENV as CBUILD_CACHE  # noqa: E402  (tests/ is on the path only from here)
+from durations import Recorder, order  # noqa: E402
 from warm_python import GC_THRESHOLDS  # noqa: E402
 
 IN_CI = os.environ.get("CI", "").lower() in ("1", "true", "yes")
@@ -59,8 +62,10 @@ gc.set_threshold(*GC_THRESHOLDS)
 def pytest_collection_modifyitems(session, config, items):
     """The longest test files first, by the CPU seconds recorded in tests/durations.json
     (tests/durations.py writes it): pytest-xdist hands whole files to the workers in collection
-    order (--dist loadfile), so a long file collected last would leave one worker running it alone
-    while the other idles. A stable sort: the tests of one file keep their order."""
+    order (--dist loadfile with --no-loadscope-reorder, pyproject.toml: pytest-xdist 3.8 otherwise
+    reorders the files by their number of tests), so a long file collected last would leave one
+    worker running it alone while the other idles. A stable sort: the tests of one file keep
+    their order."""
     rank = order([item.path.name for item in items])
     items.sort(key=lambda item: rank[item.path.name])
 
@@ -119,22 +124,25 @@ def pytest_sessionfinish(session):
 
 @pytest.fixture(autouse=True, scope="session")
 def _temporary_symdyn_cache(tmp_path_factory):
-    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.compilation.cache).
+    """Every test compiles into a temporary cache folder, never the user's (symdyn.apps.compilation.cache),
+    and the tests' own builds of generated C (tests/cbuild.py) are cached in another.
 
-    Under pytest-xdist the workers share one folder (in the run's common temporary root), so a
-    library one worker compiled is a cache hit for the others: the cache's writes are atomic and
-    it is safe under concurrent builds (tests of the cache itself use folders of their own).
+    Under pytest-xdist the workers share each folder (in the run's common temporary root), so a
+    library one worker compiled is a cache hit for the others: both caches' writes are atomic and
+    safe under concurrent builds (tests of symdyn's cache itself use folders of their own).
     """
-    old = os.environ.get("SYMDYN_CACHE_DIR")
+    old = {name: os.environ.get(name) for name in ("SYMDYN_CACHE_DIR", CBUILD_CACHE)}
     os.environ.setdefault("SYMDYN_MARCH", "none")
-    if os.environ.get("PYTEST_XDIST_WORKER"):
-        folder = tmp_path_factory.getbasetemp().parent / "symdyn-cache"
-        folder.mkdir(exist_ok=True)
-    else:
-        folder = tmp_path_factory.mktemp("symdyn-cache")
-    os.environ["SYMDYN_CACHE_DIR"] = str(folder)
+    for name, stem in (("SYMDYN_CACHE_DIR", "symdyn-cache"), (CBUILD_CACHE, "cbuild-cache")):
+        if os.environ.get("PYTEST_XDIST_WORKER"):
+            folder = tmp_path_factory.getbasetemp().parent / stem
+            folder.mkdir(exist_ok=True)
+        else:
+            folder = tmp_path_factory.mktemp(stem)
+        os.environ[name] = str(folder)
     yield
-    if old is None:
-        os.environ.pop("SYMDYN_CACHE_DIR", None)
-    else:
-        os.environ["SYMDYN_CACHE_DIR"] = old
+    for name, value in old.items():
+        if value is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = value

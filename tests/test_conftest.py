@@ -46,3 +46,63 @@ def test_files_run_longest_first_and_unknown_ones_as_an_average_file(monkeypatch
     rank = durations.order(["a.py", "new.py", "c.py", "b.py", "a.py"])
     assert sorted(rank, key=rank.get) == ["b.py", "c.py", "new.py", "a.py"]
     assert durations.UNKNOWN_SECONDS == 5.0  # between c.py and a.py above
+
+
+def test_pytest_xdist_keeps_the_files_in_collection_order(request):
+    """--no-loadscope-reorder (pyproject.toml): without it pytest-xdist 3.8 hands the files out
+    by their number of tests, not longest first as pytest_collection_modifyitems orders them."""
+    assert request.config.getoption("loadscopereorder") is False
+
+
+def _c_files(folder, header_value: int):
+    folder.mkdir()
+    (folder / "value.h").write_text(f"#define VALUE {header_value}\n")
+    (folder / "main.c").write_text('#include "value.h"\nint main(void)\n{\n    return VALUE;\n}\n')
+    return folder / "main.c"
+
+
+def test_a_build_is_compiled_once_and_copied_for_the_same_files_elsewhere(tmp_path, monkeypatch):
+    """tests/cbuild.py's cache: the same source and header in another folder is a hit (the
+    compiler is not run); a changed header, or other flags, is another build."""
+    import subprocess
+
+    import cbuild
+
+    if not cbuild.compilers():
+        return
+    monkeypatch.setenv(cbuild.CACHE_ENV, str(tmp_path / "cache"))
+    runs = []
+    real = cbuild._run
+    monkeypatch.setattr(cbuild, "_run", lambda cmd: runs.append(cmd) or real(cmd))
+
+    def exit_status(exe):
+        return subprocess.run([str(exe)]).returncode
+
+    first = cbuild.compile_program([_c_files(tmp_path / "a", 3)], tmp_path / "a" / "prog")
+    same = cbuild.compile_program([_c_files(tmp_path / "b", 3)], tmp_path / "b" / "prog")
+    assert len(runs) == 1 and exit_status(first) == exit_status(same) == 3
+    changed = cbuild.compile_program([_c_files(tmp_path / "c", 5)], tmp_path / "c" / "prog")
+    assert len(runs) == 2 and exit_status(changed) == 5
+    other = cbuild.compile_program([tmp_path / "a" / "main.c"], tmp_path / "a" / "prog1", opt="-O1")
+    assert len(runs) == 3 and exit_status(other) == 3
+    cbuild.compile_program([tmp_path / "a" / "main.c"], tmp_path / "a" / "main.s", extra=("-S",))
+    cbuild.compile_program([tmp_path / "a" / "main.c"], tmp_path / "a" / "main.s", extra=("-S",))
+    assert len(runs) == 5  # a build with another output than its program is never cached
+
+
+def test_a_failed_build_is_not_cached(tmp_path, monkeypatch):
+    import cbuild
+
+    if not cbuild.compilers():
+        return
+    monkeypatch.setenv(cbuild.CACHE_ENV, str(tmp_path / "cache"))
+    source = tmp_path / "warns.c"
+    source.write_text("int main(void)\n{\n    int unused;\n    return 0;\n}\n")
+    for _ in range(2):
+        try:
+            cbuild.compile_program([source], tmp_path / "warns")
+        except cbuild.CompileError as error:
+            assert "unused" in str(error)
+        else:
+            raise AssertionError("a warning under -Werror must fail the build each time")
+    assert not (tmp_path / "cache").exists() or not list((tmp_path / "cache").iterdir())
