@@ -222,7 +222,7 @@ def worker(
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in functions}}
     if own:
-        out.update(own={}, grad={}, jacfwd={}, jacrev={}, scan={}, xla_grad={})
+        out.update(own={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, xla_grad={})
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
         routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
         for f in functions:
@@ -239,6 +239,10 @@ def worker(
             for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)) if jacobians else ():
                 log(f"{key} {f}")
                 out[key][f] = _jax_timing(jax.jit(jax.vmap(jacobian(fn))), args, count, max(1, reps // 2))
+            if jacobians and hasattr(arm, f"{f}_derivatives"):  # the analytic Jacobians, for comparison
+                log(f"derivatives {f}")
+                derivatives = jax.jit(jax.vmap(getattr(arm, f"{f}_derivatives")))
+                out["derivatives"][f] = _jax_timing(derivatives, args, count, max(1, reps // 2))
     if urdf is not None:
         from importlib.metadata import version
 
@@ -325,7 +329,8 @@ def table(results: dict, opts, robot) -> list[str]:
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
     pick = lambda route, f: ns(route[f][1]) if route and f in route else "-"  # noqa: E731
     head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
-    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "jacrev", "scan", "f_batch, XLA_FLAGS"]
+    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "jacrev", "f_derivatives", "scan"]
+    head += ["f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
     head += ["vmap/f_batch", "grad/vmap", "JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
@@ -334,7 +339,7 @@ def table(results: dict, opts, robot) -> list[str]:
         one, batch = results["numpy"][f]
         jx = min(here["symdyn"][f][1], plain["symdyn"][f][1]) if plain else here["symdyn"][f][1]
         row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here["own"], f), pick(here["grad"], f)]
-        row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "scan")]
+        row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "derivatives", "scan")]
         row += [pick(plain and plain["symdyn"], f)]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
@@ -351,6 +356,7 @@ def table(results: dict, opts, robot) -> list[str]:
 
     routes = [("f_batch", here["symdyn"]), ("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
     routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("jacrev", here["jacrev"])]
+    routes += [("f_derivatives", here["derivatives"])]
     routes += [("scan", here["scan"])]
     routes += [("XLA_FLAGS", plain["symdyn"])] if plain else []
     routes += [("ADAM", there["adam"])] if there else []
@@ -367,6 +373,8 @@ def table(results: dict, opts, robot) -> list[str]:
         "forward dynamics' through the inverse dynamics' adjoint); "
         "jit(grad), XLA: the same by XLA's autodiff of the body (--xla-grad); "
         "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q); "
+        "f_derivatives: jax.jit(jax.vmap(f_derivatives)), the generated derivative functions "
+        "(every Jacobian); "
         "scan: jax.jit of jax.lax.scan over the "
         "states, one call a step; "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
