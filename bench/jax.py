@@ -22,7 +22,8 @@ of --functions (default inverse dynamics, M and forward dynamics) is timed per s
   the first argument (q), through the adjoint program where there is one, with --xla-grad also
   by XLA's autodiff of the body it differentiates, each checked against central differences of
   the same loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q) and
-  jax.jit(jax.vmap(jax.jacrev(f))); a jax.lax.scan over the
+  jax.jit(jax.vmap(jax.jacrev(f))), and jax.jit(jax.vmap(f_derivatives)) where the module has the
+  generated derivative functions of f (--groups with derivatives); a jax.lax.scan over the
   states, one call a step; then (unless --no-xla-flags) f_batch again in a process with
   XLA_FLAGS turning the emitters off for everything;
 * ADAM (adam-robotics, its JAX backend; the Panda only) on the same URDF and batch,
