@@ -226,6 +226,7 @@ def worker(
         out.update(own={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, xla_grad={})
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
         routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
+        gradients = {}
         for f in functions:
             fn, args = getattr(arm, f), _arguments(device, f)
             grads = {"grad": fn}
@@ -237,6 +238,7 @@ def worker(
                 error = _grad_error(jax, jnp, g, grad, _arguments(check, f))
                 out["error"][f"{key} {f} (against central differences)"] = error
                 out[key][f] = _jax_timing(grad, args, count, max(1, reps // 2))
+                gradients[key, f] = grad
             for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)) if jacobians else ():
                 log(f"{key} {f}")
                 out[key][f] = _jax_timing(jax.jit(jax.vmap(jacobian(fn))), args, count, max(1, reps // 2))
@@ -256,6 +258,17 @@ def worker(
             want = np.asarray(reference[f])
             out["error"][f"{route} {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
             out[route][f] = _jax_timing(fns[f], _arguments(device, f), count, reps)
+    if own:  # grad/vmap from interleaved calls: the load of a shared machine moves between routes
+        for f in functions:
+            log(f"own and grad {f}, interleaved")
+            args = _arguments(device, f)
+            pair = (("own", routes["own"][f]), ("grad", gradients["grad", f]))
+            times: dict = {key: [] for key, _ in pair}
+            for _ in range(reps):
+                for key, fn in pair:
+                    times[key].append(_jax_timing(fn, args, count, 1)[1])
+            for key, _ in pair:
+                out[key][f] = (out[key][f][0], statistics.median(times[key]))
     return out
 
 
@@ -379,7 +392,8 @@ def table(results: dict, opts, robot) -> list[str]:
         "scan: jax.jit of jax.lax.scan over the "
         "states, one call a step; "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
-        "(one run); JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
+        "(one run; jit(vmap(f)) and jit(grad) timed in turns, call by call); "
+        "JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
         "compile time of the first call (s): " + "; ".join(compiles(n, r) for n, r in routes if r),
         "largest relative error against symdyn.rnea on 8 states (grad: its derivative along one direction): "
         + ", ".join(f"{k} {v:.1e}" for k, v in {**here["error"], **(there or {}).get("error", {})}.items()),

@@ -7,9 +7,9 @@ inverse dynamics on a free flyer, 1,870 statements: 212 sines for its 32, 109 ms
 across a while loop, so the body is cut into stages of STAGE_SIZE statements, each the body of a
 jax.lax.while_loop whose trip count is 1 computed at run time (the module's _once: a population
 count XLA cannot bound), carrying the values that later statements read. Measured on the Talos'
-inverse dynamics (2,000 states, the machine loaded about tenfold): stages of 150 statements
-took 51 us a state under jax.jit(jax.vmap(...)) (compiled in 182 s), stages of 400 statements
-728 us; its f_batch 60 us.
+inverse dynamics (2,000 states, the machine loaded about fivefold): 32 us a state under
+jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us; the same body rewritten outside the
+generator took 51 us in stages of 150 statements and 728 us in stages of 400 (loaded tenfold).
 
 Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
 their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
