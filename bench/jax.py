@@ -22,7 +22,8 @@ of --functions (default inverse dynamics, M and forward dynamics) is timed per s
   the first argument (q), through the adjoint program where there is one, with --xla-grad also
   by XLA's autodiff of the body it differentiates, each checked against central differences of
   the same loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q) and
-  jax.jit(jax.vmap(jax.jacrev(f))); a jax.lax.scan over the
+  jax.jit(jax.vmap(jax.jacrev(f))), and jax.jit(jax.vmap(f_derivatives)) where the module has the
+  generated derivative functions of f (--groups with derivatives); a jax.lax.scan over the
   states, one call a step; then (unless --no-xla-flags) f_batch again in a process with
   XLA_FLAGS turning the emitters off for everything;
 * ADAM (adam-robotics, its JAX backend; the Panda only) on the same URDF and batch,
@@ -222,9 +223,10 @@ def worker(
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in functions}}
     if own:
-        out.update(own={}, grad={}, jacfwd={}, jacrev={}, scan={}, xla_grad={})
+        out.update(own={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, xla_grad={})
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
         routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
+        gradients = {}
         for f in functions:
             fn, args = getattr(arm, f), _arguments(device, f)
             grads = {"grad": fn}
@@ -236,9 +238,14 @@ def worker(
                 error = _grad_error(jax, jnp, g, grad, _arguments(check, f))
                 out["error"][f"{key} {f} (against central differences)"] = error
                 out[key][f] = _jax_timing(grad, args, count, max(1, reps // 2))
+                gradients[key, f] = grad
             for key, jacobian in (("jacfwd", jax.jacfwd), ("jacrev", jax.jacrev)) if jacobians else ():
                 log(f"{key} {f}")
                 out[key][f] = _jax_timing(jax.jit(jax.vmap(jacobian(fn))), args, count, max(1, reps // 2))
+            if jacobians and hasattr(arm, f"{f}_derivatives"):  # the analytic Jacobians, for comparison
+                log(f"derivatives {f}")
+                derivatives = jax.jit(jax.vmap(getattr(arm, f"{f}_derivatives")))
+                out["derivatives"][f] = _jax_timing(derivatives, args, count, max(1, reps // 2))
     if urdf is not None:
         from importlib.metadata import version
 
@@ -251,6 +258,17 @@ def worker(
             want = np.asarray(reference[f])
             out["error"][f"{route} {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
             out[route][f] = _jax_timing(fns[f], _arguments(device, f), count, reps)
+    if own:  # grad/vmap from interleaved calls: the load of a shared machine moves between routes
+        for f in functions:
+            log(f"own and grad {f}, interleaved")
+            args = _arguments(device, f)
+            pair = (("own", routes["own"][f]), ("grad", gradients["grad", f]))
+            times: dict = {key: [] for key, _ in pair}
+            for _ in range(reps):
+                for key, fn in pair:
+                    times[key].append(_jax_timing(fn, args, count, 1)[1])
+            for key, _ in pair:
+                out[key][f] = (out[key][f][0], statistics.median(times[key]))
     return out
 
 
@@ -325,7 +343,8 @@ def table(results: dict, opts, robot) -> list[str]:
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
     pick = lambda route, f: ns(route[f][1]) if route and f in route else "-"  # noqa: E731
     head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
-    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "jacrev", "scan", "f_batch, XLA_FLAGS"]
+    head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "jacrev", "f_derivatives", "scan"]
+    head += ["f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
     head += ["vmap/f_batch", "grad/vmap", "JAX/NumPy batch"] + (["JAX/ADAM"] if there else [])
@@ -334,7 +353,7 @@ def table(results: dict, opts, robot) -> list[str]:
         one, batch = results["numpy"][f]
         jx = min(here["symdyn"][f][1], plain["symdyn"][f][1]) if plain else here["symdyn"][f][1]
         row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here["own"], f), pick(here["grad"], f)]
-        row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "scan")]
+        row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "derivatives", "scan")]
         row += [pick(plain and plain["symdyn"], f)]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
@@ -351,6 +370,7 @@ def table(results: dict, opts, robot) -> list[str]:
 
     routes = [("f_batch", here["symdyn"]), ("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
     routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("jacrev", here["jacrev"])]
+    routes += [("f_derivatives", here["derivatives"])]
     routes += [("scan", here["scan"])]
     routes += [("XLA_FLAGS", plain["symdyn"])] if plain else []
     routes += [("ADAM", there["adam"])] if there else []
@@ -367,10 +387,13 @@ def table(results: dict, opts, robot) -> list[str]:
         "forward dynamics' through the inverse dynamics' adjoint); "
         "jit(grad), XLA: the same by XLA's autodiff of the body (--xla-grad); "
         "jacfwd, jacrev: jax.jit(jax.vmap(jax.jacfwd(f))), the same with jax.jacrev (by q); "
+        "f_derivatives: jax.jit(jax.vmap(f_derivatives)), the generated derivative functions "
+        "(every Jacobian); "
         "scan: jax.jit of jax.lax.scan over the "
         "states, one call a step; "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
-        "(one run); JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
+        "(one run; jit(vmap(f)) and jit(grad) timed in turns, call by call); "
+        "JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
         "compile time of the first call (s): " + "; ".join(compiles(n, r) for n, r in routes if r),
         "largest relative error against symdyn.rnea on 8 states (grad: its derivative along one direction): "
         + ", ".join(f"{k} {v:.1e}" for k, v in {**here["error"], **(there or {}).get("error", {})}.items()),

@@ -15,6 +15,7 @@ import without JAX's x64 mode.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 import inspect
 import warnings
@@ -28,6 +29,7 @@ from symdyn import load_robot
 from symdyn.algorithms.closed_loops import analyse
 from symdyn.cli import main
 from symdyn.codegen import context, render
+from symdyn.codegen.jax import stages as jax_stages
 from symdyn.codegen.jax import target as jax_target
 from symdyn.errors import SymdynWarning
 from symdyn.generated_modules import load_module
@@ -495,6 +497,37 @@ def test_lax_scan_simulation(modules):
     assert path.shape == (steps, 2)
     _close(q_end, q, rtol=1e-10)
     _close(qd_end, qd, rtol=1e-10)
+
+
+def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
+    """A long body cut into stages (symdyn.codegen.jax.stages: while loops of one pass that XLA
+    does not fuse across; Roger's arm staged by 4 statements, as the Talos' inverse dynamics is by
+    150) gives the committed module's values, forward and reverse derivatives (jacfwd through the
+    loops, the gradient of a vmapped loss by the adjoint program), under jit and vmap."""
+    monkeypatch.setattr(jax_stages, "STAGE_ABOVE", 0)
+    monkeypatch.setattr(jax_stages, "STAGE_SIZE", 4)
+    text = render(example("roger_arm"), targets=("jax",))["roger_arm_jax.py"]
+    (tmp_path / "roger_arm_jax.py").write_text(text)
+    staged = load_module(tmp_path / "roger_arm_jax.py", "_symdyn_test_staged_roger_arm_jax")
+    plain, _, _ = modules["roger_arm"]
+    rng = np.random.default_rng(17)
+    Q, QD, QDD = rng.uniform(-2.0, 2.0, (3, 5, 2))
+    p = _params(plain, rng)
+    assert "while" in str(jax.make_jaxpr(staged.inverse_dynamics)(Q[0], QD[0], QDD[0], p))
+
+    @functools.partial(jax.jit, static_argnums=4)
+    def every(Q, QD, QDD, p, f):
+        vmapped = jax.vmap(f, in_axes=(0, 0, 0, None))
+        return (
+            vmapped(Q, QD, QDD, p),
+            jax.vmap(jax.jacfwd(f, argnums=(0, 1, 2, 3)), in_axes=(0, 0, 0, None))(Q, QD, QDD, p),
+            jax.grad(lambda q, p: jnp.sum(vmapped(q, QD, QDD, p) ** 2), argnums=(0, 1))(Q, p),
+        )
+
+    got = jax.tree.leaves(every(Q, QD, QDD, p, staged.inverse_dynamics))
+    want = jax.tree.leaves(every(Q, QD, QDD, p, plain.inverse_dynamics))
+    for g, w in zip(got, want, strict=True):
+        _close(g, w, rtol=1e-12)
 
 
 def test_float32_module(tmp_path):

@@ -151,7 +151,19 @@ def _nest(f, levels):
     return f
 
 
-def _adjoint_ruled(name, plain, adjoint, shape):
+def _apart(x):
+    """x (..., n) as its product by the identity, a dot that XLA's CPU compiler neither fuses
+    nor merges with x's other uses. The adjoint program reads its cotangent w entry by entry,
+    and under jax.grad of a loss w comes from the forward pass: XLA fused that pass into each
+    read, once per entry, and merged the statements the adjoint program recomputes from the
+    inputs with the forward pass's, whose values then had consumers in both and were cut into
+    small fusions computed again in each (the Solo-12's inverse dynamics under
+    jax.jit(jax.grad(...)) of its vmapped loss: 144 sines for its 12 and 9.3 us a state,
+    against 3.4 us with the product, the forward pass 1.1 us; docs/jax.md)."""
+    return x @ jnp.eye(x.shape[-1], dtype=x.dtype)
+
+
+def _adjoint_ruled(name, plain, adjoint, shape, apart=True):
     """plain (its arguments, one output of `shape`) as a jax.custom_jvp function whose tangent is
     a linear primitive whose transpose is the adjoint program `adjoint` (plain's arguments and the
     output's cotangent w -> w^T d(output)/d(argument) for each argument, p's included).
@@ -162,7 +174,9 @@ def _adjoint_ruled(name, plain, adjoint, shape):
     jax.jacfwd) evaluates it as JAX's forward mode of plain; reverse mode (jax.grad, jax.jacrev,
     jax.vjp) transposes it, which is the adjoint program, not XLA's transpose of the long
     straight-line body (10 times slower, docs/jax.md); jax.vmap binds it again with one more
-    level; its own derivative (second order, jax.hessian) is forward mode of the tangent map."""
+    level; its own derivative (second order, jax.hessian) is forward mode of the tangent map.
+    With `apart`, the transpose gives the adjoint program its inputs and cotangent through
+    _apart."""
 
     def tangent(*args):
         n = len(args) // 2
@@ -178,7 +192,10 @@ def _adjoint_ruled(name, plain, adjoint, shape):
         n = len(args) // 2
         if any(ad.is_undefined_primal(a) for a in args[:n]):
             raise NotImplementedError(f"{name}: the primals of its derivative are not linear inputs")
-        cotangents = _nest(adjoint, levels)(*args[:n], ad.instantiate_zeros(w))
+        inputs, w = args[:n], ad.instantiate_zeros(w)
+        if apart:
+            inputs, w = [_apart(a) for a in inputs], _apart(w)
+        cotangents = _nest(adjoint, levels)(*inputs, w)
         return [None] * n + [c if ad.is_undefined_primal(t) else None for c, t in zip(cotangents, args[n:])]
 
     def derivative(primals, tangents, *, levels):
@@ -2147,8 +2164,12 @@ def _forward_dynamics_adjoint(q, qd, tau, p, w):
 
 
 #: forward mode by JAX's forward mode of the body, reverse mode through the inverse dynamics'
-#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled
-_forward_dynamics_rule = _adjoint_ruled("forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (6,))
+#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled, without _apart (the solve keeps w apart
+#: already, and the adjoint's forward pass, M and the inverse dynamics' statements merge with the
+#: function's: the Panda's jax.jit(jax.grad(...)) took 14.7 us a state with _apart, 11.4 without)
+_forward_dynamics_rule = _adjoint_ruled(
+    "forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (6,), apart=False
+)
 
 
 def regressor(q, qd, qdd, p=None):

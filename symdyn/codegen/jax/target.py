@@ -38,6 +38,7 @@ from ..function_rows import FunctionSpec
 from ..python.printer import NumpyPrinter, local_names
 from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
+from . import stages as staging
 
 __all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "adjoint_view"]
 
@@ -154,10 +155,25 @@ def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
     return {name: view for name, view in views.items() if view is not None}
 
 
+def stage_views(ctx: RenderContext, adjoints: dict[str, dict]) -> dict[str, list[dict]]:
+    """{function: its stages (symdyn.codegen.jax.stages)} for the functions with an adjoint
+    program (`adjoints`: their reverse mode does not go through the stages' while loops) whose
+    body has more than staging.STAGE_ABOVE statements."""
+    printer = NumpyPrinter(local_names(ctx), module="jnp")
+    return {
+        spec.name: staging.stages(spec, printer, staging.STAGE_SIZE)
+        for spec in ctx.functions
+        if spec.name in adjoints and len(spec.temporaries) > staging.STAGE_ABOVE
+    }
+
+
 def render(ctx: RenderContext) -> dict[str, str]:
     """{NAME_jax.py: module text} for the robot of `ctx`."""
     adjoints = adjoint_views(ctx)
     through = identities(ctx, adjoints)
     derived = {name: d for name, d in rules(ctx).items() if name not in through}
-    text = render_module(ctx, "jax/module.py.j2", "jnp", rules=derived, adjoints=adjoints, identities=through)
+    staged = stage_views(ctx, adjoints)
+    text = render_module(
+        ctx, "jax/module.py.j2", "jnp", rules=derived, adjoints=adjoints, identities=through, stages=staged
+    )
     return {file_name(ctx.name): text}

@@ -1,0 +1,57 @@
+"""Stages of a long straight-line body, for the JAX target: each a jax.lax.while_loop of one pass.
+
+Under jax.jit(jax.vmap(f)) with XLA's default CPU flags, a body of thousands of statements is
+compiled into a few huge fusions whose every root recomputes the statements it reads (the Talos'
+inverse dynamics on a free flyer, 1,870 statements: 212 sines for its 32, 109 ms a state against
+60 us for its f_batch, compiled with the fusion emitters off; docs/jax.md). XLA does not fuse
+across a while loop, so the body is cut into stages of STAGE_SIZE statements, each the body of a
+jax.lax.while_loop whose trip count is 1 computed at run time (the module's _once: a population
+count XLA cannot bound), carrying the values that later statements read. Measured on the Talos'
+inverse dynamics (2,000 states, the machine loaded about fivefold): 32 us a state under
+jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us; the same body rewritten outside the
+generator took 51 us in stages of 150 statements and 728 us in stages of 400 (loaded tenfold).
+
+Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
+their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
+their body exceeds STAGE_ABOVE statements.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from ..function_rows import FunctionSpec
+from ..python.printer import NumpyPrinter
+
+__all__ = ["STAGE_ABOVE", "STAGE_SIZE", "stages"]
+
+#: Bodies of more statements than this are staged (the Solo-12's inverse dynamics, 650, is not:
+#: it compiles well as one body).
+STAGE_ABOVE = 1000
+#: Statements per stage (chosen by measurement on the Talos: module docstring).
+STAGE_SIZE = 150
+
+
+def stages(spec: FunctionSpec, printer: NumpyPrinter, size: int = STAGE_SIZE) -> list[dict]:
+    """The stages of `spec`'s temporaries, runs of `size`: for each, the slice of temporaries
+    [start, stop), `inputs`, the names defined before it (the inputs' entries or temporaries)
+    that it or later statements read, and `outputs`, those defined up to its end read after it
+    (the next stage's inputs), all printed by `printer`, in a fixed order."""
+    temporaries = spec.temporaries
+    after: list[set[sp.Symbol]] = [set() for _ in range(len(temporaries) + 1)]
+    after[-1] = set().union(*(sp.sympify(e).free_symbols for e in spec.outputs))
+    for k in range(len(temporaries) - 1, -1, -1):
+        after[k] = after[k + 1] | temporaries[k][1].free_symbols
+    defined = {s for inp in spec.inputs for s in inp.symbols}
+
+    def names(symbols: set[sp.Symbol]) -> list[str]:
+        return [printer.doprint(s) for s in sorted(symbols, key=sp.default_sort_key)]
+
+    out = []
+    for start in range(0, len(temporaries), size):
+        stop = min(start + size, len(temporaries))
+        inputs = defined & after[start]
+        defined |= {s for s, _ in temporaries[start:stop]}
+        outputs = names(defined & after[stop])
+        out.append({"start": start, "stop": stop, "inputs": names(inputs), "outputs": outputs})
+    return out
