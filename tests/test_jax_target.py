@@ -502,8 +502,9 @@ def test_lax_scan_simulation(modules):
 def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
     """A long body cut into stages (symdyn.codegen.jax.stages: while loops of one pass that XLA
     does not fuse across; Roger's arm staged by 4 statements, as the Talos' inverse dynamics is by
-    150) gives the committed module's values, forward and reverse derivatives (jacfwd through the
-    loops, the gradient of a vmapped loss by the adjoint program), under jit and vmap."""
+    150, and its adjoint program with it) gives the committed module's values, forward and reverse
+    derivatives (jacfwd through the loops, the gradient of a vmapped loss by the staged adjoint
+    program), under jit and vmap."""
     monkeypatch.setattr(jax_stages, "STAGE_ABOVE", 0)
     monkeypatch.setattr(jax_stages, "STAGE_SIZE", 4)
     text = render(example("roger_arm"), targets=("jax",))["roger_arm_jax.py"]
@@ -514,6 +515,7 @@ def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
     Q, QD, QDD = rng.uniform(-2.0, 2.0, (3, 5, 2))
     p = _params(plain, rng)
     assert "while" in str(jax.make_jaxpr(staged.inverse_dynamics)(Q[0], QD[0], QDD[0], p))
+    assert "while" in str(jax.make_jaxpr(staged._inverse_dynamics_adjoint)(Q[0], QD[0], QDD[0], p, QDD[1]))
 
     @functools.partial(jax.jit, static_argnums=4)
     def every(Q, QD, QDD, p, f):

@@ -113,6 +113,13 @@ def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
         "unpack": [(printer.doprint(s), array, k) for s, array, k in read],
         "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in program.temporaries],
         "cotangents": cotangents,
+        "stages": (
+            staging.cut_into_stages(
+                program.temporaries, program.outputs, {s for s, _, _ in read}, printer, staging.STAGE_SIZE
+            )
+            if len(spec.temporaries) > staging.STAGE_ABOVE
+            else None
+        ),
     }
 
 
