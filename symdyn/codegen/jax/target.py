@@ -75,7 +75,7 @@ IDENTITIES = {"forward_dynamics": ("inverse_dynamics", "mass_matrix")}
 #: The functions without an adjoint program or rule that are staged when their body is long
 #: (symdyn.codegen.jax.stages), differentiated through their body without the loops (the
 #: template's _loops_aside). Chosen by measurement on the Talos (2,000 states, loaded about once):
-#: jax.jit(jax.vmap(mass_matrix)) 18 us a state staged against 31 us in one body (its f_batch 29);
+#: jax.jit(jax.vmap(mass_matrix)) 18 us a state staged against 31 us in one body (f_batch 24, 29);
 #: the functions of ADJOINTS and IDENTITIES are staged too (the Talos' forward dynamics 70 us).
 STAGED = ("mass_matrix",)
 
