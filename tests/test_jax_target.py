@@ -501,9 +501,11 @@ def test_lax_scan_simulation(modules):
 
 def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
     """A long body cut into stages (symdyn.codegen.jax.stages: while loops of one pass that XLA
-    does not fuse across; Roger's arm staged by 4 statements, as the Talos' inverse dynamics is by
-    150) gives the committed module's values, forward and reverse derivatives (jacfwd through the
-    loops, the gradient of a vmapped loss by the adjoint program), under jit and vmap."""
+    does not fuse across; Roger's arm staged by 4 statements, as the Talos' functions are by 150:
+    the inverse dynamics and its adjoint program, the forward dynamics differentiated through it,
+    the mass matrix through its body without the loops) gives the committed module's values,
+    forward and reverse derivatives (jacfwd through the loops, the gradient of a vmapped loss),
+    under jit and vmap."""
     monkeypatch.setattr(jax_stages, "STAGE_ABOVE", 0)
     monkeypatch.setattr(jax_stages, "STAGE_SIZE", 4)
     text = render(example("roger_arm"), targets=("jax",))["roger_arm_jax.py"]
@@ -513,21 +515,34 @@ def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
     rng = np.random.default_rng(17)
     Q, QD, QDD = rng.uniform(-2.0, 2.0, (3, 5, 2))
     p = _params(plain, rng)
-    assert "while" in str(jax.make_jaxpr(staged.inverse_dynamics)(Q[0], QD[0], QDD[0], p))
+    for f, args in [
+        (staged.inverse_dynamics, (Q[0], QD[0], QDD[0], p)),
+        (staged._inverse_dynamics_adjoint, (Q[0], QD[0], QDD[0], p, QDD[1])),
+        (staged.forward_dynamics, (Q[0], QD[0], QDD[0], p)),
+        (staged.mass_matrix, (Q[0], p)),
+    ]:
+        assert "while" in str(jax.make_jaxpr(f)(*args)), f.__name__
 
-    @functools.partial(jax.jit, static_argnums=4)
-    def every(Q, QD, QDD, p, f):
-        vmapped = jax.vmap(f, in_axes=(0, 0, 0, None))
+    @functools.partial(jax.jit, static_argnums=(2, 3))
+    def every(states, p, f, forward):
+        n = len(states)
+        vmapped = jax.vmap(f, in_axes=(0,) * n + (None,))
+        jacobians = jax.vmap(jax.jacfwd(f, argnums=tuple(range(n + 1))), in_axes=(0,) * n + (None,))
         return (
-            vmapped(Q, QD, QDD, p),
-            jax.vmap(jax.jacfwd(f, argnums=(0, 1, 2, 3)), in_axes=(0, 0, 0, None))(Q, QD, QDD, p),
-            jax.grad(lambda q, p: jnp.sum(vmapped(q, QD, QDD, p) ** 2), argnums=(0, 1))(Q, p),
+            vmapped(*states, p),
+            jacobians(*states, p) if forward else (),
+            jax.grad(lambda q, p: jnp.sum(vmapped(q, *states[1:], p) ** 2), argnums=(0, 1))(states[0], p),
         )
 
-    got = jax.tree.leaves(every(Q, QD, QDD, p, staged.inverse_dynamics))
-    want = jax.tree.leaves(every(Q, QD, QDD, p, plain.inverse_dynamics))
-    for g, w in zip(got, want, strict=True):
-        _close(g, w, rtol=1e-12)
+    for name, states, forward in [
+        ("inverse_dynamics", (Q, QD, QDD), True),
+        ("forward_dynamics", (Q, QD, QDD), False),
+        ("mass_matrix", (Q,), False),
+    ]:
+        got = jax.tree.leaves(every(states, p, getattr(staged, name), forward))
+        want = jax.tree.leaves(every(states, p, getattr(plain, name), forward))
+        for g, w in zip(got, want, strict=True):
+            _close(g, w, rtol=1e-12)
 
 
 def test_float32_module(tmp_path):

@@ -13,7 +13,11 @@ generator took 51 us in stages of 150 statements and 728 us in stages of 400 (lo
 
 Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
 their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
-their body exceeds STAGE_ABOVE statements.
+their body exceeds STAGE_ABOVE statements; their adjoint program (plain jnp code evaluated
+forward) is staged with them. The Talos' jax.jit(jax.grad(...)) of the vmapped inverse dynamics'
+loss (2,000 states, the machine loaded about once): with the adjoint program in one body it did
+not finish compiling in 7 minutes; staged, compiled in 144 s, 81 us a state against the forward
+pass's 19 us (4.3 times).
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import sympy as sp
 from ..function_rows import FunctionSpec
 from ..python.printer import NumpyPrinter
 
-__all__ = ["STAGE_ABOVE", "STAGE_SIZE", "stages"]
+__all__ = ["STAGE_ABOVE", "STAGE_SIZE", "cut_into_stages", "stages"]
 
 #: Bodies of more statements than this are staged (the Solo-12's inverse dynamics, 650, is not:
 #: it compiles well as one body).
@@ -33,16 +37,28 @@ STAGE_SIZE = 150
 
 
 def stages(spec: FunctionSpec, printer: NumpyPrinter, size: int = STAGE_SIZE) -> list[dict]:
-    """The stages of `spec`'s temporaries, runs of `size`: for each, the slice of temporaries
-    [start, stop), `inputs`, the names defined before it (the inputs' entries or temporaries)
-    that it or later statements read, and `outputs`, those defined up to its end read after it
-    (the next stage's inputs), all printed by `printer`, in a fixed order."""
-    temporaries = spec.temporaries
+    """The stages of `spec`'s temporaries (cut_into_stages of its body)."""
+    defined = {s for inp in spec.inputs for s in inp.symbols}
+    return cut_into_stages(spec.temporaries, spec.outputs, defined, printer, size)
+
+
+def cut_into_stages(
+    temporaries: list[tuple[sp.Symbol, sp.Expr]],
+    outputs: list,
+    defined: set[sp.Symbol],
+    printer: NumpyPrinter,
+    size: int = STAGE_SIZE,
+) -> list[dict]:
+    """The stages of the straight-line body `temporaries` (then `outputs` read), runs of `size`:
+    for each, the slice of temporaries [start, stop), `inputs`, the names defined before it (of
+    `defined`, the symbols the body reads from its arguments, or temporaries) that it or later
+    statements read, and `outputs`, those defined up to its end read after it (the next stage's
+    inputs), all printed by `printer`, in a fixed order."""
     after: list[set[sp.Symbol]] = [set() for _ in range(len(temporaries) + 1)]
-    after[-1] = set().union(*(sp.sympify(e).free_symbols for e in spec.outputs))
+    after[-1] = set().union(*(sp.sympify(e).free_symbols for e in outputs))
     for k in range(len(temporaries) - 1, -1, -1):
         after[k] = after[k + 1] | temporaries[k][1].free_symbols
-    defined = {s for inp in spec.inputs for s in inp.symbols}
+    defined = set(defined)
 
     def names(symbols: set[sp.Symbol]) -> list[str]:
         return [printer.doprint(s) for s in sorted(symbols, key=sp.default_sort_key)]

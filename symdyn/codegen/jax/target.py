@@ -40,7 +40,7 @@ from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 from . import stages as staging
 
-__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "adjoint_view"]
+__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "STAGED", "adjoint_view"]
 
 #: The functions whose derivative is a linear primitive transposed by their generated adjoint program
 #: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
@@ -71,6 +71,13 @@ RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
 #: state (2.7 times the forward pass, compiled in 19 s), against 108 us by RULES (compiled in 551 s).
 #: Taken over RULES when the module holds the three functions with these inputs.
 IDENTITIES = {"forward_dynamics": ("inverse_dynamics", "mass_matrix")}
+
+#: The functions without an adjoint program or rule that are staged when their body is long
+#: (symdyn.codegen.jax.stages), differentiated through their body without the loops (the
+#: template's _loops_aside). Chosen by measurement on the Talos (2,000 states, loaded about once):
+#: jax.jit(jax.vmap(mass_matrix)) 18 us a state staged against 31 us in one body (f_batch 24, 29);
+#: the functions of ADJOINTS and IDENTITIES are staged too (the Talos' forward dynamics 70 us).
+STAGED = ("mass_matrix",)
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
@@ -113,6 +120,13 @@ def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
         "unpack": [(printer.doprint(s), array, k) for s, array, k in read],
         "temporaries": [(printer.doprint(s), printer.doprint(e)) for s, e in program.temporaries],
         "cotangents": cotangents,
+        "stages": (
+            staging.cut_into_stages(
+                program.temporaries, program.outputs, {s for s, _, _ in read}, printer, staging.STAGE_SIZE
+            )
+            if len(spec.temporaries) > staging.STAGE_ABOVE
+            else None
+        ),
     }
 
 
@@ -155,15 +169,23 @@ def adjoint_views(ctx: RenderContext) -> dict[str, dict]:
     return {name: view for name, view in views.items() if view is not None}
 
 
-def stage_views(ctx: RenderContext, adjoints: dict[str, dict]) -> dict[str, list[dict]]:
-    """{function: its stages (symdyn.codegen.jax.stages)} for the functions with an adjoint
-    program (`adjoints`: their reverse mode does not go through the stages' while loops) whose
-    body has more than staging.STAGE_ABOVE statements."""
+def stage_views(
+    ctx: RenderContext, adjoints: dict[str, dict], through: dict[str, dict], derived: dict[str, str]
+) -> dict[str, list[dict]]:
+    """{function: its stages (symdyn.codegen.jax.stages)} for the functions of `adjoints`,
+    `through` (IDENTITIES) and STAGED whose body has more than staging.STAGE_ABOVE statements,
+    but those differentiated by a rule of `derived` (RULES:
+    its tangent of p is forward mode of the body, which reverse mode would transpose through the
+    stages' while loops). The others' reverse mode does not enter the loops: it is their adjoint
+    program (ADJOINTS, IDENTITIES) or JAX's of the body without them (the template's _loops_aside)."""
     printer = NumpyPrinter(local_names(ctx), module="jnp")
     return {
         spec.name: staging.stages(spec, printer, staging.STAGE_SIZE)
         for spec in ctx.functions
-        if spec.name in adjoints and len(spec.temporaries) > staging.STAGE_ABOVE
+        if spec.name not in derived
+        and (spec.name in adjoints or spec.name in through or spec.name in STAGED)
+        and any(inp.name != "p" for inp in spec.inputs)
+        and len(spec.temporaries) > staging.STAGE_ABOVE
     }
 
 
@@ -172,8 +194,16 @@ def render(ctx: RenderContext) -> dict[str, str]:
     adjoints = adjoint_views(ctx)
     through = identities(ctx, adjoints)
     derived = {name: d for name, d in rules(ctx).items() if name not in through}
-    staged = stage_views(ctx, adjoints)
+    staged = stage_views(ctx, adjoints, through, derived)
+    loose = [name for name in staged if name not in adjoints and name not in through]
     text = render_module(
-        ctx, "jax/module.py.j2", "jnp", rules=derived, adjoints=adjoints, identities=through, stages=staged
+        ctx,
+        "jax/module.py.j2",
+        "jnp",
+        rules=derived,
+        adjoints=adjoints,
+        identities=through,
+        stages=staged,
+        loose=loose,
     )
     return {file_name(ctx.name): text}
