@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .cse import fast_cse
+from .program import derivative
 
 __all__ = ["Derived", "partial", "adjoint_program"]
 
@@ -40,33 +41,9 @@ class Derived:
 
 
 def partial(e: sp.Expr, s: sp.Symbol) -> sp.Expr:
-    """d e / d s for the forms of generated code: sums, products, numeric powers, sin, cos, sign,
-    Heaviside, Abs (others by SymPy's diff)."""
-    if e == s:
-        return sp.S.One
-    if e.is_Atom or s not in e.free_symbols:
-        return _ZERO
-    args = e.args
-    if e.is_Add:
-        return sp.Add(*[partial(a, s) for a in args])
-    if e.is_Mul:
-        terms = []
-        for i, a in enumerate(args):
-            d = partial(a, s)
-            if d is not _ZERO:
-                terms.append(sp.Mul(*args[:i], *args[i + 1 :], d))
-        return sp.Add(*terms)
-    if e.is_Pow and args[1].is_Number:
-        return args[1] * args[0] ** (args[1] - 1) * partial(args[0], s)
-    if isinstance(e, sp.sin):
-        return sp.cos(args[0]) * partial(args[0], s)
-    if isinstance(e, sp.cos):
-        return -sp.sin(args[0]) * partial(args[0], s)
-    if isinstance(e, (sp.sign, sp.Heaviside)):
-        return _ZERO
-    if isinstance(e, sp.Abs):
-        return sp.sign(args[0]) * partial(args[0], s)
-    return e.diff(s).replace(sp.DiracDelta, lambda *_: _ZERO)
+    """d e / d s: symdyn.symbolic.program.derivative with s's derivative 1 (the forms of generated
+    code directly: sums, products, numeric powers, sin, cos, sign, Heaviside, Abs)."""
+    return derivative(e, {s: sp.S.One}, {})
 
 
 def _partials(

@@ -24,7 +24,7 @@ from collections.abc import Iterable, Sequence
 
 import sympy as sp
 
-__all__ = ["Program", "dependencies", "is_trivial"]
+__all__ = ["Program", "dependencies", "derivative", "is_trivial"]
 
 
 def _negated(expr: sp.Expr) -> sp.Expr | None:
@@ -48,11 +48,13 @@ def is_trivial(expr: sp.Expr) -> bool:
 _ZERO = sp.S.Zero  # a singleton: `is` tests avoid SymPy's slow comparisons
 
 
-def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
-    """Total derivative of e, given the derivatives `dmap` of the symbols it uses (others 0).
+def derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
+    """Total derivative of e, given the derivatives `dmap` of the symbols it uses (others 0);
+    `memo` caches it for the subexpressions (a dict the caller keeps, or a fresh one).
 
     Handles the forms the recursions produce (sums, products, integer powers,
-    sin, cos, sign, Heaviside) directly, which is much faster than SymPy's general diff.
+    sin, cos, sign, Heaviside, Abs) directly, which is much faster than SymPy's general diff
+    (whose derivative of Abs, for symbols not declared real, is written with re and im).
     """
     if e.is_Symbol:
         return dmap.get(e, sp.S.Zero)
@@ -63,25 +65,29 @@ def _derivative(e: sp.Expr, dmap: dict, memo: dict) -> sp.Expr:
         return hit
     args = e.args
     if e.is_Add:
-        out = sp.Add(*[d for d in (_derivative(a, dmap, memo) for a in args) if d is not _ZERO])
+        out = sp.Add(*[d for d in (derivative(a, dmap, memo) for a in args) if d is not _ZERO])
     elif e.is_Mul:
         terms = []
         for i, a in enumerate(args):
-            da = _derivative(a, dmap, memo)
+            da = derivative(a, dmap, memo)
             if da is not _ZERO:
                 terms.append(sp.Mul(*args[:i], *args[i + 1 :], da))
         out = sp.Add(*terms)
     elif e.is_Pow and args[1].is_Number:
-        db = _derivative(args[0], dmap, memo)
+        db = derivative(args[0], dmap, memo)
         out = args[1] * args[0] ** (args[1] - 1) * db if db is not _ZERO else _ZERO
     elif isinstance(e, (sp.sin, sp.cos)):
-        da = _derivative(args[0], dmap, memo)
+        da = derivative(args[0], dmap, memo)
         slope = sp.cos(args[0]) if isinstance(e, sp.sin) else -sp.sin(args[0])
         out = slope * da if da is not _ZERO else _ZERO
     elif isinstance(e, (sp.sign, sp.Heaviside)):
         out = sp.S.Zero  # almost everywhere (Coulomb friction)
+    elif isinstance(e, sp.Abs):
+        da = derivative(args[0], dmap, memo)
+        out = sp.sign(args[0]) * da if da is not _ZERO else _ZERO
     else:
         out = sp.Add(*[e.diff(s) * d for s, d in dmap.items() if s in e.free_symbols])
+        out = out.replace(sp.DiracDelta, lambda *_: _ZERO)  # steps' derivatives: 0, as sign's
     memo[e] = out
     return out
 
@@ -178,11 +184,11 @@ class Program:
         """d(outputs)/dx by forward-mode propagation; derivatives become new intermediates."""
         dmap: dict[sp.Basic, sp.Expr] = {x: sp.S.One}
         for sym, expr in self.needed(outputs):
-            d = _derivative(expr, dmap, {})
+            d = derivative(expr, dmap, {})
             if d is not _ZERO:
                 dmap[sym] = self.let(d, hint)
         memo: dict = {}
-        return [_derivative(sp.sympify(e), dmap, memo) for e in outputs]
+        return [derivative(sp.sympify(e), dmap, memo) for e in outputs]
 
     def expand(self, exprs: Iterable[sp.Expr]) -> list[sp.Expr]:
         """Substitute every intermediate back: closed forms over inputs only."""
