@@ -227,9 +227,14 @@ class CompiledDynamics(FrameMethods):
         """(ffi, lib) of the scalar library, or of the library at `path` with the scalar one's `ffi`
         (symdyn.apps.compilation.calling.load_library)."""
         meta = self._entry.meta
-        width = f"{meta['robot']['name']}_batch_width"
         solve = meta.get("solve_loops")
-        return load_library(path or self._library, meta["functions"], width, solve=solve, ffi=ffi)
+        functions = meta["functions"]
+        return load_library(path or self._library, functions, self._width_symbol, solve=solve, ffi=ffi)
+
+    @property
+    def _width_symbol(self) -> str:
+        """The C name of the library's NAME_batch_width function."""
+        return f"{self._entry.meta['robot']['name']}_batch_width"
 
     def _batch_loaded(self) -> tuple:
         """(lib, W) of the batch library (NAME_batch ...), built and cached on the first call that needs
@@ -245,10 +250,7 @@ class CompiledDynamics(FrameMethods):
                 entry = batch_entry(self._entry)
             ffi, _ = self._loaded()
             _, lib = self._loaded(entry.file(entry.meta["library"]), ffi)
-            loaded = self._batch = (
-                lib,
-                int(getattr(lib, f"{self._entry.meta['robot']['name']}_batch_width")()),
-            )
+            loaded = self._batch = (lib, int(getattr(lib, self._width_symbol)()))
         return loaded
 
     def _batch_library(self):
