@@ -10,12 +10,12 @@ tests/test_c_target.py compile without -mavx2, so they cover the C library's pat
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import importlib
 import platform
 import re
 import subprocess
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -45,11 +45,9 @@ import symdyn.codegen
 from symdyn.codegen import c as c_backend
 from symdyn.codegen.c.sincos import BLOCK, gather
 from symdyn.model.robot import Mimic
-from symdyn.parsers import load_robot
 
 oracle = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 #: The builds that take the vector path: -O2 and -O3, with and without FMA contraction (-std=c99
 #: turns contraction off; -ffp-contract=fast is GNU C's default), and the machine's own CPU.
 VECTOR_BUILDS = {
@@ -72,12 +70,6 @@ def _has_avx2() -> bool:
 
 
 needs_avx2 = pytest.mark.skipif(not _has_avx2(), reason="needs gcc and an x86-64 CPU with AVX2")
-
-
-def _load(name: str):
-    with warnings.catch_warnings():  # published PUMA data is implausible (a warning, not an error)
-        warnings.simplefilter("ignore")
-        return load_robot(EXAMPLES / f"{name}.yaml")
 
 
 def _mimic_chain():
@@ -114,14 +106,16 @@ def test_gather_resolves_temporaries_and_drops_dead_ones():
 
 
 def test_float_keeps_the_library_calls_and_double_reads_the_arrays():
-    robot = _load("puma560")
-    double = symdyn.codegen.render(robot, targets=("c",))["puma560_dynamics.c"]
-    single = symdyn.codegen.render(robot, targets=("c",), precision="float")["puma560_dynamics.c"]
+    """The PUMA's C in double and in float precision, over the session's derivation
+    (`_rendered`: symdyn.codegen.render's context, robots.example_context)."""
+    _, ctx, files = _rendered("puma560")
+    double = files["puma560_dynamics.c"]
+    single = c_backend.render(dataclasses.replace(ctx, precision="float"))["puma560_dynamics.c"]
     assert "sincos" not in single and "sinf(" in single
     functions: dict[str, str] = {}  # each function's text with its parts' (symdyn.codegen.c.parts)
     for m in re.finditer(r"^(?:static \w+ )?void puma560_(\w+?)(?:_part\d+)?\(.*?^}", double, re.M | re.S):
         functions[m.group(1)] = functions.get(m.group(1), "") + m.group(0)
-    assert len(functions) == len(symdyn.codegen.context(robot).functions)
+    assert len(functions) == len(ctx.functions)
     for body in functions.values():
         assert not re.search(r"\b(sin|cos)\(", body)  # only the macros, which the helper's arrays back
         uses = "puma560_SIN(" in body or "puma560_COS(" in body
@@ -235,7 +229,7 @@ int main(void)
 @pytest.fixture(scope="module")
 def puma_files(tmp_path_factory):
     out = tmp_path_factory.mktemp("puma_sincos")
-    write_files(symdyn.codegen.render(_load("puma560"), targets=("c",)), out)
+    write_files(_rendered("puma560")[2], out)
     return out
 
 
