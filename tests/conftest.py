@@ -7,6 +7,10 @@
   vector bodies double a library's compile time). tests/test_batch.py compiles and checks the
   vector path, and symdyn.compile's default -march=native, itself. A SYMDYN_MARCH set by the
   caller is kept.
+- symdyn.compile builds its libraries at -O0 (SYMDYN_OPT=0), as tests/cbuild.py builds the tests'
+  own C: the values do not depend on the level (no -ffast-math, no contraction), and gcc -O2 took
+  six times as long on the PUMA 560's C (1.9 s against 0.3 s of one core). tests/test_batch.py
+  builds with symdyn.compile's default -O2 -march=native; a SYMDYN_OPT set by the caller is kept.
 - Progress reports are off (SYMDYN_QUIET=1, symdyn.progress), in this process and the commands it
   starts.
 - Under CI (the environment variable CI set to true, as .ci/run is run), a skipped test is a
@@ -133,6 +137,7 @@ def _temporary_symdyn_cache(tmp_path_factory):
     """
     old = {name: os.environ.get(name) for name in ("SYMDYN_CACHE_DIR", CBUILD_CACHE)}
     os.environ.setdefault("SYMDYN_MARCH", "none")
+    os.environ.setdefault("SYMDYN_OPT", "0")
     for name, stem in (("SYMDYN_CACHE_DIR", "symdyn-cache"), (CBUILD_CACHE, "cbuild-cache")):
         if os.environ.get("PYTEST_XDIST_WORKER"):
             folder = tmp_path_factory.getbasetemp().parent / stem

@@ -272,16 +272,18 @@ def test_the_vector_path_under_sanitizers(tree, tmp_path, name):
 @pytest.fixture(scope="module")
 def compiled():
     """planar_3r through symdyn.compile with its default flags (-O2 -march=native; the suite's
-    conftest.py builds without -march otherwise)."""
+    conftest.py builds at -O0 without -march otherwise)."""
     robot = example("planar_3r")
     with pytest.MonkeyPatch.context() as mp:
         mp.delenv(build.ARCH_ENV, raising=False)
+        mp.delenv(build.OPT_ENV, raising=False)
         return robot, symdyn.compile(robot)
 
 
 def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch):
     robot, fast = compiled
     monkeypatch.delenv(build.ARCH_ENV, raising=False)  # symdyn.compile's default flags, as `compiled`
+    monkeypatch.delenv(build.OPT_ENV, raising=False)
     n = robot.n
     rng = np.random.default_rng(3)
     q, qd, qdd = (rng.uniform(-2, 2, (1001, n)) for _ in range(3))
@@ -329,14 +331,26 @@ def test_compiled_batches_without_copies_and_with_threads(compiled, monkeypatch)
 
 
 def test_the_cache_key_holds_the_flags_and_the_machine(monkeypatch):
-    """-march=native by default, with the CPU's fingerprint in the key; $SYMDYN_MARCH another target
-    (no fingerprint then: the library runs on any machine of that target), or none."""
+    """-O2 -march=native by default, with the CPU's fingerprint in the key; $SYMDYN_MARCH another
+    target (no fingerprint then: the library runs on any machine of that target), or none;
+    $SYMDYN_OPT another optimisation level, in place of -O2."""
     from symdyn.apps.compilation.entry import build_options
 
     monkeypatch.delenv(build.ARCH_ENV, raising=False)
+    monkeypatch.delenv(build.OPT_ENV, raising=False)
     native = build_options("newton-euler")
     assert "-march=native" in native["flags"] and native["machine"] == build.machine_fingerprint()
     assert "-ffp-contract=off" in native["flags"]
+    assert [f for f in native["flags"] if f.startswith("-O")] == ["-O2"] and native["opt"] == "-O2"
+    for level in build.OPT_LEVELS:
+        monkeypatch.setenv(build.OPT_ENV, f" {level} ")
+        options = build_options("newton-euler")
+        assert [f for f in options["flags"] if f.startswith("-O")] == [f"-O{level}"] == [options["opt"]]
+    for bad in ("-O3", "fast", "2 -fno-strict-aliasing", "4"):
+        monkeypatch.setenv(build.OPT_ENV, bad)
+        with pytest.raises(SymdynError, match=r"^\$SYMDYN_OPT=.* is not an optimisation level"):
+            build_options("newton-euler")
+    monkeypatch.delenv(build.OPT_ENV)
     monkeypatch.setenv(build.ARCH_ENV, "x86-64-v3")
     portable = build_options("newton-euler")
     assert "-march=x86-64-v3" in portable["flags"] and portable["machine"] is None

@@ -10,12 +10,12 @@ tests/test_c_target.py compile without -mavx2, so they cover the C library's pat
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import importlib
 import platform
 import re
 import subprocess
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -45,11 +45,9 @@ import symdyn.codegen
 from symdyn.codegen import c as c_backend
 from symdyn.codegen.c.sincos import BLOCK, gather
 from symdyn.model.robot import Mimic
-from symdyn.parsers import load_robot
 
 oracle = importlib.import_module("symdyn.rnea")  # the module (symdyn.rnea is also the function)
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 #: The builds that take the vector path: -O2 and -O3, with and without FMA contraction (-std=c99
 #: turns contraction off; -ffp-contract=fast is GNU C's default), and the machine's own CPU.
 VECTOR_BUILDS = {
@@ -72,12 +70,6 @@ def _has_avx2() -> bool:
 
 
 needs_avx2 = pytest.mark.skipif(not _has_avx2(), reason="needs gcc and an x86-64 CPU with AVX2")
-
-
-def _load(name: str):
-    with warnings.catch_warnings():  # published PUMA data is implausible (a warning, not an error)
-        warnings.simplefilter("ignore")
-        return load_robot(EXAMPLES / f"{name}.yaml")
 
 
 def _mimic_chain():
@@ -114,14 +106,16 @@ def test_gather_resolves_temporaries_and_drops_dead_ones():
 
 
 def test_float_keeps_the_library_calls_and_double_reads_the_arrays():
-    robot = _load("puma560")
-    double = symdyn.codegen.render(robot, targets=("c",))["puma560_dynamics.c"]
-    single = symdyn.codegen.render(robot, targets=("c",), precision="float")["puma560_dynamics.c"]
+    """The PUMA's C in double and in float precision, over the session's derivation
+    (`_rendered`: symdyn.codegen.render's context, robots.example_context)."""
+    _, ctx, files = _rendered("puma560")
+    double = files["puma560_dynamics.c"]
+    single = c_backend.render(dataclasses.replace(ctx, precision="float"))["puma560_dynamics.c"]
     assert "sincos" not in single and "sinf(" in single
     functions: dict[str, str] = {}  # each function's text with its parts' (symdyn.codegen.c.parts)
     for m in re.finditer(r"^(?:static \w+ )?void puma560_(\w+?)(?:_part\d+)?\(.*?^}", double, re.M | re.S):
         functions[m.group(1)] = functions.get(m.group(1), "") + m.group(0)
-    assert len(functions) == len(symdyn.codegen.context(robot).functions)
+    assert len(functions) == len(ctx.functions)
     for body in functions.values():
         assert not re.search(r"\b(sin|cos)\(", body)  # only the macros, which the helper's arrays back
         uses = "puma560_SIN(" in body or "puma560_COS(" in body
@@ -235,7 +229,7 @@ int main(void)
 @pytest.fixture(scope="module")
 def puma_files(tmp_path_factory):
     out = tmp_path_factory.mktemp("puma_sincos")
-    write_files(symdyn.codegen.render(_load("puma560"), targets=("c",)), out)
+    write_files(_rendered("puma560")[2], out)
     return out
 
 
@@ -281,12 +275,13 @@ def _rendered(name: str):
 
 
 #: The optimisation level of each robot's AVX2 build. -O3 (the vector code as it is meant to be
-#: compiled: the helper's loop vectorised, `restrict` relied on) for the PUMA, the tree and the
-#: mimic chain; the Panda at the suite's TEST_OPT (-O0), still with -mavx2, so still the vector
-#: path (the macros reading the helper's arrays, chosen by __AVX2__ alone) over seven joints:
-#: its values do not depend on the level (no -ffast-math, cbuild's docstring), the helper's
-#: -O2/-O3 builds are judged above, and gcc -O3 on the Panda's file costs ten seconds.
-VECTOR_OPT = {"puma560": "-O3", "ytree": "-O3", "mimic3": "-O3", "panda": TEST_OPT}
+#: compiled: the helper's loop vectorised, `restrict` relied on) for the PUMA and the mimic
+#: chain; the Panda and the tree at the suite's TEST_OPT (-O0), still with -mavx2, so still the
+#: vector path (the macros reading the helper's arrays, chosen by __AVX2__ alone) over seven
+#: joints and over a tree's general axes: their values do not depend on the level (no
+#: -ffast-math, cbuild's docstring), the helper's -O2/-O3 builds are judged above, and gcc -O3
+#: costs ten seconds on the Panda's file and 3.4 s on the tree's 530 KB (-O0: 0.7 s).
+VECTOR_OPT = {"puma560": "-O3", "ytree": TEST_OPT, "mimic3": "-O3", "panda": TEST_OPT}
 
 
 @needs_avx2
@@ -314,7 +309,9 @@ def test_functions_with_the_vector_path_match_rnea(name, tmp_path):
 @pytest.mark.parametrize("name", ["mimic3", "puma560"])
 def test_functions_with_the_vector_path_under_the_sanitizers(name, tmp_path):
     """Every function of the file once, with -mavx2, under ASan and UBSan (the helper reads and
-    writes the padded arrays)."""
+    writes the padded arrays). Built at the suite's TEST_OPT (-O0): the sanitizers check every
+    access unoptimised as well (cbuild's docstring), -O1 does not vectorise the helper's loop
+    either, and gcc -O1 with the sanitizers took 9 s of one core on the PUMA's file (-O0: 1.2 s)."""
     robot, ctx, files = _rendered(name)
     out = tmp_path
     write_files(files, out)
@@ -340,7 +337,7 @@ def test_functions_with_the_vector_path_under_the_sanitizers(name, tmp_path):
     driver = tmp_path / "driver.c"
     driver.write_text("\n".join([*lines, "    return 0;", "}", ""]))
     exe = compile_program(
-        [driver, out / f"{name}_dynamics.c"], tmp_path / "driver", "gcc", "-O1",
+        [driver, out / f"{name}_dynamics.c"], tmp_path / "driver", "gcc", TEST_OPT,
         (*STRICT_FLAGS, *SANITIZE_FLAGS, "-mavx2", f"-I{out}"),
     )  # fmt: skip
     run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)

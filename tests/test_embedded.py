@@ -130,6 +130,22 @@ def rendered(tmp_path_factory):
     return get
 
 
+@pytest.fixture(scope="module")
+def compiled(tmp_path_factory):
+    """(folder of `rendered`, core, -O level) -> its objects (cross_compile), each compiled once
+    per module: the QEMU cells, the freestanding checks and the instruction count share the
+    Panda's and the PUMA's -Os builds for the M4F. The objects are only read (linked, nm)."""
+    objects: dict[tuple[Path, str, str], list[Path]] = {}
+
+    def get(folder: Path, cpu: str, opt: str) -> list[Path]:
+        key = (folder, cpu, opt)
+        if key not in objects:
+            objects[key] = cross_compile(folder, cpu, opt, tmp_path_factory.mktemp(f"{folder.name}-{cpu}"))
+        return objects[key]
+
+    return get
+
+
 def _check_object(objects, precision: str) -> None:
     """A float object calls no double helper of libgcc and no double function of libm."""
     undefined = undefined_symbols(objects)
@@ -145,11 +161,10 @@ def test_cross_compiles(rendered, tmp_path, robot, cpu, opt, precision):
     _check_object(objects, precision)
 
 
-def _compare(folder: Path, build: Path, robot: str, cpu: str, opt: str, precision: str) -> None:
-    """Every function of the C in `folder` at 100 states on the emulated core, within the stated
-    tolerances of the host's double results (see the module's docstring)."""
+def _compare(objects: list[Path], folder: Path, build: Path, robot: str, cpu: str, opt: str, precision: str):
+    """Every function of the C in `folder` (its `objects`) at 100 states on the emulated core,
+    within the stated tolerances of the host's double results (see the module's docstring)."""
     r = _robot(robot)
-    objects = cross_compile(folder, cpu, opt, build)
     _check_object(objects, precision)
     name = next(folder.glob("*_dynamics.h")).name.removesuffix("_dynamics.h")
     elf = link_harness(folder, objects, cpu, name, precision, r.nq, r.nv, build)
@@ -167,17 +182,18 @@ def _compare(folder: Path, build: Path, robot: str, cpu: str, opt: str, precisio
 
 
 @pytest.mark.parametrize("robot,cpu,opt,precision", QEMU_CELLS)
-def test_runs_under_qemu(rendered, tmp_path, robot, cpu, opt, precision):
+def test_runs_under_qemu(rendered, compiled, tmp_path, robot, cpu, opt, precision):
     """Every function at 100 states on the emulated core, within the stated tolerances of the
     host's double results (see the module's docstring)."""
-    _compare(rendered(robot, precision), tmp_path, robot, cpu, opt, precision)
+    folder = rendered(robot, precision)
+    _compare(compiled(folder, cpu, opt), folder, tmp_path, robot, cpu, opt, precision)
 
 
 # --------------------------------------------------------------------------- --freestanding
 
 
 @pytest.mark.parametrize("precision", PRECISIONS)
-def test_freestanding_runs_under_qemu(rendered, tmp_path, precision):
+def test_freestanding_runs_under_qemu(rendered, compiled, tmp_path, precision):
     """--freestanding: no header of the C library in the files, and the same tolerances on the
     M4F (the float file with symdyn's own sinf and cosf, the double one with its own sin and cos)."""
     folder = rendered("puma560", precision, True)
@@ -185,14 +201,14 @@ def test_freestanding_runs_under_qemu(rendered, tmp_path, precision):
         text = path.read_text()
         assert "#include <" not in text, path.name
     assert "its own" in (folder / "puma560_dynamics.h").read_text()
-    _compare(folder, tmp_path, "puma560", "m4f", "-Os", precision)
+    _compare(compiled(folder, "m4f", "-Os"), folder, tmp_path, "puma560", "m4f", "-Os", precision)
 
 
 @pytest.mark.parametrize("robot", ROBOTS)
-def test_freestanding_float_needs_nothing(rendered, tmp_path, robot):
+def test_freestanding_float_needs_nothing(rendered, compiled, tmp_path, robot):
     """A freestanding float object has no undefined symbol (no libm, no libgcc, no memset for the
     zeros of a floating base's M), so it links with -nostdlib."""
-    objects = cross_compile(rendered(robot, "float", True), "m4f", "-Os", tmp_path)
+    objects = compiled(rendered(robot, "float", True), "m4f", "-Os")
     assert undefined_symbols(objects) == set()
     name = next(rendered(robot, "float", True).glob("*_dynamics.h")).name.removesuffix("_dynamics.h")
     link_bare(objects, "m4f", f"{name}_inverse_dynamics", tmp_path)
@@ -334,7 +350,7 @@ def test_a_users_cmakelists_is_never_overwritten(capsys, tmp_path):
 COUNT_MARGIN = 8
 
 
-def test_inverse_dynamics_is_branch_free_and_its_count_is_qemus(rendered, tmp_path):
+def test_inverse_dynamics_is_branch_free_and_its_count_is_qemus(rendered, compiled, tmp_path):
     """The Panda's float inverse dynamics on the M4F at -Os has no branch but its calls and its
     return (with newlib's sinf and cosf, and freestanding), so one call runs each instruction once:
     freestanding, its static count (its own instructions, plus NAME_sincos's one loop once per
@@ -342,11 +358,11 @@ def test_inverse_dynamics_is_branch_free_and_its_count_is_qemus(rendered, tmp_pa
     from embedded import instructions, loop_count, static_count
 
     _, callees, broken = static_count(
-        cross_compile(rendered("panda", "float"), "m4f", "-Os", tmp_path / "l")[0], "panda_inverse_dynamics"
+        compiled(rendered("panda", "float"), "m4f", "-Os")[0], "panda_inverse_dynamics"
     )
     assert not broken and sorted(set(callees)) == ["cosf", "sinf"], (broken, callees)
     folder = rendered("panda", "float", True)
-    objects = cross_compile(folder, "m4f", "-Os", tmp_path / "f")
+    objects = compiled(folder, "m4f", "-Os")
     count, callees, broken = static_count(objects[0], "panda_inverse_dynamics")
     assert not broken and len(callees) == 1 and callees[0].startswith("panda_sincos"), (broken, callees)
     count += loop_count(objects[0], callees[0], 6)  # the Panda's six angles, q2 to q7

@@ -79,5 +79,7 @@ def _build(entry: cache.Entry, folder) -> dict:
     headers = [name for name in entry.digests if name.endswith(".h") and name not in batch["sources"]]
     sources = {name: entry.file(name).read_text(encoding="utf-8") for name in [*headers, *batch["sources"]]}
     objects = [entry.file(name) for name in batch["objects"]]
-    compile_library(batch["compiler"], sources, folder / batch["library"], batch["arch"], objects)
+    compile_library(
+        batch["compiler"], sources, folder / batch["library"], batch["arch"], objects, opt=batch["opt"]
+    )
     return {"library": batch["library"], "scalar": entry.key}

@@ -18,18 +18,21 @@ __all__ = ["build_options", "entry_builder", "loaded_files"]
 
 
 def build_options(method: str, precision: str = "double") -> dict:
-    """What a library depends on besides the robot: the method, the compiler, its flags, and with
-    -march=native the machine (symdyn.apps.compilation.build)."""
-    from .build import COMPILE_FLAGS, arch_flags, find_compiler, machine_fingerprint
+    """What a library depends on besides the robot: the method, the compiler, its flags (the
+    optimisation level of $SYMDYN_OPT, the -march of $SYMDYN_MARCH), and with -march=native the
+    machine (symdyn.apps.compilation.build)."""
+    from .build import arch_flags, compile_flags, find_compiler, machine_fingerprint, opt_flag
 
     compiler = find_compiler()
     arch = list(arch_flags()) if compiler else []
+    opt = opt_flag() if compiler else None
     return {
         "method": method,
         "precision": precision,
         "compiler": compiler,
-        "flags": [*COMPILE_FLAGS, *arch] if compiler else None,
+        "flags": [*compile_flags(opt), *arch] if compiler else None,
         "arch": arch,
+        "opt": opt,
         "machine": machine_fingerprint() if "-march=native" in arch else None,
     }
 
@@ -70,6 +73,7 @@ def entry_builder(robot, method: str, options: dict, frames: dict | None = None)
                 folder / library,
                 options["arch"],
                 keep=kept,
+                opt=options["opt"],
             )
         return {
             "robot": {
@@ -88,6 +92,7 @@ def entry_builder(robot, method: str, options: dict, frames: dict | None = None)
                 "library": f"lib{ctx.name}_batch{library_suffix()}",
                 "compiler": options["compiler"],  # those of the key, as the scalar library's
                 "arch": options["arch"],
+                "opt": options["opt"],
             },
         }
 
