@@ -218,17 +218,18 @@ def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True):
     _apart. With `rows`, jax.jacfwd (the same primals along a batch of at least as many tangents
     as the output has entries) goes through the adjoint program, one pass per output entry (by_rows),
     other batches of tangents run over one batch axis (_flat), and so does the adjoint program under
-    jax.jacrev for at most _FLAT_ADJOINTS entries; without, every batch runs in nested vmaps (the
-    forward dynamics through the identity, whose adjoint recomputes the forward pass and M: the
-    Panda's jacfwd took 42 us a state nested, 58 us by the rows, 110 us flat)."""
+    jax.jacrev for at most _FLAT_ADJOINTS entries; without, batches run in nested vmaps up to
+    _FLAT_ADJOINTS entries and over one axis above (the forward dynamics through the identity,
+    whose adjoint recomputes the forward pass and M: the Panda's jacfwd took 42 us a state
+    nested, 58 us by the rows, 110 us flat; the Solo-12's did not compile in 8 minutes nested)."""
 
     def tangent(*args):
         n = len(args) // 2
         return jax.jvp(plain, args[:n], args[n:])[1]
 
     def linear(*args, levels):
-        if not rows:
-            return _nest(tangent, levels)(*args)
+        if not rows:  # nested, but flat for a large output (the Solo-12's nested did not compile)
+            return (_flat if math.prod(shape) > _FLAT_ADJOINTS else _nest)(tangent, levels)(*args)
         out = _flat(tangent, levels)(*args)
         return _apart(out) if levels > 1 else out  # not fused into a transpose (jax.jacfwd's)
 
