@@ -163,7 +163,8 @@ def _every_mode(f, plain, args, batch=None, hessian=True):
     jax.hessian itself if `hessian`, and given the states `batch` (of the first argument) both
     Jacobians vmapped over them, a jax.lax.scan of jax.jvp over them and jax.grad through that
     scan, all under one jax.jit, of f (a ruled function) and of plain (its body: XLA's autodiff,
-    forward mode for both Jacobians), as pairs of arrays."""
+    forward mode for both Jacobians), as pairs of arrays; the last len(args) pairs are jax.jacrev
+    of f by each argument."""
     every = tuple(range(len(args)))
     tangents = tuple(np.cos(np.arange(np.size(a)) + k) for k, a in enumerate(args))
     weights = np.linspace(-1.0, 2.0, len(plain(*args)))
@@ -324,7 +325,18 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     rng = np.random.default_rng(37)
     q = np.concatenate([rng.normal(size=3), 1.7 * rng.normal(size=4), rng.uniform(-1, 1, robot.n)])
     qd, tau = rng.normal(size=(2, robot.nv))
-    got = jax.jit(jax.jacrev(mod.forward_dynamics))(q, qd, tau)
+    qdd = rng.normal(size=robot.nv)
+    pairs = {}
+    for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
+        f, plain = getattr(mod, name), getattr(mod, f"_{name}_plain")
+        # vmap and lax.scan of both: test_every_mode_of_the_ruled_functions_equals_autodiff; the
+        # forward dynamics' hessian took 30 s to compile here: its Hessian-vector product
+        pairs[name] = _every_mode(
+            f, lambda *a, plain=plain: plain(*a, jnp.zeros(0)), args, None, name == "inverse_dynamics"
+        )
+        for got, want in pairs[name]:
+            _close(got, want, rtol=1e-9)
+    got = pairs["forward_dynamics"][-3][0]  # jax.jacrev of the rule by q, compiled with the modes
     h = 1e-6
     want = np.array(
         [
@@ -336,18 +348,8 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     _close(got, want, rtol=1e-7)
     np.testing.assert_allclose(np.asarray(got)[:, :3], 0.0, atol=1e-12)
     np.testing.assert_allclose(np.asarray(got)[:, 3:7] @ q[3:7], 0.0, atol=1e-9)
-    # the identity's reverse mode in q's entries, op by op (compiling would cost more)
-    _close(jax.jacrev(identity.forward_dynamics)(q, qd, tau), want, rtol=1e-7)
-    qdd = rng.normal(size=robot.nv)
-    for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
-        f, plain = getattr(mod, name), getattr(mod, f"_{name}_plain")
-        # vmap and lax.scan of both: test_every_mode_of_the_ruled_functions_equals_autodiff; the
-        # forward dynamics' hessian took 30 s to compile here: its Hessian-vector product
-        pairs = _every_mode(
-            f, lambda *a, plain=plain: plain(*a, jnp.zeros(0)), args, None, name == "inverse_dynamics"
-        )
-        for got, want in pairs:
-            _close(got, want, rtol=1e-9)
+    # the identity's reverse mode in q's entries, jitted (1.5 CPU s; op by op 2.9 s)
+    _close(jax.jit(jax.jacrev(identity.forward_dynamics))(q, qd, tau), want, rtol=1e-7)
 
 
 def test_jacrev_of_inverse_dynamics_on_a_tree(modules):
@@ -369,7 +371,8 @@ def test_gradient_in_the_parameters(modules):
     rng = np.random.default_rng(5)
     q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 2))
     p = _params(jax_mod, rng)
-    got = jax.jacrev(jax_mod.inverse_dynamics, argnums=3)(q, qd, qdd, p)
+    # jitted: 0.25 CPU s, where op by op its first call took 2 s (every operation compiled alone)
+    got = jax.jit(jax.jacrev(jax_mod.inverse_dynamics, argnums=3))(q, qd, qdd, p)
     h = 1e-6
     want = np.stack(
         [
@@ -501,13 +504,15 @@ def test_lax_scan_simulation(modules):
 
 def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
     """A long body cut into stages (symdyn.codegen.jax.stages: while loops of one pass that XLA
-    does not fuse across; Roger's arm staged by 4 statements, as the Talos' functions are by 150:
+    does not fuse across; Roger's arm staged by 12 statements, as the Talos' functions are by 150:
     the inverse dynamics and its adjoint program, the forward dynamics differentiated through it,
     the mass matrix through its body without the loops) gives the committed module's values,
     forward and reverse derivatives (jacfwd through the loops, the gradient of a vmapped loss),
-    under jit and vmap."""
+    under jit and vmap. Stages of 12 (3 for the inverse dynamics, 4 for its adjoint and the
+    forward dynamics, the mass matrix's one) carry values between stages as stages of 4 do, and
+    compile in two thirds of their time."""
     monkeypatch.setattr(jax_stages, "STAGE_ABOVE", 0)
-    monkeypatch.setattr(jax_stages, "STAGE_SIZE", 4)
+    monkeypatch.setattr(jax_stages, "STAGE_SIZE", 12)
     text = render(example("roger_arm"), targets=("jax",))["roger_arm_jax.py"]
     (tmp_path / "roger_arm_jax.py").write_text(text)
     staged = load_module(tmp_path / "roger_arm_jax.py", "_symdyn_test_staged_roger_arm_jax")

@@ -38,6 +38,7 @@ module refuses to import (ImportError) until it is enabled, before the import:
 """
 
 import functools
+import math
 
 import jax
 import jax.numpy as jnp
@@ -151,6 +152,26 @@ def _nest(f, levels):
     return f
 
 
+def _flat(f, levels):
+    """f over the `levels` leading batch axes of every argument (each of the same sizes) taken as
+    ONE batch axis: jax.vmap of f over their product, reshaped back. Under jax.jacfwd's vmap of the
+    tangents inside a vmap of the states, nested vmaps compute the primal statements once a state
+    and the tangents once a direction, in arrays of two shapes, and XLA cut the primal into many
+    fusions (the Panda's inverse dynamics: 73, 226 sines for its 12), each recomputing what it
+    reads; one batch axis of every (state, direction) pair is one fusion like a single jax.jvp's
+    (9.2 times 7 forward passes before, 1.4 times with this and _apart, docs/jax.md)."""
+    if levels < 2:
+        return _nest(f, levels)
+
+    def flat(*args):
+        lead = args[0].shape[:levels]
+        size = math.prod(lead)
+        out = jax.vmap(f)(*(a.reshape((size, *a.shape[levels:])) for a in args))
+        return jax.tree_util.tree_map(lambda o: o.reshape((*lead, *o.shape[1:])), out)
+
+    return flat
+
+
 def _apart(x):
     """x (..., n) as its product by the identity, a dot that XLA's CPU compiler neither fuses
     nor merges with x's other uses. The adjoint program reads its cotangent w entry by entry,
@@ -163,7 +184,25 @@ def _apart(x):
     return x @ jnp.eye(x.shape[-1], dtype=x.dtype)
 
 
-def _adjoint_ruled(name, plain, adjoint, shape, apart=True):
+#: The adjoint program under jax.jacrev's vmap of the cotangents (one per output entry) and a vmap
+#: of the states runs over one batch axis (_flat) for outputs of at most this many entries, in
+#: nested vmaps above: flat, it computes its statements from the inputs once per (state, entry),
+#: nested once per state but in many fusions that recompute them (the Panda's 7 entries: 1.1 us a
+#: state flat against 5.9 us nested; the Solo-12's 18: 37 us against 10 us; docs/jax.md).
+_FLAT_ADJOINTS = 12
+
+
+def _batched(args, axes):
+    """args with their batch axis (axes: its position in each, None where unbatched) moved to 0,
+    the unbatched broadcast to the batch's size."""
+    size = next(a.shape[axis] for a, axis in zip(args, axes) if axis is not None)
+    return [
+        jnp.broadcast_to(a, (size, *a.shape)) if axis is None else jnp.moveaxis(a, axis, 0)
+        for a, axis in zip(args, axes)
+    ]
+
+
+def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True):
     """plain (its arguments, one output of `shape`) as a jax.custom_jvp function whose tangent is
     a linear primitive whose transpose is the adjoint program `adjoint` (plain's arguments and the
     output's cotangent w -> w^T d(output)/d(argument) for each argument, p's included).
@@ -176,14 +215,23 @@ def _adjoint_ruled(name, plain, adjoint, shape, apart=True):
     straight-line body (10 times slower, docs/jax.md); jax.vmap binds it again with one more
     level; its own derivative (second order, jax.hessian) is forward mode of the tangent map.
     With `apart`, the transpose gives the adjoint program its inputs and cotangent through
-    _apart."""
+    _apart. With `rows`, jax.jacfwd (the same primals along a batch of at least as many tangents
+    as the output has entries) goes through the adjoint program, one pass per output entry (by_rows),
+    other batches of tangents run over one batch axis (_flat), and so does the adjoint program under
+    jax.jacrev for at most _FLAT_ADJOINTS entries; without, batches run in nested vmaps up to
+    _FLAT_ADJOINTS entries and over one axis above (the forward dynamics through the identity,
+    whose adjoint recomputes the forward pass and M: the Panda's jacfwd took 42 us a state
+    nested, 58 us by the rows, 110 us flat; the Solo-12's did not compile in 8 minutes nested)."""
 
     def tangent(*args):
         n = len(args) // 2
         return jax.jvp(plain, args[:n], args[n:])[1]
 
     def linear(*args, levels):
-        return _nest(tangent, levels)(*args)
+        if not rows:  # nested, but flat for a large output (the Solo-12's nested did not compile)
+            return (_flat if math.prod(shape) > _FLAT_ADJOINTS else _nest)(tangent, levels)(*args)
+        out = _flat(tangent, levels)(*args)
+        return _apart(out) if levels > 1 else out  # not fused into a transpose (jax.jacfwd's)
 
     def abstract(*args, levels):
         return jax.core.ShapedArray(args[0].shape[:levels] + shape, args[0].dtype)
@@ -192,23 +240,77 @@ def _adjoint_ruled(name, plain, adjoint, shape, apart=True):
         n = len(args) // 2
         if any(ad.is_undefined_primal(a) for a in args[:n]):
             raise NotImplementedError(f"{name}: the primals of its derivative are not linear inputs")
-        inputs, w = args[:n], ad.instantiate_zeros(w)
-        if apart:
-            inputs, w = [_apart(a) for a in inputs], _apart(w)
-        cotangents = _nest(adjoint, levels)(*inputs, w)
+        cotangents = adjoints(args[:n], ad.instantiate_zeros(w), levels)
         return [None] * n + [c if ad.is_undefined_primal(t) else None for c, t in zip(cotangents, args[n:])]
 
     def derivative(primals, tangents, *, levels):
         tangents = tuple(ad.instantiate_zeros(t) for t in tangents)
         return jax.jvp(functools.partial(linear, levels=levels), primals, tangents)
 
+    flat = rows and math.prod(shape) <= _FLAT_ADJOINTS
+
+    def adjoints(inputs, w, levels, along=False):
+        # the adjoint program at inputs and w over `levels` batch axes of both, and with `along`
+        # over one more of w only: as the primitive NAME_adjoint over one axis (_flat), or as
+        # plain code in nested vmaps that keep the inputs' statements unbatched along w's batch
+        if apart:
+            inputs, w = [_apart(a) for a in inputs], _apart(w)
+        if flat:
+            if along:
+                inputs = [jnp.broadcast_to(a, (w.shape[0], *a.shape)) for a in inputs]
+            return reverse.bind(*inputs, w, levels=levels + along)
+        program = _nest(adjoint, levels)
+        if along:
+            return jax.vmap(program, in_axes=(*[None] * len(inputs), 0))(*inputs, w)
+        return program(*inputs, w)
+
+    def by_rows(primals, tangents, axes, levels):
+        # jax.jacfwd: the same primals along a batch of at least as many tangents as the output
+        # has entries. The Jacobians by the adjoint program, one pass per entry (the forward mode
+        # of the body under jacfwd's vmap took 5 to 13 times NV forward passes, docs/jax.md),
+        # applied to the batched tangents as products and sums (a batched dot of the Panda's
+        # 7 x 7 matrices took twice the passes' time), with the batch's axis last, where
+        # jax.jacfwd puts it; the tangents that do not vary along the batch by forward mode, once
+        moving = [i for i, axis in enumerate(axes) if axis is not None]
+        fixed = [jnp.zeros_like(primals[i]) if i in moving else t for i, t in enumerate(tangents)]
+        out = primitive.bind(*primals, *fixed, levels=levels)[..., None]
+        count, lead = math.prod(shape), primals[0].shape[:levels]
+        w = jnp.eye(count, dtype=DTYPE).reshape((count, *[1] * levels, *shape))
+        jacobians = adjoints(primals, jnp.broadcast_to(w, (count, *lead, *shape)), levels, along=True)
+        for i in moving:
+            row = jnp.moveaxis(jacobians[i], 0, -2)  # (*lead, count, x)
+            t = jnp.moveaxis(tangents[i], axes[i], -1)  # (*lead, x, k)
+            out = out + sum(row[..., x, None] * t[..., None, x, :] for x in range(t.shape[-2]))
+        return out.reshape((*lead, *shape, out.shape[-1])), levels + len(shape)
+
     def batch(args, axes, *, levels):
+        n = len(args) // 2
         size = next(a.shape[axis] for a, axis in zip(args, axes) if axis is not None)
-        args = [
-            jnp.broadcast_to(a, (size, *a.shape)) if axis is None else jnp.moveaxis(a, axis, 0)
-            for a, axis in zip(args, axes)
-        ]
-        return primitive.bind(*args, levels=levels + 1), 0
+        if rows and all(axis is None for axis in axes[:n]) and size >= math.prod(shape):
+            return by_rows(args[:n], args[n:], axes[n:], levels)
+        return primitive.bind(*_batched(args, axes), levels=levels + 1), 0
+
+    def backward(*args, levels):
+        out = _flat(adjoint, levels)(*args)
+        return [_apart(c) for c in out] if levels > 1 else list(out)
+
+    def backward_abstract(*args, levels):
+        return [jax.core.ShapedArray(a.shape, a.dtype) for a in args[:-1]]
+
+    def backward_derivative(primals, tangents, *, levels):
+        tangents = tuple(ad.instantiate_zeros(t) for t in tangents)
+        return jax.jvp(functools.partial(backward, levels=levels), primals, tangents)
+
+    def backward_batch(args, axes, *, levels):
+        return reverse.bind(*_batched(args, axes), levels=levels + 1), [0] * (len(args) - 1)
+
+    reverse = Primitive(f"{name}_adjoint")
+    reverse.multiple_results = True
+    reverse.def_impl(backward)
+    reverse.def_abstract_eval(backward_abstract)
+    mlir.register_lowering(reverse, mlir.lower_fun(backward, multiple_results=True))
+    ad.primitive_jvps[reverse] = backward_derivative
+    batching.primitive_batchers[reverse] = backward_batch
 
     primitive = Primitive(f"{name}_linear")
     primitive.def_impl(linear)
@@ -618,7 +720,7 @@ def _forward_dynamics_adjoint(q, qd, tau, p, w):
 #: already, and the adjoint's forward pass, M and the inverse dynamics' statements merge with the
 #: function's: the Panda's jax.jit(jax.grad(...)) took 14.7 us a state with _apart, 11.4 without)
 _forward_dynamics_rule = _adjoint_ruled(
-    "forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (2,), apart=False
+    "forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (2,), apart=False, rows=False
 )
 
 
