@@ -16,6 +16,7 @@ from robots import (
     EXAMPLE_NAMES,
     derived,
     derived_rational,
+    derived_robot,
     example,
     random_params,
     random_state,
@@ -36,7 +37,9 @@ NAMES = ("M", "B", "Csq", "G")
 
 
 def _both(robot):
-    return [derive(robot, method=m, simplify=False) for m in ("newton-euler", "lagrange")]
+    """Both routes' derivations of a hand-built robot, session-cached (robots.derived_robot: the
+    trees' are test_tree's and test_mimic's too, and each carries its configuration form)."""
+    return [derived_robot(robot, m) for m in ("newton-euler", "lagrange")]
 
 
 def _entries(dyn, name):
@@ -98,7 +101,7 @@ ROBOTS = {**TREES, "forest": forest_robot}
 @cache
 def _derived(name: str):
     """The Newton-Euler derivation of an example or of a robot of ROBOTS (cached)."""
-    return derive(ROBOTS[name](), simplify=False) if name in ROBOTS else derived(name, "newton-euler")
+    return derived_robot(ROBOTS[name](), "newton-euler") if name in ROBOTS else derived(name, "newton-euler")
 
 
 @pytest.mark.parametrize("case", sorted(TREES))

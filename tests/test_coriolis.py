@@ -25,6 +25,7 @@ from robots import (
     derived_robot,
     ev,
     example,
+    example_context,
     random_params,
     random_state,
     rational_example,
@@ -33,7 +34,6 @@ from robots import (
     sym3_data,
 )
 
-from symdyn.codegen.functions import build_functions
 from symdyn.parsers.robot_file import robot_from_data
 from symdyn.rnea import bias_torque
 
@@ -89,5 +89,5 @@ def test_columns_on_random_chains(spec):
 
 @pytest.mark.parametrize("name", ["puma560", "stanford", "panda"])
 def test_at_most_three_times_the_operations_of_V(name):
-    ops = {f.name: f.ops.total for f in build_functions(derived(name, "newton-euler"))}
+    ops = {f.name: f.ops.total for f in example_context(name).functions}  # session-cached
     assert ops["coriolis_matrix"] <= 3 * ops["coriolis"], ops

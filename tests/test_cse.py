@@ -8,9 +8,8 @@ import random
 import numpy as np
 import pytest
 import sympy as sp
-from robots import derived
+from robots import example_context
 
-from symdyn.codegen.functions import build_functions
 from symdyn.symbolic.cse import fast_cse
 from symdyn.symbolic.simplify import count_ops, eliminate_many
 
@@ -86,8 +85,7 @@ def test_same_input_same_output():
 @pytest.mark.parametrize("name", ["puma560", "panda"])
 def test_operation_counts_match_sympy_cse(name):
     """Over everything the seven generated functions compute: within 1 % of sympy.cse."""
-    dyn = derived(name, "newton-euler")
-    functions = build_functions(dyn)
+    functions = example_context(name).functions  # build_functions(derived(name, ...)), session-cached
     outputs = [e for f in functions for e in f.outputs]
     steps = [a for f in functions for a in f.temporaries]
     exprs = [e for _, e in steps]

@@ -181,18 +181,40 @@ def _puma(joints: int, exact: bool):
         return robot_from_data(_puma_data(joints, exact))
 
 
-def test_puma_arm_with_symbolic_inertia_is_exact(tmp_path, capsys):
+def _run_derived(capsys, monkeypatch, path, *argv):
+    """(_run's text, the Dynamics the command derived): symdyn.dynamics.derive is watched while
+    it runs, so a test checks the printed form against the very derivation (and its base
+    parameters, found once) instead of deriving the robot again."""
+    import symdyn.dynamics
+
+    kept = []
+    real = symdyn.dynamics.derive
+
+    def watched(*args, **kwargs):
+        kept.append(real(*args, **kwargs))
+        return kept[-1]
+
+    with monkeypatch.context() as m:
+        m.setattr(symdyn.dynamics, "derive", watched)
+        text = _run(capsys, path, *argv)
+    assert len(kept) == 1
+    return text, kept[0]
+
+
+def test_puma_arm_with_symbolic_inertia_is_exact(tmp_path, capsys, monkeypatch):
     """The PUMA 560's first four links, 40 inertial parameters and 4 rotor inertias symbolic, a2
     symbolic (so the base parameters are exact): every entry of M, B, Csq and G substituted back
     is exactly the unlumped one, and the printed form is the oracle's at random values."""
     path = tmp_path / "puma4.yaml"
     path.write_text(yaml.safe_dump(_puma_data(4, True)))
     plain, _, _ = _parse(_run(capsys, path))
-    entries, sections, notes = _parse(_run(capsys, path, "--lumped"))
+    text, dyn = _run_derived(capsys, monkeypatch, path, "--lumped")
+    entries, sections, notes = _parse(text)
     assert not notes and set(entries) == set(plain)
     for label, e in entries.items():
         assert sp.expand(_back(e, sections) - plain[label]) == 0, label
-    dyn = derive(_puma(4, True), simplify=False)
+    # the command's derivation is of the robot _puma(4, True) builds from the same data
+    assert dyn.robot.links == _puma(4, True).resolved().links and dyn.method == "newton-euler"
     _check_names(dyn, entries, sections)
     # Izz1R regroups the links' masses carried about joint 1's axis (Khalil and Dombre)
     assert "Izz1R" in {str(s) for s in sections["base parameters"]}

@@ -12,7 +12,16 @@ import subprocess
 import numpy as np
 import pytest
 import sympy as sp
-from robots import EXAMPLE_NAMES, EXAMPLES_DIR, derived, derived_rational, example, random_state, trig_zero
+from robots import (
+    EXAMPLE_NAMES,
+    EXAMPLES_DIR,
+    derived,
+    derived_rational,
+    derived_robot,
+    example,
+    random_state,
+    trig_zero,
+)
 
 from symdyn import rnea
 from symdyn.algorithms.configuration_space import pair_columns
@@ -259,7 +268,7 @@ def test_mimic_joints_and_trees(case):
     fractional multiple as its own atom) and kinematic trees: still the configuration form."""
     from test_mimic import CASES as MIMIC_CASES
 
-    dyn = derive(MIMIC_CASES[case][0], simplify=False)
+    dyn = derived_robot(MIMIC_CASES[case][0], "newton-euler")  # test_mimic's, test_configuration_space's
     dyn.product_form().check(dyn.configuration_space, rel=1e-12)
 
 

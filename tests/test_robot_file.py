@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import sympy as sp
 import yaml
+from robots import example, example_context
 from timebound import refused
 
 import symdyn.codegen
@@ -611,7 +612,8 @@ def test_puma560_with_decimal_angles_is_the_pi_over_2_robot(tmp_path):
     assert decimal_warnings == exact_warnings  # the file's inertia warnings only, no angle warning
     assert decimal.links == exact.links
 
-    ops = {f.name: f.ops for f in symdyn.codegen.context(exact).functions}
+    assert exact == example("puma560")  # whose context the session caches (robots.example_context)
+    ops = {f.name: f.ops for f in example_context("puma560").functions}
     assert ops["inverse_dynamics"].total == 434  # the count in generated/puma560/puma560_dynamics.h
     decimal_functions = symdyn.codegen.context(decimal).functions
     assert {f.name: f.ops for f in decimal_functions} == ops

@@ -126,7 +126,7 @@ def point_jacobian(
     link: int,
     point: Sequence = (0, 0, 0),
     q: Sequence | None = None,
-    poses: list[Transform] | None = None,
+    poses: Sequence[Transform] | None = None,
 ) -> sp.Matrix:
     """The geometric Jacobian of a point fixed to a link (Spong et al. (2006), sec. 4.6).
 
@@ -234,11 +234,20 @@ class PoseJacobian(NamedTuple):
     jacobian: np.ndarray
 
 
+@lru_cache(maxsize=16)
+def _symbolic_poses(robot: Robot) -> tuple[tuple[sp.Symbol, ...], Robot, tuple[Transform, ...]]:
+    """(q symbols, the resolved robot, its links' poses over q in the base frame): the forward
+    kinematics that the pose and Jacobian functions of every link and point of `robot` share,
+    computed once (the whole chain's products, n links, for each of them otherwise)."""
+    q = tuple(joint_symbols(robot.n)[0])
+    r = robot.resolved()
+    return q, r, tuple(forward_kinematics(r, list(q)))
+
+
 @lru_cache(maxsize=64)
 def _pose_jacobian_function(robot: Robot, link: int, point: tuple):
-    q = list(joint_symbols(robot.n)[0])
-    r = robot.resolved()
-    poses = forward_kinematics(r, q)
+    symbols, r, poses = _symbolic_poses(robot)
+    q = list(symbols)
     T = poses[link].matrix()
     T[:3, 3] = poses[link].apply(point)
     J = point_jacobian(r, link, point, q, poses)

@@ -106,6 +106,10 @@ def cmd_derive(args: argparse.Namespace) -> int:
 
     robot = load_robot_argument(args)
     loops = loop_report(robot)  # generate's check of the loops, before any derivation
+    if args.form == "product" and not robot.floating:
+        from ..algorithms.product_form import check_product_size
+
+        check_product_size(robot)  # a chain beyond the bound is refused before it is derived
     simplify = None if args.simplify == "auto" else args.simplify == "yes"
     with progress_stage(f"deriving '{robot.name}' ({robot.n} joints, {args.method})"):
         dyn = derive(robot, method=args.method, simplify=simplify)
