@@ -27,13 +27,19 @@ import sympy as sp
 from ..function_rows import FunctionSpec
 from ..python.printer import NumpyPrinter
 
-__all__ = ["STAGE_ABOVE", "STAGE_SIZE", "cut_into_stages", "stages"]
+__all__ = ["STAGE_ABOVE", "STAGE_SIZE", "long_body", "cut_into_stages", "stages"]
 
 #: Bodies of more statements than this are staged (the Solo-12's inverse dynamics, 650, is not:
 #: it compiles well as one body).
 STAGE_ABOVE = 1000
 #: Statements per stage (chosen by measurement on the Talos: module docstring).
 STAGE_SIZE = 150
+
+
+def long_body(spec: FunctionSpec) -> bool:
+    """Whether `spec`'s body has more than STAGE_ABOVE statements (then it and its adjoint
+    program are staged)."""
+    return len(spec.temporaries) > STAGE_ABOVE
 
 
 def stages(spec: FunctionSpec, printer: NumpyPrinter, size: int = STAGE_SIZE) -> list[dict]:

@@ -124,7 +124,7 @@ def adjoint_view(spec: FunctionSpec, printer: NumpyPrinter) -> dict | None:
             staging.cut_into_stages(
                 program.temporaries, program.outputs, {s for s, _, _ in read}, printer, staging.STAGE_SIZE
             )
-            if len(spec.temporaries) > staging.STAGE_ABOVE
+            if staging.long_body(spec)
             else None
         ),
     }
@@ -185,7 +185,7 @@ def stage_views(
         if spec.name not in derived
         and (spec.name in adjoints or spec.name in through or spec.name in STAGED)
         and any(inp.name != "p" for inp in spec.inputs)
-        and len(spec.temporaries) > staging.STAGE_ABOVE
+        and staging.long_body(spec)
     }
 
 
