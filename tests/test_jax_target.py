@@ -409,7 +409,8 @@ def test_vmapped_vectors_are_selected_not_concatenated(modules):
     """The fast path under XLA's defaults: jax.jit(jax.vmap(f)) of a vector function holds no
     concatenate (XLA's CPU fusion emitters recomputed the statements shared by the entries of
     one, once per path: the Panda's inverse dynamics ran 250 times slower than f_batch), and
-    equals the NumPy module over a batch; the matrices keep jnp.array."""
+    equals the NumPy module over a batch; the matrices are concatenated selected blocks
+    (test_matrices_are_concatenated_blocks)."""
     jax_mod, numpy_mod, _ = modules["panda"]
     rng = np.random.default_rng(13)
     q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 32, jax_mod.NDOF))
@@ -418,10 +419,31 @@ def test_vmapped_vectors_are_selected_not_concatenated(modules):
         assert "concatenate" not in text, name
     vmapped = jax.jit(jax.vmap(jax_mod.inverse_dynamics))
     _close(vmapped(q, qd, qdd), numpy_mod.inverse_dynamics(q, qd, qdd))
-    assert "concatenate" in jax.jit(jax.vmap(jax_mod.mass_matrix)).lower(q).as_text()
     one = jax_mod._vector_of(1)
     assert one.shape == (1,) and one.dtype == jnp.float64 and float(one[0]) == 1.0
     np.testing.assert_array_equal(jax_mod._vector_of(2, jnp.float64(3.5), -1), [2.0, 3.5, -1.0])
+
+
+def test_matrices_are_concatenated_blocks(modules):
+    """_matrix_of: one selection up to _FUSED_CONCATENATE entries, above it a concatenate of more
+    than _FUSED_CONCATENATE selected blocks of at most _BLOCK entries (XLA's CPU compiler computes
+    the operands of such a concatenate apart), whatever the size, entry by entry in row order;
+    the Panda's M (49 entries: 10 blocks of 5) under jax.jit(jax.vmap(...)) equals the NumPy
+    module's and is built so."""
+    jax_mod, numpy_mod, _ = modules["panda"]
+    fused, block = jax_mod._FUSED_CONCATENATE, jax_mod._BLOCK
+    for rows, cols in ((1, 1), (1, fused), (1, fused + 1), (3, 7), (7, 7), (7, 91), (3, 20 * block + 1)):
+        entries = [float(k) for k in range(rows * cols)]
+        entries[-1] = jnp.float64(entries[-1])  # a traced-like entry among numbers
+        got = jax_mod._matrix_of((rows, cols), *entries)
+        assert got.shape == (rows, cols) and got.dtype == jnp.float64
+        np.testing.assert_array_equal(got, np.arange(rows * cols, dtype=float).reshape(rows, cols))
+    q = np.random.default_rng(17).uniform(-2.0, 2.0, (16, jax_mod.NDOF))
+    vmapped = jax.jit(jax.vmap(jax_mod.mass_matrix))
+    text = vmapped.lower(q).as_text()
+    concatenates = [line for line in text.splitlines() if "stablehlo.concatenate" in line]
+    assert len(concatenates) == 1 and concatenates[0].count("%") == 10 + 1, concatenates
+    _close(vmapped(q), numpy_mod.mass_matrix(q))
 
 
 def test_jit_grad_of_a_vmapped_loss_equals_differences(modules):
