@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import inspect
+import os
 import re
 import statistics
 import sys
@@ -165,8 +166,10 @@ def main(argv=None) -> int:
     routes = [r for r in opts.routes.split(",") if r]
     if not set(routes) <= set(ROUTES):
         parser.error(f"--routes takes {', '.join(ROUTES)}")
+    before = os.getloadavg()
     rows = measure(opts.module, functions, opts.batch, opts.reps, routes)
     print(f"{opts.module.name}: {opts.batch:,} states, median of {opts.reps} (per state; scan: per step)")
+    print(f"load average {before[0]:.1f} before, {os.getloadavg()[0]:.1f} after (the machine is shared)")
     print("\n".join(table(rows)))
     return 0
 
