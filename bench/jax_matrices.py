@@ -4,11 +4,12 @@
                                  [--routes vmap,batch,scan]
 
 MODULE_jax.py (default generated/panda/panda_jax.py) is a generated JAX module, double precision.
-It is loaded twice: as generated, where every matrix is the module's _matrix_of (one selection up
-to _FUSED_CONCATENATE entries, above it a concatenate of selected blocks), and with _matrix_of
-replaced by jnp.array(entries).reshape(shape), the module before issue 37's matrices (a
-concatenate of every entry). For each of --functions (default the matrix functions the module
-holds of mass_matrix, inverse_dynamics_derivatives, forward_dynamics_derivatives and regressor),
+It is loaded twice: as generated, where the matrices are the module's _matrix_of (one selection up
+to _FUSED_CONCATENATE entries, above it a concatenate of selected blocks; those of a body of more
+than 1,000 statements _array_of, jnp.array, the same in both ways), and with _matrix_of replaced
+by jnp.array(entries).reshape(shape), the module before issue 37's matrices (a concatenate of
+every entry). For each of --functions (default the matrix functions the module holds of
+mass_matrix, coriolis_matrix and regressor),
 each way and each route is timed per state over a batch of N random states (default 20,000):
 jax.jit(jax.vmap(f)) under XLA's defaults, f_batch (the module's batch twin: the fusion emitters
 off) and a jit of jax.lax.scan over the states (one call a step, per step). The routes are timed
@@ -37,7 +38,7 @@ sys.path[:] = [p for p in sys.path if p != _BENCH] + [_BENCH]
 import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-FUNCTIONS = ("mass_matrix", "inverse_dynamics_derivatives", "forward_dynamics_derivatives", "regressor")
+FUNCTIONS = ("mass_matrix", "coriolis_matrix", "regressor")
 ROUTES = ("vmap", "batch", "scan")
 WAYS = ("jnp.array", "_matrix_of")
 

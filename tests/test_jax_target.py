@@ -429,8 +429,16 @@ def test_matrices_are_concatenated_blocks(modules):
     than _FUSED_CONCATENATE selected blocks of at most _BLOCK entries (XLA's CPU compiler computes
     the operands of such a concatenate apart), whatever the size, entry by entry in row order;
     the Panda's M (49 entries: 10 blocks of 5) under jax.jit(jax.vmap(...)) equals the NumPy
-    module's and is built so."""
+    module's and is built so; the matrices of a long body (the derivative functions) are one
+    concatenate of every entry (_array_of), as the other functions' are blocks."""
     jax_mod, numpy_mod, _ = modules["panda"]
+    for name in ("inverse_dynamics_derivatives", "forward_dynamics_derivatives", "linearize"):
+        text = inspect.getsource(getattr(jax_mod, name))
+        assert "_array_of(" in text and "_matrix_of(" not in text, name
+    for name in ("mass_matrix", "regressor", "link7_jacobian"):
+        text = inspect.getsource(getattr(jax_mod, name))
+        assert "_matrix_of(" in text and "_array_of(" not in text, name
+    np.testing.assert_array_equal(jax_mod._array_of((2, 3), *range(6)), np.arange(6.0).reshape(2, 3))
     fused, block = jax_mod._FUSED_CONCATENATE, jax_mod._BLOCK
     for rows, cols in ((1, 1), (1, fused), (1, fused + 1), (3, 7), (7, 7), (7, 91), (3, 20 * block + 1)):
         entries = [float(k) for k in range(rows * cols)]

@@ -131,6 +131,15 @@ def _matrix_of(shape, *entries):
     return jnp.concatenate(blocks).reshape(shape)
 
 
+def _array_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
+    statements (symdyn.codegen.jax.stages.long_body), which XLA compiled far longer in blocks
+    (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
+    under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
+    return jnp.array(entries, dtype=DTYPE).reshape(shape)
+
+
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
 #: in recent jax (0.10; not in 0.6), compile a long straight-line body into far slower code: the
 #: Panda's inverse dynamics vmapped over 100,000 states took 88 us a state with them and 0.6 us
@@ -7497,7 +7506,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x1964 = 2*x1963
     x1965 = 2*x1741
     return (
-        _matrix_of(
+        _array_of(
             (7, 7),
             0,
             x594,
@@ -7549,7 +7558,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
             x1230,
             x1281,
         ),
-        _matrix_of(
+        _array_of(
             (7, 7),
             x1533,
             x1658,
@@ -9954,7 +9963,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x2318 = -x2205*x232 - x2211*x870 - x2220*x829 - x2226*x833 - x2233*x805 - x2237*x233 + 2*x2206*x880
     x2319 = -x2240*x232 - x2252*x870 - x2259*x829 - x2265*x833 - x2272*x805 - x2276*x233 + 2*x2244*x880
     return (
-        _matrix_of(
+        _array_of(
             (7, 7),
             0,
             x1016,
@@ -10006,7 +10015,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             x1769,
             x1770,
         ),
-        _matrix_of(
+        _array_of(
             (7, 7),
             x2094,
             x2122,
@@ -10058,7 +10067,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             x2318,
             x2319,
         ),
-        _matrix_of(
+        _array_of(
             (7, 7),
             x239,
             x244,
@@ -12815,7 +12824,7 @@ def linearize(q, qd, tau, p=None):
     x2318 = -x2169*x232 - x2175*x870 - x2184*x829 - x2190*x833 - x2197*x805 - x2201*x233 + 2*x2170*x880
     x2319 = -x2204*x232 - x2216*x870 - x2223*x829 - x2229*x833 - x2236*x805 - x2240*x233 + 2*x2208*x880
     return (
-        _matrix_of(
+        _array_of(
             (14, 14),
             0,
             0,
@@ -13014,7 +13023,7 @@ def linearize(q, qd, tau, p=None):
             x2318,
             x2319,
         ),
-        _matrix_of(
+        _array_of(
             (14, 7),
             0,
             0,

@@ -122,6 +122,15 @@ def _matrix_of(shape, *entries):
     return jnp.concatenate(blocks).reshape(shape)
 
 
+def _array_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
+    statements (symdyn.codegen.jax.stages.long_body), which XLA compiled far longer in blocks
+    (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
+    under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
+    return jnp.array(entries, dtype=DTYPE).reshape(shape)
+
+
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
 #: in recent jax (0.10; not in 0.6), compile a long straight-line body into far slower code: the
 #: Panda's inverse dynamics vmapped over 100,000 states took 88 us a state with them and 0.6 us
@@ -6131,7 +6140,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x1232 = 0.42728302093540005*x511 - x1148*x139 - x1152*x504 - x1160*x476 - x1163*x463 - x1172*x140
     x1233 = -0.2158232532732*x139 - x1180*x504 - x1190*x476 - x1193*x463 - x1202*x140 + 2*x1176*x511
     return (
-        _matrix_of(
+        _array_of(
             (6, 6),
             0,
             x614,
@@ -6170,7 +6179,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             x899,
             x900,
         ),
-        _matrix_of(
+        _array_of(
             (6, 6),
             x1073,
             x1097,
@@ -6209,7 +6218,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             x1232,
             x1233,
         ),
-        _matrix_of(
+        _array_of(
             (6, 6),
             x145,
             x149,
@@ -7730,7 +7739,7 @@ def linearize(q, qd, tau, p=None):
     x1232 = 0.42728302093540005*x511 - x1123*x139 - x1127*x504 - x1135*x476 - x1138*x463 - x1147*x140
     x1233 = -0.2158232532732*x139 - x1155*x504 - x1165*x476 - x1168*x463 - x1177*x140 + 2*x1151*x511
     return (
-        _matrix_of(
+        _array_of(
             (12, 12),
             0,
             0,
@@ -7877,7 +7886,7 @@ def linearize(q, qd, tau, p=None):
             x1232,
             x1233,
         ),
-        _matrix_of(
+        _array_of(
             (12, 6),
             0,
             0,

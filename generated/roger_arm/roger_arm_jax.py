@@ -122,6 +122,15 @@ def _matrix_of(shape, *entries):
     return jnp.concatenate(blocks).reshape(shape)
 
 
+def _array_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
+    statements (symdyn.codegen.jax.stages.long_body), which XLA compiled far longer in blocks
+    (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
+    under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
+    return jnp.array(entries, dtype=DTYPE).reshape(shape)
+
+
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
 #: in recent jax (0.10; not in 0.6), compile a long straight-line body into far slower code: the
 #: Panda's inverse dynamics vmapped over 100,000 states took 88 us a state with them and 0.6 us

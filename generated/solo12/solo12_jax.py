@@ -122,6 +122,15 @@ def _matrix_of(shape, *entries):
     return jnp.concatenate(blocks).reshape(shape)
 
 
+def _array_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
+    statements (symdyn.codegen.jax.stages.long_body), which XLA compiled far longer in blocks
+    (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
+    under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
+    return jnp.array(entries, dtype=DTYPE).reshape(shape)
+
+
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
 #: in recent jax (0.10; not in 0.6), compile a long straight-line body into far slower code: the
 #: Panda's inverse dynamics vmapped over 100,000 states took 88 us a state with them and 0.6 us
@@ -8950,7 +8959,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x1288 = 2*x1287
     x1289 = 2*x1278
     return (
-        _matrix_of(
+        _array_of(
             (12, 12),
             x23,
             x172,
@@ -9097,7 +9106,7 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
             x794,
             x796,
         ),
-        _matrix_of(
+        _array_of(
             (12, 12),
             x837,
             x878,
@@ -10895,7 +10904,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x1600 = -x1566*x1054 - x1573*x920 - x1595*x1045
     x1601 = -x1579*x1054 - x1590*x920 - x1597*x1045
     return (
-        _matrix_of(
+        _array_of(
             (12, 12),
             x63,
             x261,
@@ -11042,7 +11051,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             x1144,
             x1145,
         ),
-        _matrix_of(
+        _array_of(
             (12, 12),
             x1220,
             x1234,
@@ -11189,7 +11198,7 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
             x1600,
             x1601,
         ),
-        _matrix_of(
+        _array_of(
             (12, 12),
             x58,
             -x62,
@@ -13327,7 +13336,7 @@ def linearize(q, qd, tau, p=None):
     x1600 = -x1560*x1395 - x1567*x1261 - x1592*x1386
     x1601 = -x1573*x1395 - x1584*x1261 - x1594*x1386
     return (
-        _matrix_of(
+        _array_of(
             (24, 24),
             0,
             0,
@@ -13906,7 +13915,7 @@ def linearize(q, qd, tau, p=None):
             x1600,
             x1601,
         ),
-        _matrix_of(
+        _array_of(
             (24, 12),
             0,
             0,

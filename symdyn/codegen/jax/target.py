@@ -192,12 +192,15 @@ def stage_views(
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
-    """{NAME_jax.py: module text} for the robot of `ctx`."""
+    """{NAME_jax.py: module text} for the robot of `ctx`: the matrices of a function whose body is
+    long (staging.long_body) are each one concatenate of every entry (the module's _array_of),
+    the others concatenated blocks (_matrix_of)."""
     adjoints = adjoint_views(ctx)
     through = identities(ctx, adjoints)
     derived = {name: d for name, d in rules(ctx).items() if name not in through}
     staged = stage_views(ctx, adjoints, through, derived)
     loose = [name for name in staged if name not in adjoints and name not in through]
+    whole = [spec.name for spec in ctx.functions if staging.long_body(spec)]
     text = render_module(
         ctx,
         "jax/module.py.j2",
@@ -207,5 +210,6 @@ def render(ctx: RenderContext) -> dict[str, str]:
         identities=through,
         stages=staged,
         loose=loose,
+        whole=whole,
     )
     return {file_name(ctx.name): text}
