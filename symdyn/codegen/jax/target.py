@@ -42,7 +42,19 @@ from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 from . import stages as staging
 
-__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "STAGED", "adjoint_view"]
+__all__ = [
+    "render",
+    "file_name",
+    "TOOLS",
+    "ADJOINTS",
+    "RULES",
+    "IDENTITIES",
+    "STAGED",
+    "SELECTED_ENTRIES",
+    "SELECTED_BODY",
+    "adjoint_view",
+    "matrix_builders",
+]
 
 #: The functions whose derivative is a linear primitive transposed by their generated adjoint program
 #: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
@@ -83,6 +95,34 @@ STAGED = ("mass_matrix",)
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
+
+
+#: A matrix of at most SELECTED_ENTRIES entries, of a body of at most SELECTED_BODY statements, is
+#: one selection (the module's _selection_of); a longer body's, or a larger matrix, concatenated
+#: selected blocks (_matrix_of); a body of more than staging.STAGE_ABOVE statements keeps one
+#: concatenate of every entry (_array_of). Chosen by measurement (the Panda, jax.jit(jax.vmap(f)),
+#: 20,000 states, one process, docs/jax.md): one selection against blocks, link7_jacobian (42
+#: entries) 257 against 685 ns a state, M (49, 184 statements) 442 against 711, the
+#: operational-space inertia (36, 481 statements) 1,592 against 1,730, coriolis_matrix (49, 648
+#: statements) 3,389 against 889.
+SELECTED_ENTRIES = 64
+SELECTED_BODY = 500
+
+
+def matrix_builders(spec: FunctionSpec) -> list[str | None]:
+    """The module's function that builds each output of `spec` (None for a vector): _selection_of,
+    _matrix_of or _array_of (SELECTED_ENTRIES)."""
+    long, short = staging.long_body(spec), len(spec.temporaries) <= SELECTED_BODY
+    return [
+        None
+        if not out.matrix
+        else "_array_of"
+        if long
+        else "_selection_of"
+        if short and out.size <= SELECTED_ENTRIES
+        else "_matrix_of"
+        for out in spec.results
+    ]
 
 
 def file_name(name: str) -> str:
@@ -192,15 +232,13 @@ def stage_views(
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
-    """{NAME_jax.py: module text} for the robot of `ctx`: the matrices of a function whose body is
-    long (staging.long_body) are each one concatenate of every entry (the module's _array_of),
-    the others concatenated blocks (_matrix_of)."""
+    """{NAME_jax.py: module text} for the robot of `ctx`, its matrices built as matrix_builders says."""
     adjoints = adjoint_views(ctx)
     through = identities(ctx, adjoints)
     derived = {name: d for name, d in rules(ctx).items() if name not in through}
     staged = stage_views(ctx, adjoints, through, derived)
     loose = [name for name in staged if name not in adjoints and name not in through]
-    whole = [spec.name for spec in ctx.functions if staging.long_body(spec)]
+    builders = {spec.name: matrix_builders(spec) for spec in ctx.functions}
     text = render_module(
         ctx,
         "jax/module.py.j2",
@@ -210,6 +248,6 @@ def render(ctx: RenderContext) -> dict[str, str]:
         identities=through,
         stages=staged,
         loose=loose,
-        whole=whole,
+        builders=builders,
     )
     return {file_name(ctx.name): text}
