@@ -4,12 +4,13 @@
                                  [--routes vmap,batch,scan]
 
 MODULE_jax.py (default generated/panda/panda_jax.py) is a generated JAX module, double precision.
-It is loaded twice: as generated, where the matrices are the module's _matrix_of (one selection up
-to _FUSED_CONCATENATE entries, above it a concatenate of selected blocks; those of a body of more
-than 1,000 statements _array_of, jnp.array, the same in both ways), and with _matrix_of replaced
-by jnp.array(entries).reshape(shape), the module before issue 37's matrices (a concatenate of
-every entry). For each of --functions (default the matrix functions the module holds of
-mass_matrix, coriolis_matrix and regressor),
+It is loaded twice: as generated, where each matrix is built as symdyn.codegen.jax.target.
+matrix_builders says (one selection, _selection_of; a concatenate of selected blocks,
+_matrix_of; those of a body of more than 1,000 statements by _array_of, jnp.array, the same in
+both ways), and with _selection_of and _matrix_of replaced by jnp.array(entries).reshape(shape),
+the module before issue 37's matrices (a concatenate of every entry). For each of --functions
+(default the matrix functions the module holds of mass_matrix, link7_jacobian, coriolis_matrix
+and regressor),
 each way and each route is timed per state over a batch of N random states (default 20,000):
 jax.jit(jax.vmap(f)) under XLA's defaults, f_batch (the module's batch twin: the fusion emitters
 off) and a jit of jax.lax.scan over the states (one call a step, per step). The routes are timed
@@ -38,13 +39,14 @@ sys.path[:] = [p for p in sys.path if p != _BENCH] + [_BENCH]
 import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-FUNCTIONS = ("mass_matrix", "coriolis_matrix", "regressor")
+FUNCTIONS = ("mass_matrix", "link7_jacobian", "coriolis_matrix", "regressor")
 ROUTES = ("vmap", "batch", "scan")
-WAYS = ("jnp.array", "_matrix_of")
+WAYS = ("jnp.array", "generated")
 
 
 def _load(path: Path, way: str):
-    """The module at `path`, its _matrix_of replaced by jnp.array for the way 'jnp.array'."""
+    """The module at `path`, its _selection_of and _matrix_of replaced by jnp.array for the way
+    'jnp.array'."""
     import jax.numpy as jnp
 
     spec = importlib.util.spec_from_file_location(f"_bench_{way.replace('.', '_')}", path)
@@ -52,7 +54,9 @@ def _load(path: Path, way: str):
     spec.loader.exec_module(module)
     if way == "jnp.array":
         dtype = module.DTYPE
-        module._matrix_of = lambda shape, *entries: jnp.array(entries, dtype=dtype).reshape(shape)
+        module._matrix_of = module._selection_of = lambda shape, *entries: jnp.array(
+            entries, dtype=dtype
+        ).reshape(shape)
     return module
 
 
@@ -127,7 +131,7 @@ def measure(path: Path, functions, count: int, reps: int, routes) -> list[dict]:
                 jax.block_until_ready(run["fn"](*args))
                 run["times"].append(time.perf_counter() - start)
         for route in routes:
-            old, new = outs["jnp.array", route], outs["_matrix_of", route]
+            old, new = outs["jnp.array", route], outs["generated", route]
             error = float(jnp.max(jnp.abs(new - old)) / jnp.max(jnp.abs(old)))
             row = {"function": function, "route": route, "error": error}
             for way in WAYS:
@@ -138,11 +142,11 @@ def measure(path: Path, functions, count: int, reps: int, routes) -> list[dict]:
 
 
 def table(rows: list[dict]) -> list[str]:
-    head = f"{'function':30} {'route':6} {'jnp.array ns':>13} {'_matrix_of ns':>14} {'ratio':>6}"
+    head = f"{'function':30} {'route':6} {'jnp.array ns':>13} {'generated ns':>14} {'ratio':>6}"
     head += f" {'fusions':>9} {'sines':>9} {'first s':>11} {'rel. diff':>9}"
     lines = [head]
     for r in rows:
-        old, new = r["jnp.array"], r["_matrix_of"]
+        old, new = r["jnp.array"], r["generated"]
         fusions = f"{old[2]}/{new[2]}" if old[2] is not None else "-"
         sines = f"{old[3]}/{new[3]}" if old[3] is not None else "-"
         times = f"{old[0] * 1e9:13,.0f} {new[0] * 1e9:14,.0f} {old[0] / new[0]:6.2f}"

@@ -112,34 +112,6 @@ _FUSED_CONCATENATE = 8
 _BLOCK = 32
 
 
-def _matrix_of(shape, *entries):
-    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE: one
-    selection (_vector_of) for at most _FUSED_CONCATENATE entries, above it the
-    concatenate of more than _FUSED_CONCATENATE selected blocks of at most _BLOCK
-    entries each, which XLA's CPU compiler computes apart, each block's statements once,
-    and copies. Under jax.vmap one selection of a matrix costs about one operation per
-    entry for each entry and re-evaluates per entry what it does not compute apart (the
-    Panda's inverse_dynamics_derivatives, two 7 x 7 matrices: 124 us a state against 14
-    us by jnp.array), and jnp.array, a concatenate of every entry, computes each entry
-    apart, the statements it reads again for each (the Panda's regressor: 1,060 sines for
-    its 12); the blocks took 4.8 us and 7.7 us, M 1.0 us against 2.7 (docs/jax.md)."""
-    size = len(entries)
-    if size <= _FUSED_CONCATENATE:
-        return _vector_of(*entries).reshape(shape)
-    block = max(1, min(_BLOCK, size // (_FUSED_CONCATENATE + 1)))
-    blocks = [_vector_of(*entries[start : start + block]) for start in range(0, size, block)]
-    return jnp.concatenate(blocks).reshape(shape)
-
-
-def _selection_of(shape, *entries):
-    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
-    selection (_vector_of): the matrices of at most 64 entries of a body of at most 500
-    statements (symdyn.codegen.jax.target.matrix_builders), where it beat the blocks of
-    _matrix_of under jax.vmap (the Panda's link7_jacobian 257 against 685 ns a state, M 442
-    against 711; docs/jax.md)."""
-    return _vector_of(*entries).reshape(shape)
-
-
 def _array_of(shape, *entries):
     """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
     concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
@@ -147,6 +119,56 @@ def _array_of(shape, *entries):
     (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
     under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
     return jnp.array(entries, dtype=DTYPE).reshape(shape)
+
+
+def _tangent_concatenated(build):
+    """build(shape, *entries) as a jax.custom_jvp function whose tangent is _array_of the entries'
+    tangents, a concatenate, whose transpose slices the cotangent: JAX's own derivative of a
+    selection sums a selection per entry, and the Panda's M, selected, took 13.3 us a state
+    under jax.jit(jax.grad(...)) of its vmapped loss and 14.7 us under jax.vmap(jax.jacfwd(...)),
+    against 1.4 and 3.0 us by jnp.array; with this tangent 0.57 and 3.0 us (docs/jax.md)."""
+    ruled = jax.custom_jvp(build, nondiff_argnums=(0,))
+
+    @ruled.defjvp
+    def _(shape, primals, tangents):
+        return build(shape, *primals), _array_of(shape, *tangents)
+
+    @functools.wraps(build)
+    def call(shape, *entries):
+        return ruled(shape, *(jnp.asarray(e, dtype=DTYPE) for e in entries))
+
+    return call
+
+
+@_tangent_concatenated
+def _selection_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    selection (_vector_of): the matrices of at most 64 entries of a body of at most 500
+    statements (symdyn.codegen.jax.target.matrix_builders), where it beat the blocks of
+    _matrix_of under jax.vmap (the Panda's link7_jacobian 257 against 685 ns a state, M 442
+    against 711; docs/jax.md); its tangent by _tangent_concatenated."""
+    return _vector_of(*entries).reshape(shape)
+
+
+@_tangent_concatenated
+def _matrix_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE: one
+    selection (_vector_of) for at most _FUSED_CONCATENATE entries, above it the
+    concatenate of more than _FUSED_CONCATENATE selected blocks of at most _BLOCK
+    entries each, which XLA's CPU compiler computes apart, each block's statements once,
+    and copies; its tangent by _tangent_concatenated. Under jax.vmap one selection of a
+    matrix costs about one operation per entry for each entry and re-evaluates per entry
+    what it does not compute apart (the Panda's inverse_dynamics_derivatives, two 7 x 7
+    matrices: 124 us a state against 14 us by jnp.array), and jnp.array, a concatenate of
+    every entry, computes each entry apart, the statements it reads again for each (the
+    Panda's regressor: 1,060 sines for its 12); the blocks took 4.8 us and 3.9 us against
+    8.8 (docs/jax.md)."""
+    size = len(entries)
+    if size <= _FUSED_CONCATENATE:
+        return _vector_of(*entries).reshape(shape)
+    block = max(1, min(_BLOCK, size // (_FUSED_CONCATENATE + 1)))
+    blocks = [_vector_of(*entries[start : start + block]) for start in range(0, size, block)]
+    return jnp.concatenate(blocks).reshape(shape)
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
