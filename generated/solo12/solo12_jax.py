@@ -25,8 +25,8 @@ jax.lax.scan apply to them unchanged, on any device JAX runs on; p is an
 argument, so parameters can be fitted by gradient.
 
 jax.jit(jax.vmap(f)) under XLA's default flags is the fast path for the
-functions returning vectors (built by _vector_of) and matrices (_matrix_of).
-Each function f also has a
+functions returning vectors (built by _vector_of) and matrices (_selection_of,
+_matrix_of; _array_of for the long bodies). Each function f also has a
 batched twin f_batch: f vmapped over the leading axis of every argument that has
 one more axis than for one state (an argument of one state's shape is shared by
 all), and jitted; at the top level with XLA's CPU fusion emitters off
@@ -89,7 +89,8 @@ def _vector_of(*entries):
     its 12), where a selection reads every entry at one indexing and computes each
     statement once. A selection costs about one operation per entry for each entry, and
     XLA evaluates in it, once per entry, the statements it does not compute apart, so it
-    serves vectors and small blocks; matrices are concatenated blocks (_matrix_of)."""
+    serves vectors, small matrices of short bodies (_selection_of) and blocks of larger ones
+    (_matrix_of)."""
     size = len(entries)
     cases = (jnp.broadcast_to(jnp.asarray(e, dtype=DTYPE), (size,)) for e in entries)
     return jax.lax.select_n(jnp.arange(size, dtype=jnp.int32), *cases)

@@ -7,8 +7,9 @@ on a value, no in-place update and no NumPy call, so that jax.jit, jax.vmap, jax
 jax.lax.scan apply to them unchanged; p is an argument, so parameters can be fitted by
 gradient. Vectors are returned through jax.lax.select_n (the module's _vector_of), not
 jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times slower under jax.vmap
-for the Panda, and matrices as a concatenate of more than 8 selected blocks (_matrix_of),
-which XLA's CPU compiler computes apart, each block's statements once (docs/jax.md). Each
+for the Panda; matrices as one selection, a concatenate of more than 8 selected blocks (which
+XLA's CPU compiler computes apart, each block's statements once) or jnp.array, per output
+(matrix_builders; docs/jax.md). Each
 function has a batched twin NAME_batch (vmapped over the leading axis of the arguments that
 have one, jitted). Inputs and outputs are float64
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
