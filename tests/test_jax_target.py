@@ -409,7 +409,8 @@ def test_vmapped_vectors_are_selected_not_concatenated(modules):
     """The fast path under XLA's defaults: jax.jit(jax.vmap(f)) of a vector function holds no
     concatenate (XLA's CPU fusion emitters recomputed the statements shared by the entries of
     one, once per path: the Panda's inverse dynamics ran 250 times slower than f_batch), and
-    equals the NumPy module over a batch; the matrices keep jnp.array."""
+    equals the NumPy module over a batch; the matrices are concatenated selected blocks
+    (test_matrices_are_selected_or_concatenated_blocks)."""
     jax_mod, numpy_mod, _ = modules["panda"]
     rng = np.random.default_rng(13)
     q, qd, qdd = rng.uniform(-2.0, 2.0, (3, 32, jax_mod.NDOF))
@@ -418,10 +419,48 @@ def test_vmapped_vectors_are_selected_not_concatenated(modules):
         assert "concatenate" not in text, name
     vmapped = jax.jit(jax.vmap(jax_mod.inverse_dynamics))
     _close(vmapped(q, qd, qdd), numpy_mod.inverse_dynamics(q, qd, qdd))
-    assert "concatenate" in jax.jit(jax.vmap(jax_mod.mass_matrix)).lower(q).as_text()
     one = jax_mod._vector_of(1)
     assert one.shape == (1,) and one.dtype == jnp.float64 and float(one[0]) == 1.0
     np.testing.assert_array_equal(jax_mod._vector_of(2, jnp.float64(3.5), -1), [2.0, 3.5, -1.0])
+
+
+def test_matrices_are_selected_or_concatenated_blocks(modules):
+    """The three ways a matrix is built (symdyn.codegen.jax.target.matrix_builders), entry by entry
+    in row order: _selection_of (one selection: the Panda's M, 49 entries of a short body),
+    _matrix_of (one selection up to _FUSED_CONCATENATE entries, above it a concatenate of more
+    than _FUSED_CONCATENATE selected blocks of at most _BLOCK entries, which XLA's CPU compiler
+    computes apart: coriolis_matrix, 49 entries of 648 statements, 10 blocks of 5, and the
+    regressor), _array_of (one concatenate of every entry: the derivative functions' long
+    bodies); jax.jit(jax.vmap(...)) of a selected and of a blocked matrix equal the NumPy module's."""
+    jax_mod, numpy_mod, _ = modules["panda"]
+    ways = {
+        "_array_of": ("inverse_dynamics_derivatives", "forward_dynamics_derivatives", "linearize"),
+        "_selection_of": ("mass_matrix", "link7_jacobian", "mass_matrix_inverse"),
+        "_matrix_of": ("coriolis_matrix", "regressor", "base_regressor"),
+    }
+    source = Path(jax_mod.__file__).read_text()
+    for way, names in ways.items():
+        for name in names:
+            body = source.split(f"\ndef {name}(")[1].split("\ndef ")[0]
+            assert [w for w in ways if f"{w}(" in body] == [way], name
+    fused, block = jax_mod._FUSED_CONCATENATE, jax_mod._BLOCK
+    for rows, cols in ((1, 1), (1, fused), (1, fused + 1), (3, 7), (7, 7), (7, 91), (3, 20 * block + 1)):
+        entries = [float(k) for k in range(rows * cols)]
+        entries[-1] = jnp.float64(entries[-1])  # an array among numbers
+        want = np.arange(rows * cols, dtype=float).reshape(rows, cols)
+        for way in ways if rows * cols <= 64 else ("_matrix_of",):  # the others: one op each
+            got = getattr(jax_mod, way)((rows, cols), *entries)
+            assert got.shape == (rows, cols) and got.dtype == jnp.float64
+            np.testing.assert_array_equal(got, want)
+    rng = np.random.default_rng(17)
+    q, qd = rng.uniform(-2.0, 2.0, (2, 16, jax_mod.NDOF))
+    selected = jax.jit(jax.vmap(jax_mod.mass_matrix))
+    assert "stablehlo.concatenate" not in selected.lower(q).as_text()
+    _close(selected(q), numpy_mod.mass_matrix(q))
+    blocked = jax.jit(jax.vmap(jax_mod.coriolis_matrix))
+    lines = [x for x in blocked.lower(q, qd).as_text().splitlines() if "stablehlo.concatenate" in x]
+    assert len(lines) == 1 and lines[0].count("%") == 10 + 1, lines
+    _close(blocked(q, qd), numpy_mod.coriolis_matrix(q, qd))
 
 
 def test_jit_grad_of_a_vmapped_loss_equals_differences(modules):

@@ -25,7 +25,8 @@ jax.lax.scan apply to them unchanged, on any device JAX runs on; p is an
 argument, so parameters can be fitted by gradient.
 
 jax.jit(jax.vmap(f)) under XLA's default flags is the fast path for the
-functions returning vectors (built by _vector_of). Each function f also has a
+functions returning vectors (built by _vector_of) and matrices (_selection_of,
+_matrix_of; _array_of for the long bodies). Each function f also has a
 batched twin f_batch: f vmapped over the leading axis of every argument that has
 one more axis than for one state (an argument of one state's shape is shared by
 all), and jitted; at the top level with XLA's CPU fusion emitters off
@@ -86,12 +87,80 @@ def _vector_of(*entries):
     indexing and evaluate the statements shared by several entries once per path to
     them (the Panda's inverse dynamics: about 25,000 sines and cosines per state for
     its 12), where a selection reads every entry at one indexing and computes each
-    statement once. A selection costs about one operation per entry for each entry, so
-    it serves vectors; matrices keep jnp.array (selected, the Panda's derivative
-    matrices took 11 times longer under jax.vmap)."""
+    statement once. A selection costs about one operation per entry for each entry, and
+    XLA evaluates in it, once per entry, the statements it does not compute apart, so it
+    serves vectors, small matrices of short bodies (_selection_of) and blocks of larger ones
+    (_matrix_of)."""
     size = len(entries)
     cases = (jnp.broadcast_to(jnp.asarray(e, dtype=DTYPE), (size,)) for e in entries)
     return jax.lax.select_n(jnp.arange(size, dtype=jnp.int32), *cases)
+
+
+#: XLA's CPU compiler fuses the operands of a concatenate of at most this many into it
+#: (then each operand is read at its own indexing, and the statements shared by several are
+#: computed again for each); a concatenate of more operands reads them computed (_matrix_of).
+_FUSED_CONCATENATE = 8
+#: The most entries of one block of a matrix (_matrix_of).
+_BLOCK = 32
+
+
+def _array_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
+    statements (symdyn.codegen.jax.stages.long_body), which XLA compiled far longer in blocks
+    (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
+    under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
+    return jnp.array(entries, dtype=DTYPE).reshape(shape)
+
+
+def _tangent_concatenated(build):
+    """build(shape, *entries) as a jax.custom_jvp function whose tangent is _array_of the entries'
+    tangents, a concatenate, whose transpose slices the cotangent: JAX's own derivative of a
+    selection sums a selection per entry, and the Panda's M, selected, took 13.3 us a state
+    under jax.jit(jax.grad(...)) of its vmapped loss and 14.7 us under jax.vmap(jax.jacfwd(...)),
+    against 1.4 and 3.0 us by jnp.array; with this tangent 0.57 and 3.0 us (docs/jax.md)."""
+    ruled = jax.custom_jvp(build, nondiff_argnums=(0,))
+
+    @ruled.defjvp
+    def _(shape, primals, tangents):
+        return build(shape, *primals), _array_of(shape, *tangents)
+
+    @functools.wraps(build)
+    def call(shape, *entries):
+        return ruled(shape, *(jnp.asarray(e, dtype=DTYPE) for e in entries))
+
+    return call
+
+
+@_tangent_concatenated
+def _selection_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
+    selection (_vector_of): the matrices of at most 64 entries of a body of at most 500
+    statements (symdyn.codegen.jax.target.matrix_builders), where it beat the blocks of
+    _matrix_of under jax.vmap (the Panda's link7_jacobian 257 against 685 ns a state, M 442
+    against 711; docs/jax.md); its tangent by _tangent_concatenated."""
+    return _vector_of(*entries).reshape(shape)
+
+
+@_tangent_concatenated
+def _matrix_of(shape, *entries):
+    """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE: one
+    selection (_vector_of) for at most _FUSED_CONCATENATE entries, above it the
+    concatenate of more than _FUSED_CONCATENATE selected blocks of at most _BLOCK
+    entries each, which XLA's CPU compiler computes apart, each block's statements once,
+    and copies; its tangent by _tangent_concatenated. Under jax.vmap one selection of a
+    matrix costs about one operation per entry for each entry and re-evaluates per entry
+    what it does not compute apart (the Panda's inverse_dynamics_derivatives, two 7 x 7
+    matrices: 124 us a state against 14 us by jnp.array), and jnp.array, a concatenate of
+    every entry, computes each entry apart, the statements it reads again for each (the
+    Panda's regressor: 1,060 sines for its 12); the blocks took 4.8 us and 3.9 us against
+    8.8 (docs/jax.md)."""
+    size = len(entries)
+    if size <= _FUSED_CONCATENATE:
+        return _vector_of(*entries).reshape(shape)
+    block = max(1, min(_BLOCK, size // (_FUSED_CONCATENATE + 1)))
+    blocks = [_vector_of(*entries[start : start + block]) for start in range(0, size, block)]
+    return jnp.concatenate(blocks).reshape(shape)
 
 
 #: The XLA options the batched twins are compiled with. XLA's CPU fusion emitters, on by default
@@ -497,15 +566,13 @@ def mass_matrix(q, p=None):
     x6 = l1*l1
     x7 = m1*x6
     x8 = x0 + x7 + m2*x6 + 2*x4
-    return jnp.array(
-        [
-            x8,
-            x5,
-            x5,
-            x0,
-        ],
-        dtype=DTYPE,
-    ).reshape((2, 2))
+    return _selection_of(
+        (2, 2),
+        x8,
+        x5,
+        x5,
+        x0,
+    )
 
 
 def coriolis_matrix(q, qd, p=None):
@@ -541,15 +608,13 @@ def coriolis_matrix(q, qd, p=None):
     x16 = 2*x7 - x6
     x17 = x15*x1 + x16*x5
     x18 = x14 + x17*l1
-    return jnp.array(
-        [
-            x13,
-            x18,
-            x4,
-            x14,
-        ],
-        dtype=DTYPE,
-    ).reshape((2, 2))
+    return _selection_of(
+        (2, 2),
+        x13,
+        x18,
+        x4,
+        x14,
+    )
 
 
 def coriolis(q, qd, p=None):
@@ -760,63 +825,61 @@ def regressor(q, qd, qdd, p=None):
     x16 = x9 + x11*x15 - x10*x14
     x17 = -x8 - x10*x15 - x11*x14
     x18 = jnp.sign(qd2)
-    return jnp.array(
-        [
-            0,
-            x0,
-            x1,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            qdd1,
-            qdd1,
-            qd1,
-            x2,
-            x12,
-            x16,
-            x17,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            x15,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            x9,
-            -x8,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            x15,
-            qdd2,
-            qd2,
-            x18,
-        ],
-        dtype=DTYPE,
-    ).reshape((2, 26))
+    return _selection_of(
+        (2, 26),
+        0,
+        x0,
+        x1,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        qdd1,
+        qdd1,
+        qd1,
+        x2,
+        x12,
+        x16,
+        x17,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        x15,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        x9,
+        -x8,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        x15,
+        qdd2,
+        qd2,
+        x18,
+    )
 
 
 def base_regressor(q, qd, qdd, p=None):
@@ -854,33 +917,31 @@ def base_regressor(q, qd, qdd, p=None):
     x15 = x6*x7 + x9*x10
     x16 = -x15 - x12*x5 - x13*x4
     x17 = jnp.sign(qd2)
-    return jnp.array(
-        [
-            x0,
-            x1,
-            qdd1,
-            qd1,
-            x2,
-            x14,
-            x16,
-            x5,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            x11,
-            -x15,
-            x5,
-            qdd2,
-            qd2,
-            x17,
-        ],
-        dtype=DTYPE,
-    ).reshape((2, 11))
+    return _selection_of(
+        (2, 11),
+        x0,
+        x1,
+        qdd1,
+        qd1,
+        x2,
+        x14,
+        x16,
+        x5,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        x11,
+        -x15,
+        x5,
+        qdd2,
+        qd2,
+        x17,
+    )
 
 
 def inverse_dynamics_derivatives(q, qd, qdd, p=None):
@@ -959,24 +1020,20 @@ def inverse_dynamics_derivatives(q, qd, qdd, p=None):
     x53 = 2*x38
     x54 = 2*x47
     return (
-        jnp.array(
-            [
-                x14,
-                x34,
-                x9,
-                x21,
-            ],
-            dtype=DTYPE,
-        ).reshape((2, 2)),
-        jnp.array(
-            [
-                x46,
-                x52,
-                x53,
-                x54,
-            ],
-            dtype=DTYPE,
-        ).reshape((2, 2)),
+        _selection_of(
+            (2, 2),
+            x14,
+            x34,
+            x9,
+            x21,
+        ),
+        _selection_of(
+            (2, 2),
+            x46,
+            x52,
+            x53,
+            x54,
+        ),
     )
 
 
@@ -1091,33 +1148,27 @@ def forward_dynamics_derivatives(q, qd, tau, p=None):
     x88 = -x78*x26 + x77*x27
     x89 = -x86*x26 + x85*x27
     return (
-        jnp.array(
-            [
-                x29,
-                x64,
-                x65,
-                x66,
-            ],
-            dtype=DTYPE,
-        ).reshape((2, 2)),
-        jnp.array(
-            [
-                x79,
-                x87,
-                x88,
-                x89,
-            ],
-            dtype=DTYPE,
-        ).reshape((2, 2)),
-        jnp.array(
-            [
-                x28,
-                -x27,
-                -x27,
-                x26,
-            ],
-            dtype=DTYPE,
-        ).reshape((2, 2)),
+        _selection_of(
+            (2, 2),
+            x29,
+            x64,
+            x65,
+            x66,
+        ),
+        _selection_of(
+            (2, 2),
+            x79,
+            x87,
+            x88,
+            x89,
+        ),
+        _selection_of(
+            (2, 2),
+            x28,
+            -x27,
+            -x27,
+            x26,
+        ),
     )
 
 
@@ -1148,15 +1199,13 @@ def mass_matrix_inverse(q, p=None):
     x12 = 1/x11
     x13 = x10*x12
     x14 = x8 + x10*x13
-    return jnp.array(
-        [
-            x14,
-            -x13,
-            -x13,
-            x12,
-        ],
-        dtype=DTYPE,
-    ).reshape((2, 2))
+    return _selection_of(
+        (2, 2),
+        x14,
+        -x13,
+        -x13,
+        x12,
+    )
 
 
 def linearize(q, qd, tau, p=None):
@@ -1270,40 +1319,36 @@ def linearize(q, qd, tau, p=None):
     x88 = -x76*x26 + x75*x27
     x89 = -x84*x26 + x83*x27
     return (
-        jnp.array(
-            [
-                0,
-                0,
-                1,
-                0,
-                0,
-                0,
-                0,
-                1,
-                x29,
-                x64,
-                x77,
-                x85,
-                x86,
-                x87,
-                x88,
-                x89,
-            ],
-            dtype=DTYPE,
-        ).reshape((4, 4)),
-        jnp.array(
-            [
-                0,
-                0,
-                0,
-                0,
-                x28,
-                -x27,
-                -x27,
-                x26,
-            ],
-            dtype=DTYPE,
-        ).reshape((4, 2)),
+        _selection_of(
+            (4, 4),
+            0,
+            0,
+            1,
+            0,
+            0,
+            0,
+            0,
+            1,
+            x29,
+            x64,
+            x77,
+            x85,
+            x86,
+            x87,
+            x88,
+            x89,
+        ),
+        _selection_of(
+            (4, 2),
+            0,
+            0,
+            0,
+            0,
+            x28,
+            -x27,
+            -x27,
+            x26,
+        ),
     )
 
 

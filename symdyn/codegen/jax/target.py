@@ -7,8 +7,11 @@ on a value, no in-place update and no NumPy call, so that jax.jit, jax.vmap, jax
 jax.lax.scan apply to them unchanged; p is an argument, so parameters can be fitted by
 gradient. Vectors are returned through jax.lax.select_n (the module's _vector_of), not
 jnp.array, a concatenate that XLA's CPU fusion emitters made 280 times slower under jax.vmap
-for the Panda (docs/jax.md). Each function has a batched twin NAME_batch (vmapped over the
-leading axis of the arguments that have one, jitted). Inputs and outputs are float64
+for the Panda; matrices as one selection, a concatenate of more than 8 selected blocks (which
+XLA's CPU compiler computes apart, each block's statements once) or jnp.array, per output
+(matrix_builders; docs/jax.md). Each
+function has a batched twin NAME_batch (vmapped over the leading axis of the arguments that
+have one, jitted). Inputs and outputs are float64
 (--precision double, which needs JAX's x64 mode: the module refuses to import without it
 rather than compute in float32) or float32.
 
@@ -40,7 +43,19 @@ from ..python.target import JOINT_INPUTS, render_module
 from ..render import RenderContext
 from . import stages as staging
 
-__all__ = ["render", "file_name", "TOOLS", "ADJOINTS", "RULES", "IDENTITIES", "STAGED", "adjoint_view"]
+__all__ = [
+    "render",
+    "file_name",
+    "TOOLS",
+    "ADJOINTS",
+    "RULES",
+    "IDENTITIES",
+    "STAGED",
+    "SELECTED_ENTRIES",
+    "SELECTED_BODY",
+    "adjoint_view",
+    "matrix_builders",
+]
 
 #: The functions whose derivative is a linear primitive transposed by their generated adjoint program
 #: (adjoint_view), when their one output is a vector named as no input (its cotangent is the
@@ -81,6 +96,34 @@ STAGED = ("mass_matrix",)
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
 TOOLS = {"_jax.py": ("sympy",)}
+
+
+#: A matrix of at most SELECTED_ENTRIES entries, of a body of at most SELECTED_BODY statements, is
+#: one selection (the module's _selection_of); a longer body's, or a larger matrix, concatenated
+#: selected blocks (_matrix_of); a body of more than staging.STAGE_ABOVE statements keeps one
+#: concatenate of every entry (_array_of). Chosen by measurement (the Panda, jax.jit(jax.vmap(f)),
+#: 20,000 states, one process, docs/jax.md): one selection against blocks, link7_jacobian (42
+#: entries) 257 against 685 ns a state, M (49, 184 statements) 442 against 711, the
+#: operational-space inertia (36, 481 statements) 1,592 against 1,730, coriolis_matrix (49, 648
+#: statements) 3,389 against 889.
+SELECTED_ENTRIES = 64
+SELECTED_BODY = 500
+
+
+def matrix_builders(spec: FunctionSpec) -> list[str | None]:
+    """The module's function that builds each output of `spec` (None for a vector): _selection_of,
+    _matrix_of or _array_of (SELECTED_ENTRIES)."""
+    long, short = staging.long_body(spec), len(spec.temporaries) <= SELECTED_BODY
+    return [
+        None
+        if not out.matrix
+        else "_array_of"
+        if long
+        else "_selection_of"
+        if short and out.size <= SELECTED_ENTRIES
+        else "_matrix_of"
+        for out in spec.results
+    ]
 
 
 def file_name(name: str) -> str:
@@ -190,12 +233,13 @@ def stage_views(
 
 
 def render(ctx: RenderContext) -> dict[str, str]:
-    """{NAME_jax.py: module text} for the robot of `ctx`."""
+    """{NAME_jax.py: module text} for the robot of `ctx`, its matrices built as matrix_builders says."""
     adjoints = adjoint_views(ctx)
     through = identities(ctx, adjoints)
     derived = {name: d for name, d in rules(ctx).items() if name not in through}
     staged = stage_views(ctx, adjoints, through, derived)
     loose = [name for name in staged if name not in adjoints and name not in through]
+    builders = {spec.name: matrix_builders(spec) for spec in ctx.functions}
     text = render_module(
         ctx,
         "jax/module.py.j2",
@@ -205,5 +249,6 @@ def render(ctx: RenderContext) -> dict[str, str]:
         identities=through,
         stages=staged,
         loose=loose,
+        builders=builders,
     )
     return {file_name(ctx.name): text}
