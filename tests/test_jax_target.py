@@ -736,3 +736,37 @@ def test_a_floating_robot_takes_q_of_nq_and_equals_the_oracle(tmp_path):
     _close(mod.inverse_dynamics_batch(q, qd, qdd, p), np.array(want), rtol=1e-10)
     with pytest.raises(ValueError, match=r"q must have shape \(9,\)"):
         mod.mass_matrix(q[0, 1:], p)
+
+
+def _accelerator():
+    """JAX's first device that is not the CPU (a GPU or TPU), else None."""
+    try:
+        return next((d for d in jax.devices() if d.platform != "cpu"), None)
+    except RuntimeError:  # no backend but the CPU's
+        return None
+
+
+@pytest.mark.accelerator
+@pytest.mark.skipif(_accelerator() is None, reason="no accelerator (GPU or TPU) for JAX")
+def test_an_accelerator_gives_the_cpus_values(modules):
+    """On a GPU or TPU: jax.jit(jax.vmap(f)), f_batch and jax.grad through the adjoint program run
+    there (their outputs stay on the device) and equal the NumPy module's values and the CPU's
+    gradient in float64."""
+    device, cpu = _accelerator(), jax.devices("cpu")[0]
+    jax_mod, numpy_mod, _ = modules["panda"]
+    rng = np.random.default_rng(41)
+    host = rng.uniform(-2.0, 2.0, (3, 256, jax_mod.NDOF))
+    args = jax.device_put(tuple(host), device)
+    want = numpy_mod.inverse_dynamics(*host)
+    for got in (jax.jit(jax.vmap(jax_mod.inverse_dynamics))(*args), jax_mod.inverse_dynamics_batch(*args)):
+        assert got.devices() == {device}
+        _close(got, want)
+    _close(jax_mod.mass_matrix_batch(args[0]), numpy_mod.mass_matrix(host[0]))
+
+    def loss(q, qd, qdd):
+        return jnp.sum(jax.vmap(jax_mod.inverse_dynamics)(q, qd, qdd) ** 2)
+
+    grad = jax.jit(jax.grad(loss))
+    there = grad(*args)
+    assert there.devices() == {device}
+    _close(there, grad(*jax.device_put(tuple(host), cpu)), rtol=1e-10)
