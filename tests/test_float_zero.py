@@ -1,6 +1,6 @@
 """symdyn.symbolic.float_zero: SymPy's Float.is_zero answered by SymPy's own handler, installed
-by importing symdyn's model or symbolic floor, equal to SymPy's property on every kind of Float,
-and leaving the other facts to SymPy's deduction."""
+by importing symdyn's symbolic floor or the robot model, equal to SymPy's property on every kind
+of Float, and leaving the other facts to SymPy's deduction."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import sys
 
 import sympy as sp
 
-import symdyn.model  # noqa: F401  (installs it)
+import symdyn.model.robot  # noqa: F401  (installs it)
 from symdyn.symbolic import float_zero
 
 #: Floats of every kind: zeros of several precisions, subnormal, tiny beyond double, huge,

@@ -108,7 +108,7 @@ def _array_of(shape, *entries):
     """The matrix of `shape` whose entries, row by row, are `entries`, of dtype DTYPE, as one
     concatenate of every entry (jnp.array): the matrices of a body of more than 1,000
     statements (symdyn.codegen.jax.stages.long_body), which XLA compiled far longer in blocks
-    (_matrix_of): the Panda's forward_dynamics_derivatives (2,320 statements) had not compiled
+    (_matrix_of): the Panda's derivatives of its forward dynamics (2,320 statements) had not compiled
     under jax.jit(jax.vmap(...)) after 13 minutes, against 113 s by jnp.array (docs/jax.md)."""
     return jnp.array(entries, dtype=DTYPE).reshape(shape)
 

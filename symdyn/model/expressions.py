@@ -29,6 +29,7 @@ from collections.abc import Callable
 import sympy as sp
 
 from ..errors import SymdynError
+from ..symbolic import float_zero as _float_zero  # noqa: F401  (SymPy's Float.is_zero, fast)
 from .bounded import MAX_EXPANDED_TERMS, MAX_EXPONENT, check_bounded, check_expansion, check_power
 
 __all__ = [

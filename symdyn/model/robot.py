@@ -35,6 +35,7 @@ import sympy as sp
 
 from ..errors import SymdynError
 from ..spatial.transform import Transform, rot_axis
+from ..symbolic import float_zero as _float_zero  # noqa: F401  (SymPy's Float.is_zero, fast)
 from .contacts import Contact, check_contacts
 from .frames import Frame, check_frame_names, unknown_frame
 from .free_flyer import NQ_BASE, NV_BASE, BaseBody

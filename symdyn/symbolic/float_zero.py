@@ -13,9 +13,11 @@ the same expressions; docs/python-api.md).
 `install()` gives `sympy.Float` an `is_zero` property that returns a fact already known to the
 object, else SymPy's handler's answer: the value SymPy's own property returns, for every Float
 (tests/test_float_zero.py compares them), without deducing the other facts, which later queries
-still deduce as before. It changes no expression, no printed text and no generated file; it
-applies to the process's SymPy once symdyn's model or symbolic floor is imported, and only to
-`Float` (`original_is_zero` is SymPy's property, kept for the comparison).
+still deduce as before. It changes no expression, no printed text and no generated file. It
+applies to the process's SymPy once symdyn's symbolic floor, the robot model
+(symdyn.model.robot) or the robot-file number parser (symdyn.model.expressions) is imported, not
+the model package alone, which a warm `simulate` imports without SymPy; and only to `Float`
+(`original_is_zero` is SymPy's property, kept for the comparison).
 """
 
 from __future__ import annotations
