@@ -16,7 +16,6 @@ accelerator it times the CPU alone and says so: bench/jax.py is the CPU's full t
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import sys
 import tempfile
 from pathlib import Path
@@ -25,16 +24,9 @@ _BENCH = Path(__file__).resolve().parent
 sys.path[:] = [p for p in sys.path if p != str(_BENCH)] + [str(_BENCH)]
 
 import numpy as np  # noqa: E402
+from jax_ops import bench_jax  # noqa: E402  (bench/jax_ops.py: bench/jax.py under another name)
 
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
-
-
-def _bench_jax():
-    """bench/jax.py as a module of another name (its own name is the library's)."""
-    spec = importlib.util.spec_from_file_location("_symdyn_bench_jax", _BENCH / "jax.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _relative(got, want) -> float:
@@ -43,7 +35,7 @@ def _relative(got, want) -> float:
 
 
 def main(argv=None) -> int:
-    bench = _bench_jax()
+    bench = bench_jax()
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robot", choices=tuple(bench.ROBOTS), default="panda")
     parser.add_argument("--batch", type=int, default=100_000)

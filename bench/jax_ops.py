@@ -39,7 +39,7 @@ ARITHMETIC = ("mul", "add", "sub", "neg", "div", "integer_pow", "sin", "cos")
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
 
 
-def _bench_jax():
+def bench_jax():
     """bench/jax.py as a module of another name (its own name is the library's)."""
     spec = importlib.util.spec_from_file_location("_symdyn_bench_jax", _BENCH / "jax.py")
     module = importlib.util.module_from_spec(spec)
@@ -104,7 +104,7 @@ def floors(module, name: str, nq: int, nv: int) -> dict[str, float | int | str]:
 
 
 def main(argv=None) -> int:
-    bench = _bench_jax()
+    bench = bench_jax()
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--robot", choices=tuple(bench.ROBOTS), default="panda")
     parser.add_argument("--functions", default=",".join(FUNCTIONS))
