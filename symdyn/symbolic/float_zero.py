@@ -6,7 +6,7 @@ new object, and the first assumption query on an object runs SymPy's whole deduc
 (`Float._eval_is_zero`, a comparison of the mpf with mpmath's zero), then the implications of the
 answer over every other fact (`sympy.core.facts.FactKB.deduce_all_facts`), which costs about a
 hundred times the comparison. A derivation with float data (a robot file's `0.316`, `1.5707963267948966`)
-creates tens of thousands of such Floats: twelve random chains of up to five joints asked 23,000
+creates tens of thousands of such Floats: twelve random chains of up to five joints asked 21,500
 of them, and the deduction took a third of `derive`'s time (3.97 s without this, 2.66 s with it,
 the same expressions; docs/python-api.md).
 
