@@ -45,18 +45,13 @@ WAYS = ("jnp.array", "generated")
 
 
 def _load(path: Path, way: str):
-    """The module at `path`, its _selection_of and _matrix_of replaced by jnp.array for the way
-    'jnp.array'."""
-    import jax.numpy as jnp
-
+    """The module at `path`, its _selection_of and _matrix_of replaced by its own _array_of
+    (jnp.array of every entry) for the way 'jnp.array'."""
     spec = importlib.util.spec_from_file_location(f"_bench_{way.replace('.', '_')}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     if way == "jnp.array":
-        dtype = module.DTYPE
-        module._matrix_of = module._selection_of = lambda shape, *entries: jnp.array(
-            entries, dtype=dtype
-        ).reshape(shape)
+        module._matrix_of = module._selection_of = module._array_of
     return module
 
 

@@ -113,17 +113,19 @@ SELECTED_BODY = 500
 def matrix_builders(spec: FunctionSpec) -> list[str | None]:
     """The module's function that builds each output of `spec` (None for a vector): _selection_of,
     _matrix_of or _array_of (SELECTED_ENTRIES)."""
-    long, short = staging.long_body(spec), len(spec.temporaries) <= SELECTED_BODY
-    return [
-        None
-        if not out.matrix
-        else "_array_of"
-        if long
-        else "_selection_of"
-        if short and out.size <= SELECTED_ENTRIES
-        else "_matrix_of"
-        for out in spec.results
-    ]
+    if staging.long_body(spec):
+        whole = "_array_of"
+    elif len(spec.temporaries) <= SELECTED_BODY:
+        whole = None  # per output: one selection when small enough
+    else:
+        whole = "_matrix_of"
+
+    def builder(out) -> str | None:
+        if not out.matrix:
+            return None
+        return whole or ("_selection_of" if out.size <= SELECTED_ENTRIES else "_matrix_of")
+
+    return [builder(out) for out in spec.results]
 
 
 def file_name(name: str) -> str:
