@@ -42,6 +42,8 @@ def main(argv=None) -> int:
     parser.add_argument("--reps", type=int, default=5)
     parser.add_argument("--precision", choices=("double", "float"), default="double")
     opts = parser.parse_args(argv)
+    if opts.batch < 1 or opts.reps < 1:
+        parser.error("--batch and --reps must be at least 1")
     import jax
     import jax.numpy as jnp
 

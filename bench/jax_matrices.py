@@ -160,9 +160,16 @@ def main(argv=None) -> int:
     parser.add_argument("--reps", type=int, default=5)
     parser.add_argument("--routes", default=",".join(ROUTES))
     opts = parser.parse_args(argv)
+    if opts.batch < 1 or opts.reps < 1:
+        parser.error("--batch and --reps must be at least 1")
+    if not opts.module.is_file():
+        parser.error(f"{opts.module}: no such module file")
     text = opts.module.read_text()
     held = [f for f in FUNCTIONS if f"\ndef {f}(" in text]
     functions = opts.functions.split(",") if opts.functions else held
+    missing = [f for f in functions if f"\ndef {f}(" not in text]
+    if missing:
+        parser.error(f"{opts.module.name} has no function {', '.join(missing)}")
     routes = [r for r in opts.routes.split(",") if r]
     if not set(routes) <= set(ROUTES):
         parser.error(f"--routes takes {', '.join(ROUTES)}")

@@ -109,6 +109,9 @@ def main(argv=None) -> int:
     parser.add_argument("--robot", choices=tuple(bench.ROBOTS), default="panda")
     parser.add_argument("--functions", default=",".join(FUNCTIONS))
     opts = parser.parse_args(argv)
+    unknown = sorted(set(opts.functions.split(",")) - set(FUNCTIONS))
+    if unknown:
+        parser.error(f"--functions takes {', '.join(FUNCTIONS)}; not {', '.join(unknown)}")
     jax.config.update("jax_enable_x64", True)
     from robots import example_robot_file  # bench/robots.py
 
