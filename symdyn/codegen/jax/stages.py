@@ -8,16 +8,25 @@ across a while loop, so the body is cut into stages of STAGE_SIZE statements, ea
 jax.lax.while_loop whose trip count is 1 computed at run time (the module's _once: a population
 count XLA cannot bound), carrying the values that later statements read. Measured on the Talos'
 inverse dynamics (2,000 states, the machine loaded about fivefold): 32 us a state under
-jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us; the same body rewritten outside the
-generator took 51 us in stages of 150 statements and 728 us in stages of 400 (loaded tenfold).
+jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us, in stages of 150.
+
+STAGE_SIZE was then measured on the generated Talos module with nothing else running (2,000
+states; jit(vmap) and jit(grad) of the vmapped inverse dynamics' loss timed in turns, one process
+a size), in us a state, jit(vmap) / jit(grad): 150: 24.5-27.5 / 57-63; 200: 20.9 / 49.8; 250:
+15.3 / 38.0; 300: 9.9-12.0 / 33-37 (f_batch 8.8); 400: 6.7-7.7 / 27-28 (jit(grad) 3.7-4.1 times
+the forward pass); 600: 7.3 / 26.5 (f_batch 5.0); 1,000: 6.4 / 636, where the adjoint program's
+stages grow past what XLA fuses well. At 300 against 150 the mass matrix was unchanged (17.6 and
+15.7 us under jit(vmap), f_batch 13.8 and 14.9) and the forward dynamics faster (43 against 71 us,
+compiled in 55 s against 126). 300 keeps both standards of issue 37 with room (jit(vmap) within
+1.5 times f_batch, jit(grad) within 4 times jit(vmap)) at half the time of 150.
 
 Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
 their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
 their body exceeds STAGE_ABOVE statements; their adjoint program (plain jnp code evaluated
 forward) is staged with them. The Talos' jax.jit(jax.grad(...)) of the vmapped inverse dynamics'
 loss (2,000 states, the machine loaded about once): with the adjoint program in one body it did
-not finish compiling in 7 minutes; staged, compiled in 144 s, 81 us a state against the forward
-pass's 19 us (4.3 times).
+not finish compiling in 7 minutes; in stages of 150, compiled in 144 s, 81 us a state against the
+forward pass's 19 us (4.3 times); in stages of 300, 33-37 us, compiled in 52 s.
 """
 
 from __future__ import annotations
@@ -33,7 +42,7 @@ __all__ = ["STAGE_ABOVE", "STAGE_SIZE", "long_body", "cut_into_stages", "stages"
 #: it compiles well as one body).
 STAGE_ABOVE = 1000
 #: Statements per stage (chosen by measurement on the Talos: module docstring).
-STAGE_SIZE = 150
+STAGE_SIZE = 300
 
 
 def long_body(spec: FunctionSpec) -> bool:
