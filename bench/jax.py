@@ -16,7 +16,8 @@ of --functions (default inverse dynamics, M and forward dynamics) is timed per s
 * NumPy, one call on the whole batch of N states (default 100,000), divided by N;
 * JAX: the module's f_batch (jax.vmap of the one-state function, jax.jit with XLA's CPU fusion
   emitters off, the module's own compiler option) on the batch, the arrays already on the device,
-  after a first call that compiles (its time is listed); then jax.jit(jax.vmap(f)) of the
+  after a first call that compiles (its time is listed); jax.jit(f) of the one-state function
+  called from Python on one state, per call (dispatch included); then jax.jit(jax.vmap(f)) of the
   one-state function with XLA's defaults, as one's own jit gets it, and
   jax.jit(jax.grad(lambda x: jnp.sum(jax.vmap(f)(x, ...) ** 2))), its gradient with respect to
   the first argument (q), through the adjoint program where there is one, with --xla-grad also
@@ -24,8 +25,9 @@ of --functions (default inverse dynamics, M and forward dynamics) is timed per s
   the same loss along one direction; jax.jit(jax.vmap(jax.jacfwd(f))) (by q) and
   jax.jit(jax.vmap(jax.jacrev(f))), and jax.jit(jax.vmap(f_derivatives)) where the module has the
   generated derivative functions of f (--groups with derivatives); a jax.lax.scan over the
-  states, one call a step; then (unless --no-xla-flags) f_batch again in a process with
-  XLA_FLAGS turning the emitters off for everything;
+  states, one call a step, and one over steps of ROLLOUTS (50) states, jax.vmap(f) a step (a
+  batch of rollouts, as learning and MPC pipelines scan them); then (unless --no-xla-flags)
+  f_batch again in a process with XLA_FLAGS turning the emitters off for everything;
 * ADAM (adam-robotics, its JAX backend; the Panda only) on the same URDF and batch,
   jax.jit(jax.vmap(..)):
   M is the joint block of its floating-base mass_matrix, inverse dynamics M qdd + h, h its
@@ -47,6 +49,7 @@ import argparse
 import functools
 import importlib.util
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -73,6 +76,11 @@ ROBOTS = {
 }
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
 NCHECK = 8
+#: States a step of the scan of a batch of rollouts (column "scan, 50 a step"): 100,000, 20,000 and
+#: 2,000 states are whole numbers of steps.
+ROLLOUTS = 50
+#: Calls of a run of the column "jit(f), 1 state".
+ONE_STATE_CALLS = 2000
 #: XLA's CPU fusion emitters (the default in recent jax) can make a large fused function far slower
 NO_EMITTERS = "--xla_cpu_use_fusion_emitters=false"
 
@@ -109,8 +117,10 @@ def _arguments(states, function: str):
     return tuple(states[n] for n in names[function])
 
 
-def _jax_timing(fn, args, count: int, reps: int) -> tuple[float, float]:
-    """(seconds of the first call, which compiles; median seconds per state of the next calls)."""
+def _jax_timing(fn, args, count: int, reps: int, calls: int = 1) -> tuple[float, float]:
+    """(seconds of the first call, which compiles; the median over `reps` runs of the seconds per
+    state of `calls` calls each waited for, on `count` states a call): with calls > 1 on one state,
+    a jitted one-state function called from Python, dispatch included."""
     import jax
 
     t = time.perf_counter()
@@ -119,9 +129,10 @@ def _jax_timing(fn, args, count: int, reps: int) -> tuple[float, float]:
     times = []
     for _ in range(reps):
         t = time.perf_counter()
-        jax.block_until_ready(fn(*args))
+        for _ in range(calls):
+            jax.block_until_ready(fn(*args))
         times.append(time.perf_counter() - t)
-    return compile_s, statistics.median(times) / count
+    return compile_s, statistics.median(times) / (count * calls)
 
 
 def _fixed_fingers(urdf: str, folder: str) -> tuple[str, list[float]]:
@@ -223,9 +234,19 @@ def worker(
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in functions}}
     if own:
-        out.update(own={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, xla_grad={})
+        out.update(own={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, scan_batch={}, xla_grad={})
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
         routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
+        routes["scan_batch"] = {f: _scan_route(jax, getattr(arm, f), ROLLOUTS) for f in functions}
+        out["one"] = {}
+        for f in functions:  # jax.jit(f) called from Python on one state
+            log(f"jit(f), 1 state {f}")
+            one = jax.jit(getattr(arm, f))
+            state = tuple(a[0] for a in _arguments(device, f))
+            out["one"][f] = _jax_timing(one, state, 1, reps, ONE_STATE_CALLS)  # its first call compiles
+            got = np.asarray(one(*(a[0] for a in _arguments(check, f))))
+            want = np.asarray(reference[f])[0]
+            out["error"][f"jit(f), 1 state {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
         gradients = {}
         for f in functions:
             fn, args = getattr(arm, f), _arguments(device, f)
@@ -272,9 +293,22 @@ def worker(
     return out
 
 
-def _scan_route(jax, f):
-    """jit of a jax.lax.scan over the states, one call of the one-state f a step."""
-    return jax.jit(lambda *xs: jax.lax.scan(lambda c, x: (c, f(*x)), 0.0, xs)[1])
+def _scan_route(jax, f, rollouts: int = 0):
+    """jit of a jax.lax.scan over the states, one call of the one-state f a step; with `rollouts`,
+    the states taken as a trajectory of steps of that many states (or of the largest divisor of the
+    batch below it), jax.vmap(f) a step: a batch of rollouts, as a learning or MPC pipeline scans
+    them, its output flattened back to one row a state."""
+    if not rollouts:
+        return jax.jit(lambda *xs: jax.lax.scan(lambda c, x: (c, f(*x)), 0.0, xs)[1])
+    batched = jax.vmap(f)
+
+    def scan(*xs):
+        width = math.gcd(xs[0].shape[0], rollouts)
+        steps = [x.reshape((x.shape[0] // width, width, *x.shape[1:])) for x in xs]
+        out = jax.lax.scan(lambda c, x: (c, batched(*x)), 0.0, steps)[1]
+        return out.reshape((xs[0].shape[0], *out.shape[2:]))
+
+    return jax.jit(scan)
 
 
 def log(text: str) -> None:
@@ -342,8 +376,9 @@ def table(results: dict, opts, robot) -> list[str]:
     here, plain, there = results["here"], results.get("plain"), results.get("there")
     ns = lambda s: f"{1e9 * s:,.0f}"  # noqa: E731
     pick = lambda route, f: ns(route[f][1]) if route and f in route else "-"  # noqa: E731
-    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})"]
+    head = ["function", "NumPy 1 state", "NumPy batch", f"JAX f_batch (jax {here['jax']})", "jit(f), 1 state"]
     head += ["jit(vmap(f))", "jit(grad)", "jit(grad), XLA", "jacfwd", "jacrev", "f_derivatives", "scan"]
+    head += [f"scan, {ROLLOUTS} a step"]
     head += ["f_batch, XLA_FLAGS"]
     if there:
         head += [f"JAX (jax {there['jax']})", f"ADAM {there.get('adam_version', '')}"]
@@ -352,8 +387,10 @@ def table(results: dict, opts, robot) -> list[str]:
     for f in opts.functions:
         one, batch = results["numpy"][f]
         jx = min(here["symdyn"][f][1], plain["symdyn"][f][1]) if plain else here["symdyn"][f][1]
-        row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here["own"], f), pick(here["grad"], f)]
+        row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here.get("one"), f)]
+        row += [pick(here["own"], f), pick(here["grad"], f)]
         row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "derivatives", "scan")]
+        row += [pick(here.get("scan_batch"), f)]
         row += [pick(plain and plain["symdyn"], f)]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
@@ -368,10 +405,11 @@ def table(results: dict, opts, robot) -> list[str]:
     def compiles(name: str, route) -> str:
         return f"{name} " + ", ".join(f"{f} {route[f][0]:.1f}" for f in opts.functions if f in route)
 
-    routes = [("f_batch", here["symdyn"]), ("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
+    routes = [("f_batch", here["symdyn"]), ("jit(f), 1 state", here.get("one"))]
+    routes += [("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
     routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("jacrev", here["jacrev"])]
     routes += [("f_derivatives", here["derivatives"])]
-    routes += [("scan", here["scan"])]
+    routes += [("scan", here["scan"]), (f"scan, {ROLLOUTS} a step", here.get("scan_batch"))]
     routes += [("XLA_FLAGS", plain["symdyn"])] if plain else []
     routes += [("ADAM", there["adam"])] if there else []
     lines = [
@@ -380,7 +418,9 @@ def table(results: dict, opts, robot) -> list[str]:
         _row(["-" * w for w in widths], widths),
         *(_row(r, widths) for r in rows[1:]),
         "",
-        "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(vmap(f)): "
+        "f_batch: the module's batch twin (compiled with the CPU fusion emitters off); jit(f), 1 state: "
+        f"jax.jit of the one-state function called from Python on one state, per call ({ONE_STATE_CALLS:,} "
+        "calls, each waited for, dispatch included); jit(vmap(f)): "
         "the one-state function under XLA's defaults; jit(grad): jax.jit(jax.grad(lambda x: "
         "jnp.sum(jax.vmap(f)(x, ...) ** 2))), argument 0 (q), XLA's defaults, through the module's "
         "adjoint program or custom_jvp rule where it has one (the inverse dynamics' linear primitive, the "
@@ -390,7 +430,8 @@ def table(results: dict, opts, robot) -> list[str]:
         "f_derivatives: jax.jit(jax.vmap(f_derivatives)), the generated derivative functions "
         "(every Jacobian); "
         "scan: jax.jit of jax.lax.scan over the "
-        "states, one call a step; "
+        f"states, one call a step; scan, {ROLLOUTS} a step: the same over steps of {ROLLOUTS} states, "
+        "jax.vmap(f) a step (a batch of rollouts); "
         f"XLA_FLAGS: {NO_EMITTERS} for the process; vmap/f_batch and grad/vmap: ratios of those columns "
         "(one run; jit(vmap(f)) and jit(grad) timed in turns, call by call); "
         "JAX/NumPy batch: the faster f_batch column; JAX/ADAM: f_batch and ADAM under ADAM's jax",
