@@ -17,8 +17,10 @@ a size), in us a state, jit(vmap) / jit(grad): 150: 24.5-27.5 / 57-63; 200: 20.9
 the forward pass); 600: 7.3 / 26.5 (f_batch 5.0); 1,000: 6.4 / 636, where the adjoint program's
 stages grow past what XLA fuses well. At 300 against 150 the mass matrix was unchanged (17.6 and
 15.7 us under jit(vmap), f_batch 13.8 and 14.9) and the forward dynamics faster (43 against 71 us,
-compiled in 55 s against 126). 300 keeps both standards of issue 37 with room (jit(vmap) within
-1.5 times f_batch, jit(grad) within 4 times jit(vmap)) at half the time of 150.
+compiled in 55 s against 126). 300 halves the times of 150. The ratio of jit(grad) to jit(vmap)
+is not steady between processes at any size: at 300, 2.7 to 3.4 in the runs above and 6.0 in a
+bench run (bench/results/jax_talos.txt: 42.9 against 7.2 us, where stages of 150 had 65.2 against
+16.6 us, 3.9 times), the forward pass moving from 7 to 15 us.
 
 Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
 their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
@@ -26,7 +28,7 @@ their body exceeds STAGE_ABOVE statements; their adjoint program (plain jnp code
 forward) is staged with them. The Talos' jax.jit(jax.grad(...)) of the vmapped inverse dynamics'
 loss (2,000 states, the machine loaded about once): with the adjoint program in one body it did
 not finish compiling in 7 minutes; in stages of 150, compiled in 144 s, 81 us a state against the
-forward pass's 19 us (4.3 times); in stages of 300, 33-37 us, compiled in 52 s.
+forward pass's 19 us (4.3 times); in stages of 300, 33-43 us, compiled in 45-68 s.
 """
 
 from __future__ import annotations
