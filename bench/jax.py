@@ -117,6 +117,12 @@ def _arguments(states, function: str):
     return tuple(states[n] for n in names[function])
 
 
+def _relative(got, want) -> float:
+    """max |got - want| over max |want| (the oracle's largest entry; 1e-300 when it is all zeros)."""
+    got, want = np.asarray(got, dtype=np.float64), np.asarray(want, dtype=np.float64)
+    return float(np.max(np.abs(got - want)) / max(float(np.max(np.abs(want))), 1e-300))
+
+
 def _jax_timing(fn, args, count: int, reps: int, calls: int = 1) -> tuple[float, float]:
     """(seconds of the first call, which compiles; the median over `reps` runs of the seconds per
     state of `calls` calls each waited for, on `count` states a call): with calls > 1 on one state,
@@ -234,19 +240,18 @@ def worker(
     out: dict = {"jax": jax.__version__, "symdyn": {}, "adam": {}, "error": {}}
     routes = {"symdyn": {f: getattr(arm, f"{f}_batch") for f in functions}}
     if own:
-        out.update(own={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, scan_batch={}, xla_grad={})
+        out.update(own={}, one={}, grad={}, jacfwd={}, jacrev={}, derivatives={}, scan={}, scan_batch={})
+        out.update(xla_grad={})
         routes["own"] = {f: jax.jit(jax.vmap(getattr(arm, f))) for f in functions}
         routes["scan"] = {f: _scan_route(jax, getattr(arm, f)) for f in functions}
         routes["scan_batch"] = {f: _scan_route(jax, getattr(arm, f), ROLLOUTS) for f in functions}
-        out["one"] = {}
         for f in functions:  # jax.jit(f) called from Python on one state
             log(f"jit(f), 1 state {f}")
             one = jax.jit(getattr(arm, f))
             state = tuple(a[0] for a in _arguments(device, f))
             out["one"][f] = _jax_timing(one, state, 1, reps, ONE_STATE_CALLS)  # its first call compiles
-            got = np.asarray(one(*(a[0] for a in _arguments(check, f))))
-            want = np.asarray(reference[f])[0]
-            out["error"][f"jit(f), 1 state {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
+            got = one(*(a[0] for a in _arguments(check, f)))
+            out["error"][f"jit(f), 1 state {f}"] = _relative(got, np.asarray(reference[f])[0])
         gradients = {}
         for f in functions:
             fn, args = getattr(arm, f), _arguments(device, f)
@@ -275,9 +280,7 @@ def worker(
     for route, fns in routes.items():
         for f in functions:
             log(f"{route} {f}")
-            got = np.asarray(fns[f](*_arguments(check, f)))
-            want = np.asarray(reference[f])
-            out["error"][f"{route} {f}"] = float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
+            out["error"][f"{route} {f}"] = _relative(fns[f](*_arguments(check, f)), reference[f])
             out[route][f] = _jax_timing(fns[f], _arguments(device, f), count, reps)
     if own:  # grad/vmap from interleaved calls: the load of a shared machine moves between routes
         for f in functions:
@@ -387,10 +390,10 @@ def table(results: dict, opts, robot) -> list[str]:
     for f in opts.functions:
         one, batch = results["numpy"][f]
         jx = min(here["symdyn"][f][1], plain["symdyn"][f][1]) if plain else here["symdyn"][f][1]
-        row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here.get("one"), f)]
+        row = [f, ns(one), ns(batch), pick(here["symdyn"], f), pick(here["one"], f)]
         row += [pick(here["own"], f), pick(here["grad"], f)]
         row += [pick(here[key], f) for key in ("xla_grad", "jacfwd", "jacrev", "derivatives", "scan")]
-        row += [pick(here.get("scan_batch"), f)]
+        row += [pick(here["scan_batch"], f)]
         row += [pick(plain and plain["symdyn"], f)]
         if there:
             row += [ns(there["symdyn"][f][1]), ns(there["adam"][f][1])]
@@ -405,11 +408,11 @@ def table(results: dict, opts, robot) -> list[str]:
     def compiles(name: str, route) -> str:
         return f"{name} " + ", ".join(f"{f} {route[f][0]:.1f}" for f in opts.functions if f in route)
 
-    routes = [("f_batch", here["symdyn"]), ("jit(f), 1 state", here.get("one"))]
+    routes = [("f_batch", here["symdyn"]), ("jit(f), 1 state", here["one"])]
     routes += [("jit(vmap(f))", here["own"]), ("jit(grad)", here["grad"])]
     routes += [("jit(grad), XLA", here["xla_grad"]), ("jacfwd", here["jacfwd"]), ("jacrev", here["jacrev"])]
     routes += [("f_derivatives", here["derivatives"])]
-    routes += [("scan", here["scan"]), (f"scan, {ROLLOUTS} a step", here.get("scan_batch"))]
+    routes += [("scan", here["scan"]), (f"scan, {ROLLOUTS} a step", here["scan_batch"])]
     routes += [("XLA_FLAGS", plain["symdyn"])] if plain else []
     routes += [("ADAM", there["adam"])] if there else []
     lines = [
@@ -469,6 +472,11 @@ def main(argv=None) -> int:
         return 0
     opts.groups = tuple(opts.groups.split(","))
     opts.functions = tuple(opts.functions.split(","))
+    if opts.batch < 1 or opts.reps < 1:
+        parser.error("--batch and --reps must be at least 1")
+    unknown = sorted(set(opts.functions) - set(FUNCTIONS))
+    if unknown:
+        parser.error(f"--functions takes {', '.join(FUNCTIONS)}; not {', '.join(unknown)}")
     if opts.adam_python and opts.robot != "panda":
         raise SystemExit("bench/jax.py: --adam-python compares the Panda only")
     suffix = "" if opts.robot == "panda" else f"_{opts.robot}"

@@ -29,11 +29,6 @@ from jax_ops import bench_jax  # noqa: E402  (bench/jax_ops.py: bench/jax.py und
 FUNCTIONS = ("inverse_dynamics", "mass_matrix", "forward_dynamics")
 
 
-def _relative(got, want) -> float:
-    got, want = np.asarray(got, dtype=np.float64), np.asarray(want, dtype=np.float64)
-    return float(np.max(np.abs(got - want)) / max(float(np.max(np.abs(want))), 1e-300))
-
-
 def main(argv=None) -> int:
     bench = bench_jax()
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -98,7 +93,7 @@ def main(argv=None) -> int:
                     if device is cpu:
                         reference[route] = np.asarray(out)
                     else:
-                        worst = max(worst, _relative(out, reference[route]))
+                        worst = max(worst, bench._relative(out, reference[route]))
                 diff = "-" if device is cpu else f"{worst:.1e}"
                 print(
                     f"{name:<18} {device.platform + ':' + str(device.id):<14} "
