@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import sympy as sp
 from robots import example
 
 from symdyn import load_robot
@@ -31,6 +32,7 @@ from symdyn.cli import main
 from symdyn.codegen import context, render
 from symdyn.codegen.jax import stages as jax_stages
 from symdyn.codegen.jax import target as jax_target
+from symdyn.codegen.python.printer import NumpyPrinter
 from symdyn.errors import SymdynWarning
 from symdyn.generated_modules import load_module
 from symdyn.oracle import closed_loops as oc
@@ -307,27 +309,33 @@ def test_forward_dynamics_rule_by_the_quaternion_entries(x64, tmp_path):
     space of the generated Jacobians: jax.jacrev of the
     forward dynamics by q equals central differences of the numeric oracle in q's entries (the
     base position's columns 0, a change along the quaternion none), and so does jax.jacrev of the
-    forward dynamics through the inverse dynamics' adjoint (a module with M too). Only these
-    functions are rendered (the groups' other functions dropped before printing)."""
+    forward dynamics through the inverse dynamics' adjoint (a module with the inverse dynamics too,
+    without its derivative function). Only these functions are rendered (the groups' other
+    functions dropped before printing)."""
     (tmp_path / "flyer.yaml").write_text(FLYER)
     robot = load_robot(tmp_path / "flyer.yaml")
     full = context(robot, functions=["dynamics", "derivatives"])
-    keep = ("inverse_dynamics", "forward_dynamics", "forward_dynamics_derivatives", "mass_matrix")
-    modules = []
-    for kept in (keep[:3], keep):  # without M the rule, with M the identity (IDENTITIES)
+    # the forward dynamics with its derivative function: the rule (RULES); with the inverse
+    # dynamics: the identity (IDENTITIES, taken over the rule when a module holds all three)
+    kinds = {
+        "rule": ("forward_dynamics", "forward_dynamics_derivatives"),
+        "identity": ("inverse_dynamics", "forward_dynamics"),
+    }
+    modules = {}
+    for kind, kept in kinds.items():
         ctx = dataclasses.replace(full, functions=tuple(f for f in full.functions if f.name in kept))
         (text,) = jax_target.render(ctx).values()
-        (tmp_path / f"flyer{len(kept)}_jax.py").write_text(text)
-        modules.append(
-            load_module(tmp_path / f"flyer{len(kept)}_jax.py", f"_symdyn_test_flyer{len(kept)}_jax")
-        )
-    mod, identity = modules
+        assert ("_forward_dynamics_jvp" in text) == (kind == "rule"), kind
+        (tmp_path / f"flyer_{kind}_jax.py").write_text(text)
+        modules[kind] = load_module(tmp_path / f"flyer_{kind}_jax.py", f"_symdyn_test_flyer_{kind}_jax")
+    identity = modules["identity"]
     rng = np.random.default_rng(37)
     q = np.concatenate([rng.normal(size=3), 1.7 * rng.normal(size=4), rng.uniform(-1, 1, robot.n)])
     qd, tau = rng.normal(size=(2, robot.nv))
     qdd = rng.normal(size=robot.nv)
     pairs = {}
     for name, args in (("inverse_dynamics", (q, qd, qdd)), ("forward_dynamics", (q, qd, tau))):
+        mod = modules["identity" if name == "inverse_dynamics" else "rule"]
         f, plain = getattr(mod, name), getattr(mod, f"_{name}_plain")
         # vmap and lax.scan of both: test_every_mode_of_the_ruled_functions_equals_autodiff; the
         # forward dynamics' hessian took 30 s to compile here: its Hessian-vector product
@@ -541,9 +549,22 @@ def test_lax_scan_simulation(modules):
     _close(qd_end, qd, rtol=1e-10)
 
 
+def test_a_stage_carries_only_what_it_reads_and_defines():
+    """cut_into_stages: a stage's loop takes the values its statements read and returns its own
+    values read later; a value read two stages on passes the stage between outside its loop."""
+    a, b, t0, t1, t2 = sp.symbols("a b t0 t1 t2")
+    body = [(t0, a * b), (t1, a + 1), (t2, t0 + b)]
+    got = jax_stages.cut_into_stages(body, [t1, t2], {a, b}, NumpyPrinter(module="jnp"), 1)
+    assert [(s["start"], s["stop"], s["inputs"], s["outputs"]) for s in got] == [
+        (0, 1, ["a", "b"], ["t0"]),
+        (1, 2, ["a"], ["t1"]),
+        (2, 3, ["b", "t0"], ["t2"]),
+    ]
+
+
 def test_a_staged_body_equals_the_plain_one(modules, tmp_path, monkeypatch):
     """A long body cut into stages (symdyn.codegen.jax.stages: while loops of one pass that XLA
-    does not fuse across; Roger's arm staged by 12 statements, as the Talos' functions are by 150:
+    does not fuse across; Roger's arm staged by 12 statements, as the Talos' functions are by 300:
     the inverse dynamics and its adjoint program, the forward dynamics differentiated through it,
     the mass matrix through its body without the loops) gives the committed module's values,
     forward and reverse derivatives (jacfwd through the loops, the gradient of a vmapped loss),

@@ -3428,10 +3428,13 @@ def _forward_dynamics_plain(q, qd, tau, p):
 def _forward_dynamics_adjoint(q, qd, tau, p, w):
     """The cotangents of (q, qd, tau, p) for the cotangent w of forward_dynamics's qdd, by the identity
     inverse_dynamics(q, qd, qdd, p) = tau at qdd = forward_dynamics(q, qd, tau, p): with u = M(q)^-1 w
-    (M = mass_matrix, symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd,
-    p (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T."""
-    qdd = _forward_dynamics_plain(q, qd, tau, p)
-    u = jnp.linalg.solve(mass_matrix(q, p), w)
+    (M symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd, p
+    (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T. qdd and u in one pass of
+    the body: qdd = M^-1 (tau - V - G - F) is affine in tau, so its derivative along w is u, the
+    unrolled LDL^T's triangular solves of w, JAX's forward mode computing only what depends on
+    tau (the Talos' jax.jit(jax.grad(...)) of the vmapped loss 27 us a state, against 48 by
+    jnp.linalg.solve of M: docs/jax.md)."""
+    qdd, u = jax.jvp(lambda t: _forward_dynamics_plain(q, qd, t, p), (tau,), (w,))
     dq, dqd, _, dp = _inverse_dynamics_adjoint(q, qd, qdd, p, u)
     return -dq, -dqd, u, -dp
 

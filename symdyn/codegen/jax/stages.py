@@ -6,21 +6,22 @@ inverse dynamics on a free flyer, 1,870 statements: 212 sines for its 32, 109 ms
 60 us for its f_batch, compiled with the fusion emitters off; docs/jax.md). XLA does not fuse
 across a while loop, so the body is cut into stages of STAGE_SIZE statements, each the body of a
 jax.lax.while_loop whose trip count is 1 computed at run time (the module's _once: a population
-count XLA cannot bound), carrying the values that later statements read. Measured on the Talos'
-inverse dynamics (2,000 states, the machine loaded about fivefold): 32 us a state under
-jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us, in stages of 150.
+count XLA cannot bound), carrying the values its statements read and returning those later
+statements read (cut_into_stages). Measured on the Talos' inverse dynamics (2,000 states, the
+machine loaded about fivefold): 32 us a state under jax.jit(jax.vmap(...)), compiled in 21 s,
+its f_batch 66 us, in stages of 150.
 
-STAGE_SIZE was then measured on the generated Talos module with nothing else running (2,000
-states; jit(vmap) and jit(grad) of the vmapped inverse dynamics' loss timed in turns, one process
-a size), in us a state, jit(vmap) / jit(grad): 150: 24.5-27.5 / 57-63; 200: 20.9 / 49.8; 250:
-15.3 / 38.0; 300: 9.9-12.0 / 33-37 (f_batch 8.8); 400: 6.7-7.7 / 27-28 (jit(grad) 3.7-4.1 times
-the forward pass); 600: 7.3 / 26.5 (f_batch 5.0); 1,000: 6.4 / 636, where the adjoint program's
-stages grow past what XLA fuses well. At 300 against 150 the mass matrix was unchanged (17.6 and
-15.7 us under jit(vmap), f_batch 13.8 and 14.9) and the forward dynamics faster (43 against 71 us,
-compiled in 55 s against 126). 300 halves the times of 150. The ratio of jit(grad) to jit(vmap)
-is not steady between processes at any size: at 300, 2.7 to 3.4 in the runs above and 6.0 in a
-bench run (bench/results/jax_talos.txt: 42.9 against 7.2 us, where stages of 150 had 65.2 against
-16.6 us, 3.9 times), the forward pass moving from 7 to 15 us.
+Each loop carries only what its stage reads and defines. Every stage first carried every value
+live across it (those it reads and those later stages read), up to 870 values a loop in the
+Talos' adjoint program (the loops' bookkeeping, not their arithmetic, then dominated; how XLA
+spends it was not isolated: a small loop passing five values through had one copy): on the
+generated Talos module with nothing else running (2,000 states, stages of 300, us a state),
+jax.jit(jax.vmap(...)) of the inverse dynamics 10.6 -> 6.6, its adjoint program 27.8 -> 9.3,
+jax.jit(jax.grad(...)) of the vmapped loss 37.3 -> 16.4 (compiled in 67 -> 33 s), f_batch 7.5
+-> 5.6. STAGE_SIZE was measured then (the same runs, jit(vmap) / adjoint / jit(grad)): 200: 7.4 /
+12.7 / 22.9; 300: 6.6 / 9.3 / 16.4; 500: 6.9 / 11.8 / 17.8. Before, with every live value
+carried: 150: 24.5-27.5 / - / 57-63; 300: 9.9-12.0 / 27.8 / 33-37; 1,000: 6.4 / - / 636, where
+the adjoint program's stages grow past what XLA fuses well.
 
 Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
 their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
@@ -68,9 +69,12 @@ def cut_into_stages(
 ) -> list[dict]:
     """The stages of the straight-line body `temporaries` (then `outputs` read), runs of `size`:
     for each, the slice of temporaries [start, stop), `inputs`, the names defined before it (of
-    `defined`, the symbols the body reads from its arguments, or temporaries) that it or later
-    statements read, and `outputs`, those defined up to its end read after it (the next stage's
-    inputs), all printed by `printer`, in a fixed order."""
+    `defined`, the symbols the body reads from its arguments, or temporaries) that its own
+    statements read, and `outputs`, its temporaries read after it, all printed by `printer`, in
+    a fixed order. A value goes into the loops of the stages that read it only: one defined in
+    stage 1 and read in stage 5 is an output of stage 1 and an input of stage 5, and stages 2 to
+    4 do not carry it (module docstring: carrying every live value made the Talos' adjoint
+    program three times slower)."""
     after: list[set[sp.Symbol]] = [set() for _ in range(len(temporaries) + 1)]
     after[-1] = set().union(*(sp.sympify(e).free_symbols for e in outputs))
     for k in range(len(temporaries) - 1, -1, -1):
@@ -83,8 +87,9 @@ def cut_into_stages(
     out = []
     for start in range(0, len(temporaries), size):
         stop = min(start + size, len(temporaries))
-        inputs = defined & after[start]
-        defined |= {s for s, _ in temporaries[start:stop]}
-        outputs = names(defined & after[stop])
-        out.append({"start": start, "stop": stop, "inputs": names(inputs), "outputs": outputs})
+        read = set().union(*(e.free_symbols for _, e in temporaries[start:stop]))
+        own = {s for s, _ in temporaries[start:stop]}
+        inputs = names(defined & read)
+        defined |= own
+        out.append({"start": start, "stop": stop, "inputs": inputs, "outputs": names(own & after[stop])})
     return out

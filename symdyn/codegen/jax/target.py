@@ -79,13 +79,17 @@ RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
 
 
 #: The functions reverse-differentiated through another's adjoint program by an identity,
-#: {function: (inverse dynamics, mass matrix)}: differentiating ID(q, qd, FD(q, qd, tau)) = tau
-#: gives w^T dqdd/dx = -(M^-1 w)^T dID/dx for x = q, qd, p (at qdd = FD) and w^T dqdd/dtau =
-#: (M^-1 w)^T: one solve and the inverse dynamics' adjoint program. Chosen by measurement (the
-#: Panda, bench/jax.py on the loaded machine): jax.jit(jax.grad(...)) through jax.vmap 15.5 us a
-#: state (2.7 times the forward pass, compiled in 19 s), against 108 us by RULES (compiled in 551 s).
-#: Taken over RULES when the module holds the three functions with these inputs.
-IDENTITIES = {"forward_dynamics": ("inverse_dynamics", "mass_matrix")}
+#: {function: inverse dynamics}: differentiating ID(q, qd, FD(q, qd, tau)) = tau gives
+#: w^T dqdd/dx = -(M^-1 w)^T dID/dx for x = q, qd, p (at qdd = FD) and w^T dqdd/dtau = (M^-1 w)^T,
+#: where M^-1 w is FD's derivative along tau = w (FD is affine in tau): one pass of FD's body in
+#: forward mode and the inverse dynamics' adjoint program. Chosen by measurement (bench/jax.py,
+#: docs/jax.md): for the Panda (on the loaded machine, M^-1 w then by jnp.linalg.solve of M),
+#: jax.jit(jax.grad(...)) through jax.vmap 15.5 us a state (2.7 times the forward pass, compiled
+#: in 19 s), against 108 us by RULES (compiled in 551 s); for the Talos (quiet, 2,000 states)
+#: 27 us a state (3.1 times the forward pass), against 48 us by jnp.linalg.solve of M (a batch of
+#: 38 x 38 solves took 15 us a state). Taken over RULES when the module holds both functions with
+#: these inputs.
+IDENTITIES = {"forward_dynamics": "inverse_dynamics"}
 
 #: The functions without an adjoint program or rule that are staged when their body is long
 #: (symdyn.codegen.jax.stages), differentiated through their body without the loops (the
@@ -192,18 +196,18 @@ def rules(ctx: RenderContext) -> dict[str, str]:
 
 
 def identities(ctx: RenderContext, adjoints: dict[str, dict]) -> dict[str, dict]:
-    """{function: {"inverse": ..., "mass": ..., "shape": ...}} for the entries of IDENTITIES whose
-    three functions are in `ctx` with the inputs (q, qd, tau, p), (q, qd, qdd, p) and (q, p), the
-    inverse dynamics having an adjoint program (`adjoints`)."""
+    """{function: {"inverse": ..., "shape": ...}} for the entries of IDENTITIES whose two functions
+    are in `ctx` with the inputs (q, qd, tau, p) and (q, qd, qdd, p), the inverse dynamics having an
+    adjoint program (`adjoints`)."""
     specs = {spec.name: spec for spec in ctx.functions}
-    wanted = (["q", "qd", "tau", "p"], ["q", "qd", "qdd", "p"], ["q", "p"])
+    wanted = (["q", "qd", "tau", "p"], ["q", "qd", "qdd", "p"])
     out = {}
-    for name, (inverse, mass) in IDENTITIES.items():
-        found = [specs.get(n) for n in (name, inverse, mass)]
+    for name, inverse in IDENTITIES.items():
+        found = [specs.get(n) for n in (name, inverse)]
         if inverse not in adjoints or any(s is None for s in found):
             continue
         if [[inp.name for inp in s.inputs] for s in found] == list(wanted) and len(found[0].results) == 1:
-            out[name] = {"inverse": inverse, "mass": mass, "shape": [found[0].results[0].size]}
+            out[name] = {"inverse": inverse, "shape": [found[0].results[0].size]}
     return out
 
 
