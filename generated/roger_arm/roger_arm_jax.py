@@ -271,7 +271,7 @@ def _batched(args, axes):
     ]
 
 
-def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True):
+def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True, valued=False):
     """plain (its arguments, one output of `shape`) as a jax.custom_jvp function whose tangent is
     a linear primitive whose transpose is the adjoint program `adjoint` (plain's arguments and the
     output's cotangent w -> w^T d(output)/d(argument) for each argument, p's included).
@@ -290,7 +290,15 @@ def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True):
     jax.jacrev for at most _FLAT_ADJOINTS entries; without, batches run in nested vmaps up to
     _FLAT_ADJOINTS entries and over one axis above (the forward dynamics through the identity,
     whose adjoint recomputes the forward pass and M: the Panda's jacfwd took 42 us a state
-    nested, 58 us by the rows, 110 us flat; the Solo-12's did not compile in 8 minutes nested)."""
+    nested, 58 us by the rows, 110 us flat; the Solo-12's did not compile in 8 minutes nested).
+    With `valued`, the adjoint program reads plain's value too: it is passed to the primitive as
+    one more primal, after plain's arguments, with a zero tangent, and the adjoint program takes
+    it before w and returns a cotangent for it (zeros), which is dropped."""
+    function = plain
+    if valued:
+
+        def plain(*args):
+            return function(*args[:-1])
 
     def tangent(*args):
         n = len(args) // 2
@@ -388,11 +396,14 @@ def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True):
     ad.primitive_transposes[primitive] = transpose
     ad.primitive_jvps[primitive] = derivative
     batching.primitive_batchers[primitive] = batch
-    ruled = jax.custom_jvp(plain)
+    ruled = jax.custom_jvp(function)
 
     @ruled.defjvp
     def _(primals, tangents):
-        return plain(*primals), primitive.bind(*primals, *tangents, levels=0)
+        value = function(*primals)
+        if valued:
+            return value, primitive.bind(*primals, value, *tangents, jnp.zeros_like(value), levels=0)
+        return value, primitive.bind(*primals, *tangents, levels=0)
 
     return ruled
 
@@ -770,25 +781,34 @@ def _forward_dynamics_plain(q, qd, tau, p):
 
 
 def _forward_dynamics_adjoint(q, qd, tau, p, w):
-    """The cotangents of (q, qd, tau, p) for the cotangent w of forward_dynamics's qdd, by the identity
-    inverse_dynamics(q, qd, qdd, p) = tau at qdd = forward_dynamics(q, qd, tau, p): with u = M(q)^-1 w
-    (M symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd, p
-    (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T. qdd and u in one pass of
-    the body: qdd = M^-1 (tau - V - G - F) is affine in tau, so its derivative along w is u, the
-    unrolled LDL^T's triangular solves of w, JAX's forward mode computing only what depends on
-    tau (the Talos' jax.jit(jax.grad(...)) of the vmapped loss 27 us a state, against 48 by
-    jnp.linalg.solve of M: docs/jax.md)."""
+    """The cotangents of (q, qd, tau, p) for the cotangent w of forward_dynamics's qdd, by the
+    identity inverse_dynamics(q, qd, qdd, p) = tau at qdd = forward_dynamics(q, qd, tau, p): with
+    u = M(q)^-1 w (M symmetric), w^T dqdd/dx = -u^T dinverse_dynamics/dx for x = q, qd, p
+    (_inverse_dynamics_adjoint at weight u) and w^T dqdd/dtau = u^T. qdd = M^-1 (tau - V - G
+    - F) is affine in tau, so u is its derivative along w: the unrolled LDL^T's triangular solves
+    of w by JAX's forward mode of the body (against jnp.linalg.solve of M: the Talos' jax.jit(
+    jax.grad(...)) of the vmapped loss 27.5 against 48 us a state, a batch of its 38 x 38 solves
+    alone 15 us; the Panda's 1.6 against 2.9 us; docs/jax.md).
+    qdd and u from one jax.jvp, which XLA merges with the function's own pass: the Panda's 1.6 us
+    a state against 2.3 with qdd passed from that pass (valued in _adjoint_ruled).
+    """
     qdd, u = jax.jvp(lambda t: _forward_dynamics_plain(q, qd, t, p), (tau,), (w,))
     dq, dqd, _, dp = _inverse_dynamics_adjoint(q, qd, qdd, p, u)
     return -dq, -dqd, u, -dp
 
 
 #: forward mode by JAX's forward mode of the body, reverse mode through the inverse dynamics'
-#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled, without _apart (the solve keeps w apart
-#: already, and the adjoint's forward pass, M and the inverse dynamics' statements merge with the
-#: function's: the Panda's jax.jit(jax.grad(...)) took 14.7 us a state with _apart, 11.4 without)
+#: adjoint program (_forward_dynamics_adjoint): _adjoint_ruled, without _apart (the adjoint's forward
+#: pass merges with the function's: the Panda's jax.jit(jax.grad(...)) of the vmapped loss took
+#: 2.4 us a state with _apart, 1.55 without, its forward pass 1.1)
 _forward_dynamics_rule = _adjoint_ruled(
-    "forward_dynamics", _forward_dynamics_plain, _forward_dynamics_adjoint, (2,), apart=False, rows=False
+    "forward_dynamics",
+    _forward_dynamics_plain,
+    _forward_dynamics_adjoint,
+    (2,),
+    apart=False,
+    rows=False,
+    valued=False,
 )
 
 

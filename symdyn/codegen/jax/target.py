@@ -74,7 +74,7 @@ ADJOINTS = ("inverse_dynamics",)
 #: docs/jax.md): for the Panda, jax.jit(jax.grad(...)) through jax.vmap of the forward dynamics
 #: took 6.2 ms a state by XLA's reverse mode and 108 us by the rule; the inverse dynamics keeps
 #: XLA's autodiff, which was faster than its rule (12 against 17 us; jacfwd 16 against 31 us).
-#: IDENTITIES takes the forward dynamics over when the module holds the inverse dynamics and M.
+#: IDENTITIES takes the forward dynamics over when the module holds the inverse dynamics.
 RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
 
 
