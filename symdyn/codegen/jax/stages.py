@@ -29,7 +29,9 @@ their body exceeds STAGE_ABOVE statements; their adjoint program (plain jnp code
 forward) is staged with them. The Talos' jax.jit(jax.grad(...)) of the vmapped inverse dynamics'
 loss (2,000 states, the machine loaded about once): with the adjoint program in one body it did
 not finish compiling in 7 minutes; in stages of 150, compiled in 144 s, 81 us a state against the
-forward pass's 19 us (4.3 times); in stages of 300, 33-43 us, compiled in 45-68 s.
+forward pass's 19 us (4.3 times); in stages of 300, 33-43 us, compiled in 45-68 s; each loop
+carrying only what its stage reads, 11-22 us in bench runs (2.2 and 3.1 times the forward pass),
+compiled in 34 s.
 """
 
 from __future__ import annotations

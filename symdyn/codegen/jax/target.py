@@ -85,10 +85,10 @@ RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
 #: forward mode and the inverse dynamics' adjoint program. Chosen by measurement (bench/jax.py,
 #: docs/jax.md): for the Panda (on the loaded machine, M^-1 w then by jnp.linalg.solve of M),
 #: jax.jit(jax.grad(...)) through jax.vmap 15.5 us a state (2.7 times the forward pass, compiled
-#: in 19 s), against 108 us by RULES (compiled in 551 s); for the Talos (quiet, 2,000 states)
-#: 27 us a state (3.1 times the forward pass), against 48 us by jnp.linalg.solve of M (a batch of
-#: 38 x 38 solves took 15 us a state). Taken over RULES when the module holds both functions with
-#: these inputs.
+#: in 19 s), against 108 us by RULES (compiled in 551 s); for the Talos (quiet, 2,000 states, one
+#: process) 23.7 us a state (3.1 times the forward pass; 4.0 to 5.0 times in bench runs), against
+#: 48 us by jnp.linalg.solve of M (a batch of 38 x 38 solves took 15 us a state). Taken over
+#: RULES when the module holds both functions with these inputs.
 IDENTITIES = {"forward_dynamics": "inverse_dynamics"}
 
 #: The functions without an adjoint program or rule that are staged when their body is long
