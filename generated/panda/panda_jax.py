@@ -298,8 +298,9 @@ def _adjoint_ruled(name, plain, adjoint, shape, apart=True, rows=True, valued=Fa
     other batches of tangents run over one batch axis (_flat), and so does the adjoint program under
     jax.jacrev for at most _FLAT_ADJOINTS entries; without, batches run in nested vmaps up to
     _FLAT_ADJOINTS entries and over one axis above (the forward dynamics through the identity,
-    whose adjoint recomputes the forward pass and M: the Panda's jacfwd took 42 us a state
-    nested, 58 us by the rows, 110 us flat; the Solo-12's did not compile in 8 minutes nested).
+    whose adjoint recomputes the forward pass, M too when it solved with M: the Panda's jacfwd
+    took 42 us a state nested, 58 us by the rows, 110 us flat; the Solo-12's did not compile in 8
+    minutes nested).
     With `valued`, the adjoint program reads plain's value too: it is passed to the primitive as
     one more primal, after plain's arguments, with a zero tangent, and the adjoint program takes
     it before w and returns a cotangent for it (zeros), which is dropped."""
