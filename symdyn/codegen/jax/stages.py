@@ -1,15 +1,15 @@
-"""Stages of a long straight-line body, for the JAX target: each a jax.lax.while_loop of one pass.
+"""Stages of a long straight-line body, for the JAX target: each the taken branch of a jax.lax.cond.
 
 Under jax.jit(jax.vmap(f)) with XLA's default CPU flags, a body of thousands of statements is
 compiled into a few huge fusions whose every root recomputes the statements it reads (the Talos'
 inverse dynamics on a free flyer, 1,870 statements: 212 sines for its 32, 109 ms a state against
 60 us for its f_batch, compiled with the fusion emitters off; docs/jax.md). XLA does not fuse
-across a while loop, so the body is cut into stages of STAGE_SIZE statements, each the body of a
-jax.lax.while_loop whose trip count is 1 computed at run time (the module's _once: a population
-count XLA cannot bound), carrying the values its statements read and returning those later
-statements read (cut_into_stages). Measured on the Talos' inverse dynamics (2,000 states, the
-machine loaded about fivefold): 32 us a state under jax.jit(jax.vmap(...)), compiled in 21 s,
-its f_batch 66 us, in stages of 150.
+across a conditional, so the body is cut into stages of STAGE_SIZE statements, each the true
+branch of a jax.lax.cond whose predicate is true at run time but not provably so (the module's
+_once: a population count XLA cannot bound, not batched under jax.vmap), taking the values its
+statements read and returning those later statements read (cut_into_stages). Measured on the
+Talos' inverse dynamics (2,000 states, the machine loaded about fivefold): 32 us a state under
+jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us, in stages of 150.
 
 Each loop carries only what its stage reads and defines. Every stage first carried every value
 live across it (those it reads and those later stages read), up to 870 values a loop in the
@@ -23,9 +23,20 @@ jax.jit(jax.grad(...)) of the vmapped loss 37.3 -> 16.4 (compiled in 67 -> 33 s)
 carried: 150: 24.5-27.5 / - / 57-63; 300: 9.9-12.0 / 27.8 / 33-37; 1,000: 6.4 / - / 636, where
 the adjoint program's stages grow past what XLA fuses well.
 
-Reverse mode does not go through a while_loop, so only functions differentiated in reverse by
-their own adjoint program (ADJOINTS of symdyn.codegen.jax.target) are staged, and only when
-their body exceeds STAGE_ABOVE statements; their adjoint program (plain jnp code evaluated
+The stages were while loops of one pass before (issue 37). XLA copied each loop's inputs into
+its carry, and JAX turned the loop's trip count, batched under jax.vmap, into a selection of
+every carried value: the Talos' jax.jit(jax.grad(...)) of its vmapped forward dynamics had
+3,600 copies and 3,600 selections, and 65 MB of XLA's temporary buffer at 2,000 states where the
+conds need 18 MB. Above 32 MB, glibc maps such a buffer afresh at every call, and every page
+faults when first touched: 15,900 faults a call, 11 of that gradient's 27 us a state. With conds
+(us a state, one process): jax.jit(jax.vmap(...)) of the inverse dynamics 6.1 -> 5.3 and its
+jit(grad) 15.5 -> 9.6; the forward dynamics 6.8 -> 4.9 and its jit(grad) 24.1 -> 13.3.
+
+Forward and reverse mode go through the conds (the predicate's input has its gradient stopped:
+JAX does not linearize a custom_vmap function of a differentiated input), but the functions with
+an adjoint program (ADJOINTS of symdyn.codegen.jax.target, and the forward dynamics through it)
+are differentiated in reverse by it; the others (STAGED) by JAX through the stages. Only bodies
+longer than STAGE_ABOVE statements are staged; an adjoint program (plain jnp code evaluated
 forward) is staged with them. The Talos' jax.jit(jax.grad(...)) of the vmapped inverse dynamics'
 loss (2,000 states, the machine loaded about once): with the adjoint program in one body it did
 not finish compiling in 7 minutes; in stages of 150, compiled in 144 s, 81 us a state against the

@@ -86,16 +86,19 @@ RULES = {"forward_dynamics": "forward_dynamics_derivatives"}
 #: docs/jax.md): for the Panda (on the loaded machine, M^-1 w then by jnp.linalg.solve of M),
 #: jax.jit(jax.grad(...)) through jax.vmap 15.5 us a state (2.7 times the forward pass, compiled
 #: in 19 s), against 108 us by RULES (compiled in 551 s); for the Talos (quiet, 2,000 states, one
-#: process) 23.7 us a state (3.1 times the forward pass; 4.0 to 5.0 times in bench runs), against
-#: 48 us by jnp.linalg.solve of M (a batch of 38 x 38 solves took 15 us a state). Taken over
-#: RULES when the module holds both functions with these inputs.
+#: process, its stages then while loops) 23.7 us a state (3.1 times the forward pass; 4.0 to 5.0
+#: times in bench runs), against 48 us by jnp.linalg.solve of M (a batch of 38 x 38 solves took
+#: 15 us a state); with the stages as conds 12.1 us, 2.6 times (bench/results/jax_talos.txt).
+#: Taken over RULES when the module holds both functions with these inputs.
 IDENTITIES = {"forward_dynamics": "inverse_dynamics"}
 
 #: The functions without an adjoint program or rule that are staged when their body is long
-#: (symdyn.codegen.jax.stages), differentiated through their body without the loops (the
-#: template's _loops_aside). Chosen by measurement on the Talos (2,000 states, loaded about once):
-#: jax.jit(jax.vmap(mass_matrix)) 18 us a state staged against 31 us in one body (f_batch 24, 29);
-#: the functions of ADJOINTS and IDENTITIES are staged too (the Talos' forward dynamics 70 us).
+#: (symdyn.codegen.jax.stages), differentiated by JAX through the stages. Chosen by measurement on
+#: the Talos (2,000 states, loaded about once): jax.jit(jax.vmap(mass_matrix)) 18 us a state
+#: staged against 31 us in one body (f_batch 24, 29); the functions of ADJOINTS and IDENTITIES
+#: are staged too (the Talos' forward dynamics 70 us then). Its jax.jit(jax.grad(...)) of the
+#: vmapped loss through the stages (quiet, one process): 13.5 us a state, compiled in 23 s, where
+#: JAX's forward mode of the body in one piece, transposed, took 31 to 38 us, compiled in 200 s.
 STAGED = ("mass_matrix",)
 
 #: The tools the file's bytes depend on besides symdyn: SymPy builds and prints every expression.
@@ -223,10 +226,9 @@ def stage_views(
 ) -> dict[str, list[dict]]:
     """{function: its stages (symdyn.codegen.jax.stages)} for the functions of `adjoints`,
     `through` (IDENTITIES) and STAGED whose body has more than staging.STAGE_ABOVE statements,
-    but those differentiated by a rule of `derived` (RULES:
-    its tangent of p is forward mode of the body, which reverse mode would transpose through the
-    stages' while loops). The others' reverse mode does not enter the loops: it is their adjoint
-    program (ADJOINTS, IDENTITIES) or JAX's of the body without them (the template's _loops_aside)."""
+    but those differentiated by a rule of `derived` (RULES, not measured in stages). Reverse mode
+    goes through the stages for STAGED (JAX's transpose of the body) and is the adjoint program
+    for the others (ADJOINTS, IDENTITIES)."""
     printer = NumpyPrinter(local_names(ctx), module="jnp")
     return {
         spec.name: staging.stages(spec, printer, staging.STAGE_SIZE)
@@ -244,7 +246,6 @@ def render(ctx: RenderContext) -> dict[str, str]:
     through = identities(ctx, adjoints)
     derived = {name: d for name, d in rules(ctx).items() if name not in through}
     staged = stage_views(ctx, adjoints, through, derived)
-    loose = [name for name in staged if name not in adjoints and name not in through]
     builders = {spec.name: matrix_builders(spec) for spec in ctx.functions}
     text = render_module(
         ctx,
@@ -254,7 +255,6 @@ def render(ctx: RenderContext) -> dict[str, str]:
         adjoints=adjoints,
         identities=through,
         stages=staged,
-        loose=loose,
         builders=builders,
     )
     return {file_name(ctx.name): text}
