@@ -30,7 +30,10 @@ every carried value: the Talos' jax.jit(jax.grad(...)) of its vmapped forward dy
 conds need 18 MB. Above 32 MB, glibc maps such a buffer afresh at every call, and every page
 faults when first touched: 15,900 faults a call, 11 of that gradient's 27 us a state. With conds
 (us a state, one process): jax.jit(jax.vmap(...)) of the inverse dynamics 6.1 -> 5.3 and its
-jit(grad) 15.5 -> 9.6; the forward dynamics 6.8 -> 4.9 and its jit(grad) 24.1 -> 13.3.
+jit(grad) 15.5 -> 9.6; the forward dynamics 6.8 -> 4.9 and its jit(grad) 24.1 -> 13.3. Stages
+of 600 as conds against 300 (the same script; jit(vmap) and jit(grad)): the inverse dynamics 3.8
+and 9.7 against 5.0 and 10.2, M 16.3 and 14.4 against 12.7 and 13.9, the forward dynamics 16.0
+and 34.0 against 5.4 and 12.9: 300 kept.
 
 Forward and reverse mode go through the conds (the predicate's input has its gradient stopped:
 JAX does not linearize a custom_vmap function of a differentiated input), but the functions with
