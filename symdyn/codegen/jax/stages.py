@@ -11,10 +11,10 @@ statements read and returning those later statements read (cut_into_stages). Mea
 Talos' inverse dynamics (2,000 states, the machine loaded about fivefold): 32 us a state under
 jax.jit(jax.vmap(...)), compiled in 21 s, its f_batch 66 us, in stages of 150.
 
-Each loop carries only what its stage reads and defines. Every stage first carried every value
-live across it (those it reads and those later stages read), up to 870 values a loop in the
-Talos' adjoint program (the loops' bookkeeping, not their arithmetic, then dominated; how XLA
-spends it was not isolated: a small loop passing five values through had one copy): on the
+Each stage takes only the values it reads and returns only its own that later statements read.
+Every stage first carried every value live across it (those it reads and those later stages
+read), up to 870 values a stage in the Talos' adjoint program (the stages' bookkeeping, not their
+arithmetic, then dominated: the while loops' copies and selections, below): on the
 generated Talos module with nothing else running (2,000 states, stages of 300, us a state),
 jax.jit(jax.vmap(...)) of the inverse dynamics 10.6 -> 6.6, its adjoint program 27.8 -> 9.3,
 jax.jit(jax.grad(...)) of the vmapped loss 37.3 -> 16.4 (compiled in 67 -> 33 s), f_batch 7.5
@@ -87,9 +87,9 @@ def cut_into_stages(
     for each, the slice of temporaries [start, stop), `inputs`, the names defined before it (of
     `defined`, the symbols the body reads from its arguments, or temporaries) that its own
     statements read, and `outputs`, its temporaries read after it, all printed by `printer`, in
-    a fixed order. A value goes into the loops of the stages that read it only: one defined in
-    stage 1 and read in stage 5 is an output of stage 1 and an input of stage 5, and stages 2 to
-    4 do not carry it (module docstring: carrying every live value made the Talos' adjoint
+    a fixed order. A value goes into the stages that read it only: one defined in stage 1 and
+    read in stage 5 is an output of stage 1 and an input of stage 5, and stages 2 to 4 do not
+    carry it (module docstring: carrying every live value made the Talos' adjoint
     program three times slower)."""
     after: list[set[sp.Symbol]] = [set() for _ in range(len(temporaries) + 1)]
     after[-1] = set().union(*(sp.sympify(e).free_symbols for e in outputs))
